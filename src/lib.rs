@@ -27,9 +27,11 @@
 pub mod analysis;
 pub mod error;
 pub mod force;
+pub mod heater;
 pub mod model;
 pub mod ode;
 pub mod quadrature;
+pub mod report;
 pub mod scene;
 pub mod surface;
 pub mod units;

@@ -1,0 +1,302 @@
+//! Static equilibria along the heater power: the S-curve, its folds and their stability.
+//!
+//! At fixed heater power and DC voltage the slider rests where `F_ab(y, 0) + F_if(d) = 0`. The
+//! equilibria are parametrised by the bulge gap `d`: for each `d` the air-bearing balance gives
+//! `y`, hence the protrusion `δ = h0 + y − d` and the power `P = δ/η`. An equilibrium is stable
+//! where the total stiffness `k_ab − ∂F_if/∂y` is positive; folds are where it vanishes.
+
+use super::roots::brent;
+use crate::error::{Error, Result};
+use crate::force::{ForceEval, Gaps};
+use crate::model::SliderModel;
+use serde::Serialize;
+
+/// One equilibrium of the slider.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Equilibrium {
+    /// Bulge gap `d` (m).
+    pub d: f64,
+    /// Air-bearing displacement `y` (m).
+    pub y: f64,
+    /// Protrusion `δ` (m).
+    pub protrusion: f64,
+    /// Heater power `P = δ/η` (W).
+    pub power: f64,
+    /// Total stiffness `k_ab − ∂F_if/∂y` (N/m); positive is stable.
+    pub stiffness: f64,
+    /// Interface force (N).
+    pub interface_force: f64,
+    /// Contact force (N).
+    pub contact_force: f64,
+}
+
+impl Equilibrium {
+    /// Whether the equilibrium is stable.
+    pub fn is_stable(&self) -> bool {
+        self.stiffness > 0.0
+    }
+}
+
+/// Where an S-curve branch turns back: a jump into or out of contact.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Fold {
+    /// Heater power at the fold (W).
+    pub power: f64,
+    /// Bulge gap at the fold (m).
+    pub d: f64,
+    /// `true` where the power has a local maximum along decreasing `d` (the flying branch ends
+    /// and the head jumps into contact); `false` at a local minimum (the contact branch ends).
+    pub jump_in: bool,
+}
+
+/// The gap grid of a scan.
+///
+/// ```
+/// use hdi_tribology::analysis::equilibrium::ScanGrid;
+/// let g = ScanGrid::default();
+/// assert!(g.fine_step < g.coarse_step);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScanGrid {
+    /// Spacing (m) below `fine_until`.
+    pub fine_step: f64,
+    /// Spacing (m) above `fine_until`.
+    pub coarse_step: f64,
+    /// Gap (m) below which the fine spacing is used.
+    pub fine_until: f64,
+}
+
+impl Default for ScanGrid {
+    fn default() -> Self {
+        ScanGrid {
+            fine_step: 2e-12,
+            coarse_step: 5e-11,
+            fine_until: 5e-9,
+        }
+    }
+}
+
+impl ScanGrid {
+    /// Gaps from `hi` down to `lo`, decreasing.
+    pub fn descending(&self, lo: f64, hi: f64) -> Vec<f64> {
+        let mut out = Vec::new();
+        let mut d = hi;
+        // Bounded: the grid has at most (hi − lo)/fine_step + 1 points.
+        let max_points = ((hi - lo) / self.fine_step).ceil() as usize + 2;
+        while d > lo && out.len() < max_points {
+            out.push(d);
+            d -= if d > self.fine_until {
+                self.coarse_step
+            } else {
+                self.fine_step
+            };
+        }
+        out.push(lo);
+        out
+    }
+}
+
+/// Evaluates equilibria of one model at one `V²`, tabulated or exact.
+#[derive(Clone, Copy, Debug)]
+pub struct EquilibriumSolver<'a> {
+    model: &'a SliderModel,
+    volt2: f64,
+}
+
+impl<'a> EquilibriumSolver<'a> {
+    /// A solver for `V² = volt2` (use `(V_dc − φ)²` for the DC equilibria).
+    pub fn new(model: &'a SliderModel, volt2: f64) -> Self {
+        EquilibriumSolver { model, volt2 }
+    }
+
+    /// The equilibrium whose bulge gap is `d`, through the tables.
+    pub fn at_gap(&self, d: f64) -> Result<Equilibrium> {
+        let (y, f) = self.model.bearing_balance(d, self.volt2)?;
+        Ok(self.assemble(d, y, &f))
+    }
+
+    /// The equilibrium whose bulge gap is `d`, from direct evaluation of every term.
+    pub fn at_gap_exact(&self, d: f64) -> Result<Equilibrium> {
+        let m = self.model;
+        let h0 = m.nominal_clearance;
+        // Newton on the balance with exact forces, started from the tabulated solution.
+        let (mut y, _) = m.bearing_balance(d, self.volt2)?;
+        let mut f = ForceEval::default();
+        for _ in 0..50 {
+            f = m.interface_force_exact(Gaps { bulge: d, pad: h0 + y }, self.volt2)?;
+            let r = m.bearing().force(y, 0.0) + f.value;
+            let dr = -m.bearing().stiffness(y) + f.d_pad;
+            let step = -r / dr;
+            y += step;
+            if step.abs() <= 1e-16 * h0 + 1e-13 * y.abs() {
+                break;
+            }
+        }
+        Ok(self.assemble(d, y, &f))
+    }
+
+    fn assemble(&self, d: f64, y: f64, f: &ForceEval) -> Equilibrium {
+        let m = self.model;
+        let protrusion = m.nominal_clearance + y - d;
+        let g = Gaps {
+            bulge: d,
+            pad: m.nominal_clearance + y,
+        };
+        Equilibrium {
+            d,
+            y,
+            protrusion,
+            power: m.power_for(protrusion),
+            stiffness: m.total_stiffness(y, f),
+            interface_force: f.value,
+            contact_force: m.contact_force(g),
+        }
+    }
+
+    /// Locates the gap in `[a, b]` where the stiffness changes sign, to `1e-12` relative.
+    pub fn refine_fold(&self, a: f64, b: f64) -> Result<Equilibrium> {
+        let tol = fold_tolerance(a, b, self.model.nominal_clearance);
+        let d = brent(
+            |d| {
+                self.at_gap_exact(d)
+                    .map_or(f64::NAN, |e| e.stiffness)
+            },
+            a,
+            b,
+            tol,
+        )?;
+        self.at_gap_exact(d)
+    }
+
+    /// Locates the gap in `[a, b]` where the contact force equals `threshold`.
+    pub fn refine_threshold(&self, a: f64, b: f64, threshold: f64) -> Result<Equilibrium> {
+        let tol = fold_tolerance(a, b, self.model.nominal_clearance);
+        let d = brent(
+            |d| {
+                self.at_gap_exact(d)
+                    .map_or(f64::NAN, |e| e.contact_force - threshold)
+            },
+            a,
+            b,
+            tol,
+        )?;
+        self.at_gap_exact(d)
+    }
+}
+
+/// Absolute tolerance on a gap: 1e-12 relative to the larger of the gap and 1e-3·h0.
+fn fold_tolerance(a: f64, b: f64, h0: f64) -> f64 {
+    1e-12 * a.abs().max(b.abs()).max(1e-3 * h0)
+}
+
+/// The equilibria of a model over a range of gaps, with their folds.
+#[derive(Clone, Debug, Serialize)]
+pub struct SCurve {
+    /// `V²` the curve was computed at (V²).
+    pub volt2: f64,
+    /// Equilibria ordered by decreasing gap (increasing power on stable flying parts).
+    pub points: Vec<Equilibrium>,
+    /// Folds, located to 1e-12 relative in `d`, in order of decreasing gap.
+    pub folds: Vec<Fold>,
+}
+
+/// The S-curve at the model's DC voltage `(V_dc − φ)²`, over the gaps `[d_lo, d_hi]` (`None`:
+/// the model's table range).
+///
+/// ```no_run
+/// use hdi_tribology::{analysis::equilibrium::{s_curve, ScanGrid}, model::SliderModel, scene::Scene};
+/// let model = SliderModel::from_scene(&Scene::paper())?;
+/// let curve = s_curve(&model, None, &ScanGrid::default())?;
+/// for f in &curve.folds {
+///     println!("fold at {:.3} mW, d = {:.3} nm", f.power * 1e3, f.d * 1e9);
+/// }
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) -> Result<SCurve> {
+    let volt2 = model.voltage.effective_dc().powi(2);
+    let (lo, hi) = range.unwrap_or_else(|| model.forces().table_range());
+    if !(lo < hi) {
+        return Err(Error::invalid("range", format!("need d_lo < d_hi, got [{lo:e}, {hi:e}]")));
+    }
+    let solver = EquilibriumSolver::new(model, volt2);
+    let mut points = Vec::new();
+    for d in grid.descending(lo, hi) {
+        points.push(solver.at_gap(d)?);
+    }
+    let mut folds = Vec::new();
+    for w in points.windows(2) {
+        if (w[0].stiffness > 0.0) != (w[1].stiffness > 0.0) {
+            let e = solver.refine_fold(w[1].d, w[0].d)?;
+            // Along decreasing d a stable part that ends is a power maximum (jump into contact).
+            folds.push(Fold {
+                power: e.power,
+                d: e.d,
+                jump_in: w[0].stiffness > 0.0,
+            });
+        }
+    }
+    Ok(SCurve {
+        volt2,
+        points,
+        folds,
+    })
+}
+
+/// The stable flying equilibrium at heater power `power` (W) and `V² = volt2`: the first
+/// equilibrium reached scanning down from the largest tabulated gap.
+///
+/// Fails when the flying branch ends (fold) before reaching that power: the head is then in
+/// contact at that power.
+///
+/// ```no_run
+/// use hdi_tribology::{analysis::equilibrium::{flying_equilibrium, ScanGrid}, model::SliderModel, scene::Scene};
+/// let model = SliderModel::from_scene(&Scene::paper())?;
+/// let e = flying_equilibrium(&model, 0.06, 0.0, &ScanGrid::default())?;
+/// println!("d = {:.3} nm at 60 mW", e.d * 1e9);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn flying_equilibrium(
+    model: &SliderModel,
+    power: f64,
+    volt2: f64,
+    grid: &ScanGrid,
+) -> Result<Equilibrium> {
+    crate::error::check_finite("power", power)?;
+    crate::error::check_non_negative("volt2", volt2)?;
+    let solver = EquilibriumSolver::new(model, volt2);
+    let target = model.protrusion(power);
+    let (lo, hi) = model.forces().table_range();
+    let mut prev: Option<Equilibrium> = None;
+    for d in grid.descending(lo, hi) {
+        let e = solver.at_gap(d)?;
+        if !e.is_stable() {
+            return Err(Error::analysis(
+                "flying equilibrium",
+                format!(
+                    "the flying branch ends at a fold (d = {d:e} m) below {power} W: the head is in contact there"
+                ),
+            ));
+        }
+        if e.protrusion >= target {
+            let Some(p) = prev else {
+                return Err(Error::analysis(
+                    "flying equilibrium",
+                    "the largest tabulated gap is already below the equilibrium: widen the table range",
+                ));
+            };
+            let tol = fold_tolerance(e.d, p.d, model.nominal_clearance);
+            let d = brent(
+                |x| solver.at_gap(x).map_or(f64::NAN, |q| q.protrusion - target),
+                e.d,
+                p.d,
+                tol,
+            )?;
+            return solver.at_gap(d);
+        }
+        prev = Some(e);
+    }
+    Err(Error::analysis(
+        "flying equilibrium",
+        format!("no flying equilibrium at {power} W inside the table range"),
+    ))
+}

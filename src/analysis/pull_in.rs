@@ -1,0 +1,152 @@
+//! Pull-in voltage and clearance change with DC voltage (MODEL.md section 6).
+//!
+//! At fixed protrusion `δ = ηP` the equilibria are parametrised by the bulge gap `d`:
+//! `y = d − h0 + δ` and the voltage that holds the head there is
+//! `V²(d) = −(F_ab(y, 0) + F_static(d))/G_e(d)`. Pull-in is the first maximum of `V²` (where the
+//! total stiffness vanishes) or the first gap whose contact force reaches `F_th`, scanning `d`
+//! down from the zero-voltage equilibrium.
+
+use super::equilibrium::EquilibriumSolver;
+use super::roots::brent;
+use super::touchdown::{touchdown_at, Cause, StaticOptions};
+use crate::error::{check_finite, Error, Result};
+use crate::force::Gaps;
+use crate::model::{SliderModel, Voltage};
+use serde::Serialize;
+
+/// The pull-in voltage at one heater power.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PullIn {
+    /// `|V_dc − φ|` at pull-in (V).
+    pub voltage: f64,
+    /// Bulge gap just before the jump (m).
+    pub d: f64,
+    /// Fold of the flying branch or contact threshold.
+    pub cause: Cause,
+}
+
+struct VoltageBalance<'a> {
+    model: &'a SliderModel,
+    delta: f64,
+}
+
+impl VoltageBalance<'_> {
+    /// `(V², total stiffness, contact force)` at gap `d`, tabulated or exact.
+    fn at(&self, d: f64, exact: bool) -> Result<(f64, f64, f64)> {
+        let m = self.model;
+        let y = d - m.nominal_clearance + self.delta;
+        let g = Gaps { bulge: d, pad: d + self.delta };
+        let (s, e) = if exact {
+            m.interface_parts_exact(g)?
+        } else {
+            (m.forces().static_part(g), m.forces().per_volt2_part(g))
+        };
+        let volt2 = -(m.bearing().force(y, 0.0) + s.value) / e.value;
+        let k = m.bearing().stiffness(y) - (s.d_bulge + s.d_pad) - volt2 * (e.d_bulge + e.d_pad);
+        Ok((volt2, k, m.contact_force(g)))
+    }
+}
+
+/// Pull-in voltage `|V_dc − φ|` at heater power `power` (W).
+///
+/// Returns 0 V when the head is already past touchdown at that power without voltage.
+///
+/// ```no_run
+/// use hdi_tribology::{analysis::{pull_in::pull_in_voltage, touchdown::StaticOptions}, model::SliderModel, scene::Scene};
+/// let model = SliderModel::from_scene(&Scene::paper())?;
+/// let pi = pull_in_voltage(&model, 0.0, &StaticOptions::new(5e-5))?;
+/// println!("V_pi = {:.3} V", pi.voltage);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) -> Result<PullIn> {
+    check_finite("power", power)?;
+    if !model.forces().has_voltage_terms() {
+        return Err(Error::analysis("pull-in voltage", "the scene has no electrostatic term"));
+    }
+    let td0 = touchdown_at(model, 0.0, opts)?;
+    if power >= td0.power {
+        return Ok(PullIn { voltage: 0.0, d: td0.at.d, cause: td0.cause });
+    }
+    let delta = model.protrusion(power);
+    let vb = VoltageBalance { model, delta };
+    // Zero-voltage equilibrium at this power: the flying one, on the tables.
+    let d0 = EquilibriumSolver::new(model, 0.0);
+    let (lo, hi) = model.forces().table_range();
+    let grid = opts.grid.descending(lo, hi);
+    let mut started = false;
+    let mut prev: Option<(f64, f64, f64, f64)> = None; // (d, V², k, F_c)
+    for d in grid {
+        if !started {
+            // Flying equilibria have δ(d) increasing as d falls; start once δ(d) reaches δ.
+            if d0.at_gap(d)?.protrusion < delta {
+                continue;
+            }
+            started = true;
+        }
+        let (v2, k, fc) = vb.at(d, false)?;
+        if let Some((pd, _pv2, _pk, _)) = prev {
+            let tol = 1e-12 * d.abs().max(1e-3 * model.nominal_clearance);
+            if k <= 0.0 {
+                let df = brent(|x| vb.at(x, true).map_or(f64::NAN, |r| r.1), d, pd, tol)?;
+                let (v2f, _, _) = vb.at(df, true)?;
+                return Ok(PullIn { voltage: v2f.max(0.0).sqrt(), d: df, cause: Cause::Fold });
+            }
+            if fc >= opts.contact_threshold {
+                let dt = brent(
+                    |x| vb.at(x, true).map_or(f64::NAN, |r| r.2 - opts.contact_threshold),
+                    d,
+                    pd,
+                    tol,
+                )?;
+                let (v2t, _, _) = vb.at(dt, true)?;
+                return Ok(PullIn { voltage: v2t.max(0.0).sqrt(), d: dt, cause: Cause::Threshold });
+            }
+        }
+        prev = Some((d, v2, k, fc));
+    }
+    Err(Error::analysis("pull-in voltage", "no pull-in inside the table range"))
+}
+
+/// One point of the clearance change against DC voltage.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ClearanceChange {
+    /// DC voltage `V_dc` (V).
+    pub dc_voltage: f64,
+    /// Touchdown power at that voltage (W).
+    pub touchdown_power: f64,
+    /// `ΔFH = η (P_TD(V_dc) − P_TD(φ))` (m); negative is a loss of clearance.
+    pub clearance_change: f64,
+}
+
+/// Clearance change `ΔFH(V_dc) = η (P_TD(V_dc) − P_TD(φ))` at each DC voltage (paper Fig. 2b).
+///
+/// ```no_run
+/// use hdi_tribology::{analysis::{pull_in::clearance_change, touchdown::StaticOptions}, model::SliderModel, scene::Scene};
+/// let model = SliderModel::from_scene(&Scene::paper())?;
+/// for c in clearance_change(&model, &[-1.0, 1.0], &StaticOptions::new(5e-5))? {
+///     println!("{} V: {:.3} nm", c.dc_voltage, c.clearance_change * 1e9);
+/// }
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn clearance_change(
+    model: &SliderModel,
+    dc_voltages: &[f64],
+    opts: &StaticOptions,
+) -> Result<Vec<ClearanceChange>> {
+    let phi = model.voltage.contact_potential;
+    let reference = touchdown_at(model, 0.0, opts)?.power;
+    dc_voltages
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            check_finite(&format!("dc_voltages[{i}]"), v)?;
+            let m = model.with_voltage(Voltage { dc: v, ..model.voltage });
+            let p = touchdown_at(&m, (v - phi).powi(2), opts)?.power;
+            Ok(ClearanceChange {
+                dc_voltage: v,
+                touchdown_power: p,
+                clearance_change: model.efficiency * (p - reference),
+            })
+        })
+        .collect()
+}

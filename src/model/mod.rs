@@ -1,0 +1,323 @@
+//! The assembled slider: interface forces, air bearing, heater and voltage of one scene.
+//!
+//! [`SliderModel`] evaluates the physics of MODEL.md sections 2, 4 and 5 at a given state;
+//! [`SliderSystem`] lays that physics out as an ODE for [`crate::ode`]. This is the only module
+//! that knows both the physics and the stepper.
+
+mod system;
+
+pub use system::{SliderSystem, StateLayout};
+
+use crate::error::{Error, Result};
+use crate::force::{AirBearing, Breakdown, ForceEval, Gaps, InterfaceForces};
+use crate::heater::Programme;
+use crate::scene::Scene;
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+/// Voltage between head and disk: `V(t) = V_dc + V_ac sin(2π f t) − φ`.
+///
+/// ```
+/// use hdi_tribology::model::Voltage;
+/// let v = Voltage { dc: 1.0, ac_amplitude: 0.5, frequency: 1.0e4, contact_potential: 0.2 };
+/// assert!((v.at(0.0) - 0.8).abs() < 1e-15);
+/// assert!((v.squared(0.25e-4) - 1.3f64.powi(2)).abs() < 1e-12);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Voltage {
+    /// DC voltage `V_dc` (V).
+    pub dc: f64,
+    /// AC amplitude `V_ac` (V).
+    pub ac_amplitude: f64,
+    /// AC frequency `f` (Hz).
+    pub frequency: f64,
+    /// Contact potential `φ` (V).
+    pub contact_potential: f64,
+}
+
+impl Voltage {
+    /// `V(t)` (V).
+    pub fn at(&self, t: f64) -> f64 {
+        self.dc - self.contact_potential + self.ac_amplitude * (2.0 * PI * self.frequency * t).sin()
+    }
+
+    /// `V(t)²` (V²).
+    pub fn squared(&self, t: f64) -> f64 {
+        let v = self.at(t);
+        v * v
+    }
+
+    /// `d(V²)/dt` (V²/s).
+    pub fn squared_rate(&self, t: f64) -> f64 {
+        let w = 2.0 * PI * self.frequency;
+        2.0 * self.at(t) * self.ac_amplitude * w * (w * t).cos()
+    }
+
+    /// Whether the voltage changes in time.
+    pub fn is_time_dependent(&self) -> bool {
+        self.ac_amplitude != 0.0 && self.frequency != 0.0
+    }
+
+    /// The DC part of the effective voltage, `V_dc − φ`.
+    pub fn effective_dc(&self) -> f64 {
+        self.dc - self.contact_potential
+    }
+}
+
+/// Friction and flash-temperature parameters (MODEL.md section 5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Friction {
+    /// Friction coefficient μ.
+    pub coefficient: f64,
+    /// Disk speed `v` (m/s).
+    pub disk_speed: f64,
+    /// Thermal conductivity of the head `k` (W/(m K)).
+    pub conductivity: f64,
+}
+
+impl Friction {
+    /// Flash temperature `ΔT = μ F_c v / (4 a k)` with `a = √(A_r/π)`; zero when there is no
+    /// real contact area or no contact force.
+    ///
+    /// ```
+    /// use hdi_tribology::model::Friction;
+    /// let fr = Friction { coefficient: 0.2, disk_speed: 10.0, conductivity: 20.0 };
+    /// let a: f64 = 1e-7;
+    /// let dt = fr.flash_temperature(1e-4, std::f64::consts::PI * a * a);
+    /// assert!((dt - 0.2 * 1e-4 * 10.0 / (4.0 * a * 20.0)).abs() < 1e-9);
+    /// assert_eq!(fr.flash_temperature(1e-4, 0.0), 0.0);
+    /// ```
+    pub fn flash_temperature(&self, contact_force: f64, real_area: f64) -> f64 {
+        if real_area <= 0.0 || contact_force <= 0.0 {
+            return 0.0;
+        }
+        let a = (real_area / PI).sqrt();
+        self.coefficient * contact_force * self.disk_speed / (4.0 * a * self.conductivity)
+    }
+}
+
+/// One degree-of-freedom slider with a heater-driven bulge (MODEL.md section 2).
+///
+/// ```no_run
+/// use hdi_tribology::{model::SliderModel, scene::Scene};
+/// let model = SliderModel::from_scene(&Scene::paper())?;
+/// // Interface force at the flying position with the heater at 60 mW, no voltage:
+/// let g = model.gaps(0.0, model.protrusion(0.06));
+/// println!("{} N", model.interface_force(g, 0.0).value);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct SliderModel {
+    forces: Arc<InterfaceForces>,
+    bearing: Arc<dyn AirBearing>,
+    /// Lumped mass `m` (kg).
+    pub mass: f64,
+    /// Nominal clearance `h0` (m).
+    pub nominal_clearance: f64,
+    /// Heater efficiency `η` (m/W).
+    pub efficiency: f64,
+    /// Thermal lag `τ_th` (s); 0 removes the state.
+    pub thermal_lag: f64,
+    /// Interface lag `τ_lag` (s); 0 removes the state.
+    pub interface_lag: f64,
+    /// Head–disk voltage.
+    pub voltage: Voltage,
+    /// Friction and flash temperature.
+    pub friction: Friction,
+}
+
+impl SliderModel {
+    /// Builds the model of a scene: validates it, tabulates the enabled interface terms and builds
+    /// the air bearing.
+    pub fn from_scene(scene: &Scene) -> Result<Self> {
+        scene.validate()?;
+        let forces = scene.build_interface()?;
+        let bearing: Arc<dyn AirBearing> = Arc::from(scene.build_air_bearing()?);
+        let contact_potential = scene
+            .electrostatic
+            .as_ref()
+            .map_or(0.0, |e| e.contact_potential_v);
+        Ok(SliderModel {
+            forces: Arc::new(forces),
+            bearing,
+            mass: scene.slider.mass_kg,
+            nominal_clearance: scene.nominal_clearance_m,
+            efficiency: scene.heater.efficiency_m_per_w,
+            thermal_lag: scene.heater.thermal_lag_s,
+            interface_lag: scene.slider.interface_lag_s,
+            voltage: Voltage {
+                dc: scene.voltage.dc_v,
+                ac_amplitude: scene.voltage.ac_amplitude_v,
+                frequency: scene.voltage.ac_frequency_hz,
+                contact_potential,
+            },
+            friction: Friction {
+                coefficient: scene.friction.coefficient,
+                disk_speed: scene.friction.disk_speed_m_per_s,
+                conductivity: scene.friction.head_conductivity_w_per_m_k,
+            },
+        })
+    }
+
+    /// The same model with another voltage (tables are shared, not rebuilt).
+    pub fn with_voltage(&self, voltage: Voltage) -> Self {
+        SliderModel {
+            voltage,
+            ..self.clone()
+        }
+    }
+
+    /// The tabulated interface forces.
+    pub fn forces(&self) -> &InterfaceForces {
+        &self.forces
+    }
+
+    /// The air bearing.
+    pub fn bearing(&self) -> &dyn AirBearing {
+        &*self.bearing
+    }
+
+    /// Protrusion at steady state for heater power `p` (W): `δ = η P`.
+    pub fn protrusion(&self, p: f64) -> f64 {
+        self.efficiency * p
+    }
+
+    /// Heater power that makes protrusion `delta` at steady state.
+    pub fn power_for(&self, delta: f64) -> f64 {
+        delta / self.efficiency
+    }
+
+    /// Gaps at displacement `y` and protrusion `delta`: bulge `h0 + y − δ`, pad `h0 + y`.
+    pub fn gaps(&self, y: f64, delta: f64) -> Gaps {
+        Gaps {
+            bulge: self.nominal_clearance + y - delta,
+            pad: self.nominal_clearance + y,
+        }
+    }
+
+    /// Interface force `F_if = F_static + V² G_e` and its partial derivatives.
+    pub fn interface_force(&self, g: Gaps, volt2: f64) -> ForceEval {
+        let s = self.forces.static_part(g);
+        if volt2 == 0.0 || !self.forces.has_voltage_terms() {
+            return s;
+        }
+        add_scaled(s, self.forces.per_volt2_part(g), volt2)
+    }
+
+    /// The static part and the per-V² part of the interface force from direct (untabulated)
+    /// evaluation of every term: slow, for refinement and checks.
+    pub fn interface_parts_exact(&self, g: Gaps) -> Result<(ForceEval, ForceEval)> {
+        use crate::force::{Coupling, GapReference};
+        let (mut stat, mut per_v2) = (ForceEval::default(), ForceEval::default());
+        for term in self.forces.terms() {
+            let (d, on_pad) = match term.gap() {
+                GapReference::Bulge => (g.bulge, false),
+                GapReference::Pad => (g.pad, true),
+            };
+            let (f, df) = term.force(d)?;
+            let out = match term.coupling() {
+                Coupling::Static => &mut stat,
+                Coupling::PerVoltSquared => &mut per_v2,
+            };
+            out.value += f;
+            if on_pad {
+                out.d_pad += df;
+            } else {
+                out.d_bulge += df;
+            }
+        }
+        Ok((stat, per_v2))
+    }
+
+    /// Interface force from direct (untabulated) evaluation of every term.
+    pub fn interface_force_exact(&self, g: Gaps, volt2: f64) -> Result<ForceEval> {
+        let (s, e) = self.interface_parts_exact(g)?;
+        Ok(add_scaled(s, e, volt2))
+    }
+
+    /// Every force at one state, for reports.
+    pub fn breakdown(&self, g: Gaps, volt2: f64) -> Breakdown {
+        self.forces.breakdown(g, volt2)
+    }
+
+    /// Contact force `F_c` at the given gaps.
+    pub fn contact_force(&self, g: Gaps) -> f64 {
+        self.forces.contact(g).value
+    }
+
+    /// Flash temperature rise `ΔT` at the given gaps (MODEL.md section 5).
+    pub fn flash_temperature(&self, g: Gaps) -> f64 {
+        if !self.forces.has_contact() {
+            return 0.0;
+        }
+        let fc = self.forces.contact(g).value;
+        let area = self.forces.real_contact_area(g);
+        self.friction.flash_temperature(fc, area)
+    }
+
+    /// Air-bearing displacement `y` that balances the interface force at bulge gap `d` (the pad
+    /// gap follows `y`), for `V² = volt2`. Returns `y` and the interface force there.
+    ///
+    /// Solved by a safeguarded Newton iteration on `F_ab(y, 0) + F_if(d, h0 + y) = 0`; with no pad
+    /// terms and a linear bearing it converges in one step.
+    pub fn bearing_balance(&self, d: f64, volt2: f64) -> Result<(f64, ForceEval)> {
+        let h0 = self.nominal_clearance;
+        let eval = |y: f64| {
+            let g = Gaps {
+                bulge: d,
+                pad: h0 + y,
+            };
+            let f = self.interface_force(g, volt2);
+            let r = self.bearing.force(y, 0.0) + f.value;
+            let dr = -self.bearing.stiffness(y) + f.d_pad;
+            (r, dr, f)
+        };
+        // Start from the linearised bearing.
+        let k0 = self.bearing.stiffness(0.0);
+        let f0 = self.interface_force(Gaps { bulge: d, pad: h0 }, volt2);
+        let mut y = f0.value / k0;
+        // Keep the pad gap positive: the power-law bearing is singular at g = 0.
+        let y_floor = -h0 * (1.0 - 1e-9);
+        if y <= y_floor {
+            y = 0.5 * y_floor;
+        }
+        for _ in 0..200 {
+            let (r, dr, f) = eval(y);
+            if !r.is_finite() || !dr.is_finite() || dr >= 0.0 {
+                break;
+            }
+            let step = -r / dr;
+            let mut y_new = y + step;
+            if y_new <= y_floor {
+                y_new = 0.5 * (y + y_floor);
+            }
+            if (y_new - y).abs() <= 1e-15 * h0 + 1e-12 * y.abs() {
+                return Ok((y_new, f));
+            }
+            y = y_new;
+        }
+        Err(Error::no_convergence(
+            "air-bearing balance",
+            format!("no displacement balances the interface force at d = {d:e} m, V² = {volt2}"),
+        ))
+    }
+
+    /// Total vertical stiffness `k_ab(y) − ∂F_if/∂y` at fixed protrusion; positive means stable.
+    pub fn total_stiffness(&self, y: f64, f: &ForceEval) -> f64 {
+        self.bearing.stiffness(y) - f.d_bulge - f.d_pad
+    }
+
+    /// A heater programme from the scene's knots.
+    pub fn programme_from_knots(knots: &[[f64; 2]]) -> Result<Programme> {
+        Programme::new(knots.iter().map(|k| (k[0], k[1])).collect())
+    }
+}
+
+/// `a + scale·b`, component by component.
+fn add_scaled(a: ForceEval, b: ForceEval, scale: f64) -> ForceEval {
+    ForceEval {
+        value: a.value + scale * b.value,
+        d_bulge: a.d_bulge + scale * b.d_bulge,
+        d_pad: a.d_pad + scale * b.d_pad,
+    }
+}
