@@ -129,12 +129,14 @@ impl Tabulated {
         if self.segments.len() == 1 {
             return self.segments[0].eval(d);
         }
-        for t in &self.segments {
-            if d <= t.range().1 {
+        // Right-continuous at the cuts, like the terms themselves (d ≥ h_c counts as non-contact).
+        let last = self.segments.len() - 1;
+        for t in &self.segments[..last] {
+            if d < t.range().1 {
                 return t.eval(d);
             }
         }
-        None
+        self.segments[last].eval(d)
     }
 
     /// Table look-up; outside the range the exact sum; NaN if that fails.
