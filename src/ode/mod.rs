@@ -1,1 +1,111 @@
-//! (being written)
+//! A generic ODE stepper that knows no physics: explicit, Rosenbrock and Radau methods with
+//! step size control, dense output, events and automatic stiffness switching.
+//!
+//! A problem is an [`OdeSystem`] (or a closure in [`FnSystem`]) on nalgebra vectors: a
+//! fixed-size `SVector` stays on the stack, a `DVector` serves larger systems. [`solve`] takes
+//! the system, the time span, a [`Method`] and [`Options`], and returns a [`Solution`] with
+//! saved states, a dense interpolant ([`Solution::sample`]), located [`Event`]s and [`Stats`].
+//! Failures are typed ([`OdeError`]) and say at which `t` and why.
+//!
+//! The stiff Van der Pol oscillator `y₁' = y₂`, `y₂' = μ((1 − y₁²)y₂ − y₁)`, μ = 1000:
+//!
+//! ```
+//! use hdi_tribology::ode::{solve, FnSystem, Method, Options};
+//! use nalgebra::Vector2;
+//!
+//! let mu = 1000.0;
+//! let vdp = FnSystem::new(move |_t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>| {
+//!     dy[0] = y[1];
+//!     dy[1] = mu * ((1.0 - y[0] * y[0]) * y[1] - y[0]);
+//! });
+//! let opts = Options::default().rtol(1e-6).atol(1e-6);
+//! let sol = solve(&vdp, 0.0, Vector2::new(2.0, 0.0), 3000.0, Method::Auto, &opts, &mut [])?;
+//! // One relaxation period is about (3 − 2 ln 2) μ ≈ 1614: y₁ is back near its start.
+//! assert!(sol.y_final()[0] > 1.0);
+//! let mid = sol.sample(1500.0).unwrap();
+//! assert!(mid[0] < -1.0);
+//! println!("{} steps, {} switches", sol.stats.accepted, sol.stats.stiffness_switches);
+//! # Ok::<(), hdi_tribology::ode::OdeError>(())
+//! ```
+
+mod dense;
+mod driver;
+mod error;
+mod event;
+mod options;
+mod solution;
+mod stepper;
+mod system;
+mod tsit5;
+
+pub use dense::DenseOutput;
+pub use error::OdeError;
+pub use event::{Direction, Event, EventHit};
+pub use options::{Method, Options, SaveAt, Tolerance};
+pub use solution::{Solution, Stats};
+pub use system::{complex_step_jacobian, finite_difference_jacobian, FnSystem, OdeSystem};
+
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
+
+/// Integrates `y' = f(t, y)` from `(t0, y0)` to `tf > t0` with `method`.
+///
+/// `events` may be empty (`&mut []`). See the [module documentation](self) for an example.
+///
+/// # Errors
+/// [`OdeError::InvalidInput`] for bad arguments or options; [`OdeError::StepTooSmall`],
+/// [`OdeError::TooManySteps`], [`OdeError::NonFinite`], [`OdeError::NewtonDivergence`] or
+/// [`OdeError::SingularMatrix`] when the integration cannot go on.
+pub fn solve<D: Dim, S: OdeSystem<D> + ?Sized>(
+    sys: &S,
+    t0: f64,
+    y0: OVector<f64, D>,
+    tf: f64,
+    method: Method,
+    opts: &Options,
+    events: &mut [Event<'_, D>],
+) -> Result<Solution<D>, OdeError>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    opts.validate(y0.len())?;
+    if y0.is_empty() {
+        return Err(OdeError::invalid("y0", "the state must have at least one component"));
+    }
+    if !t0.is_finite() || !tf.is_finite() {
+        return Err(OdeError::invalid(
+            "t0, tf",
+            format!("must be finite, got t0 = {t0}, tf = {tf}"),
+        ));
+    }
+    if tf <= t0 {
+        return Err(OdeError::invalid(
+            "tf",
+            format!("must be greater than t0 (forward integration only), got t0 = {t0}, tf = {tf}"),
+        ));
+    }
+    if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
+        return Err(OdeError::invalid(
+            format!("y0[{i}]"),
+            format!("must be finite, got {}", y0[i]),
+        ));
+    }
+    let problem = driver::Problem {
+        sys,
+        t0,
+        y0,
+        tf,
+        method,
+        opts,
+        events,
+    };
+    match method {
+        Method::Tsit5 => {
+            let mut m = tsit5::Tsit5::new(&problem.y0);
+            driver::integrate(problem, &mut [&mut m])
+        }
+        other => Err(OdeError::invalid(
+            "method",
+            format!("{other} is not available yet"),
+        )),
+    }
+}

@@ -1,0 +1,243 @@
+//! Non-contact terms: a pressure law averaged over Gaussian surface heights (points with local gap
+//! below the cutoff excluded) and integrated over a footprint, by one-dimensional quadrature.
+
+use std::f64::consts::PI;
+
+use statrs::function::erf::erfc;
+
+use super::{Coupling, Footprint, GapReference, InterfaceTerm, PressureLaw, TermKind};
+use crate::error::check_positive;
+use crate::quadrature::{integrate_with_breaks, QuadOptions};
+use crate::surface::GaussianHeights;
+use crate::{Error, Result};
+
+/// Half-width of the Gaussian window in units of σ: exp(−40²/2) ≈ 1e-348 underflows, so nothing
+/// outside contributes even against the 1/h⁹ growth of the repulsive law.
+const WINDOW_SIGMAS: f64 = 40.0;
+
+/// Relative tolerance of the direct quadrature: three decades below the default table tolerance,
+/// so that quadrature noise does not disturb the table builder.
+const QUAD_REL_TOL: f64 = 1e-12;
+
+/// A [`PressureLaw`] averaged over surface heights and integrated over a [`Footprint`].
+///
+/// With Gaussian heights of standard deviation σ and cutoff `h_c` (points closer than `h_c` are in
+/// contact and excluded) the mean pressure is `p̄(d) = ∫_{h_c}^∞ p(h) φ_σ(d − h) dh`. A flat
+/// footprint gives `F = area · p̄(d)`; a paraboloid gives the Derjaguin integral
+/// `F = 2π Rc ∫_d^{d+Δ} p̄(s) ds`, evaluated as a single integral through the interaction energy
+/// `W` (see `docs/model.md`). σ = 0 is evaluated in closed form.
+///
+/// ```
+/// use hdi_tribology::force::{AveragedTerm, Coupling, Coulomb, Footprint, GapReference, InterfaceTerm, TermKind};
+/// use hdi_tribology::surface::GaussianHeights;
+/// # fn main() -> hdi_tribology::Result<()> {
+/// let plate = Footprint::Flat { area_m2: 1e-8 };
+/// let t = AveragedTerm::new("plates", TermKind::Electrostatic, Coupling::PerVoltSquared,
+///     Coulomb::new(0.0)?, 1e-10, GaussianHeights::new(0.0)?, plate, GapReference::Bulge)?;
+/// let (f, _) = t.force(5e-9)?;
+/// let exact = -hdi_tribology::units::EPSILON_0 * 1e-8 / (2.0 * 25e-18);
+/// assert!((f - exact).abs() < 1e-14 * exact.abs());
+/// # Ok(()) }
+/// ```
+#[derive(Clone, Debug)]
+pub struct AveragedTerm<L> {
+    name: String,
+    kind: TermKind,
+    coupling: Coupling,
+    law: L,
+    cutoff: f64,
+    sigma: f64,
+    footprint: Footprint,
+    gap: GapReference,
+}
+
+impl<L: PressureLaw> AveragedTerm<L> {
+    /// Builds the term; `cutoff` (m, > 0) is the local gap below which points count as in
+    /// contact, `heights` the surface-height statistics.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        name: impl Into<String>,
+        kind: TermKind,
+        coupling: Coupling,
+        law: L,
+        cutoff: f64,
+        heights: GaussianHeights,
+        footprint: Footprint,
+        gap: GapReference,
+    ) -> Result<Self> {
+        check_positive("cutoff_m", cutoff)?;
+        footprint.validate("footprint")?;
+        let sigma = heights.sigma();
+        if !(sigma.is_finite() && sigma >= 0.0) {
+            return Err(Error::invalid(
+                "height_sigma_m",
+                format!("must be finite and >= 0, got {sigma}"),
+            ));
+        }
+        for (what, v) in [
+            ("pressure", law.pressure(cutoff)),
+            ("energy", law.energy(cutoff)),
+        ] {
+            if !v.is_finite() {
+                return Err(Error::invalid(
+                    "cutoff_m",
+                    format!("the {what} of the law is not finite at the cutoff {cutoff} m"),
+                ));
+            }
+        }
+        Ok(AveragedTerm {
+            name: name.into(),
+            kind,
+            coupling,
+            law,
+            cutoff,
+            sigma,
+            footprint,
+            gap,
+        })
+    }
+
+    /// The pressure law.
+    pub fn law(&self) -> &L {
+        &self.law
+    }
+
+    /// The cutoff `h_c`, m.
+    pub fn cutoff(&self) -> f64 {
+        self.cutoff
+    }
+
+    /// Standard deviation of the surface heights, m.
+    pub fn sigma(&self) -> f64 {
+        self.sigma
+    }
+
+    /// The footprint.
+    pub fn footprint(&self) -> Footprint {
+        self.footprint
+    }
+
+    fn gauss(&self, x: f64) -> f64 {
+        let s = self.sigma;
+        (-0.5 * (x / s) * (x / s)).exp() / (s * (2.0 * PI).sqrt())
+    }
+
+    /// `∫_{h_c}^∞ k(h) φ_σ(d − h) dh` for σ > 0.
+    fn weighted(&self, d: f64, kernel: impl Fn(f64) -> f64) -> Result<f64> {
+        let (s, hc) = (self.sigma, self.cutoff);
+        let a = hc.max(d - WINDOW_SIGMAS * s);
+        let b = d + WINDOW_SIGMAS * s;
+        if b <= a {
+            return Ok(0.0);
+        }
+        let mut breaks: Vec<f64> = [
+            d - 8.0 * s,
+            d - 2.0 * s,
+            d,
+            d + 2.0 * s,
+            d + 8.0 * s,
+            1.5 * hc,
+            2.0 * hc,
+            4.0 * hc,
+        ]
+        .into_iter()
+        .filter(|&x| x > a && x < b)
+        .collect();
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup();
+        let integrand = |h: f64| kernel(h) * self.gauss(d - h);
+        // The scale of the integral sets the absolute tolerance, so that values that are zero to
+        // rounding (a force passing through zero) do not demand impossible relative accuracy.
+        let scale = std::iter::once(a)
+            .chain(breaks.iter().copied())
+            .map(|x| (integrand(x) * s).abs())
+            .fold(0.0, f64::max);
+        if scale == 0.0 {
+            return Ok(0.0);
+        }
+        let opts = QuadOptions {
+            abs_tol: 1e-16 * scale,
+            rel_tol: QUAD_REL_TOL,
+            max_intervals: 2000,
+        };
+        let est = integrate_with_breaks(integrand, a, b, &breaks, &opts)
+            .map_err(|e| Error::no_convergence(format!("{} at d = {d} m", self.name), e.to_string()))?;
+        Ok(est.value)
+    }
+
+    /// Mean pressure `p̄(d)`, Pa.
+    pub fn mean_pressure(&self, d: f64) -> Result<f64> {
+        if self.sigma == 0.0 {
+            return Ok(if d >= self.cutoff { self.law.pressure(d) } else { 0.0 });
+        }
+        self.weighted(d, |h| self.law.pressure(h))
+    }
+
+    /// `dp̄/dd`, Pa/m.
+    pub fn mean_pressure_slope(&self, d: f64) -> Result<f64> {
+        let hc = self.cutoff;
+        if self.sigma == 0.0 {
+            return Ok(if d >= hc { self.law.pressure_slope(d) } else { 0.0 });
+        }
+        let edge = self.gauss(d - hc) * self.law.pressure(hc);
+        Ok(edge + self.weighted(d, |h| self.law.pressure_slope(h))?)
+    }
+
+    /// `∫_d^∞ p̄(s) ds = W(h_c) Φc((d − h_c)/σ) + ∫_{h_c}^∞ W(h) φ_σ(d − h) dh`, J/m².
+    pub fn mean_energy(&self, d: f64) -> Result<f64> {
+        let hc = self.cutoff;
+        if self.sigma == 0.0 {
+            return Ok(self.law.energy(d.max(hc)));
+        }
+        let survival = 0.5 * erfc((d - hc) / (self.sigma * std::f64::consts::SQRT_2));
+        Ok(self.law.energy(hc) * survival + self.weighted(d, |h| self.law.energy(h))?)
+    }
+}
+
+impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn kind(&self) -> TermKind {
+        self.kind
+    }
+    fn coupling(&self) -> Coupling {
+        self.coupling
+    }
+    fn gap(&self) -> GapReference {
+        self.gap
+    }
+    fn force(&self, d: f64) -> Result<(f64, f64)> {
+        if !d.is_finite() {
+            return Err(Error::invalid("d", format!("must be finite, got {d}")));
+        }
+        match self.footprint {
+            Footprint::Flat { area_m2 } => Ok((
+                area_m2 * self.mean_pressure(d)?,
+                area_m2 * self.mean_pressure_slope(d)?,
+            )),
+            Footprint::Paraboloid {
+                radius_of_curvature_m,
+                ..
+            } => {
+                let c = 2.0 * PI * radius_of_curvature_m;
+                let delta = self.footprint.derjaguin_depth();
+                if delta.is_infinite() {
+                    Ok((c * self.mean_energy(d)?, -c * self.mean_pressure(d)?))
+                } else {
+                    let f = self.mean_energy(d)? - self.mean_energy(d + delta)?;
+                    let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
+                    Ok((c * f, -c * df))
+                }
+            }
+        }
+    }
+    fn kinks(&self) -> Vec<f64> {
+        let delta = self.footprint.derjaguin_depth();
+        let mut k = vec![self.cutoff];
+        if delta > 0.0 && delta.is_finite() {
+            k.push(self.cutoff - delta);
+        }
+        k
+    }
+}

@@ -1,0 +1,171 @@
+//! Greenwood–Williamson asperity contact over a peak-height distribution.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use super::{Coupling, Footprint, GapReference, InterfaceTerm, TermKind};
+use crate::error::check_positive;
+use crate::surface::PeakDistribution;
+use crate::{Error, Result};
+
+/// Composite elastic modulus of two bodies, `1/E* = (1−ν₁²)/E₁ + (1−ν₂²)/E₂` (Pa).
+///
+/// ```
+/// let e = hdi_tribology::force::composite_modulus(200e9, 0.25, 200e9, 0.25).unwrap();
+/// assert!((e - 200e9 / (2.0 * (1.0 - 0.0625))).abs() < 1e-3);
+/// ```
+pub fn composite_modulus(e1: f64, nu1: f64, e2: f64, nu2: f64) -> Result<f64> {
+    check_positive("e1", e1)?;
+    check_positive("e2", e2)?;
+    for (field, nu) in [("nu1", nu1), ("nu2", nu2)] {
+        if !(nu.is_finite() && nu > -1.0 && nu <= 0.5) {
+            return Err(Error::invalid(field, format!("must lie in (-1, 0.5], got {nu}")));
+        }
+    }
+    Ok(1.0 / ((1.0 - nu1 * nu1) / e1 + (1.0 - nu2 * nu2) / e2))
+}
+
+/// Greenwood–Williamson elastic contact of spherical asperities (radius `R`, areal density `η_s`)
+/// with peak heights from a [`PeakDistribution`]:
+/// `p_c(d) = (4/3) E* √R η_s M_{3/2}(d)` with the partial moments
+/// `M_p(d) = ∫_d^∞ (z − d)^p f_p(z) dz`, integrated over a footprint in closed form through
+/// `∫_d^∞ M_p = M_{p+1}/(p+1)`. Real contact area per nominal area: `π R η_s M_1(d)`.
+///
+/// ```
+/// use std::sync::Arc;
+/// use hdi_tribology::force::{Footprint, GapReference, GreenwoodWilliamson, InterfaceTerm};
+/// use hdi_tribology::surface::Gaussian;
+/// # fn main() -> hdi_tribology::Result<()> {
+/// let peaks = Arc::new(Gaussian::new(0.0, 1e-9)?);
+/// let gw = GreenwoodWilliamson::new(1e11, 1e-7, 1.5e14, peaks,
+///     Footprint::Flat { area_m2: 1e-8 }, GapReference::Bulge)?;
+/// let (f, slope) = gw.force(1e-9)?;
+/// assert!(f > 0.0 && slope < 0.0);
+/// assert!(gw.real_contact_area(1e-9)? > 0.0);
+/// # Ok(()) }
+/// ```
+#[derive(Clone, Debug)]
+pub struct GreenwoodWilliamson {
+    modulus: f64,
+    radius: f64,
+    density: f64,
+    peaks: Arc<dyn PeakDistribution>,
+    footprint: Footprint,
+    gap: GapReference,
+}
+
+impl GreenwoodWilliamson {
+    /// Composite modulus `E*` (Pa), asperity radius `R` (m), asperity areal density `η_s` (m⁻²).
+    pub fn new(
+        composite_modulus: f64,
+        asperity_radius: f64,
+        asperity_density: f64,
+        peaks: Arc<dyn PeakDistribution>,
+        footprint: Footprint,
+        gap: GapReference,
+    ) -> Result<Self> {
+        check_positive("composite_modulus_pa", composite_modulus)?;
+        check_positive("asperity_radius_m", asperity_radius)?;
+        check_positive("asperity_density_per_m2", asperity_density)?;
+        footprint.validate("footprint")?;
+        Ok(GreenwoodWilliamson {
+            modulus: composite_modulus,
+            radius: asperity_radius,
+            density: asperity_density,
+            peaks,
+            footprint,
+            gap,
+        })
+    }
+
+    /// The peak-height distribution.
+    pub fn peaks(&self) -> &Arc<dyn PeakDistribution> {
+        &self.peaks
+    }
+
+    fn moment(&self, d: f64, p: f64) -> Result<f64> {
+        let m = self.peaks.partial_moment(d, p);
+        if m.is_finite() {
+            Ok(m)
+        } else {
+            Err(Error::no_convergence(
+                "contact partial moment",
+                format!("M_{p}({d} m) = {m}"),
+            ))
+        }
+    }
+
+    /// `M_p(d) − M_p(d + Δ)` (Δ may be infinite).
+    fn moment_band(&self, d: f64, p: f64, delta: f64) -> Result<f64> {
+        let m = self.moment(d, p)?;
+        if delta.is_infinite() {
+            Ok(m)
+        } else {
+            Ok(m - self.moment(d + delta, p)?)
+        }
+    }
+}
+
+impl InterfaceTerm for GreenwoodWilliamson {
+    fn name(&self) -> &str {
+        "contact"
+    }
+    fn kind(&self) -> TermKind {
+        TermKind::Contact
+    }
+    fn coupling(&self) -> Coupling {
+        Coupling::Static
+    }
+    fn gap(&self) -> GapReference {
+        self.gap
+    }
+    fn force(&self, d: f64) -> Result<(f64, f64)> {
+        if !d.is_finite() {
+            return Err(Error::invalid("d", format!("must be finite, got {d}")));
+        }
+        let k = 4.0 / 3.0 * self.modulus * self.radius.sqrt() * self.density;
+        match self.footprint {
+            Footprint::Flat { area_m2 } => Ok((
+                area_m2 * k * self.moment(d, 1.5)?,
+                -area_m2 * k * 1.5 * self.moment(d, 0.5)?,
+            )),
+            Footprint::Paraboloid {
+                radius_of_curvature_m,
+                ..
+            } => {
+                let c = 2.0 * PI * radius_of_curvature_m * k;
+                let delta = self.footprint.derjaguin_depth();
+                Ok((
+                    c * 0.4 * self.moment_band(d, 2.5, delta)?,
+                    -c * self.moment_band(d, 1.5, delta)?,
+                ))
+            }
+        }
+    }
+    fn real_contact_area(&self, d: f64) -> Result<f64> {
+        Ok(self.real_contact_area_and_slope(d)?.0)
+    }
+    fn real_contact_area_and_slope(&self, d: f64) -> Result<(f64, f64)> {
+        if !d.is_finite() {
+            return Err(Error::invalid("d", format!("must be finite, got {d}")));
+        }
+        let k = PI * self.radius * self.density;
+        match self.footprint {
+            Footprint::Flat { area_m2 } => Ok((
+                area_m2 * k * self.moment(d, 1.0)?,
+                -area_m2 * k * self.moment(d, 0.0)?,
+            )),
+            Footprint::Paraboloid {
+                radius_of_curvature_m,
+                ..
+            } => {
+                let c = 2.0 * PI * radius_of_curvature_m * k;
+                let delta = self.footprint.derjaguin_depth();
+                Ok((
+                    c * 0.5 * self.moment_band(d, 2.0, delta)?,
+                    -c * self.moment_band(d, 1.0, delta)?,
+                ))
+            }
+        }
+    }
+}

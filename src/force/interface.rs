@@ -1,0 +1,408 @@
+//! [`InterfaceForces`]: every enabled term tabulated once, merged by time dependence and gap, for a
+//! hot path of a few table look-ups.
+
+use std::sync::Arc;
+
+use serde::Serialize;
+
+use super::{Coupling, GapReference, InterfaceTerm, TermKind};
+use crate::quadrature::{Table, TableOptions};
+use crate::{Error, Result};
+
+/// The two gaps a term may see: at the bulge (`d`) and at the pad (`d + δ`), both in m.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gaps {
+    /// Bulge gap `d`, m.
+    pub bulge: f64,
+    /// Pad gap `d + δ`, m.
+    pub pad: f64,
+}
+
+impl Gaps {
+    /// Both gaps equal to `d` (no pad terms, or no protrusion).
+    pub fn same(d: f64) -> Self {
+        Gaps { bulge: d, pad: d }
+    }
+}
+
+/// A value and its partial derivatives with respect to the bulge gap and the pad gap.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ForceEval {
+    /// The value (N, or N/V²).
+    pub value: f64,
+    /// ∂value/∂d_bulge.
+    pub d_bulge: f64,
+    /// ∂value/∂d_pad.
+    pub d_pad: f64,
+}
+
+/// Every force by kind at one point, SI (N, m²), positive = away from the disk.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Breakdown {
+    /// Intermolecular force, N.
+    pub intermolecular: f64,
+    /// Asperity contact force, N.
+    pub contact: f64,
+    /// Electrostatic force per V², N/V².
+    pub electrostatic_per_volt2: f64,
+    /// Electrostatic force at the given V², N.
+    pub electrostatic: f64,
+    /// Terms of kind [`TermKind::Other`], N.
+    pub other: f64,
+    /// Real contact area, m².
+    pub real_contact_area: f64,
+    /// Sum of the forces, N.
+    pub total: f64,
+}
+
+/// A sum of terms tabulated over one gap, split at the terms' kinks, with exact fallback.
+#[derive(Debug)]
+struct Tabulated {
+    members: Vec<usize>,
+    area: bool,
+    segments: Vec<Table>,
+}
+
+impl Tabulated {
+    fn exact_one(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> Result<(f64, f64)> {
+        let (mut v, mut s) = (0.0, 0.0);
+        for &i in &self.members {
+            let (a, b) = if self.area {
+                terms[i].real_contact_area_and_slope(d)?
+            } else {
+                terms[i].force(d)?
+            };
+            v += a;
+            s += b;
+        }
+        Ok((v, s))
+    }
+
+    fn build(
+        terms: &[Box<dyn InterfaceTerm>],
+        members: Vec<usize>,
+        area: bool,
+        (lo, hi): (f64, f64),
+        opts: &TableOptions,
+    ) -> Result<Self> {
+        let mut cuts: Vec<f64> = members
+            .iter()
+            .flat_map(|&i| terms[i].kinks())
+            .filter(|&k| k.is_finite() && k > lo && k < hi)
+            .collect();
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-30));
+        let mut edges = vec![lo];
+        edges.extend(cuts);
+        edges.push(hi);
+        let mut me = Tabulated {
+            members,
+            area,
+            segments: Vec::with_capacity(edges.len() - 1),
+        };
+        let names: Vec<&str> = me.members.iter().map(|&i| terms[i].name()).collect();
+        let what = format!(
+            "{} table of [{}]",
+            if area { "contact-area" } else { "force" },
+            names.join(", ")
+        );
+        for (k, w) in edges.windows(2).enumerate() {
+            let (a, b) = (w[0], w[1]);
+            // At an interior kink evaluate one ulp inside the segment, so that each piece sees the
+            // one-sided limit of a function that jumps there (smooth surface, flat footprint).
+            let a_in = if k == 0 { a } else { next_toward(a, b) };
+            let b_in = if k + 2 == edges.len() { b } else { next_toward(b, a) };
+            let table = Table::build(
+                |x| me.exact_one(terms, x.clamp(a_in, b_in)),
+                a,
+                b,
+                opts,
+            )
+            .map_err(|e| Error::no_convergence(what.clone(), e.to_string()))?;
+            me.segments.push(table);
+        }
+        Ok(me)
+    }
+
+    #[inline]
+    fn lookup(&self, d: f64) -> Option<(f64, f64)> {
+        if self.segments.len() == 1 {
+            return self.segments[0].eval(d);
+        }
+        // Right-continuous at the cuts, like the terms themselves (d ≥ h_c counts as non-contact).
+        let last = self.segments.len() - 1;
+        for t in &self.segments[..last] {
+            if d < t.range().1 {
+                return t.eval(d);
+            }
+        }
+        self.segments[last].eval(d)
+    }
+
+    /// Table look-up; outside the range the exact sum; NaN if that fails.
+    #[inline]
+    fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+        match self.lookup(d) {
+            Some(v) => v,
+            None => self.exact_one(terms, d).unwrap_or((f64::NAN, f64::NAN)),
+        }
+    }
+}
+
+fn next_toward(x: f64, toward: f64) -> f64 {
+    let step = (x.abs() * f64::EPSILON).max(f64::MIN_POSITIVE);
+    if toward > x {
+        x + step
+    } else {
+        x - step
+    }
+}
+
+type PerGap = [Option<Arc<Tabulated>>; 2];
+
+/// All enabled terms, tabulated over the separation.
+///
+/// Static terms are merged into one table per gap reference in use, voltage-driven terms likewise;
+/// the contact force and the real contact area have their own tables (friction and the contact
+/// indicator need them every step), and each kind has one for [`InterfaceForces::breakdown`].
+/// Tables are piecewise cubic Hermite in value and slope, built to the accuracy of
+/// [`TableOptions`] against the terms' direct quadrature (the area tables use an absolute tolerance
+/// 1e-8 times the force one, in m² instead of N).
+///
+/// Outside the table range every hot-path function falls back to the exact term evaluation (slow
+/// but correct; nothing is clamped). The hot-path functions are infallible: if that fallback fails
+/// they return NaN, which an ODE solver reports as a non-finite state.
+///
+/// ```
+/// use hdi_tribology::force::{Gaps, InterfaceForces};
+/// use hdi_tribology::scene::Scene;
+/// # fn main() -> hdi_tribology::Result<()> {
+/// let scene = Scene::paper();
+/// let forces = scene.build_interface()?;
+/// let g = Gaps::same(2e-9);
+/// let f = forces.static_part(g).value + 1.0 * forces.per_volt2_part(g).value;
+/// let b = forces.breakdown(g, 1.0);
+/// assert!((f - b.total).abs() <= 1e-8 * f.abs());
+/// assert!(b.intermolecular < 0.0 && b.electrostatic < 0.0 && b.contact > 0.0);
+/// # Ok(()) }
+/// ```
+#[derive(Clone, Debug)]
+pub struct InterfaceForces {
+    terms: Arc<Vec<Box<dyn InterfaceTerm>>>,
+    range: (f64, f64),
+    static_part: PerGap,
+    per_volt2: PerGap,
+    contact: PerGap,
+    area: PerGap,
+    by_kind: Vec<(TermKind, Coupling, GapReference, Arc<Tabulated>)>,
+}
+
+impl InterfaceForces {
+    /// Tabulates `terms` over `range` = (d_min, d_max) (m; both gap references use it).
+    pub fn build(
+        terms: Vec<Box<dyn InterfaceTerm>>,
+        range: (f64, f64),
+        opts: &TableOptions,
+    ) -> Result<Self> {
+        let (lo, hi) = range;
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(Error::invalid(
+                "table range",
+                format!("needs finite d_min < d_max, got ({lo}, {hi})"),
+            ));
+        }
+        for t in &terms {
+            if t.kind() == TermKind::Contact && t.coupling() != Coupling::Static {
+                return Err(Error::invalid(
+                    format!("term {}", t.name()),
+                    "contact terms must be static",
+                ));
+            }
+        }
+        let area_opts = TableOptions {
+            abs_tol: opts.abs_tol * 1e-8,
+            ..opts.clone()
+        };
+        let gaps = [GapReference::Bulge, GapReference::Pad];
+        let kinds = [
+            TermKind::Intermolecular,
+            TermKind::Contact,
+            TermKind::Electrostatic,
+            TermKind::Other,
+        ];
+        let select = |f: &dyn Fn(&dyn InterfaceTerm) -> bool| -> Vec<usize> {
+            (0..terms.len()).filter(|&i| f(terms[i].as_ref())).collect()
+        };
+        let mut by_kind = Vec::new();
+        for gap in gaps {
+            for kind in kinds {
+                for coupling in [Coupling::Static, Coupling::PerVoltSquared] {
+                    let m = select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
+                    if !m.is_empty() {
+                        let tab = Tabulated::build(&terms, m, false, range, opts)?;
+                        by_kind.push((kind, coupling, gap, Arc::new(tab)));
+                    }
+                }
+            }
+        }
+        let mut static_part: PerGap = [None, None];
+        let mut per_volt2: PerGap = [None, None];
+        let mut contact: PerGap = [None, None];
+        let mut area: PerGap = [None, None];
+        for gap in gaps {
+            let g = gap.index();
+            for (coupling, slot) in [
+                (Coupling::Static, &mut static_part[g]),
+                (Coupling::PerVoltSquared, &mut per_volt2[g]),
+            ] {
+                let m = select(&|t| t.gap() == gap && t.coupling() == coupling);
+                if m.is_empty() {
+                    continue;
+                }
+                // Reuse a per-kind table when the merged set is a single kind.
+                let reuse = by_kind
+                    .iter()
+                    .find(|(_, _, _, t)| t.members == m)
+                    .map(|(_, _, _, t)| Arc::clone(t));
+                *slot = Some(match reuse {
+                    Some(t) => t,
+                    None => Arc::new(Tabulated::build(&terms, m, false, range, opts)?),
+                });
+            }
+            contact[g] = by_kind
+                .iter()
+                .find(|(k, _, gp, _)| *k == TermKind::Contact && *gp == gap)
+                .map(|(_, _, _, t)| Arc::clone(t));
+            let m = select(&|t| t.gap() == gap && t.has_contact_area());
+            if !m.is_empty() {
+                area[g] = Some(Arc::new(Tabulated::build(&terms, m, true, range, &area_opts)?));
+            }
+        }
+        Ok(InterfaceForces {
+            terms: Arc::new(terms),
+            range,
+            static_part,
+            per_volt2,
+            contact,
+            area,
+            by_kind,
+        })
+    }
+
+    #[inline]
+    fn sum(&self, slots: &PerGap, g: Gaps) -> ForceEval {
+        let mut e = ForceEval::default();
+        if let Some(t) = &slots[0] {
+            let (v, s) = t.eval(&self.terms, g.bulge);
+            e.value += v;
+            e.d_bulge = s;
+        }
+        if let Some(t) = &slots[1] {
+            let (v, s) = t.eval(&self.terms, g.pad);
+            e.value += v;
+            e.d_pad = s;
+        }
+        e
+    }
+
+    /// Sum of the static terms (N) and its partial derivatives. Hot path.
+    #[inline]
+    pub fn static_part(&self, g: Gaps) -> ForceEval {
+        self.sum(&self.static_part, g)
+    }
+
+    /// Sum of the voltage-driven terms per V² (N/V²) and its partial derivatives. Hot path.
+    #[inline]
+    pub fn per_volt2_part(&self, g: Gaps) -> ForceEval {
+        self.sum(&self.per_volt2, g)
+    }
+
+    /// Contact force only (N; included in [`InterfaceForces::static_part`]). Hot path.
+    #[inline]
+    pub fn contact(&self, g: Gaps) -> ForceEval {
+        self.sum(&self.contact, g)
+    }
+
+    /// Real contact area, m².
+    #[inline]
+    pub fn real_contact_area(&self, g: Gaps) -> f64 {
+        self.sum(&self.area, g).value
+    }
+
+    /// Every force by kind at the gaps `g` and squared voltage `volt2` (V²), through the tables.
+    pub fn breakdown(&self, g: Gaps, volt2: f64) -> Breakdown {
+        let mut b = Breakdown::default();
+        for (kind, coupling, gap, t) in &self.by_kind {
+            let d = match gap {
+                GapReference::Bulge => g.bulge,
+                GapReference::Pad => g.pad,
+            };
+            let v = t.eval(&self.terms, d).0;
+            let x = match coupling {
+                Coupling::Static => v,
+                Coupling::PerVoltSquared => v * volt2,
+            };
+            match kind {
+                TermKind::Intermolecular => b.intermolecular += x,
+                TermKind::Contact => b.contact += x,
+                TermKind::Electrostatic => {
+                    if *coupling == Coupling::PerVoltSquared {
+                        b.electrostatic_per_volt2 += v;
+                    }
+                    b.electrostatic += x;
+                }
+                TermKind::Other => b.other += x,
+            }
+        }
+        b.real_contact_area = self.real_contact_area(g);
+        b.total = b.intermolecular + b.contact + b.electrostatic + b.other;
+        b
+    }
+
+    /// Whether any term depends on the voltage.
+    pub fn has_voltage_terms(&self) -> bool {
+        self.per_volt2.iter().any(Option::is_some)
+    }
+
+    /// Whether any contact term is enabled.
+    pub fn has_contact(&self) -> bool {
+        self.contact.iter().any(Option::is_some)
+    }
+
+    /// Whether any term sees the pad gap.
+    pub fn uses_pad_gap(&self) -> bool {
+        self.terms.iter().any(|t| t.gap() == GapReference::Pad)
+    }
+
+    /// The tabulated range of separations (m).
+    pub fn table_range(&self) -> (f64, f64) {
+        self.range
+    }
+
+    /// The terms, in the order given to [`InterfaceForces::build`].
+    pub fn terms(&self) -> &[Box<dyn InterfaceTerm>] {
+        &self.terms
+    }
+
+    /// Total number of table nodes (memory and build-cost indicator).
+    pub fn table_nodes(&self) -> usize {
+        let mut seen: Vec<*const Tabulated> = Vec::new();
+        let all = self
+            .static_part
+            .iter()
+            .chain(&self.per_volt2)
+            .chain(&self.contact)
+            .chain(&self.area)
+            .flatten()
+            .chain(self.by_kind.iter().map(|(_, _, _, t)| t));
+        let mut n = 0;
+        for t in all {
+            let p = Arc::as_ptr(t);
+            if !seen.contains(&p) {
+                seen.push(p);
+                n += t.segments.iter().map(Table::len).sum::<usize>();
+            }
+        }
+        n
+    }
+}

@@ -1,0 +1,322 @@
+//! What to solve with: the [`Method`] and the [`Options`] (tolerances, step limits, output).
+
+use super::error::OdeError;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// Integration method.
+///
+/// ```
+/// use hdi_tribology::ode::Method;
+/// let m: Method = "rodas5p".parse().unwrap();
+/// assert_eq!(m, Method::Rodas5P);
+/// assert_eq!(m.to_string(), "rodas5p");
+/// assert!("euler".parse::<Method>().is_err());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Tsitouras' explicit Runge–Kutta 5(4), FSAL, 4th-order dense output. Non-stiff default.
+    Tsit5,
+    /// Dormand–Prince explicit Runge–Kutta 8(5,3) with 7th-order dense output, for tight
+    /// tolerances on non-stiff problems.
+    Dop853,
+    /// Rosenbrock method Rodas5P (Steinebach), order 5, L-stable, 4th-order dense output.
+    Rodas5P,
+    /// Radau IIA, 3 stages, order 5, L-stable, with simplified Newton iterations.
+    Radau5,
+    /// Tsit5 while the problem is non-stiff, Rodas5P while it is stiff, switching both ways.
+    Auto,
+}
+
+impl Method {
+    /// All methods, in the order of the enum.
+    pub const ALL: [Method; 5] = [
+        Method::Tsit5,
+        Method::Dop853,
+        Method::Rodas5P,
+        Method::Radau5,
+        Method::Auto,
+    ];
+
+    /// Nominal order of the method's solution (of the stiff method for `Auto`).
+    pub fn order(self) -> usize {
+        match self {
+            Method::Tsit5 | Method::Rodas5P | Method::Radau5 | Method::Auto => 5,
+            Method::Dop853 => 8,
+        }
+    }
+
+    /// The lowercase name used by `FromStr`, `Display` and serde.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Tsit5 => "tsit5",
+            Method::Dop853 => "dop853",
+            Method::Rodas5P => "rodas5p",
+            Method::Radau5 => "radau5",
+            Method::Auto => "auto",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = OdeError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let lower = s.trim().to_ascii_lowercase();
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == lower)
+            .ok_or_else(|| {
+                OdeError::invalid(
+                    "method",
+                    format!("unknown method {s:?}; expected tsit5, dop853, rodas5p, radau5 or auto"),
+                )
+            })
+    }
+}
+
+/// Absolute tolerance: one value for all components or one per component.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Tolerance {
+    /// Same absolute tolerance for every component.
+    Scalar(f64),
+    /// One absolute tolerance per component (length = state dimension).
+    PerComponent(Vec<f64>),
+}
+
+impl Tolerance {
+    /// Tolerance of component `i` (`PerComponent` must have been validated for length).
+    pub fn get(&self, i: usize) -> f64 {
+        match self {
+            Tolerance::Scalar(a) => *a,
+            Tolerance::PerComponent(v) => v.get(i).copied().unwrap_or(f64::NAN),
+        }
+    }
+}
+
+/// Which states the [`Solution`](super::Solution) keeps in `t` and `y`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum SaveAt {
+    /// The initial point and every accepted step (and a terminal event's point).
+    Steps,
+    /// Only these times, interpolated on the dense output; they must lie in `[t0, tf]` and be
+    /// sorted ascending. A terminal event cuts the list at its time.
+    Times(Vec<f64>),
+    /// Only the final point.
+    Final,
+}
+
+/// Integration options; `Options::default()` and builder-style setters.
+///
+/// ```
+/// use hdi_tribology::ode::{Options, SaveAt};
+/// let opts = Options::default().rtol(1e-8).atol(1e-10).h_max(1e-3).save(SaveAt::Final);
+/// assert!(opts.validate(2).is_ok());
+/// assert!(Options::default().rtol(-1.0).validate(2).is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Options {
+    /// Relative tolerance (> 0, ≥ 100 ε).
+    pub rtol: f64,
+    /// Absolute tolerance, scalar or per component (≥ 0).
+    pub atol: Tolerance,
+    /// Initial step size; `None` selects it automatically.
+    pub h_init: Option<f64>,
+    /// Largest step size allowed (> 0); keeps steps from jumping over short features.
+    pub h_max: f64,
+    /// Smallest step size allowed (≥ 0); a smaller step request is an error.
+    pub h_min: f64,
+    /// Budget of step attempts, accepted plus rejected.
+    pub max_steps: usize,
+    /// Times where the right-hand side has kinks; steps end exactly on them.
+    pub t_stops: Vec<f64>,
+    /// Which states to save.
+    pub save: SaveAt,
+    /// Keep the interpolation coefficients of every step so that
+    /// [`Solution::sample`](super::Solution::sample) works over the whole range.
+    pub dense: bool,
+    /// Absolute time tolerance to which event times are located.
+    pub event_tol: f64,
+    /// Step size control on (default). Off: constant steps of `h_init` (required), every step
+    /// accepted — for convergence-order studies.
+    pub adaptive: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            rtol: 1e-6,
+            atol: Tolerance::Scalar(1e-8),
+            h_init: None,
+            h_max: f64::INFINITY,
+            h_min: 0.0,
+            max_steps: 100_000,
+            t_stops: Vec::new(),
+            save: SaveAt::Steps,
+            dense: true,
+            event_tol: 1e-12,
+            adaptive: true,
+        }
+    }
+}
+
+impl Options {
+    /// Sets the relative tolerance.
+    pub fn rtol(mut self, rtol: f64) -> Self {
+        self.rtol = rtol;
+        self
+    }
+    /// Sets one absolute tolerance for all components.
+    pub fn atol(mut self, atol: f64) -> Self {
+        self.atol = Tolerance::Scalar(atol);
+        self
+    }
+    /// Sets one absolute tolerance per component.
+    pub fn atol_per_component(mut self, atol: Vec<f64>) -> Self {
+        self.atol = Tolerance::PerComponent(atol);
+        self
+    }
+    /// Sets the initial step size.
+    pub fn h_init(mut self, h: f64) -> Self {
+        self.h_init = Some(h);
+        self
+    }
+    /// Sets the largest step size.
+    pub fn h_max(mut self, h: f64) -> Self {
+        self.h_max = h;
+        self
+    }
+    /// Sets the step size floor.
+    pub fn h_min(mut self, h: f64) -> Self {
+        self.h_min = h;
+        self
+    }
+    /// Sets the budget of step attempts.
+    pub fn max_steps(mut self, n: usize) -> Self {
+        self.max_steps = n;
+        self
+    }
+    /// Sets the times where the right-hand side has kinks.
+    pub fn t_stops(mut self, t: Vec<f64>) -> Self {
+        self.t_stops = t;
+        self
+    }
+    /// Sets what to save.
+    pub fn save(mut self, save: SaveAt) -> Self {
+        self.save = save;
+        self
+    }
+    /// Turns dense output on or off.
+    pub fn dense(mut self, dense: bool) -> Self {
+        self.dense = dense;
+        self
+    }
+    /// Sets the time tolerance of event location.
+    pub fn event_tol(mut self, tol: f64) -> Self {
+        self.event_tol = tol;
+        self
+    }
+
+    /// Turns step size control on (default) or off (constant steps of `h_init`).
+    pub fn adaptive(mut self, adaptive: bool) -> Self {
+        self.adaptive = adaptive;
+        self
+    }
+
+    /// Checks every option for a state of dimension `n`.
+    pub fn validate(&self, n: usize) -> Result<(), OdeError> {
+        if !(self.rtol.is_finite() && self.rtol >= 100.0 * f64::EPSILON && self.rtol < 1.0) {
+            return Err(OdeError::invalid(
+                "options.rtol",
+                format!("must be finite, in [100 ε, 1), got {}", self.rtol),
+            ));
+        }
+        match &self.atol {
+            Tolerance::Scalar(a) => {
+                if !(a.is_finite() && *a >= 0.0) {
+                    return Err(OdeError::invalid(
+                        "options.atol",
+                        format!("must be finite and >= 0, got {a}"),
+                    ));
+                }
+            }
+            Tolerance::PerComponent(v) => {
+                if v.len() != n {
+                    return Err(OdeError::invalid(
+                        "options.atol",
+                        format!("has {} components, the state has {n}", v.len()),
+                    ));
+                }
+                if let Some((i, a)) = v.iter().enumerate().find(|(_, a)| !(a.is_finite() && **a >= 0.0)) {
+                    return Err(OdeError::invalid(
+                        format!("options.atol[{i}]"),
+                        format!("must be finite and >= 0, got {a}"),
+                    ));
+                }
+            }
+        }
+        if let Some(h) = self.h_init {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(OdeError::invalid(
+                    "options.h_init",
+                    format!("must be finite and > 0, got {h}"),
+                ));
+            }
+        }
+        if !self.adaptive && self.h_init.is_none() {
+            return Err(OdeError::invalid(
+                "options.h_init",
+                "constant steps (adaptive = false) need h_init",
+            ));
+        }
+        if !(self.h_max > 0.0) {
+            return Err(OdeError::invalid(
+                "options.h_max",
+                format!("must be > 0, got {}", self.h_max),
+            ));
+        }
+        if !(self.h_min.is_finite() && self.h_min >= 0.0 && self.h_min <= self.h_max) {
+            return Err(OdeError::invalid(
+                "options.h_min",
+                format!("must be finite, >= 0 and <= h_max, got {}", self.h_min),
+            ));
+        }
+        if self.max_steps == 0 {
+            return Err(OdeError::invalid("options.max_steps", "must be > 0, got 0"));
+        }
+        if let Some(t) = self.t_stops.iter().find(|t| !t.is_finite()) {
+            return Err(OdeError::invalid(
+                "options.t_stops",
+                format!("must be finite, got {t}"),
+            ));
+        }
+        if let SaveAt::Times(ts) = &self.save {
+            if let Some(t) = ts.iter().find(|t| !t.is_finite()) {
+                return Err(OdeError::invalid(
+                    "options.save",
+                    format!("times must be finite, got {t}"),
+                ));
+            }
+            if ts.windows(2).any(|w| w[1] < w[0]) {
+                return Err(OdeError::invalid(
+                    "options.save",
+                    "times must be sorted ascending",
+                ));
+            }
+        }
+        if !(self.event_tol.is_finite() && self.event_tol > 0.0) {
+            return Err(OdeError::invalid(
+                "options.event_tol",
+                format!("must be finite and > 0, got {}", self.event_tol),
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,125 @@
+//! The interface between the integration loop and one method, and the shared error norm.
+
+use super::dense::StepPoly;
+use super::solution::Stats;
+use super::system::OdeSystem;
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
+
+/// Tolerances and counters shared by the loop and the method.
+pub(crate) struct Ctx<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    pub atol: OVector<f64, D>,
+    pub rtol: f64,
+    pub stats: Stats,
+    /// Whether the method should estimate the spectral radius for stiffness switching.
+    pub want_stiffness: bool,
+}
+
+impl<D: Dim> Ctx<D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// Weighted RMS norm of an error estimate `e` for a step from `y0` to `y1`.
+    pub fn err_norm(&self, e: &OVector<f64, D>, y0: &OVector<f64, D>, y1: &OVector<f64, D>) -> f64 {
+        let n = e.len();
+        let mut s = 0.0;
+        for i in 0..n {
+            let sc = self.atol[i] + self.rtol * y0[i].abs().max(y1[i].abs());
+            let r = e[i] / sc;
+            s += r * r;
+        }
+        (s / n.max(1) as f64).sqrt()
+    }
+
+    /// Weighted RMS norm of a vector relative to the scale of `y`.
+    pub fn norm_at(&self, v: &OVector<f64, D>, y: &OVector<f64, D>) -> f64 {
+        self.err_norm(v, y, y)
+    }
+}
+
+/// Outcome of one step attempt.
+pub(crate) enum Trial {
+    /// The step was computed; `err` is the weighted error norm (accept when ≤ 1).
+    Done { err: f64 },
+    /// The step could not be computed; retry with `h * factor`.
+    Failed { factor: f64, kind: FailKind },
+}
+
+/// Why a step attempt failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum FailKind {
+    NonFinite,
+    Newton,
+    Singular,
+}
+
+/// One integration method.
+pub(crate) trait Stepper<D: Dim, S: OdeSystem<D> + ?Sized>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// Exponent base of the step size controller: order of the error estimate plus one.
+    fn error_order(&self) -> f64;
+
+    /// Whether this is a stiff (implicit or linearly implicit) method.
+    fn is_stiff(&self) -> bool;
+
+    /// (Re)starts at `(t, y)`: evaluates and keeps `f(t, y)`; drops reusable data that is no
+    /// longer valid (after a kink in the right-hand side or a method switch).
+    fn restart(&mut self, sys: &S, t: f64, y: &OVector<f64, D>, ctx: &mut Ctx<D>);
+
+    /// `f(t, y)` at the current point.
+    fn f0(&self) -> &OVector<f64, D>;
+
+    /// Attempts a step of size `h` from `(t, y)`, writing the new state into `y_new`.
+    fn attempt(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &OVector<f64, D>,
+        h: f64,
+        y_new: &mut OVector<f64, D>,
+        ctx: &mut Ctx<D>,
+    ) -> Trial;
+
+    /// Called after the last attempt was accepted: writes the step interpolant into `poly` and
+    /// moves the method's state to the new point.
+    fn accept(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &OVector<f64, D>,
+        h: f64,
+        y_new: &OVector<f64, D>,
+        poly: &mut StepPoly,
+        ctx: &mut Ctx<D>,
+    );
+
+    /// Stiffness indicator of the last accepted step: for explicit methods `h·ρ` (ρ estimated
+    /// spectral radius), for stiff methods `ρ`; `None` when not available.
+    fn stiffness(&self) -> Option<f64>;
+
+    /// Step size multiplier suggested after a Newton or linear-algebra difficulty, if any.
+    fn step_hint(&self) -> Option<f64> {
+        None
+    }
+}
+
+/// Is every component finite?
+pub(crate) fn all_finite<D: Dim>(v: &OVector<f64, D>) -> bool
+where
+    DefaultAllocator: Allocator<D>,
+{
+    v.iter().all(|x| x.is_finite())
+}
+
+/// Zero vector shaped like `y`.
+pub(crate) fn zeros_like<D: Dim>(y: &OVector<f64, D>) -> OVector<f64, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let (r, c) = y.shape_generic();
+    OVector::zeros_generic(r, c)
+}

@@ -1,0 +1,181 @@
+//! The problem side: the [`OdeSystem`] trait, a closure adapter and Jacobian helpers.
+
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
+use num_complex::Complex64;
+
+/// A first-order system `y' = f(t, y)` with state in a nalgebra vector of dimension `D`.
+///
+/// Only [`rhs`](OdeSystem::rhs) is required. Stiff methods use
+/// [`jacobian`](OdeSystem::jacobian) when it returns `true` and finite differences otherwise;
+/// Rosenbrock methods also use [`time_derivative`](OdeSystem::time_derivative).
+///
+/// ```
+/// use hdi_tribology::ode::OdeSystem;
+/// use nalgebra::{Matrix2, U2, Vector2};
+/// /// Harmonic oscillator y'' = -y.
+/// struct Oscillator;
+/// impl OdeSystem<U2> for Oscillator {
+///     fn rhs(&self, _t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>) {
+///         dy[0] = y[1];
+///         dy[1] = -y[0];
+///     }
+///     fn jacobian(&self, _t: f64, _y: &Vector2<f64>, j: &mut Matrix2<f64>) -> bool {
+///         *j = Matrix2::new(0.0, 1.0, -1.0, 0.0);
+///         true
+///     }
+/// }
+/// let mut dy = Vector2::zeros();
+/// Oscillator.rhs(0.0, &Vector2::new(1.0, 0.0), &mut dy);
+/// assert_eq!(dy, Vector2::new(0.0, -1.0));
+/// ```
+pub trait OdeSystem<D: Dim>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// Writes `f(t, y)` into `dydt`.
+    fn rhs(&self, t: f64, y: &OVector<f64, D>, dydt: &mut OVector<f64, D>);
+
+    /// Analytic Jacobian `∂f/∂y` into `jac`; return `false` (the default) to ask for finite
+    /// differences.
+    fn jacobian(&self, _t: f64, _y: &OVector<f64, D>, _jac: &mut OMatrix<f64, D, D>) -> bool {
+        false
+    }
+
+    /// `∂f/∂t` into `dfdt` for non-autonomous systems; return `false` (the default) to ask for a
+    /// finite difference. Autonomous systems may return `true` after writing zeros.
+    fn time_derivative(&self, _t: f64, _y: &OVector<f64, D>, _dfdt: &mut OVector<f64, D>) -> bool {
+        false
+    }
+}
+
+/// Adapter turning a closure `|t, y, dydt|` into an [`OdeSystem`] (finite-difference Jacobian).
+///
+/// ```
+/// use hdi_tribology::ode::{FnSystem, OdeSystem};
+/// use nalgebra::{U1, Vector1};
+/// let decay = FnSystem::new(|_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| dy[0] = -y[0]);
+/// let mut dy = Vector1::zeros();
+/// OdeSystem::<U1>::rhs(&decay, 0.0, &Vector1::new(2.0), &mut dy);
+/// assert_eq!(dy[0], -2.0);
+/// ```
+pub struct FnSystem<F> {
+    f: F,
+}
+
+impl<F> FnSystem<F> {
+    /// Wraps `f(t, y, dydt)`.
+    pub fn new(f: F) -> Self {
+        FnSystem { f }
+    }
+}
+
+impl<D: Dim, F> OdeSystem<D> for FnSystem<F>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    F: Fn(f64, &OVector<f64, D>, &mut OVector<f64, D>),
+{
+    fn rhs(&self, t: f64, y: &OVector<f64, D>, dydt: &mut OVector<f64, D>) {
+        (self.f)(t, y, dydt)
+    }
+}
+
+/// Forward-difference Jacobian of `sys` at `(t, y)`, given `f0 = f(t, y)`.
+///
+/// The increment of component `j` is `√ε · max(|y_j|, scale_j)`, where `scale_j` (e.g. the
+/// absolute tolerance) keeps it meaningful for components near zero. `work` is scratch space.
+/// Returns the number of right-hand-side evaluations (the state dimension).
+///
+/// ```
+/// use hdi_tribology::ode::{finite_difference_jacobian, FnSystem};
+/// use nalgebra::{Matrix2, Vector2};
+/// let sys = FnSystem::new(|_t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>| {
+///     dy[0] = y[0] * y[1];
+///     dy[1] = -3.0 * y[0];
+/// });
+/// let y = Vector2::new(2.0, 5.0);
+/// let f0 = Vector2::new(10.0, -6.0);
+/// let mut j = Matrix2::zeros();
+/// let mut work = Vector2::zeros();
+/// finite_difference_jacobian(&sys, 0.0, &y, &f0, &Vector2::repeat(1e-8), &mut j, &mut work);
+/// assert!((j[(0, 0)] - 5.0).abs() < 1e-6 && (j[(0, 1)] - 2.0).abs() < 1e-6);
+/// assert!((j[(1, 0)] + 3.0).abs() < 1e-6 && j[(1, 1)].abs() < 1e-6);
+/// ```
+pub fn finite_difference_jacobian<D: Dim, S: OdeSystem<D> + ?Sized>(
+    sys: &S,
+    t: f64,
+    y: &OVector<f64, D>,
+    f0: &OVector<f64, D>,
+    scale: &OVector<f64, D>,
+    jac: &mut OMatrix<f64, D, D>,
+    work: &mut OVector<f64, D>,
+) -> usize
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let n = y.len();
+    let mut yp = y.clone();
+    let sqrt_eps = f64::EPSILON.sqrt();
+    for j in 0..n {
+        let yj = y[j];
+        let mut delta = sqrt_eps * yj.abs().max(scale[j]);
+        if !(delta > 0.0) || !delta.is_finite() {
+            delta = sqrt_eps;
+        }
+        yp[j] = yj + delta;
+        // The increment actually represented in floating point.
+        let delta = yp[j] - yj;
+        sys.rhs(t, &yp, work);
+        for i in 0..n {
+            jac[(i, j)] = (work[i] - f0[i]) / delta;
+        }
+        yp[j] = yj;
+    }
+    n
+}
+
+/// Complex-step Jacobian: `J[:, j] = Im f(t, y + i·δ·e_j) / δ`, exact to rounding for a
+/// right-hand side `f` that is analytic and written for complex arithmetic.
+///
+/// Meant to be called from an [`OdeSystem::jacobian`] implementation.
+///
+/// ```
+/// use hdi_tribology::ode::complex_step_jacobian;
+/// use nalgebra::{Matrix2, Vector2};
+/// use num_complex::Complex64;
+/// let f = |_t: f64, y: &Vector2<Complex64>, dy: &mut Vector2<Complex64>| {
+///     dy[0] = y[0].exp() * y[1];
+///     dy[1] = y[0] * y[0];
+/// };
+/// let mut j = Matrix2::zeros();
+/// complex_step_jacobian(f, 0.0, &Vector2::new(0.5, 2.0), &mut j);
+/// assert!((j[(0, 0)] - 2.0 * 0.5f64.exp()).abs() < 1e-14);
+/// assert!((j[(0, 1)] - 0.5f64.exp()).abs() < 1e-14);
+/// assert!((j[(1, 0)] - 1.0).abs() < 1e-14 && j[(1, 1)] == 0.0);
+/// ```
+pub fn complex_step_jacobian<D: Dim, F>(
+    f: F,
+    t: f64,
+    y: &OVector<f64, D>,
+    jac: &mut OMatrix<f64, D, D>,
+) where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    F: Fn(f64, &OVector<Complex64, D>, &mut OVector<Complex64, D>),
+{
+    let n = y.len();
+    let (rows, cols) = y.shape_generic();
+    let mut yc: OVector<Complex64, D> =
+        OVector::from_fn_generic(rows, cols, |i, _| Complex64::new(y[i], 0.0));
+    let mut out: OVector<Complex64, D> =
+        OVector::from_element_generic(rows, cols, Complex64::new(0.0, 0.0));
+    for j in 0..n {
+        // Any tiny relative step works (no subtractive cancellation); scaling with |y_j|
+        // keeps the imaginary parts representable for states of any magnitude.
+        let delta = if y[j] != 0.0 { 1e-20 * y[j].abs() } else { 1e-20 };
+        yc[j].im = delta;
+        f(t, &yc, &mut out);
+        for i in 0..n {
+            jac[(i, j)] = out[i].im / delta;
+        }
+        yc[j].im = 0.0;
+    }
+}

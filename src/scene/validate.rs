@@ -1,0 +1,131 @@
+//! Field-by-field validation of a scene; every error names the dotted field path.
+
+use super::Scene;
+use crate::error::{check_finite, check_non_negative, check_positive};
+use crate::{Error, Result};
+
+impl Scene {
+    /// Checks every field; the error names the field (dotted path) and the reason.
+    pub fn validate(&self) -> Result<()> {
+        if self.name.trim().is_empty() {
+            return Err(Error::invalid("name", "must not be empty"));
+        }
+        check_positive("nominal_clearance_m", self.nominal_clearance_m)?;
+        check_non_negative("surface.height_sigma_m", self.surface.height_sigma_m)?;
+        if self.contact.is_some() {
+            self.peaks().map(|_| ())?;
+        }
+        if let Some(m) = &self.intermolecular {
+            check_positive("intermolecular.hamaker_attractive_j", m.hamaker_attractive_j)?;
+            check_positive("intermolecular.hamaker_repulsive_j_m6", m.hamaker_repulsive_j_m6)?;
+            if let Some(c) = m.cutoff_m {
+                check_positive("intermolecular.cutoff_m", c)?;
+            }
+            m.footprint.validate("intermolecular.footprint")?;
+        }
+        if let Some(e) = &self.electrostatic {
+            check_finite("electrostatic.contact_potential_v", e.contact_potential_v)?;
+            check_non_negative("electrostatic.dielectric_thickness_m", e.dielectric_thickness_m)?;
+            match e.cutoff_m {
+                Some(c) => {
+                    check_positive("electrostatic.cutoff_m", c)?;
+                }
+                None if self.intermolecular.is_none() => {
+                    return Err(Error::invalid(
+                        "electrostatic.cutoff_m",
+                        "required when the intermolecular term is off (its default is h_e)",
+                    ))
+                }
+                None => {}
+            }
+            e.footprint.validate("electrostatic.footprint")?;
+        }
+        if let Some(c) = &self.contact {
+            check_positive("contact.composite_modulus_pa", c.composite_modulus_pa)?;
+            check_positive("contact.asperity_radius_m", c.asperity_radius_m)?;
+            check_positive("contact.asperity_density_per_m2", c.asperity_density_per_m2)?;
+            c.footprint.validate("contact.footprint")?;
+        }
+        self.air_bearing.build()?;
+        check_positive("slider.mass_kg", self.slider.mass_kg)?;
+        check_non_negative("slider.interface_lag_s", self.slider.interface_lag_s)?;
+        self.validate_heater()?;
+        let v = &self.voltage;
+        check_finite("voltage.dc_v", v.dc_v)?;
+        check_non_negative("voltage.ac_amplitude_v", v.ac_amplitude_v)?;
+        check_positive("voltage.ac_frequency_hz", v.ac_frequency_hz)?;
+        check_positive("detector.contact_threshold_n", self.detector.contact_threshold_n)?;
+        check_positive("detector.window_s", self.detector.window_s)?;
+        let f = &self.friction;
+        check_non_negative("friction.coefficient", f.coefficient)?;
+        check_non_negative("friction.disk_speed_m_per_s", f.disk_speed_m_per_s)?;
+        check_positive("friction.head_conductivity_w_per_m_k", f.head_conductivity_w_per_m_k)?;
+        self.validate_solver()?;
+        for (i, &a) in self.sweep.ac_amplitudes_v.iter().enumerate() {
+            check_non_negative(&format!("sweep.ac_amplitudes_v[{i}]"), a)?;
+        }
+        Ok(())
+    }
+
+    fn validate_heater(&self) -> Result<()> {
+        let h = &self.heater;
+        check_non_negative("heater.efficiency_m_per_w", h.efficiency_m_per_w)?;
+        check_non_negative("heater.thermal_lag_s", h.thermal_lag_s)?;
+        if h.programme.len() < 2 {
+            return Err(Error::invalid(
+                "heater.programme",
+                format!("needs at least 2 knots [t_s, power_w], got {}", h.programme.len()),
+            ));
+        }
+        for (i, &[t, p]) in h.programme.iter().enumerate() {
+            check_finite(&format!("heater.programme[{i}].t_s"), t)?;
+            check_non_negative(&format!("heater.programme[{i}].power_w"), p)?;
+            if i > 0 && t <= h.programme[i - 1][0] {
+                return Err(Error::invalid(
+                    format!("heater.programme[{i}].t_s"),
+                    format!("times must increase strictly, got {t} after {}", h.programme[i - 1][0]),
+                ));
+            }
+        }
+        let tr = &h.triggered;
+        check_non_negative("heater.triggered.start_power_w", tr.start_power_w)?;
+        check_positive("heater.triggered.ramp_rate_w_per_s", tr.ramp_rate_w_per_s)?;
+        check_non_negative("heater.triggered.overshoot_w", tr.overshoot_w)?;
+        Ok(())
+    }
+
+    fn validate_solver(&self) -> Result<()> {
+        let s = &self.solver;
+        if s.method.trim().is_empty() {
+            return Err(Error::invalid("solver.method", "must not be empty"));
+        }
+        if !(s.rtol > 0.0 && s.rtol < 1.0) {
+            return Err(Error::invalid("solver.rtol", format!("must lie in (0, 1), got {}", s.rtol)));
+        }
+        check_positive("solver.atol_m", s.atol_m)?;
+        if let Some(h) = s.max_step_s {
+            check_positive("solver.max_step_s", h)?;
+        }
+        if s.max_steps == 0 {
+            return Err(Error::invalid("solver.max_steps", "must be at least 1"));
+        }
+        let t = &self.table;
+        if !(t.rel_tol > 0.0 && t.rel_tol < 1e-2) {
+            return Err(Error::invalid("table.rel_tol", format!("must lie in (0, 0.01), got {}", t.rel_tol)));
+        }
+        if let Some(lo) = t.d_min_m {
+            check_finite("table.d_min_m", lo)?;
+        }
+        if let Some(hi) = t.d_max_m {
+            check_finite("table.d_max_m", hi)?;
+        }
+        let (lo, hi) = self.table_range();
+        if !(lo < hi) {
+            return Err(Error::invalid(
+                "table",
+                format!("d_min_m must be below d_max_m, got range ({lo}, {hi})"),
+            ));
+        }
+        Ok(())
+    }
+}

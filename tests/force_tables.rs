@@ -1,0 +1,148 @@
+//! Tables against direct quadrature over the whole range, for every merged table and term.
+
+use std::sync::Arc;
+
+use hdi_tribology::force::{
+    Coupling, Electrostatic, Footprint, GapReference, Gaps, GreenwoodWilliamson, InterfaceForces,
+    InterfaceTerm, Intermolecular, TermKind,
+};
+use hdi_tribology::quadrature::TableOptions;
+use hdi_tribology::scene::Scene;
+use hdi_tribology::surface::{Gaussian, GaussianHeights};
+
+/// Deterministic points spread over [lo, hi] (a Weyl sequence: no clustering, no RNG crate).
+fn points(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    let g = 0.618_033_988_749_894_9;
+    (0..n)
+        .map(|i| lo + (hi - lo) * ((0.5 + i as f64 * g) % 1.0))
+        .collect()
+}
+
+struct Exact<'a>(&'a [Box<dyn InterfaceTerm>]);
+
+impl Exact<'_> {
+    fn sum(&self, d: f64, pick: impl Fn(&dyn InterfaceTerm) -> bool) -> (f64, f64) {
+        self.0
+            .iter()
+            .filter(|t| pick(t.as_ref()))
+            .map(|t| t.force(d).unwrap())
+            .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
+    }
+    fn area(&self, d: f64) -> (f64, f64) {
+        self.0
+            .iter()
+            .map(|t| t.real_contact_area_and_slope(d).unwrap())
+            .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
+    }
+}
+
+/// The acceptance bound: 1e-8 relative, or 1e-15 N where a force passes through zero.
+fn value_ok(table: f64, exact: f64, abs: f64) -> bool {
+    (table - exact).abs() <= 1e-8 * exact.abs() + abs
+}
+
+/// Slopes are interpolated by the derivative of the Hermite cubic: one order of node spacing
+/// less accurate than values. With spacing ~1e-2 of the local length scale, 1e-6 relative to the
+/// largest of the local slope and value/scale (scale = 0.1 nm, the finest feature) is the bound.
+fn slope_ok(table: f64, exact: f64, value: f64, abs: f64) -> bool {
+    (table - exact).abs() <= 1e-6 * exact.abs().max(value.abs() / 1e-10) + abs / 1e-10
+}
+
+fn check_all(forces: &InterfaceForces, n: usize) {
+    let (lo, hi) = forces.table_range();
+    let exact = Exact(forces.terms());
+    let mut worst = [0.0_f64; 4];
+    for d in points(lo, hi, n) {
+        let g = Gaps::same(d);
+        let cases = [
+            (forces.static_part(g), exact.sum(d, |t| t.coupling() == Coupling::Static), 1e-15),
+            (forces.per_volt2_part(g), exact.sum(d, |t| t.coupling() == Coupling::PerVoltSquared), 1e-15),
+            (forces.contact(g), exact.sum(d, |t| t.kind() == TermKind::Contact), 1e-15),
+        ];
+        for (k, (tab, (v, s), abs)) in cases.into_iter().enumerate() {
+            assert!(value_ok(tab.value, v, abs), "case {k} at d = {d}: table {} exact {v}", tab.value);
+            assert!(slope_ok(tab.d_bulge, s, v, abs), "case {k} slope at d = {d}: table {} exact {s}", tab.d_bulge);
+            worst[k] = worst[k].max((tab.value - v).abs() / (v.abs() + abs / 1e-8));
+        }
+        let (a, _) = exact.area(d);
+        // contact-area tables: the same relative bound, absolute 1e-8 × 1e-16 m²
+        assert!(value_ok(forces.real_contact_area(g), a, 1e-24), "area at d = {d}");
+        let b = forces.breakdown(g, 0.49);
+        assert!(value_ok(b.total, exact.sum(d, |t| t.coupling() == Coupling::Static).0 + 0.49 * cases_pv2(&exact, d), 3e-15));
+    }
+    eprintln!("worst relative errors (static, per V², contact): {worst:?}");
+}
+
+fn cases_pv2(exact: &Exact, d: f64) -> f64 {
+    exact.sum(d, |t| t.coupling() == Coupling::PerVoltSquared).0
+}
+
+#[test]
+fn paper_scene_tables_match_direct_quadrature_over_the_whole_range() {
+    let forces = Scene::paper().build_interface().unwrap();
+    assert!(forces.has_contact() && forces.has_voltage_terms() && !forces.uses_pad_gap());
+    eprintln!("paper scene: {} table nodes over {:?}", forces.table_nodes(), forces.table_range());
+    check_all(&forces, 400);
+}
+
+#[test]
+fn mixed_footprints_and_gaps_tabulate_correctly() {
+    let h = GaussianHeights::new(5e-10).unwrap();
+    let peaks = Arc::new(Gaussian::new(2e-10, 6e-10).unwrap());
+    let cap = Footprint::Paraboloid {
+        radius_of_curvature_m: 0.02,
+        max_radius_m: Some(2e-5),
+    };
+    let plate = Footprint::Flat { area_m2: 1e-8 };
+    let terms: Vec<Box<dyn InterfaceTerm>> = vec![
+        Box::new(Intermolecular::new(1e-19, 1e-76, None, h, cap, GapReference::Bulge).unwrap()),
+        Box::new(Intermolecular::new(5e-20, 1e-76, None, h, plate, GapReference::Pad).unwrap()),
+        Box::new(Electrostatic::new(1e-9, 2e-10, h, plate, GapReference::Pad).unwrap()),
+        Box::new(Electrostatic::new(0.0, 2e-10, h, cap, GapReference::Bulge).unwrap()),
+        Box::new(GreenwoodWilliamson::new(1e11, 1e-7, 1.5e14, peaks, cap, GapReference::Bulge).unwrap()),
+    ];
+    let forces = InterfaceForces::build(terms, (-3e-9, 20e-9), &TableOptions::default()).unwrap();
+    assert!(forces.uses_pad_gap());
+    let exact = Exact(forces.terms());
+    for d in points(-3e-9, 20e-9, 150) {
+        let g = Gaps { bulge: d, pad: d + 1e-9 };
+        let st = forces.static_part(g);
+        let pv = forces.per_volt2_part(g);
+        let pick = |gap, c| move |t: &dyn InterfaceTerm| t.gap() == gap && t.coupling() == c;
+        let sb = exact.sum(d, pick(GapReference::Bulge, Coupling::Static));
+        let sp = exact.sum(d + 1e-9, pick(GapReference::Pad, Coupling::Static));
+        let vb = exact.sum(d, pick(GapReference::Bulge, Coupling::PerVoltSquared));
+        let vp = exact.sum(d + 1e-9, pick(GapReference::Pad, Coupling::PerVoltSquared));
+        assert!(value_ok(st.value, sb.0 + sp.0, 2e-15), "static at {d}");
+        assert!(value_ok(pv.value, vb.0 + vp.0, 2e-15), "per V² at {d}");
+        assert!(slope_ok(st.d_bulge, sb.1, sb.0, 1e-15) && slope_ok(st.d_pad, sp.1, sp.0, 1e-15));
+        assert!(slope_ok(pv.d_bulge, vb.1, vb.0, 1e-15) && slope_ok(pv.d_pad, vp.1, vp.0, 1e-15));
+    }
+}
+
+#[test]
+fn outside_the_range_the_exact_terms_are_used() {
+    let forces = Scene::paper().build_interface().unwrap();
+    let (lo, hi) = forces.table_range();
+    let exact = Exact(forces.terms());
+    for d in [lo - 1e-9, hi + 1e-9, 10.0 * hi] {
+        let e = exact.sum(d, |t| t.coupling() == Coupling::Static);
+        let t = forces.static_part(Gaps::same(d));
+        assert_eq!((t.value, t.d_bulge), e, "no clamping at d = {d}");
+    }
+    assert!(forces.static_part(Gaps::same(f64::NAN)).value.is_nan());
+}
+
+#[test]
+fn smooth_flat_electrostatics_jumps_at_the_cutoff_and_the_table_follows() {
+    let hc = 3e-10;
+    let plate = Footprint::Flat { area_m2: 1e-8 };
+    let t = Electrostatic::new(0.0, hc, GaussianHeights::new(0.0).unwrap(), plate, GapReference::Bulge).unwrap();
+    let forces = InterfaceForces::build(vec![Box::new(t)], (-1e-9, 5e-9), &TableOptions::default()).unwrap();
+    let below = forces.per_volt2_part(Gaps::same(hc * (1.0 - 1e-9))).value;
+    let at = forces.per_volt2_part(Gaps::same(hc)).value;
+    let above = forces.per_volt2_part(Gaps::same(hc * (1.0 + 1e-9))).value;
+    assert_eq!(below, 0.0);
+    let p = -hdi_tribology::units::EPSILON_0 * 1e-8 / (2.0 * hc * hc);
+    assert!((at - p).abs() < 1e-8 * p.abs() && (above - p).abs() < 1e-8 * p.abs());
+}

@@ -1,0 +1,107 @@
+//! Non-stiff problem with a closed-form solution: accuracy, observed convergence order of the
+//! step and of the dense output, for every method; fixed-size and dynamic states agree.
+
+use hdi_tribology::ode::{solve, FnSystem, Method, OdeSystem, Options, SaveAt};
+use nalgebra::{DVector, Dim, OVector, Vector3, allocator::Allocator, DefaultAllocator};
+
+/// u' = −2t u², p' = q, q' = −p: u = 1/(1+t²), p = cos t, q = −sin t.
+fn rhs<D: Dim>(t: f64, y: &OVector<f64, D>, dy: &mut OVector<f64, D>)
+where
+    DefaultAllocator: Allocator<D>,
+{
+    dy[0] = -2.0 * t * y[0] * y[0];
+    dy[1] = y[2];
+    dy[2] = -y[1];
+}
+
+fn exact(t: f64) -> Vector3<f64> {
+    Vector3::new(1.0 / (1.0 + t * t), t.cos(), -t.sin())
+}
+
+const T_END: f64 = 4.0;
+
+fn max_err(y: &Vector3<f64>, t: f64) -> f64 {
+    (y - exact(t)).amax()
+}
+
+/// Global error at T_END and max dense-output error at step midpoints, constant step h.
+fn fixed_step_errors(method: Method, h: f64) -> (f64, f64) {
+    let sys = FnSystem::new(rhs::<nalgebra::U3>);
+    let opts = Options::default().adaptive(false).h_init(h);
+    let sol = solve(&sys, 0.0, Vector3::new(1.0, 1.0, 0.0), T_END, method, &opts, &mut [])
+        .expect("fixed-step run");
+    let end = max_err(sol.y_final(), sol.t_final());
+    // Dense error within steps minus the error already present at the step ends: sample at
+    // θ = 0.37 of each step and compare to the exact solution.
+    let mut dense = 0.0f64;
+    for w in sol.t.windows(2) {
+        let tm = w[0] + 0.37 * (w[1] - w[0]);
+        dense = dense.max(max_err(&sol.sample(tm).unwrap(), tm));
+    }
+    (end, dense)
+}
+
+fn observed_order(method: Method, h: f64) -> (f64, f64) {
+    let (e1, d1) = fixed_step_errors(method, h);
+    let (e2, d2) = fixed_step_errors(method, h / 2.0);
+    ((e1 / e2).log2(), (d1 / d2).log2())
+}
+
+/// Observed order within ±0.3 of nominal: step sizes are chosen in the asymptotic range
+/// (errors well above rounding, well below O(1)).
+fn check_order(method: Method, h: f64, nominal: f64, dense_nominal: f64) {
+    let (p, pd) = observed_order(method, h);
+    println!("{method}: observed order {p:.3} (nominal {nominal}), dense {pd:.3} (nominal {dense_nominal})");
+    assert!((p - nominal).abs() <= 0.3, "{method}: observed order {p}");
+    // The interpolant's local error is O(h^(q+1)) with q its order; globally the step error
+    // dominates when the step order is lower, so the dense error converges at min(q+1, p).
+    let expect = dense_nominal;
+    assert!((pd - expect).abs() <= 0.3, "{method}: dense order {pd}, expected {expect}");
+}
+
+#[test]
+fn tsit5_order_5_dense_order_5() {
+    check_order(Method::Tsit5, 0.1, 5.0, 5.0);
+}
+
+#[test]
+fn tsit5_adaptive_meets_tolerance() {
+    let sys = FnSystem::new(rhs::<nalgebra::U3>);
+    for &tol in &[1e-6, 1e-9] {
+        let opts = Options::default().rtol(tol).atol(tol);
+        let sol = solve(&sys, 0.0, Vector3::new(1.0, 1.0, 0.0), T_END, Method::Tsit5, &opts, &mut [])
+            .unwrap();
+        let e = max_err(sol.y_final(), T_END);
+        // Global error of a tolerance-driven integration is a modest multiple of the tolerance.
+        assert!(e < 20.0 * tol, "tol {tol}: error {e}");
+        assert_eq!(sol.t_final(), T_END);
+        for (t, y) in sol.t.iter().zip(&sol.y) {
+            assert!(max_err(y, *t) < 20.0 * tol);
+        }
+    }
+}
+
+#[test]
+fn fixed_and_dynamic_states_agree() {
+    let sys3 = FnSystem::new(rhs::<nalgebra::U3>);
+    let sysd = FnSystem::new(rhs::<nalgebra::Dyn>);
+    let opts = Options::default().rtol(1e-8).atol(1e-10).save(SaveAt::Times(vec![0.5, 1.0, 3.0]));
+    for m in [Method::Tsit5] {
+        let a = solve(&sys3, 0.0, Vector3::new(1.0, 1.0, 0.0), T_END, m, &opts, &mut []).unwrap();
+        let b = solve(&sysd, 0.0, DVector::from_vec(vec![1.0, 1.0, 0.0]), T_END, m, &opts, &mut [])
+            .unwrap();
+        assert_eq!(a.t, b.t);
+        assert_eq!(a.stats, b.stats);
+        for (ya, yb) in a.y.iter().zip(&b.y) {
+            // Same arithmetic in the same order: identical results.
+            assert_eq!(ya.as_slice(), yb.as_slice());
+        }
+    }
+}
+
+#[allow(dead_code)]
+fn assert_system<D: Dim, S: OdeSystem<D>>(_: &S)
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+}
