@@ -47,6 +47,9 @@ pub enum Error {
         /// Why not.
         reason: String,
     },
+    /// The ODE stepper failed (says at which time and why).
+    #[error(transparent)]
+    Ode(#[from] crate::ode::OdeError),
     /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {
@@ -95,7 +98,10 @@ pub fn check_finite(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(Error::invalid(field, format!("must be finite, got {value}")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite, got {value}"),
+        ))
     }
 }
 
@@ -110,7 +116,10 @@ pub fn check_positive(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(Error::invalid(field, format!("must be finite and > 0, got {value}")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite and > 0, got {value}"),
+        ))
     }
 }
 
@@ -125,6 +134,9 @@ pub fn check_non_negative(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(Error::invalid(field, format!("must be finite and >= 0, got {value}")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite and >= 0, got {value}"),
+        ))
     }
 }

@@ -100,7 +100,10 @@ impl Programme {
 
     /// Highest power of the programme.
     pub fn max_power(&self) -> f64 {
-        self.knots.iter().map(|k| k.1).fold(f64::NEG_INFINITY, f64::max)
+        self.knots
+            .iter()
+            .map(|k| k.1)
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// Time of the last knot at the highest power: the end of the hold, where take-off detection

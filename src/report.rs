@@ -109,18 +109,27 @@ impl Chart<'_> {
             .iter()
             .flat_map(|s| s.points.iter().copied())
             .filter(|(x, y)| {
-                x.is_finite() && y.is_finite() && (!self.log.0 || *x > 0.0) && (!self.log.1 || *y > 0.0)
+                x.is_finite()
+                    && y.is_finite()
+                    && (!self.log.0 || *x > 0.0)
+                    && (!self.log.1 || *y > 0.0)
             })
             .collect();
         if finite.is_empty() {
             return Err("no finite points to draw".into());
         }
         let span = |v: &mut dyn Iterator<Item = f64>, log: bool| {
-            let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+            let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
             if log {
                 (lo / 1.5, hi * 1.5)
             } else {
-                let pad = if hi > lo { 0.05 * (hi - lo) } else { lo.abs().max(1e-30) * 0.1 };
+                let pad = if hi > lo {
+                    0.05 * (hi - lo)
+                } else {
+                    lo.abs().max(1e-30) * 0.1
+                };
                 (lo - pad, hi + pad)
             }
         };
@@ -150,7 +159,12 @@ impl Chart<'_> {
                         .points
                         .iter()
                         .copied()
-                        .filter(|(x, y)| x.is_finite() && y.is_finite() && (!self.log.0 || *x > 0.0) && (!self.log.1 || *y > 0.0))
+                        .filter(|(x, y)| {
+                            x.is_finite()
+                                && y.is_finite()
+                                && (!self.log.0 || *x > 0.0)
+                                && (!self.log.1 || *y > 0.0)
+                        })
                         .collect();
                     let anno = if s.markers {
                         chart
@@ -174,10 +188,18 @@ impl Chart<'_> {
             }};
         }
         match self.log {
-            (false, false) => draw_series!(builder.build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(|e| e.to_string())?),
-            (true, false) => draw_series!(builder.build_cartesian_2d((xr.0..xr.1).log_scale(), yr.0..yr.1).map_err(|e| e.to_string())?),
-            (false, true) => draw_series!(builder.build_cartesian_2d(xr.0..xr.1, (yr.0..yr.1).log_scale()).map_err(|e| e.to_string())?),
-            (true, true) => draw_series!(builder.build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale()).map_err(|e| e.to_string())?),
+            (false, false) => draw_series!(builder
+                .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
+                .map_err(|e| e.to_string())?),
+            (true, false) => draw_series!(builder
+                .build_cartesian_2d((xr.0..xr.1).log_scale(), yr.0..yr.1)
+                .map_err(|e| e.to_string())?),
+            (false, true) => draw_series!(builder
+                .build_cartesian_2d(xr.0..xr.1, (yr.0..yr.1).log_scale())
+                .map_err(|e| e.to_string())?),
+            (true, true) => draw_series!(builder
+                .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
+                .map_err(|e| e.to_string())?),
         }
         root.present().map_err(|e| e.to_string())?;
         Ok(())

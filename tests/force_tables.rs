@@ -55,20 +55,47 @@ fn check_all(forces: &InterfaceForces, n: usize) {
     for d in points(lo, hi, n) {
         let g = Gaps::same(d);
         let cases = [
-            (forces.static_part(g), exact.sum(d, |t| t.coupling() == Coupling::Static), 1e-15),
-            (forces.per_volt2_part(g), exact.sum(d, |t| t.coupling() == Coupling::PerVoltSquared), 1e-15),
-            (forces.contact(g), exact.sum(d, |t| t.kind() == TermKind::Contact), 1e-15),
+            (
+                forces.static_part(g),
+                exact.sum(d, |t| t.coupling() == Coupling::Static),
+                1e-15,
+            ),
+            (
+                forces.per_volt2_part(g),
+                exact.sum(d, |t| t.coupling() == Coupling::PerVoltSquared),
+                1e-15,
+            ),
+            (
+                forces.contact(g),
+                exact.sum(d, |t| t.kind() == TermKind::Contact),
+                1e-15,
+            ),
         ];
         for (k, (tab, (v, s), abs)) in cases.into_iter().enumerate() {
-            assert!(value_ok(tab.value, v, abs), "case {k} at d = {d}: table {} exact {v}", tab.value);
-            assert!(slope_ok(tab.d_bulge, s, v, abs), "case {k} slope at d = {d}: table {} exact {s}", tab.d_bulge);
+            assert!(
+                value_ok(tab.value, v, abs),
+                "case {k} at d = {d}: table {} exact {v}",
+                tab.value
+            );
+            assert!(
+                slope_ok(tab.d_bulge, s, v, abs),
+                "case {k} slope at d = {d}: table {} exact {s}",
+                tab.d_bulge
+            );
             worst[k] = worst[k].max((tab.value - v).abs() / (v.abs() + abs / 1e-8));
         }
         let (a, _) = exact.area(d);
         // contact-area tables: the same relative bound, absolute 1e-8 × 1e-16 m²
-        assert!(value_ok(forces.real_contact_area(g), a, 1e-24), "area at d = {d}");
+        assert!(
+            value_ok(forces.real_contact_area(g), a, 1e-24),
+            "area at d = {d}"
+        );
         let b = forces.breakdown(g, 0.49);
-        assert!(value_ok(b.total, exact.sum(d, |t| t.coupling() == Coupling::Static).0 + 0.49 * cases_pv2(&exact, d), 3e-15));
+        assert!(value_ok(
+            b.total,
+            exact.sum(d, |t| t.coupling() == Coupling::Static).0 + 0.49 * cases_pv2(&exact, d),
+            3e-15
+        ));
     }
     eprintln!("worst relative errors (static, per V², contact): {worst:?}");
 }
@@ -81,7 +108,11 @@ fn cases_pv2(exact: &Exact, d: f64) -> f64 {
 fn paper_scene_tables_match_direct_quadrature_over_the_whole_range() {
     let forces = Scene::paper().build_interface().unwrap();
     assert!(forces.has_contact() && forces.has_voltage_terms() && !forces.uses_pad_gap());
-    eprintln!("paper scene: {} table nodes over {:?}", forces.table_nodes(), forces.table_range());
+    eprintln!(
+        "paper scene: {} table nodes over {:?}",
+        forces.table_nodes(),
+        forces.table_range()
+    );
     check_all(&forces, 400);
 }
 
@@ -99,13 +130,18 @@ fn mixed_footprints_and_gaps_tabulate_correctly() {
         Box::new(Intermolecular::new(5e-20, 1e-76, None, h, plate, GapReference::Pad).unwrap()),
         Box::new(Electrostatic::new(1e-9, 2e-10, h, plate, GapReference::Pad).unwrap()),
         Box::new(Electrostatic::new(0.0, 2e-10, h, cap, GapReference::Bulge).unwrap()),
-        Box::new(GreenwoodWilliamson::new(1e11, 1e-7, 1.5e14, peaks, cap, GapReference::Bulge).unwrap()),
+        Box::new(
+            GreenwoodWilliamson::new(1e11, 1e-7, 1.5e14, peaks, cap, GapReference::Bulge).unwrap(),
+        ),
     ];
     let forces = InterfaceForces::build(terms, (-3e-9, 20e-9), &TableOptions::default()).unwrap();
     assert!(forces.uses_pad_gap());
     let exact = Exact(forces.terms());
     for d in points(-3e-9, 20e-9, 150) {
-        let g = Gaps { bulge: d, pad: d + 1e-9 };
+        let g = Gaps {
+            bulge: d,
+            pad: d + 1e-9,
+        };
         let st = forces.static_part(g);
         let pv = forces.per_volt2_part(g);
         let pick = |gap, c| move |t: &dyn InterfaceTerm| t.gap() == gap && t.coupling() == c;
@@ -137,8 +173,16 @@ fn outside_the_range_the_exact_terms_are_used() {
 fn smooth_flat_electrostatics_jumps_at_the_cutoff_and_the_table_follows() {
     let hc = 3e-10;
     let plate = Footprint::Flat { area_m2: 1e-8 };
-    let t = Electrostatic::new(0.0, hc, GaussianHeights::new(0.0).unwrap(), plate, GapReference::Bulge).unwrap();
-    let forces = InterfaceForces::build(vec![Box::new(t)], (-1e-9, 5e-9), &TableOptions::default()).unwrap();
+    let t = Electrostatic::new(
+        0.0,
+        hc,
+        GaussianHeights::new(0.0).unwrap(),
+        plate,
+        GapReference::Bulge,
+    )
+    .unwrap();
+    let forces =
+        InterfaceForces::build(vec![Box::new(t)], (-1e-9, 5e-9), &TableOptions::default()).unwrap();
     let below = forces.per_volt2_part(Gaps::same(hc * (1.0 - 1e-9))).value;
     let at = forces.per_volt2_part(Gaps::same(hc)).value;
     let above = forces.per_volt2_part(Gaps::same(hc * (1.0 + 1e-9))).value;

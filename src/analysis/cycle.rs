@@ -74,9 +74,11 @@ pub struct CycleOptions {
 impl CycleOptions {
     /// The detector and solver settings of a scene, without time series.
     pub fn from_scene(scene: &crate::scene::Scene) -> Result<Self> {
-        let method: Method = scene.solver.method.parse().map_err(|e: ode::OdeError| {
-            Error::invalid("solver.method", e.to_string())
-        })?;
+        let method: Method = scene
+            .solver
+            .method
+            .parse()
+            .map_err(|e: ode::OdeError| Error::invalid("solver.method", e.to_string()))?;
         Ok(CycleOptions {
             detector: Detector {
                 contact_threshold: scene.detector.contact_threshold_n,
@@ -94,7 +96,10 @@ impl CycleOptions {
     }
 
     fn validate(&self) -> Result<()> {
-        check_positive("detector.contact_threshold", self.detector.contact_threshold)?;
+        check_positive(
+            "detector.contact_threshold",
+            self.detector.contact_threshold,
+        )?;
         check_positive("detector.window", self.detector.window)?;
         check_positive("solver.rtol", self.solver.rtol)?;
         check_positive("solver.atol_displacement", self.solver.atol_displacement)?;
@@ -191,7 +196,10 @@ pub fn simulate_cycle(
         4 => run::<U4>(model, programme, opts),
         5 => run::<U5>(model, programme, opts),
         6 => run::<U6>(model, programme, opts),
-        n => Err(Error::analysis("cycle", format!("unexpected state size {n}"))),
+        n => Err(Error::analysis(
+            "cycle",
+            format!("unexpected state size {n}"),
+        )),
     }
 }
 
@@ -308,24 +316,43 @@ where
             crate::error::check_non_negative("programme.start_power", start_power)?;
             // Search up to the power whose protrusion is twice the nominal clearance.
             let span = 2.0 * model.nominal_clearance / model.efficiency;
-            let ramp = Programme::new(vec![(0.0, start_power), (span / ramp_rate, start_power + span)])?;
+            let ramp = Programme::new(vec![
+                (0.0, start_power),
+                (span / ramp_rate, start_power + span),
+            ])?;
             (ramp, Some((start_power, ramp_rate, overshoot)))
         }
     };
 
     let t0 = initial_programme.start_time();
     let volt2_0 = model.voltage.squared(t0);
-    let eq = flying_equilibrium(model, initial_programme.power(t0), volt2_0, &ScanGrid::default())?;
+    let eq = flying_equilibrium(
+        model,
+        initial_programme.power(t0),
+        volt2_0,
+        &ScanGrid::default(),
+    )?;
     let mut sys = SliderSystem::new(model, initial_programme.clone(), true);
     let layout = sys.layout();
-    let q = layout.contact_impulse.ok_or_else(|| Error::analysis("cycle", "no impulse state"))?;
-    let heat = layout.heat.ok_or_else(|| Error::analysis("cycle", "no heat state"))?;
+    let q = layout
+        .contact_impulse
+        .ok_or_else(|| Error::analysis("cycle", "no impulse state"))?;
+    let heat = layout
+        .heat
+        .ok_or_else(|| Error::analysis("cycle", "no heat state"))?;
     let y0: OVector<f64, D> = sys.initial_state(D::name(), eq.y, eq.protrusion, eq.interface_force);
 
     let ode_opts = ode_options(model, opts, &layout, &initial_programme)?;
-    let mut traj = Trajectory::<D> { segments: Vec::new() };
+    let mut traj = Trajectory::<D> {
+        segments: Vec::new(),
+    };
     let mut stats = Stats::default();
-    let mut solve = |sys: &SliderSystem, a: f64, y: OVector<f64, D>, b: f64, o: &Options| -> Result<Solution<D>> {
+    let mut solve = |sys: &SliderSystem,
+                     a: f64,
+                     y: OVector<f64, D>,
+                     b: f64,
+                     o: &Options|
+     -> Result<Solution<D>> {
         let sol = ode::solve(sys, a, y, b, opts.solver.method, o, &mut [])?;
         add_stats(&mut stats, &sol.stats);
         Ok(sol)
@@ -350,14 +377,22 @@ where
                 let sol = solve(&sys, t, y, t1, &ode_opts)?;
                 y = sol.y_final().clone();
                 traj.segments.push(sol);
-                let found = Detecting { traj: &traj, q, detector: det }.first_crossing(t, t1, true)?;
+                let found = Detecting {
+                    traj: &traj,
+                    q,
+                    detector: det,
+                }
+                .first_crossing(t, t1, true)?;
                 if let Some(t_td) = found {
                     break t_td;
                 }
                 if t1 >= end {
                     return Err(Error::analysis(
                         "triggered cycle",
-                        format!("no touchdown detected up to {} W", initial_programme.power(end)),
+                        format!(
+                            "no touchdown detected up to {} W",
+                            initial_programme.power(end)
+                        ),
                     ));
                 }
                 t = t1;
@@ -365,7 +400,11 @@ where
             let t_peak = t_td + chunk;
             let p_peak = start_power + rate * (t_peak - t0);
             let t_end = t_peak + (p_peak - start_power) / rate;
-            final_programme = Programme::new(vec![(t0, start_power), (t_peak, p_peak), (t_end, start_power)])?;
+            final_programme = Programme::new(vec![
+                (t0, start_power),
+                (t_peak, p_peak),
+                (t_end, start_power),
+            ])?;
             sys = SliderSystem::new(model, final_programme.clone(), true);
             let o = ode_options(model, opts, &layout, &final_programme)?;
             let t_now = traj.segments.last().map_or(t0, |s| s.t_final());
@@ -375,14 +414,21 @@ where
         }
     }
 
-    let detecting = Detecting { traj: &traj, q, detector: det };
+    let detecting = Detecting {
+        traj: &traj,
+        q,
+        detector: det,
+    };
     let end = final_programme.end_time();
     let td = detecting.first_crossing(t0, end, true)?;
     let to = match td {
         Some(t) => detecting.first_crossing(search_from.max(t), end, false)?,
         None => None,
     };
-    let as_detection = |t: f64| Detection { time: t, power: final_programme.power(t) };
+    let as_detection = |t: f64| Detection {
+        time: t,
+        power: final_programme.power(t),
+    };
     let touchdown = td.map(as_detection);
     let takeoff = to.map(as_detection);
     let hysteresis = match (touchdown, takeoff) {

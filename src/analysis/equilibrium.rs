@@ -123,7 +123,13 @@ impl<'a> EquilibriumSolver<'a> {
         let (mut y, _) = m.bearing_balance(d, self.volt2)?;
         let mut f = ForceEval::default();
         for _ in 0..50 {
-            f = m.interface_force_exact(Gaps { bulge: d, pad: h0 + y }, self.volt2)?;
+            f = m.interface_force_exact(
+                Gaps {
+                    bulge: d,
+                    pad: h0 + y,
+                },
+                self.volt2,
+            )?;
             let r = m.bearing().force(y, 0.0) + f.value;
             let dr = -m.bearing().stiffness(y) + f.d_pad;
             let step = -r / dr;
@@ -157,10 +163,7 @@ impl<'a> EquilibriumSolver<'a> {
     pub fn refine_fold(&self, a: f64, b: f64) -> Result<Equilibrium> {
         let tol = fold_tolerance(a, b, self.model.nominal_clearance);
         let d = brent(
-            |d| {
-                self.at_gap_exact(d)
-                    .map_or(f64::NAN, |e| e.stiffness)
-            },
+            |d| self.at_gap_exact(d).map_or(f64::NAN, |e| e.stiffness),
             a,
             b,
             tol,
@@ -216,7 +219,10 @@ pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) 
     let volt2 = model.voltage.effective_dc().powi(2);
     let (lo, hi) = range.unwrap_or_else(|| model.forces().table_range());
     if !(lo < hi) {
-        return Err(Error::invalid("range", format!("need d_lo < d_hi, got [{lo:e}, {hi:e}]")));
+        return Err(Error::invalid(
+            "range",
+            format!("need d_lo < d_hi, got [{lo:e}, {hi:e}]"),
+        ));
     }
     let solver = EquilibriumSolver::new(model, volt2);
     let mut points = Vec::new();

@@ -35,7 +35,10 @@ impl VoltageBalance<'_> {
     fn at(&self, d: f64, exact: bool) -> Result<(f64, f64, f64)> {
         let m = self.model;
         let y = d - m.nominal_clearance + self.delta;
-        let g = Gaps { bulge: d, pad: d + self.delta };
+        let g = Gaps {
+            bulge: d,
+            pad: d + self.delta,
+        };
         let (s, e) = if exact {
             m.interface_parts_exact(g)?
         } else {
@@ -61,11 +64,18 @@ impl VoltageBalance<'_> {
 pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) -> Result<PullIn> {
     check_finite("power", power)?;
     if !model.forces().has_voltage_terms() {
-        return Err(Error::analysis("pull-in voltage", "the scene has no electrostatic term"));
+        return Err(Error::analysis(
+            "pull-in voltage",
+            "the scene has no electrostatic term",
+        ));
     }
     let td0 = touchdown_at(model, 0.0, opts)?;
     if power >= td0.power {
-        return Ok(PullIn { voltage: 0.0, d: td0.at.d, cause: td0.cause });
+        return Ok(PullIn {
+            voltage: 0.0,
+            d: td0.at.d,
+            cause: td0.cause,
+        });
     }
     let delta = model.protrusion(power);
     let vb = VoltageBalance { model, delta };
@@ -89,22 +99,36 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
             if k <= 0.0 {
                 let df = brent(|x| vb.at(x, true).map_or(f64::NAN, |r| r.1), d, pd, tol)?;
                 let (v2f, _, _) = vb.at(df, true)?;
-                return Ok(PullIn { voltage: v2f.max(0.0).sqrt(), d: df, cause: Cause::Fold });
+                return Ok(PullIn {
+                    voltage: v2f.max(0.0).sqrt(),
+                    d: df,
+                    cause: Cause::Fold,
+                });
             }
             if fc >= opts.contact_threshold {
                 let dt = brent(
-                    |x| vb.at(x, true).map_or(f64::NAN, |r| r.2 - opts.contact_threshold),
+                    |x| {
+                        vb.at(x, true)
+                            .map_or(f64::NAN, |r| r.2 - opts.contact_threshold)
+                    },
                     d,
                     pd,
                     tol,
                 )?;
                 let (v2t, _, _) = vb.at(dt, true)?;
-                return Ok(PullIn { voltage: v2t.max(0.0).sqrt(), d: dt, cause: Cause::Threshold });
+                return Ok(PullIn {
+                    voltage: v2t.max(0.0).sqrt(),
+                    d: dt,
+                    cause: Cause::Threshold,
+                });
             }
         }
         prev = Some((d, v2, k, fc));
     }
-    Err(Error::analysis("pull-in voltage", "no pull-in inside the table range"))
+    Err(Error::analysis(
+        "pull-in voltage",
+        "no pull-in inside the table range",
+    ))
 }
 
 /// One point of the clearance change against DC voltage.
@@ -140,7 +164,10 @@ pub fn clearance_change(
         .enumerate()
         .map(|(i, &v)| {
             check_finite(&format!("dc_voltages[{i}]"), v)?;
-            let m = model.with_voltage(Voltage { dc: v, ..model.voltage });
+            let m = model.with_voltage(Voltage {
+                dc: v,
+                ..model.voltage
+            });
             let p = touchdown_at(&m, (v - phi).powi(2), opts)?.power;
             Ok(ClearanceChange {
                 dc_voltage: v,

@@ -55,12 +55,18 @@ impl LinearResponse {
     pub fn transfer(&self, omega: f64) -> Complex64 {
         let n = self.a.nrows();
         let m = DMatrix::<Complex64>::from_fn(n, n, |i, j| {
-            let diag = if i == j { Complex64::new(0.0, omega) } else { Complex64::new(0.0, 0.0) };
+            let diag = if i == j {
+                Complex64::new(0.0, omega)
+            } else {
+                Complex64::new(0.0, 0.0)
+            };
             diag - Complex64::new(self.a[(i, j)], 0.0)
         });
         let mut b = DVector::<Complex64>::zeros(n);
         b[self.input] = Complex64::new(self.a_input_gain, 0.0);
-        m.lu().solve(&b).map_or(Complex64::new(f64::NAN, f64::NAN), |x| x[0])
+        m.lu()
+            .solve(&b)
+            .map_or(Complex64::new(f64::NAN, f64::NAN), |x| x[0])
     }
 }
 
@@ -161,7 +167,10 @@ pub fn simulated_dither(
     use nalgebra::U2;
     let v = model.voltage;
     if !v.is_time_dependent() {
-        return Err(Error::analysis("simulated dither", "the voltage has no AC part"));
+        return Err(Error::analysis(
+            "simulated dither",
+            "the voltage has no AC part",
+        ));
     }
     if periods == 0 {
         return Err(Error::invalid("periods", "must be at least 1"));
@@ -195,6 +204,8 @@ pub fn simulated_dither(
         .y
         .iter()
         .map(|x| x[0])
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| (a.min(y), b.max(y)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+            (a.min(y), b.max(y))
+        });
     Ok(0.5 * (hi - lo))
 }

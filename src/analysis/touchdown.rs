@@ -92,7 +92,11 @@ pub fn touchdown_power(model: &SliderModel, opts: &StaticOptions) -> Result<Tran
 }
 
 /// Touchdown at a given `V²` (V²).
-pub(crate) fn touchdown_at(model: &SliderModel, volt2: f64, opts: &StaticOptions) -> Result<Transition> {
+pub(crate) fn touchdown_at(
+    model: &SliderModel,
+    volt2: f64,
+    opts: &StaticOptions,
+) -> Result<Transition> {
     let solver = EquilibriumSolver::new(model, volt2);
     let (lo, hi) = model.forces().table_range();
     let mut prev: Option<Equilibrium> = None;
@@ -101,11 +105,19 @@ pub(crate) fn touchdown_at(model: &SliderModel, volt2: f64, opts: &StaticOptions
         if let Some(p) = prev {
             if !e.is_stable() {
                 let at = solver.refine_fold(e.d, p.d)?;
-                return Ok(Transition { power: at.power, at, cause: Cause::Fold });
+                return Ok(Transition {
+                    power: at.power,
+                    at,
+                    cause: Cause::Fold,
+                });
             }
             if e.contact_force >= opts.contact_threshold {
                 let at = solver.refine_threshold(e.d, p.d, opts.contact_threshold)?;
-                return Ok(Transition { power: at.power, at, cause: Cause::Threshold });
+                return Ok(Transition {
+                    power: at.power,
+                    at,
+                    cause: Cause::Threshold,
+                });
             }
         } else if !e.is_stable() || e.contact_force >= opts.contact_threshold {
             return Err(Error::analysis(
@@ -123,7 +135,11 @@ pub(crate) fn touchdown_at(model: &SliderModel, volt2: f64, opts: &StaticOptions
 
 /// Take-off power at the model's DC voltage, starting on the contact branch at
 /// `start_power` (W) and following it to lower power.
-pub fn takeoff_power(model: &SliderModel, start_power: f64, opts: &StaticOptions) -> Result<Transition> {
+pub fn takeoff_power(
+    model: &SliderModel,
+    start_power: f64,
+    opts: &StaticOptions,
+) -> Result<Transition> {
     opts.validate()?;
     crate::error::check_finite("start_power", start_power)?;
     let volt2 = model.voltage.effective_dc().powi(2);
@@ -149,7 +165,10 @@ pub(crate) fn takeoff_at(
         if extended > 50 {
             return Err(Error::analysis(
                 "take-off",
-                format!("no contact equilibrium at {start_power} W within {} m of interpenetration", -lo),
+                format!(
+                    "no contact equilibrium at {start_power} W within {} m of interpenetration",
+                    -lo
+                ),
             ));
         }
     }
@@ -164,7 +183,9 @@ pub(crate) fn takeoff_at(
                 if !e.is_stable() {
                     return Err(Error::analysis(
                         "take-off",
-                        format!("the equilibrium at {start_power} W on the contact side is unstable"),
+                        format!(
+                            "the equilibrium at {start_power} W on the contact side is unstable"
+                        ),
                     ));
                 }
                 started = true;
@@ -176,11 +197,19 @@ pub(crate) fn takeoff_at(
         if let Some(p) = prev {
             if !e.is_stable() {
                 let at = solver.refine_fold(p.d, e.d)?;
-                return Ok(Transition { power: at.power, at, cause: Cause::Fold });
+                return Ok(Transition {
+                    power: at.power,
+                    at,
+                    cause: Cause::Fold,
+                });
             }
             if e.contact_force < opts.contact_threshold {
                 let at = solver.refine_threshold(p.d, e.d, opts.contact_threshold)?;
-                return Ok(Transition { power: at.power, at, cause: Cause::Threshold });
+                return Ok(Transition {
+                    power: at.power,
+                    at,
+                    cause: Cause::Threshold,
+                });
             }
         }
         prev = Some(e);

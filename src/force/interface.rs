@@ -111,14 +111,13 @@ impl Tabulated {
             // At an interior kink evaluate one ulp inside the segment, so that each piece sees the
             // one-sided limit of a function that jumps there (smooth surface, flat footprint).
             let a_in = if k == 0 { a } else { next_toward(a, b) };
-            let b_in = if k + 2 == edges.len() { b } else { next_toward(b, a) };
-            let table = Table::build(
-                |x| me.exact_one(terms, x.clamp(a_in, b_in)),
-                a,
-                b,
-                opts,
-            )
-            .map_err(|e| Error::no_convergence(what.clone(), e.to_string()))?;
+            let b_in = if k + 2 == edges.len() {
+                b
+            } else {
+                next_toward(b, a)
+            };
+            let table = Table::build(|x| me.exact_one(terms, x.clamp(a_in, b_in)), a, b, opts)
+                .map_err(|e| Error::no_convergence(what.clone(), e.to_string()))?;
             me.segments.push(table);
         }
         Ok(me)
@@ -237,7 +236,8 @@ impl InterfaceForces {
         for gap in gaps {
             for kind in kinds {
                 for coupling in [Coupling::Static, Coupling::PerVoltSquared] {
-                    let m = select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
+                    let m =
+                        select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
                     if !m.is_empty() {
                         let tab = Tabulated::build(&terms, m, false, range, opts)?;
                         by_kind.push((kind, coupling, gap, Arc::new(tab)));
@@ -275,7 +275,9 @@ impl InterfaceForces {
                 .map(|(_, _, _, t)| Arc::clone(t));
             let m = select(&|t| t.gap() == gap && t.has_contact_area());
             if !m.is_empty() {
-                area[g] = Some(Arc::new(Tabulated::build(&terms, m, true, range, &area_opts)?));
+                area[g] = Some(Arc::new(Tabulated::build(
+                    &terms, m, true, range, &area_opts,
+                )?));
             }
         }
         Ok(InterfaceForces {

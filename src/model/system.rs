@@ -162,12 +162,7 @@ impl<'a> SliderSystem<'a> {
         let g = self.model.gaps(s[0], delta);
         let volt2 = self.model.voltage.squared(t);
         let f = self.model.interface_force(g, volt2);
-        Local {
-            g,
-            delta,
-            volt2,
-            f,
-        }
+        Local { g, delta, volt2, f }
     }
 
     /// Flash temperature and its derivative with respect to the bulge gap (central difference:

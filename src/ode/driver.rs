@@ -184,11 +184,7 @@ where
             h = remaining;
             hit_stop = true;
         } else if !(h >= floor) {
-            return Err(OdeError::StepTooSmall {
-                t,
-                h,
-                h_min: floor,
-            });
+            return Err(OdeError::StepTooSmall { t, h, h_min: floor });
         }
         let stepper = &mut *steppers[active];
         let k = stepper.error_order();
@@ -236,7 +232,16 @@ where
             let g_new = ev.eval(t_new, &y_new);
             ctx.stats.event_evals += 1;
             if let Some(rising) = crossing(ev.get_direction(), g_old[i], g_new) {
-                let (te, evals) = locate(ev, &poly, t, g_old[i], t_new, g_new, opts.event_tol, &mut work);
+                let (te, evals) = locate(
+                    ev,
+                    &poly,
+                    t,
+                    g_old[i],
+                    t_new,
+                    g_new,
+                    opts.event_tol,
+                    &mut work,
+                );
                 ctx.stats.event_evals += evals;
                 hits.push((i, te, rising));
             }
@@ -303,7 +308,11 @@ where
         let (alpha, beta) = (0.7 / k, 0.4 / k);
         let e = err.max(1e-10);
         let mut fac = SAFETY * e.powf(-alpha) * err_prev.powf(beta);
-        let fac_max = if stiff { FAC_MAX_STIFF } else { FAC_MAX_EXPLICIT };
+        let fac_max = if stiff {
+            FAC_MAX_STIFF
+        } else {
+            FAC_MAX_EXPLICIT
+        };
         if last_rejected {
             fac = fac.min(1.0);
         }
