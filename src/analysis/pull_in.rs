@@ -69,13 +69,18 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
             "the scene has no electrostatic term",
         ));
     }
-    let td0 = touchdown_at(model, 0.0, opts)?;
-    if power >= td0.power {
-        return Ok(PullIn {
-            voltage: 0.0,
-            d: td0.at.d,
-            cause: td0.cause,
-        });
+    // Past touchdown without voltage, pull-in is at zero volts. Without any touchdown in the
+    // table range (e.g. electrostatics alone) the scan below decides.
+    match touchdown_at(model, 0.0, opts) {
+        Ok(td0) if power >= td0.power => {
+            return Ok(PullIn {
+                voltage: 0.0,
+                d: td0.at.d,
+                cause: td0.cause,
+            });
+        }
+        Ok(_) | Err(Error::Analysis { .. }) => {}
+        Err(e) => return Err(e),
     }
     let delta = model.protrusion(power);
     let vb = VoltageBalance { model, delta };
