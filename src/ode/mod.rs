@@ -32,7 +32,10 @@ mod dense;
 mod driver;
 mod error;
 mod event;
+mod jacobian;
+mod lu;
 mod options;
+mod rodas5p;
 mod solution;
 mod stepper;
 mod system;
@@ -102,6 +105,15 @@ where
         Method::Tsit5 => {
             let mut m = tsit5::Tsit5::new(&problem.y0);
             driver::integrate(problem, &mut [&mut m])
+        }
+        Method::Rodas5P => {
+            let mut m = rodas5p::Rodas5P::new(&problem.y0);
+            driver::integrate(problem, &mut [&mut m])
+        }
+        Method::Auto => {
+            let mut explicit = tsit5::Tsit5::new(&problem.y0);
+            let mut stiff = rodas5p::Rodas5P::new(&problem.y0);
+            driver::integrate(problem, &mut [&mut explicit, &mut stiff])
         }
         other => Err(OdeError::invalid(
             "method",
