@@ -167,6 +167,10 @@ where
     let mut err_prev = 1.0f64;
     let mut last_rejected = false;
     let mut fails = (0usize, FailKind::NonFinite);
+    // Non-finite trial steps seen recently (forgotten after a run of accepted steps): a step
+    // size collapse after them is reported as what it is.
+    let mut recent_nonfinite = 0usize;
+    let mut accepted_run = 0usize;
     let mut stiff_count = 0usize;
     let mut since_check = 0usize;
     let mut return_count = 0usize;
@@ -190,6 +194,14 @@ where
             h = remaining;
             hit_stop = true;
         } else if !(h >= floor) {
+            if recent_nonfinite > 0 {
+                return Err(OdeError::NonFinite {
+                    t,
+                    what: format!(
+                        "state or right-hand side: trial steps failed down to h = {h:e} (floor {floor:e})"
+                    ),
+                });
+            }
             return Err(OdeError::StepTooSmall {
                 t,
                 h,
@@ -205,6 +217,8 @@ where
         let err = match trial {
             Trial::Done { err } if err.is_finite() => err,
             Trial::Done { .. } => {
+                recent_nonfinite += 1;
+                accepted_run = 0;
                 register_failure(&mut fails, FailKind::NonFinite, t, h)?;
                 ctx.stats.rejected += 1;
                 h *= 0.25;
@@ -212,6 +226,10 @@ where
                 continue;
             }
             Trial::Failed { factor, kind } => {
+                if kind == FailKind::NonFinite {
+                    recent_nonfinite += 1;
+                }
+                accepted_run = 0;
                 register_failure(&mut fails, kind, t, h)?;
                 ctx.stats.rejected += 1;
                 h *= factor;
@@ -230,6 +248,10 @@ where
 
         // Accepted.
         fails.0 = 0;
+        accepted_run += 1;
+        if accepted_run >= 50 {
+            recent_nonfinite = 0;
+        }
         ctx.stats.accepted += 1;
         if stiff {
             ctx.stats.stiff_steps += 1;
