@@ -76,6 +76,11 @@ fn tsit5_order_5_dense_order_5() {
 }
 
 #[test]
+fn rodas5p_order_5_dense_order_5() {
+    check_order(Method::Rodas5P, 0.1, 5.0, 5.0);
+}
+
+#[test]
 fn tsit5_adaptive_meets_tolerance() {
     let sys = FnSystem::new(rhs::<nalgebra::U3>);
     for &tol in &[1e-6, 1e-9] {

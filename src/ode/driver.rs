@@ -9,7 +9,8 @@ use super::stepper::{all_finite, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
 use super::tsit5::STABILITY_BOUNDARY;
 use super::Method;
-use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
+use super::jacobian::{eval_jacobian, spectral_radius};
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 
 /// Controller constants: PI control `fac = SAFETY · err^(−α) · err_prev^β` with
 /// `α = 0.7/k`, `β = 0.4/k` (Gustafsson/Söderlind), clamped to `[FAC_MIN, FAC_MAX]`.
@@ -21,15 +22,18 @@ const FAC_MAX_STIFF: f64 = 6.0;
 /// Consecutive failed attempts of one kind before giving up with a typed error.
 const MAX_CONSECUTIVE_FAILURES: usize = 12;
 
-/// Stiffness switching (`Auto`): switch to the stiff method after this many recent accepted
-/// explicit steps whose `h·ρ` exceeds the stability boundary ...
-const STIFF_COUNT_TO_SWITCH: usize = 10;
-/// ... forgetting them after this many non-stiff steps in a row;
-const NONSTIFF_COUNT_TO_FORGET: usize = 6;
-/// switch back after this many stiff steps whose `h·ρ` stays below `RETURN_FRACTION` of the
-/// explicit stability boundary.
-const EXPLICIT_COUNT_TO_RETURN: usize = 10;
-const RETURN_FRACTION: f64 = 0.6;
+/// Stiffness switching (`Auto`), in the spirit of LSODA. Every `CHECK_INTERVAL` explicit
+/// steps (or when the explicit method's own indicator fires) the spectral radius ρ of the
+/// Jacobian is estimated; an explicit step with `h·ρ` above `STIFF_FRACTION` of the stability
+/// boundary is limited by stability, not accuracy. Two such checks in a row switch to the
+/// stiff method; it switches back after `STEPS_TO_RETURN` steps with `h·ρ` below
+/// `RETURN_FRACTION` of the boundary (accuracy would limit an explicit step more than
+/// stability). The gap between the fractions prevents ping-pong.
+const CHECK_INTERVAL: usize = 25;
+const STIFF_FRACTION: f64 = 0.6;
+const STIFF_CHECKS_TO_SWITCH: usize = 2;
+const RETURN_FRACTION: f64 = 0.3;
+const STEPS_TO_RETURN: usize = 5;
 
 pub(crate) struct Problem<'s, 'e, 'ev, D: Dim, S: OdeSystem<D> + ?Sized>
 where
@@ -163,9 +167,14 @@ where
     let mut err_prev = 1.0f64;
     let mut last_rejected = false;
     let mut fails = (0usize, FailKind::NonFinite);
+    // Non-finite trial steps seen recently (forgotten after a run of accepted steps): a step
+    // size collapse after them is reported as what it is.
+    let mut recent_nonfinite = 0usize;
+    let mut accepted_run = 0usize;
     let mut stiff_count = 0usize;
-    let mut nonstiff_count = 0usize;
+    let mut since_check = 0usize;
     let mut return_count = 0usize;
+    let mut jac_work = (steppers.len() > 1).then(|| OMatrix::zeros_generic(rows, rows));
     let mut hits: Vec<(usize, f64, bool)> = Vec::new();
 
     loop {
@@ -176,7 +185,8 @@ where
                 max_steps: opts.max_steps,
             });
         }
-        let floor = opts.h_min.max(16.0 * f64::EPSILON * t.abs().max(tf.abs()));
+        // A step must change t in floating point by more than a few ulps.
+        let floor = opts.h_min.max(16.0 * f64::EPSILON * t.abs()).max(1e-300);
         let stop = stops[stop_idx];
         let remaining = stop - t;
         let mut hit_stop = false;
@@ -184,16 +194,31 @@ where
             h = remaining;
             hit_stop = true;
         } else if !(h >= floor) {
-            return Err(OdeError::StepTooSmall { t, h, h_min: floor });
+            if recent_nonfinite > 0 {
+                return Err(OdeError::NonFinite {
+                    t,
+                    what: format!(
+                        "state or right-hand side: trial steps failed down to h = {h:e} (floor {floor:e})"
+                    ),
+                });
+            }
+            return Err(OdeError::StepTooSmall {
+                t,
+                h,
+                h_min: floor,
+            });
         }
         let stepper = &mut *steppers[active];
         let k = stepper.error_order();
         let stiff = stepper.is_stiff();
 
         let trial = stepper.attempt(sys, t, &y, h, &mut y_new, &mut ctx);
+        let h_acc = h;
         let err = match trial {
             Trial::Done { err } if err.is_finite() => err,
             Trial::Done { .. } => {
+                recent_nonfinite += 1;
+                accepted_run = 0;
                 register_failure(&mut fails, FailKind::NonFinite, t, h)?;
                 ctx.stats.rejected += 1;
                 h *= 0.25;
@@ -201,6 +226,10 @@ where
                 continue;
             }
             Trial::Failed { factor, kind } => {
+                if kind == FailKind::NonFinite {
+                    recent_nonfinite += 1;
+                }
+                accepted_run = 0;
                 register_failure(&mut fails, kind, t, h)?;
                 ctx.stats.rejected += 1;
                 h *= factor;
@@ -219,6 +248,10 @@ where
 
         // Accepted.
         fails.0 = 0;
+        accepted_run += 1;
+        if accepted_run >= 50 {
+            recent_nonfinite = 0;
+        }
         ctx.stats.accepted += 1;
         if stiff {
             ctx.stats.stiff_steps += 1;
@@ -232,16 +265,7 @@ where
             let g_new = ev.eval(t_new, &y_new);
             ctx.stats.event_evals += 1;
             if let Some(rising) = crossing(ev.get_direction(), g_old[i], g_new) {
-                let (te, evals) = locate(
-                    ev,
-                    &poly,
-                    t,
-                    g_old[i],
-                    t_new,
-                    g_new,
-                    opts.event_tol,
-                    &mut work,
-                );
+                let (te, evals) = locate(ev, &poly, t, g_old[i], t_new, g_new, opts.event_tol, &mut work);
                 ctx.stats.event_evals += evals;
                 hits.push((i, te, rising));
             }
@@ -308,11 +332,7 @@ where
         let (alpha, beta) = (0.7 / k, 0.4 / k);
         let e = err.max(1e-10);
         let mut fac = SAFETY * e.powf(-alpha) * err_prev.powf(beta);
-        let fac_max = if stiff {
-            FAC_MAX_STIFF
-        } else {
-            FAC_MAX_EXPLICIT
-        };
+        let fac_max = if stiff { FAC_MAX_STIFF } else { FAC_MAX_EXPLICIT };
         if last_rejected {
             fac = fac.min(1.0);
         }
@@ -339,38 +359,38 @@ where
 
         // Stiffness switching.
         if steppers.len() > 1 {
-            let ind = steppers[active].stiffness();
-            let mut switch = false;
-            if !stiff {
-                if let Some(h_rho) = ind {
-                    if h_rho > STABILITY_BOUNDARY {
+            let switch = if !stiff {
+                since_check += 1;
+                // The cheap indicator of the explicit method flags growing stiff components;
+                // a periodic Jacobian check catches a step size pinned at the stability limit
+                // while those components are still damped.
+                let flagged = steppers[active]
+                    .stiffness()
+                    .is_some_and(|h_rho| h_rho > STABILITY_BOUNDARY);
+                if flagged || since_check >= CHECK_INTERVAL {
+                    since_check = 0;
+                    let rho = estimate_radius(sys, t, &y, steppers[active].f0(), &mut jac_work, &mut work, &mut ctx);
+                    if h_acc * rho > STIFF_FRACTION * STABILITY_BOUNDARY {
                         stiff_count += 1;
-                        nonstiff_count = 0;
-                        if stiff_count >= STIFF_COUNT_TO_SWITCH {
-                            switch = true;
-                        }
                     } else {
-                        nonstiff_count += 1;
-                        if nonstiff_count >= NONSTIFF_COUNT_TO_FORGET {
-                            stiff_count = 0;
-                        }
+                        stiff_count = 0;
                     }
                 }
-            } else if let Some(rho) = ind {
-                if h * rho < RETURN_FRACTION * STABILITY_BOUNDARY {
-                    return_count += 1;
-                    if return_count >= EXPLICIT_COUNT_TO_RETURN {
-                        switch = true;
+                stiff_count >= STIFF_CHECKS_TO_SWITCH
+            } else {
+                match steppers[active].stiffness() {
+                    Some(rho) if h_acc * rho < RETURN_FRACTION * STABILITY_BOUNDARY => {
+                        return_count += 1;
                     }
-                } else {
-                    return_count = 0;
+                    _ => return_count = 0,
                 }
-            }
+                return_count >= STEPS_TO_RETURN
+            };
             if switch {
                 active = (active + 1) % steppers.len();
                 ctx.stats.stiffness_switches += 1;
                 stiff_count = 0;
-                nonstiff_count = 0;
+                since_check = 0;
                 return_count = 0;
                 err_prev = 1.0;
                 steppers[active].restart(sys, t, &y, &mut ctx);
@@ -457,5 +477,29 @@ where
         h
     } else {
         h0
+    }
+}
+
+/// Spectral radius of the Jacobian at `(t, y)` for the stiffness check (∞ when the Jacobian is
+/// not finite, which sends the integration to the stiff method).
+fn estimate_radius<D: Dim, S: OdeSystem<D> + ?Sized>(
+    sys: &S,
+    t: f64,
+    y: &OVector<f64, D>,
+    f0: &OVector<f64, D>,
+    jac: &mut Option<OMatrix<f64, D, D>>,
+    work: &mut OVector<f64, D>,
+    ctx: &mut Ctx<D>,
+) -> f64
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let Some(jac) = jac.as_mut() else {
+        return 0.0;
+    };
+    if eval_jacobian(sys, t, y, f0, jac, work, ctx) {
+        spectral_radius(jac, y)
+    } else {
+        f64::INFINITY
     }
 }

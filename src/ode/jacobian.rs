@@ -1,0 +1,87 @@
+//! Jacobian evaluation shared by the stiff methods: analytic when offered, else differences;
+//! plus a spectral-radius estimate for stiffness switching.
+
+use super::stepper::{zeros_like, Ctx};
+use super::system::{finite_difference_jacobian, OdeSystem};
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
+
+/// Fills `jac` with ∂f/∂y at `(t, y)` (`f0 = f(t, y)`); `false` if it is not finite.
+pub(crate) fn eval_jacobian<D: Dim, S: OdeSystem<D> + ?Sized>(
+    sys: &S,
+    t: f64,
+    y: &OVector<f64, D>,
+    f0: &OVector<f64, D>,
+    jac: &mut OMatrix<f64, D, D>,
+    work: &mut OVector<f64, D>,
+    ctx: &mut Ctx<D>,
+) -> bool
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    ctx.stats.jac_evals += 1;
+    if !sys.jacobian(t, y, jac) {
+        ctx.stats.rhs_evals += finite_difference_jacobian(sys, t, y, f0, &ctx.atol, jac, work);
+    }
+    jac.iter().all(|v| v.is_finite())
+}
+
+/// Fills `dfdt` with ∂f/∂t at `(t, y)`, by a forward difference when the system does not
+/// provide it; `h` sets the time scale of the increment.
+pub(crate) fn eval_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
+    sys: &S,
+    t: f64,
+    y: &OVector<f64, D>,
+    f0: &OVector<f64, D>,
+    h: f64,
+    dfdt: &mut OVector<f64, D>,
+    ctx: &mut Ctx<D>,
+) where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    if sys.time_derivative(t, y, dfdt) {
+        return;
+    }
+    let delta = f64::EPSILON.sqrt() * t.abs().max(h.abs()).max(f64::MIN_POSITIVE);
+    let tp = t + delta;
+    let delta = tp - t;
+    sys.rhs(tp, y, dfdt);
+    ctx.stats.rhs_evals += 1;
+    *dfdt -= f0;
+    *dfdt /= delta;
+}
+
+/// Estimate of the spectral radius of `jac` by the growth rate of power iterations (valid for
+/// complex dominant pairs too, where the direction does not converge but the growth does).
+pub(crate) fn spectral_radius<D: Dim>(jac: &OMatrix<f64, D, D>, like: &OVector<f64, D>) -> f64
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let n = like.len();
+    let mut v = zeros_like(like);
+    for i in 0..n {
+        // A start vector unlikely to be orthogonal to the dominant eigenvectors.
+        v[i] = 1.0 + 0.37 * i as f64 * if i % 2 == 0 { 1.0 } else { -1.0 };
+    }
+    let mut w = zeros_like(like);
+    let mut log_growth = 0.0;
+    let mut counted = 0;
+    const ITERS: usize = 16;
+    for it in 0..ITERS {
+        let nv = v.norm();
+        if !(nv > 0.0) || !nv.is_finite() {
+            return if it == 0 { 0.0 } else { f64::INFINITY };
+        }
+        v /= nv;
+        w.gemv(1.0, jac, &v, 0.0);
+        let nw = w.norm();
+        if nw == 0.0 {
+            return 0.0;
+        }
+        if it >= ITERS / 2 {
+            log_growth += nw.ln();
+            counted += 1;
+        }
+        std::mem::swap(&mut v, &mut w);
+    }
+    (log_growth / counted as f64).exp()
+}

@@ -1,0 +1,95 @@
+//! In-place LU factorisation with partial pivoting for square nalgebra matrices of any
+//! dimension, real or complex, reusing its storage (no allocation after construction).
+
+use nalgebra::{allocator::Allocator, ComplexField, DefaultAllocator, Dim, OMatrix, OVector};
+
+pub(crate) struct Lu<T: ComplexField, D: Dim>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// The matrix to factor; after `factor`, L (unit lower, below the diagonal) and U.
+    pub m: OMatrix<T, D, D>,
+    piv: OVector<usize, D>,
+    valid: bool,
+}
+
+impl<T: ComplexField<RealField = f64>, D: Dim> Lu<T, D>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    pub fn new(dim: D) -> Self {
+        Lu {
+            m: OMatrix::from_element_generic(dim, dim, T::zero()),
+            piv: OVector::from_element_generic(dim, nalgebra::U1, 0),
+            valid: false,
+        }
+    }
+
+    pub fn is_valid(&self) -> bool {
+        self.valid
+    }
+
+    pub fn invalidate(&mut self) {
+        self.valid = false;
+    }
+
+    /// Factors `m` in place; `false` if it is singular (a zero or non-finite pivot).
+    pub fn factor(&mut self) -> bool {
+        let n = self.m.nrows();
+        self.valid = false;
+        for k in 0..n {
+            let mut p = k;
+            let mut best = self.m[(k, k)].clone().abs();
+            for i in k + 1..n {
+                let v = self.m[(i, k)].clone().abs();
+                if v > best {
+                    best = v;
+                    p = i;
+                }
+            }
+            if !(best > 0.0) || !best.is_finite() {
+                return false;
+            }
+            self.piv[k] = p;
+            if p != k {
+                self.m.swap_rows(p, k);
+            }
+            let pivot = self.m[(k, k)].clone();
+            for i in k + 1..n {
+                let l = self.m[(i, k)].clone() / pivot.clone();
+                self.m[(i, k)] = l.clone();
+                for j in k + 1..n {
+                    let ukj = self.m[(k, j)].clone();
+                    self.m[(i, j)] -= l.clone() * ukj;
+                }
+            }
+        }
+        self.valid = true;
+        true
+    }
+
+    /// Solves `M x = b` in place with the factors.
+    pub fn solve_mut(&self, b: &mut OVector<T, D>) {
+        let n = self.m.nrows();
+        for k in 0..n {
+            let p = self.piv[k];
+            if p != k {
+                b.swap_rows(p, k);
+            }
+        }
+        for i in 1..n {
+            let mut s = b[i].clone();
+            for j in 0..i {
+                s -= self.m[(i, j)].clone() * b[j].clone();
+            }
+            b[i] = s;
+        }
+        for i in (0..n).rev() {
+            let mut s = b[i].clone();
+            for j in i + 1..n {
+                s -= self.m[(i, j)].clone() * b[j].clone();
+            }
+            b[i] = s / self.m[(i, i)].clone();
+        }
+    }
+}

@@ -1,0 +1,324 @@
+//! Rosenbrock method Rodas5P (G. Steinebach, "Construction of Rosenbrock–Wanner method Rodas5P
+//! and numerical benchmarks within the Julia Differential Equations package", BIT 63 (2023)):
+//! 8 stages, order 5, L-stable, embedded order 4, 4th-order dense output.
+
+use super::dense::StepPoly;
+use super::jacobian::{eval_jacobian, eval_time_derivative, spectral_radius};
+use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
+use super::system::OdeSystem;
+use super::lu::Lu;
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
+
+const GAMMA: f64 = 0.211_937_563_194_290_14;
+
+/// Stage abscissae; the last three stages are at the end of the step.
+const C: [f64; 8] = [
+    0.0,
+    0.635_812_689_582_870_4,
+    0.409_579_839_339_753_5,
+    0.976_930_672_506_071_6,
+    0.428_840_360_955_866_4,
+    1.0,
+    1.0,
+    1.0,
+];
+
+/// γ_i of the time-derivative term, h·d_i·∂f/∂t.
+const D_T: [f64; 8] = [
+    0.211_937_563_194_290_14,
+    -0.423_875_126_388_580_27,
+    -0.338_462_712_623_592_4,
+    1.804_645_287_288_273_4,
+    2.325_825_639_765_069,
+    0.0,
+    0.0,
+    0.0,
+];
+
+/// Stage inputs u_s = y + Σ_j A[s][j] k_j for s = 1..5; stages 6, 7, 8 then add k6, k7, k8.
+const A: [[f64; 5]; 6] = [
+    [0.0; 5],
+    [3.0, 0.0, 0.0, 0.0, 0.0],
+    [2.849_394_379_747_939, 0.458_422_422_044_639_23, 0.0, 0.0, 0.0],
+    [-6.954_028_509_809_101, 2.489_845_061_869_568, -10.358_996_098_473_584, 0.0, 0.0],
+    [
+        2.802_998_627_562_896_4,
+        0.507_246_473_622_820_6,
+        -0.398_831_254_177_052_4,
+        -0.047_211_872_304_046_41,
+        0.0,
+    ],
+    [
+        -7.502_846_399_306_121,
+        2.561_846_144_803_919,
+        -11.627_539_656_261_098,
+        -0.182_687_676_599_422_56,
+        0.030_198_172_008_377_946,
+    ],
+];
+
+/// Coupling of earlier stages into the right-hand side of stage s: Σ_j CC[s][j]/h · k_j.
+const CC: [[f64; 7]; 8] = [
+    [0.0; 7],
+    [-14.155_112_264_123_755, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [-17.972_960_358_859_52, -2.859_693_295_451_294, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [147.121_502_757_117_16, -1.412_214_027_182_13, 71.689_402_513_023_58, 0.0, 0.0, 0.0, 0.0],
+    [
+        165.435_170_248_716_76,
+        -0.459_282_345_649_112_6,
+        42.909_383_369_586_03,
+        -5.961_986_721_573_306,
+        0.0,
+        0.0,
+        0.0,
+    ],
+    [
+        24.854_864_614_690_072,
+        -3.000_922_700_283_218_6,
+        47.493_111_002_076_8,
+        5.581_419_782_155_812_5,
+        -0.661_069_182_524_947_1,
+        0.0,
+        0.0,
+    ],
+    [
+        30.912_732_140_285_99,
+        -3.120_824_334_993_797_4,
+        77.799_546_460_708_92,
+        34.286_460_282_947_83,
+        -19.097_331_116_725_623,
+        -28.087_943_162_872_662,
+        0.0,
+    ],
+    [
+        37.802_771_233_905_63,
+        -3.257_196_902_907_227_6,
+        112.269_188_494_963_27,
+        66.934_723_124_404_7,
+        -40.066_189_370_910_02,
+        -54.667_802_628_779_68,
+        -9.488_616_523_096_27,
+    ],
+];
+
+/// Dense output: y(θ) = (1−θ)y0 + θ(y1 + (1−θ)(w1 + θ(w2 + θ w3))), w_r = Σ_j H[r][j] k_j.
+const H: [[f64; 8]; 3] = [
+    [
+        25.948_786_856_663_858,
+        -2.557_972_484_584_623_5,
+        10.433_815_404_888_879,
+        -2.367_925_102_268_520_4,
+        0.524_948_541_321_073,
+        1.124_108_831_045_040_4,
+        0.427_287_619_443_187_4,
+        -0.172_022_210_701_554_93,
+    ],
+    [
+        -9.915_688_506_951_71,
+        -0.968_994_459_411_515_4,
+        3.043_803_724_297_845_3,
+        -24.495_224_566_215_796,
+        20.176_138_334_709_044,
+        15.980_663_614_246_51,
+        -6.789_040_303_419_874,
+        -6.710_236_069_923_372,
+    ],
+    [
+        11.419_903_575_922_262,
+        2.887_964_514_613_699_4,
+        72.921_379_959_960_29,
+        80.125_118_346_226_43,
+        -52.072_871_366_152_654,
+        -59.789_936_252_667_29,
+        -0.155_826_842_827_519_13,
+        4.883_087_185_713_722,
+    ],
+];
+
+pub(crate) struct Rodas5P<D: Dim>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    f0: OVector<f64, D>,
+    f0_valid: bool,
+    jac: OMatrix<f64, D, D>,
+    dfdt: OVector<f64, D>,
+    /// J and ∂f/∂t belong to the current point (they survive rejected attempts).
+    jac_valid: bool,
+    lu: Lu<f64, D>,
+    lu_h: f64,
+    k: [OVector<f64, D>; 8],
+    u: OVector<f64, D>,
+    fu: OVector<f64, D>,
+    rho: Option<f64>,
+}
+
+impl<D: Dim> Rodas5P<D>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    pub fn new(y: &OVector<f64, D>) -> Self {
+        let z = zeros_like(y);
+        let (r, _) = y.shape_generic();
+        Rodas5P {
+            f0: z.clone(),
+            f0_valid: false,
+            jac: OMatrix::zeros_generic(r, r),
+            dfdt: z.clone(),
+            jac_valid: false,
+            lu: Lu::new(r),
+            lu_h: f64::NAN,
+            k: std::array::from_fn(|_| z.clone()),
+            u: z.clone(),
+            fu: z,
+            rho: None,
+        }
+    }
+}
+
+impl<D: Dim, S: OdeSystem<D> + ?Sized> Stepper<D, S> for Rodas5P<D>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn error_order(&self) -> f64 {
+        5.0
+    }
+
+    fn is_stiff(&self) -> bool {
+        true
+    }
+
+    fn restart(&mut self, sys: &S, t: f64, y: &OVector<f64, D>, ctx: &mut Ctx<D>) {
+        sys.rhs(t, y, &mut self.f0);
+        ctx.stats.rhs_evals += 1;
+        self.f0_valid = true;
+        self.jac_valid = false;
+        self.lu.invalidate();
+    }
+
+    fn f0(&self) -> &OVector<f64, D> {
+        &self.f0
+    }
+
+    fn attempt(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &OVector<f64, D>,
+        h: f64,
+        y_new: &mut OVector<f64, D>,
+        ctx: &mut Ctx<D>,
+    ) -> Trial {
+        let fail = |kind| Trial::Failed { factor: 0.25, kind };
+        if !self.f0_valid {
+            sys.rhs(t, y, &mut self.f0);
+            ctx.stats.rhs_evals += 1;
+            self.f0_valid = true;
+        }
+        if !all_finite(&self.f0) {
+            return fail(FailKind::NonFinite);
+        }
+        if !self.jac_valid {
+            if !eval_jacobian(sys, t, y, &self.f0, &mut self.jac, &mut self.fu, ctx) {
+                return fail(FailKind::NonFinite);
+            }
+            eval_time_derivative(sys, t, y, &self.f0, h, &mut self.dfdt, ctx);
+            if !all_finite(&self.dfdt) {
+                return fail(FailKind::NonFinite);
+            }
+            self.jac_valid = true;
+            self.lu.invalidate();
+            if ctx.want_stiffness {
+                self.rho = Some(spectral_radius(&self.jac, y));
+            }
+        }
+        if !self.lu.is_valid() || self.lu_h != h {
+            // W = I/(hγ) − J.
+            self.lu.m.copy_from(&self.jac);
+            self.lu.m.neg_mut();
+            let d = 1.0 / (h * GAMMA);
+            for i in 0..y.len() {
+                self.lu.m[(i, i)] += d;
+            }
+            ctx.stats.lu_decomps += 1;
+            if !self.lu.factor() {
+                return Trial::Failed {
+                    factor: 0.5,
+                    kind: FailKind::Singular,
+                };
+            }
+            self.lu_h = h;
+        }
+        let lu = &self.lu;
+        let inv_h = 1.0 / h;
+        for s in 0..8 {
+            let (done, rest) = self.k.split_at_mut(s);
+            let ks = &mut rest[0];
+            if s == 0 {
+                ks.copy_from(&self.f0);
+            } else {
+                if s <= 5 {
+                    self.u.copy_from(y);
+                    for (j, kj) in done.iter().enumerate().take(5) {
+                        let a = A[s][j];
+                        if a != 0.0 {
+                            self.u.axpy(a, kj, 1.0);
+                        }
+                    }
+                } else {
+                    self.u += &done[s - 1];
+                }
+                sys.rhs(t + C[s] * h, &self.u, ks);
+                ctx.stats.rhs_evals += 1;
+            }
+            for (j, kj) in done.iter().enumerate() {
+                ks.axpy(CC[s][j] * inv_h, kj, 1.0);
+            }
+            if D_T[s] != 0.0 {
+                ks.axpy(h * D_T[s], &self.dfdt, 1.0);
+            }
+            lu.solve_mut(ks);
+            ctx.stats.lin_solves += 1;
+        }
+        y_new.copy_from(&self.u);
+        *y_new += &self.k[7];
+        if !all_finite(y_new) {
+            return fail(FailKind::NonFinite);
+        }
+        Trial::Done {
+            err: ctx.err_norm(&self.k[7], y, y_new),
+        }
+    }
+
+    fn accept(
+        &mut self,
+        _sys: &S,
+        t: f64,
+        y: &OVector<f64, D>,
+        h: f64,
+        y_new: &OVector<f64, D>,
+        poly: &mut StepPoly,
+        _ctx: &mut Ctx<D>,
+    ) {
+        poly.begin(t, h, 4);
+        for i in 0..y.len() {
+            let mut w = [0.0; 3];
+            for (r, wr) in w.iter_mut().enumerate() {
+                for (j, kj) in self.k.iter().enumerate() {
+                    *wr += H[r][j] * kj[i];
+                }
+            }
+            *poly.at(0, i) = y[i];
+            *poly.at(1, i) = y_new[i] - y[i] + w[0];
+            *poly.at(2, i) = w[1] - w[0];
+            *poly.at(3, i) = w[2] - w[1];
+            *poly.at(4, i) = -w[2];
+        }
+        self.f0_valid = false;
+        self.jac_valid = false;
+    }
+
+    fn stiffness(&self) -> Option<f64> {
+        self.rho
+    }
+}
