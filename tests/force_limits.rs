@@ -103,7 +103,7 @@ fn lennard_jones_pressure_vanishes_at_h_e() {
     let (f, df) = lj.force(he).unwrap();
     // each of the two parts is ~4e8 Pa; the sum cancels to rounding
     assert!(f.abs() < 1e-15 * A / (6.0 * PI * he.powi(3)) * 8.0, "p(h_e) = {f}");
-    assert!(df > 0.0, "repulsion decreases through h_e, so the force rises as d falls");
+    assert!(df < 0.0, "repulsion decreases through h_e, so the force rises as d falls");
     assert!(lj.force(0.9 * he).unwrap().0 > 0.0 && lj.force(1.1 * he).unwrap().0 < 0.0);
 }
 
@@ -189,7 +189,7 @@ fn gw_with_gaussian_peaks_matches_independent_quadrature() {
         let pc = |s: f64| k * ts(|z| (z - s).powf(1.5) * pdf(z), s, top);
         let ar = |s: f64| PI * r * eta * ts(|z| (z - s) * pdf(z), s, top);
         assert!(rel(flat.force(d).unwrap().0, area * pc(d)) < 1e-9, "flat d = {d}");
-        assert!(rel(flat.real_contact_area(d).unwrap(), area * ar(d)) < 1e-9);
+        assert!(rel(flat.real_contact_area(d).unwrap(), area * ar(d)) < 1e-9, "{} vs {}", flat.real_contact_area(d).unwrap(), area * ar(d));
         // literal Derjaguin double integral over the truncated paraboloid
         let upper = (d + delta).min(top);
         let f = 2.0 * PI * RC * ts(pc, d, upper);
