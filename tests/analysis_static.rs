@@ -38,8 +38,16 @@ fn pull_in_flat_plate_on_linear_spring_matches_closed_form() {
     let exact = (8.0 * k * g.powi(3) / (27.0 * EPSILON_0 * area)).sqrt();
     // The fold is refined to 1e-12 in d on exact forces; V² is stationary there, so V is
     // accurate to far better than 1e-8.
-    assert!((pi.voltage / exact - 1.0).abs() < 1e-8, "{} vs {exact}", pi.voltage);
-    assert!((pi.d / (2.0 * g / 3.0) - 1.0).abs() < 1e-6, "fold at {}", pi.d);
+    assert!(
+        (pi.voltage / exact - 1.0).abs() < 1e-8,
+        "{} vs {exact}",
+        pi.voltage
+    );
+    assert!(
+        (pi.d / (2.0 * g / 3.0) - 1.0).abs() < 1e-6,
+        "fold at {}",
+        pi.d
+    );
     assert_eq!(pi.cause, Cause::Fold);
 }
 
@@ -55,7 +63,11 @@ fn pull_in_smooth_sphere_on_linear_spring_matches_closed_form() {
     let g = scene.nominal_clearance_m;
     let exact = 0.5 * g * (3e5 / (std::f64::consts::PI * rc * EPSILON_0)).sqrt();
     let pi = pull_in_voltage(&model, 0.0, &opts).unwrap();
-    assert!((pi.voltage / exact - 1.0).abs() < 1e-8, "{} vs {exact}", pi.voltage);
+    assert!(
+        (pi.voltage / exact - 1.0).abs() < 1e-8,
+        "{} vs {exact}",
+        pi.voltage
+    );
     assert!((pi.d / (0.5 * g) - 1.0).abs() < 1e-6);
     // With protrusion the effective gap shrinks: V_pi(P) uses g = h0 − ηP.
     let p = 0.03;
@@ -120,7 +132,10 @@ fn equilibria_satisfy_the_force_balance() {
     let curve = s_curve(&model, None, &ScanGrid::default()).unwrap();
     let volt2 = 1.0;
     for e in curve.points.iter().step_by(97) {
-        let g = Gaps { bulge: e.d, pad: model.nominal_clearance + e.y };
+        let g = Gaps {
+            bulge: e.d,
+            pad: model.nominal_clearance + e.y,
+        };
         let f = model.interface_force_exact(g, volt2).unwrap().value;
         let fab = model.bearing().force(e.y, 0.0);
         // Tables agree with direct quadrature to 1e-8 relative: so does the balance.
@@ -142,7 +157,10 @@ fn fold_is_a_power_maximum_of_the_flying_branch() {
         assert!(above.is_stable() && !below.is_stable());
     }
     // The same fold without voltage terms' help: a DC voltage lowers touchdown.
-    let m1 = model.with_voltage(Voltage { dc: 1.0, ..model.voltage });
+    let m1 = model.with_voltage(Voltage {
+        dc: 1.0,
+        ..model.voltage
+    });
     assert!(touchdown_power(&m1, &opts).unwrap().power < td.power);
 }
 
