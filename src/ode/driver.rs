@@ -340,8 +340,7 @@ where
             fac = fac.min(hint);
         }
         if opts.adaptive {
-            h *= fac.clamp(FAC_MIN, fac_max);
-            h = h.min(h_max);
+            h = stepper.propose(h, h * fac.clamp(FAC_MIN, fac_max)).min(h_max);
         } else if let Some(h0) = opts.h_init {
             h = h0.min(h_max);
         }

@@ -34,6 +34,7 @@ mod event;
 mod jacobian;
 mod lu;
 mod options;
+mod radau5;
 mod rodas5p;
 mod solution;
 mod stepper;
@@ -110,6 +111,10 @@ where
         }
         Method::Rodas5P => {
             let mut m = rodas5p::Rodas5P::new(&problem.y0);
+            driver::integrate(problem, &mut [&mut m])
+        }
+        Method::Radau5 => {
+            let mut m = radau5::Radau5::new(&problem.y0, opts.rtol);
             driver::integrate(problem, &mut [&mut m])
         }
         Method::Auto => {

@@ -105,6 +105,12 @@ where
     fn step_hint(&self) -> Option<f64> {
         None
     }
+
+    /// Final say on the next step size after an accepted step of size `h_acc` for which the
+    /// controller proposes `h_new` (e.g. keep `h_acc` to reuse an LU factorisation).
+    fn propose(&self, _h_acc: f64, h_new: f64) -> f64 {
+        h_new
+    }
 }
 
 /// Is every component finite?
