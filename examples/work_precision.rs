@@ -1,0 +1,364 @@
+//! Error against run time for every ODE method on standard test problems and on the slider.
+//!
+//! Solves each problem with each method at relative tolerances 1e-3 … 1e-12, prints a table
+//! (problem, method, rtol, error against the reference, wall time, steps, right-hand-side
+//! evaluations), writes it to `out/work_precision/table.csv` and draws one log–log chart of
+//! error against wall time per problem into the same folder.
+//!
+//! Problems: a non-stiff one with a closed-form solution, Van der Pol (μ = 1000), Robertson to
+//! 1e11 and HIRES against the Test Set for IVP Solvers, and the paper scene's fixed-programme
+//! touchdown/take-off cycle at V_ac = 0 and 0.6 V, whose errors are |ΔP − ΔP_ref| and
+//! |P_TD − P_TD,ref| against a reference computed at rtol 1e-11 (Tsit5, cross-checked with
+//! Radau5; the difference of the two is printed).
+//!
+//! Run with `cargo run --release --example work_precision`; `-- --quick` runs every second
+//! tolerance only.
+
+#[path = "common/problems.rs"]
+mod problems;
+
+use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
+use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::ode::{solve, Method, OdeError, Stats};
+use hdi_tribology::report::{Chart, Series};
+use hdi_tribology::scene::Scene;
+use problems::Problem;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// Step cap for explicit methods on stiff problems: far more than any method needs where it is
+/// stable, reached in milliseconds when stability, not accuracy, limits the step.
+const EXPLICIT_STEP_CAP: usize = 200_000;
+
+/// Repeat a run until this much time has been spent, and keep the fastest repetition.
+const TIMING_BUDGET: Duration = Duration::from_millis(40);
+/// At most this many repetitions.
+const MAX_REPEATS: usize = 30;
+
+/// Relative tolerance of the slider reference.
+const SLIDER_REF_RTOL: f64 = 1e-11;
+
+/// Absolute tolerance on the displacement per unit relative tolerance (m): the scene's
+/// 1e-14 m at rtol 1e-6, i.e. rtol × 10 nm, the size of the spacing.
+const SLIDER_ATOL_PER_RTOL: f64 = 1e-8;
+
+/// One row of the table.
+struct Row {
+    problem: String,
+    method: Method,
+    rtol: f64,
+    /// Error against the reference (the ΔP error for the slider); NaN on failure.
+    error: f64,
+    /// Second error (|P_TD − P_TD,ref| for the slider); NaN for the standard problems.
+    error2: f64,
+    /// Fastest wall time of the repetitions (s).
+    wall: f64,
+    stats: Stats,
+    status: String,
+}
+
+/// Runs `f` repeatedly within the timing budget and returns its last value and the fastest time.
+fn timed<T>(mut f: impl FnMut() -> T) -> (T, f64) {
+    let start = Instant::now();
+    let mut best = f64::INFINITY;
+    let mut n = 0;
+    loop {
+        let t = Instant::now();
+        let out = f();
+        best = best.min(t.elapsed().as_secs_f64());
+        n += 1;
+        if n >= MAX_REPEATS || start.elapsed() >= TIMING_BUDGET {
+            return (out, best);
+        }
+    }
+}
+
+fn explicit(m: Method) -> bool {
+    matches!(m, Method::Tsit5 | Method::Dop853)
+}
+
+fn failure_status(method: Method, stiff: bool, e: &OdeError) -> String {
+    match e {
+        OdeError::TooManySteps { .. } if stiff && explicit(method) => "failed (stiff)".into(),
+        OdeError::InvalidInput { .. } if e.to_string().contains("not available") => {
+            "unavailable".into()
+        }
+        other => format!("failed: {other}"),
+    }
+}
+
+fn run_problem<const N: usize>(p: &Problem<N>, rtols: &[f64], rows: &mut Vec<Row>) {
+    for method in Method::ALL {
+        for &rtol in rtols {
+            let mut opts = p.options(rtol).max_steps(2_000_000);
+            if p.stiff && explicit(method) {
+                opts = opts.max_steps(EXPLICIT_STEP_CAP);
+            }
+            let (res, wall) = timed(|| solve(p, 0.0, p.y0_vector(), p.t_end, method, &opts, &mut []));
+            let row = match res {
+                Ok(sol) => Row {
+                    problem: p.name.into(),
+                    method,
+                    rtol,
+                    error: p.error(sol.y_final().as_slice()),
+                    error2: f64::NAN,
+                    wall,
+                    stats: sol.stats.clone(),
+                    status: "ok".into(),
+                },
+                Err(e) => Row {
+                    problem: p.name.into(),
+                    method,
+                    rtol,
+                    error: f64::NAN,
+                    error2: f64::NAN,
+                    wall: f64::NAN,
+                    stats: Stats::default(),
+                    status: failure_status(method, p.stiff, &e),
+                },
+            };
+            let unavailable = row.status == "unavailable";
+            print_row(&row);
+            rows.push(row);
+            if unavailable {
+                break;
+            }
+        }
+    }
+}
+
+struct Slider {
+    scene: Scene,
+    model: SliderModel,
+    programme: HeaterProgramme,
+}
+
+impl Slider {
+    fn new() -> Res<Self> {
+        let scene = Scene::paper();
+        let model = SliderModel::from_scene(&scene)?;
+        let programme =
+            HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+        Ok(Slider {
+            scene,
+            model,
+            programme,
+        })
+    }
+
+    fn cycle(&self, v_ac: f64, method: Method, rtol: f64) -> hdi_tribology::Result<CycleResult> {
+        let model = self.model.with_voltage(Voltage {
+            ac_amplitude: v_ac,
+            ..self.model.voltage
+        });
+        let mut opts = CycleOptions::from_scene(&self.scene)?;
+        opts.solver.method = method;
+        opts.solver.rtol = rtol;
+        opts.solver.atol_displacement = rtol * SLIDER_ATOL_PER_RTOL;
+        simulate_cycle(&model, &self.programme, &opts)
+    }
+}
+
+/// `(ΔP, P_TD)` of a cycle, if both touchdown and take-off were detected.
+fn outputs(r: &CycleResult) -> Option<(f64, f64)> {
+    Some((r.hysteresis?, r.touchdown?.power))
+}
+
+fn run_slider(slider: &Slider, v_ac: f64, rtols: &[f64], rows: &mut Vec<Row>) -> Res<()> {
+    let name = format!("slider_{v_ac:.1}V");
+    let clock = Instant::now();
+    let reference = slider.cycle(v_ac, Method::Tsit5, SLIDER_REF_RTOL)?;
+    let (dp_ref, ptd_ref) = outputs(&reference).ok_or("reference cycle without touchdown")?;
+    let check = slider.cycle(v_ac, Method::Radau5, SLIDER_REF_RTOL)?;
+    let (dp_chk, ptd_chk) = outputs(&check).ok_or("check cycle without touchdown")?;
+    println!(
+        "# {name}: reference (tsit5, rtol {SLIDER_REF_RTOL:.0e}) ΔP = {dp_ref:.9e} W, \
+         P_TD = {ptd_ref:.9e} W; radau5 differs by {:.1e} W, {:.1e} W ({:.1} s)",
+        (dp_chk - dp_ref).abs(),
+        (ptd_chk - ptd_ref).abs(),
+        clock.elapsed().as_secs_f64()
+    );
+    for method in Method::ALL {
+        for &rtol in rtols {
+            let (res, wall) = timed(|| slider.cycle(v_ac, method, rtol));
+            let row = match res {
+                Ok(r) => match outputs(&r) {
+                    Some((dp, ptd)) => Row {
+                        problem: name.clone(),
+                        method,
+                        rtol,
+                        error: (dp - dp_ref).abs(),
+                        error2: (ptd - ptd_ref).abs(),
+                        wall,
+                        stats: r.stats.clone(),
+                        status: "ok".into(),
+                    },
+                    None => Row {
+                        problem: name.clone(),
+                        method,
+                        rtol,
+                        error: f64::NAN,
+                        error2: f64::NAN,
+                        wall,
+                        stats: r.stats.clone(),
+                        status: "failed: no touchdown or take-off detected".into(),
+                    },
+                },
+                Err(e) => Row {
+                    problem: name.clone(),
+                    method,
+                    rtol,
+                    error: f64::NAN,
+                    error2: f64::NAN,
+                    wall: f64::NAN,
+                    stats: Stats::default(),
+                    status: if e.to_string().contains("not available") {
+                        "unavailable".into()
+                    } else {
+                        format!("failed: {e}")
+                    },
+                },
+            };
+            let unavailable = row.status == "unavailable";
+            print_row(&row);
+            rows.push(row);
+            if unavailable {
+                break;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn print_header() {
+    println!(
+        "{:<14} {:<8} {:>7} {:>10} {:>10} {:>11} {:>8} {:>6} {:>9}  status",
+        "problem", "method", "rtol", "error", "error2", "wall_ms", "steps", "rej", "rhs"
+    );
+}
+
+fn print_row(r: &Row) {
+    println!(
+        "{:<14} {:<8} {:>7.0e} {:>10.2e} {:>10.2e} {:>11.4} {:>8} {:>6} {:>9}  {}",
+        r.problem,
+        r.method.name(),
+        r.rtol,
+        r.error,
+        r.error2,
+        r.wall * 1e3,
+        r.stats.accepted,
+        r.stats.rejected,
+        r.stats.rhs_evals,
+        r.status
+    );
+}
+
+fn write_table(path: &Path, rows: &[Row]) -> Res<()> {
+    let mut s = String::from(
+        "problem,method,rtol,error,error2,wall_s,steps,rejected,rhs_evals,jac_evals,lu_decomps,status\n",
+    );
+    let num = |v: f64| if v.is_finite() { format!("{v:e}") } else { String::new() };
+    for r in rows {
+        s.push_str(&format!(
+            "{},{},{:e},{},{},{},{},{},{},{},{},{}\n",
+            r.problem,
+            r.method.name(),
+            r.rtol,
+            num(r.error),
+            num(r.error2),
+            num(r.wall),
+            r.stats.accepted,
+            r.stats.rejected,
+            r.stats.rhs_evals,
+            r.stats.jac_evals,
+            r.stats.lu_decomps,
+            r.status.replace(',', ";")
+        ));
+    }
+    std::fs::write(path, s)?;
+    Ok(())
+}
+
+/// One chart of `error` (or `error2`) against wall time, one line per method.
+fn chart(out: &Path, problem: &str, file: &str, y_label: &str, rows: &[Row], second: bool) -> Res<()> {
+    let labels: Vec<String> = Method::ALL.iter().map(|m| m.name().to_string()).collect();
+    let series: Vec<Series> = Method::ALL
+        .iter()
+        .zip(&labels)
+        .filter_map(|(&m, label)| {
+            let points: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.problem == problem && r.method == m && r.status == "ok")
+                .map(|r| (r.wall * 1e3, if second { r.error2 } else { r.error }))
+                .filter(|&(_, e)| e > 0.0)
+                .collect();
+            (!points.is_empty()).then(|| Series {
+                label,
+                points,
+                markers: false,
+            })
+        })
+        .collect();
+    if series.is_empty() {
+        return Ok(());
+    }
+    let title = format!("{problem}: error against run time");
+    Chart {
+        title: &title,
+        x_label: "wall time (ms)",
+        y_label,
+        series,
+        log: (true, true),
+    }
+    .to_svg(&out.join(file), 720, 480)?;
+    Ok(())
+}
+
+fn main() -> Res<()> {
+    let clock = Instant::now();
+    let out = Path::new("out/work_precision");
+    std::fs::create_dir_all(out)?;
+    let quick = std::env::args().any(|a| a == "--quick");
+    let all: Vec<f64> = (3..=12).map(|k| 10f64.powi(-k)).collect();
+    let rtols: Vec<f64> = if quick {
+        all.iter().copied().step_by(2).collect()
+    } else {
+        all.clone()
+    };
+    // Tighter than 1e-9 is within a few hundred of the slider reference's own tolerance.
+    let slider_rtols: Vec<f64> = rtols.iter().copied().filter(|&r| r >= 1e-9).collect();
+
+    let mut rows = Vec::new();
+    print_header();
+    run_problem(&problems::exact(), &rtols, &mut rows);
+    run_problem(&problems::van_der_pol(), &rtols, &mut rows);
+    run_problem(&problems::robertson(), &rtols, &mut rows);
+    run_problem(&problems::hires(), &rtols, &mut rows);
+    let slider = Slider::new()?;
+    for v_ac in [0.0, 0.6] {
+        run_slider(&slider, v_ac, &slider_rtols, &mut rows)?;
+    }
+
+    write_table(&out.join("table.csv"), &rows)?;
+    for (p, label) in [
+        ("exact", "max abs error at t = 10"),
+        ("vdp", "max rel error at t = 2000"),
+        ("robertson", "max rel error at t = 1e11"),
+        ("hires", "max rel error at t = 321.8122"),
+    ] {
+        chart(out, p, &format!("{p}.svg"), label, &rows, false)?;
+    }
+    for p in ["slider_0.0V", "slider_0.6V"] {
+        chart(out, p, &format!("{p}_dp.svg"), "|ΔP − ΔP_ref| (W)", &rows, false)?;
+        chart(out, p, &format!("{p}_ptd.svg"), "|P_TD − P_TD,ref| (W)", &rows, true)?;
+    }
+    println!(
+        "wrote {} rows to {} in {:.1} s",
+        rows.len(),
+        out.display(),
+        clock.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
