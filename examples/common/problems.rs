@@ -58,8 +58,10 @@ impl<const N: usize> Problem<N> {
 
     /// `J·v` from the row-major Jacobian (for solvers that ask for Jacobian–vector products).
     pub fn jac_times(&self, t: f64, y: &[f64], v: &[f64], out: &mut [f64]) {
-        let mut j = vec![0.0; N * N];
-        (self.jac)(t, y, &mut j);
+        // Stack buffer: every problem here has at most 8 components.
+        let mut buf = [0.0; 64];
+        let j = &mut buf[..N * N];
+        (self.jac)(t, y, j);
         for i in 0..N {
             out[i] = (0..N).map(|k| j[i * N + k] * v[k]).sum();
         }
