@@ -386,6 +386,7 @@ fn chart(out: &Path, problem: &str, file: &str, y_label: &str, rows: &[Row], sec
                 .filter(|r| r.problem == problem && r.method == m && r.status == "ok")
                 .map(|r| (r.wall * 1e3, if second { r.error2 } else { r.error }))
                 .filter(|&(_, e)| e > 0.0)
+                .map(|(t, e)| (t.log10(), e.log10()))
                 .collect();
             (!points.is_empty()).then(|| Series {
                 label,
@@ -397,13 +398,15 @@ fn chart(out: &Path, problem: &str, file: &str, y_label: &str, rows: &[Row], sec
     if series.is_empty() {
         return Ok(());
     }
-    let title = format!("{problem}: error against run time");
+    let title = format!("{problem}: error against run time (log–log)");
+    let y_label = format!("log10 {y_label}");
+    // Decimal logarithms on linear axes: tick labels read as exponents.
     Chart {
         title: &title,
-        x_label: "wall time (ms)",
-        y_label,
+        x_label: "log10 wall time (ms)",
+        y_label: &y_label,
         series,
-        log: (true, true),
+        log: (false, false),
     }
     .to_svg(&out.join(file), 720, 480)?;
     Ok(())
