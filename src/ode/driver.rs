@@ -73,6 +73,7 @@ where
         rtol: opts.rtol,
         stats: Stats::default(),
         want_stiffness: steppers.len() > 1,
+        need_poly: opts.dense || !events.is_empty() || matches!(opts.save, SaveAt::Times(_)),
     };
 
     // Kinks strictly inside (t0, tf), then tf itself.

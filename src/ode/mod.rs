@@ -28,6 +28,7 @@
 //! ```
 
 mod dense;
+mod dop853;
 mod driver;
 mod error;
 mod event;
@@ -106,6 +107,10 @@ where
             let mut m = tsit5::Tsit5::new(&problem.y0);
             driver::integrate(problem, &mut [&mut m])
         }
+        Method::Dop853 => {
+            let mut m = dop853::Dop853::new(&problem.y0);
+            driver::integrate(problem, &mut [&mut m])
+        }
         Method::Rodas5P => {
             let mut m = rodas5p::Rodas5P::new(&problem.y0);
             driver::integrate(problem, &mut [&mut m])
@@ -119,9 +124,5 @@ where
             let mut stiff = rodas5p::Rodas5P::new(&problem.y0);
             driver::integrate(problem, &mut [&mut explicit, &mut stiff])
         }
-        other => Err(OdeError::invalid(
-            "method",
-            format!("{other} is not available yet"),
-        )),
     }
 }

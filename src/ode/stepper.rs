@@ -15,6 +15,9 @@ where
     pub stats: Stats,
     /// Whether the method should estimate the spectral radius for stiffness switching.
     pub want_stiffness: bool,
+    /// Whether the step interpolant is used (dense output, events, output at given times);
+    /// methods whose interpolant costs extra function evaluations skip it otherwise.
+    pub need_poly: bool,
 }
 
 impl<D: Dim> Ctx<D>
