@@ -1,7 +1,9 @@
 //! Options and bookkeeping: t_stops at kinks, h_max, output at given times, statistics that
 //! count what really happened, and Jacobian sources (analytic, finite-difference, complex-step).
 
-use hdi_tribology::ode::{complex_step_jacobian, solve, FnSystem, Method, OdeSystem, Options, SaveAt};
+use hdi_tribology::ode::{
+    complex_step_jacobian, solve, FnSystem, Method, OdeSystem, Options, SaveAt,
+};
 use nalgebra::{Matrix2, Vector1, Vector2, U2};
 use num_complex::Complex64;
 use std::cell::Cell;
@@ -37,7 +39,12 @@ impl OdeSystem<U2> for Counted {
         match self.jacobian {
             JacobianKind::Analytic => {
                 self.jac.set(self.jac.get() + 1);
-                *j = Matrix2::new(0.0, 1.0, -2.0 * MU * y[0] * y[1] - 1.0, MU * (1.0 - y[0] * y[0]));
+                *j = Matrix2::new(
+                    0.0,
+                    1.0,
+                    -2.0 * MU * y[0] * y[1] - 1.0,
+                    MU * (1.0 - y[0] * y[0]),
+                );
                 true
             }
             JacobianKind::ComplexStep => {
@@ -104,22 +111,40 @@ fn jacobian_sources_agree() {
     // order-preserving accuracy; differences enter at the level of the FD error ~1e-8).
     let opts = Options::default().rtol(1e-9).atol(1e-11);
     let run = |k| {
-        *solve(&counted(k), 0.0, Vector2::new(2.0, 0.0), 30.0, Method::Rodas5P, &opts, &mut [])
-            .unwrap()
-            .y_final()
+        *solve(
+            &counted(k),
+            0.0,
+            Vector2::new(2.0, 0.0),
+            30.0,
+            Method::Rodas5P,
+            &opts,
+            &mut [],
+        )
+        .unwrap()
+        .y_final()
     };
     let a = run(JacobianKind::Analytic);
     let f = run(JacobianKind::FiniteDifference);
     let c = run(JacobianKind::ComplexStep);
     assert!((a - c).amax() < 1e-12, "complex step: {}", (a - c).amax());
-    assert!((a - f).amax() < 1e-6, "finite difference: {}", (a - f).amax());
+    assert!(
+        (a - f).amax() < 1e-6,
+        "finite difference: {}",
+        (a - f).amax()
+    );
 }
 
 #[test]
 fn t_stops_and_h_max_shape_the_steps() {
     // A right-hand side with a kink at t = 1 (like a knot of a heater programme):
     // y' = t before, y' = 1 − 2(t − 1) after; exact y = t²/2, then 1/2 + (t−1) − (t−1)².
-    let exact = |t: f64| if t < 1.0 { 0.5 * t * t } else { 0.5 + (t - 1.0) - (t - 1.0).powi(2) };
+    let exact = |t: f64| {
+        if t < 1.0 {
+            0.5 * t * t
+        } else {
+            0.5 + (t - 1.0) - (t - 1.0).powi(2)
+        }
+    };
     let sys = FnSystem::new(|t: f64, _y: &Vector1<f64>, dy: &mut Vector1<f64>| {
         dy[0] = if t < 1.0 { t } else { 1.0 - 2.0 * (t - 1.0) };
     });
@@ -128,11 +153,20 @@ fn t_stops_and_h_max_shape_the_steps() {
         let sol = solve(&sys, 0.0, Vector1::new(0.0), 3.0, m, &opts, &mut []).unwrap();
         assert!(sol.t.contains(&1.0), "{m}: kink not a step end");
         assert!(!sol.t.contains(&5.0));
-        assert!(sol.t.windows(2).all(|w| w[1] - w[0] <= 0.25 * (1.0 + 1e-12)), "{m}: h_max");
+        assert!(
+            sol.t
+                .windows(2)
+                .all(|w| w[1] - w[0] <= 0.25 * (1.0 + 1e-12)),
+            "{m}: h_max"
+        );
         // Quadratic pieces: every method integrates them exactly when no step straddles the
         // kink, up to rounding and, for Rodas5P, the finite-difference ∂f/∂t (relative
         // error ~√ε entering at O(h²)): 1e-9.
-        assert!((sol.y_final()[0] - exact(3.0)).abs() < 1e-9, "{m}: {}", sol.y_final()[0]);
+        assert!(
+            (sol.y_final()[0] - exact(3.0)).abs() < 1e-9,
+            "{m}: {}",
+            sol.y_final()[0]
+        );
         for t in [0.3, 0.999, 1.0, 1.7] {
             let e = (sol.sample(t).unwrap()[0] - exact(t)).abs();
             assert!(e < 1e-9, "{m} at {t}: {e}");
@@ -160,7 +194,11 @@ fn save_at_times_interpolates_requested_points() {
         for (t, y) in sol.t.iter().zip(&sol.y) {
             // Interpolation error of the lowest-order interpolant (Radau5, order 3) at
             // tol 1e-10 stays below 1e-8.
-            assert!((y[0] - t.cos()).abs() < 1e-8, "{m} at {t}: {}", y[0] - t.cos());
+            assert!(
+                (y[0] - t.cos()).abs() < 1e-8,
+                "{m} at {t}: {}",
+                y[0] - t.cos()
+            );
         }
         let fin = Options::default().save(SaveAt::Final);
         let sol = solve(&sys, 0.0, Vector2::new(1.0, 0.0), 7.0, m, &fin, &mut []).unwrap();

@@ -73,7 +73,10 @@ where
 {
     opts.validate(y0.len())?;
     if y0.is_empty() {
-        return Err(OdeError::invalid("y0", "the state must have at least one component"));
+        return Err(OdeError::invalid(
+            "y0",
+            "the state must have at least one component",
+        ));
     }
     if !t0.is_finite() || !tf.is_finite() {
         return Err(OdeError::invalid(
