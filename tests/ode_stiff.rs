@@ -61,7 +61,7 @@ impl OdeSystem<U3> for Robertson {
 const ROBER_REF: [f64; 3] = [
     0.208_334_014_970_125_5e-7,
     0.833_336_077_033_471_3e-13,
-    0.999_999_979_166_505_0,
+    0.999_999_979_166_505,
 ];
 
 /// HIRES (Schäfer 1975), 8 components; finite-difference Jacobian on purpose.

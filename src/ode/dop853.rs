@@ -477,10 +477,10 @@ where
         y_new: &mut OVector<f64, D>,
         ctx: &mut Ctx<D>,
     ) -> Trial {
-        for s in 1..12 {
+        for (s, &cs) in C.iter().enumerate().take(12).skip(1) {
             Self::stage_input(&self.k, s, y, h, &mut self.stage);
             let (_, rest) = self.k.split_at_mut(s);
-            sys.rhs(t + C[s] * h, &self.stage, &mut rest[0]);
+            sys.rhs(t + cs * h, &self.stage, &mut rest[0]);
         }
         Self::stage_input(&self.k, 12, y, h, y_new);
         let (_, rest) = self.k.split_at_mut(12);
@@ -512,7 +512,7 @@ where
             s3 += (self.e3[i] / sc).powi(2);
         }
         let mut deno = s5 + 0.01 * s3;
-        if !(deno > 0.0) {
+        if deno.is_nan() || deno <= 0.0 {
             deno = 1.0;
         }
         Trial::Done {
@@ -531,10 +531,10 @@ where
         ctx: &mut Ctx<D>,
     ) {
         if ctx.need_poly {
-            for s in 13..16 {
+            for (s, &cs) in C.iter().enumerate().skip(13) {
                 Self::stage_input(&self.k, s, y, h, &mut self.stage);
                 let (_, rest) = self.k.split_at_mut(s);
-                sys.rhs(t + C[s] * h, &self.stage, &mut rest[0]);
+                sys.rhs(t + cs * h, &self.stage, &mut rest[0]);
             }
             ctx.stats.rhs_evals += 3;
             poly.begin(t, h, 7);

@@ -194,7 +194,7 @@ where
         if h >= remaining || remaining - h < floor.max(1e-3 * h) {
             h = remaining;
             hit_stop = true;
-        } else if !(h >= floor) {
+        } else if h.is_nan() || h < floor {
             if recent_nonfinite > 0 {
                 return Err(OdeError::NonFinite {
                     t,

@@ -68,7 +68,7 @@ where
     const ITERS: usize = 16;
     for it in 0..ITERS {
         let nv = v.norm();
-        if !(nv > 0.0) || !nv.is_finite() {
+        if nv.is_nan() || nv <= 0.0 || !nv.is_finite() {
             return if it == 0 { 0.0 } else { f64::INFINITY };
         }
         v /= nv;

@@ -47,7 +47,7 @@ where
                     p = i;
                 }
             }
-            if !(best > 0.0) || !best.is_finite() {
+            if best.is_nan() || best <= 0.0 || !best.is_finite() {
                 return false;
             }
             self.piv[k] = p;

@@ -282,7 +282,7 @@ impl Options {
                 "constant steps (adaptive = false) need h_init",
             ));
         }
-        if !(self.h_max > 0.0) {
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
             return Err(OdeError::invalid(
                 "options.h_max",
                 format!("must be > 0, got {}", self.h_max),

@@ -360,8 +360,8 @@ where
             // Update W and Z; measure the increment in Z (independent of T's scaling).
             for r in 0..n {
                 let dw = [self.tmp[r], self.cx[r].re, self.cx[r].im];
-                for i in 0..3 {
-                    self.w[i][r] += dw[i];
+                for (wi, dwi) in self.w.iter_mut().zip(dw) {
+                    wi[r] += dwi;
                 }
                 for i in 0..3 {
                     let dz = k.t[(i, 0)] * dw[0] + k.t[(i, 1)] * dw[1] + k.t[(i, 2)] * dw[2];
