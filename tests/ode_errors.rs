@@ -198,3 +198,56 @@ fn bad_input_names_the_field() {
         Err(OdeError::InvalidInput { .. })
     ));
 }
+
+#[test]
+fn newton_divergence_is_reported() {
+    // y' = −1e8·sign(y − 1) from y = 1: the state sits on a jump of the right-hand side and
+    // the stage equations have no solution at any step size; the Newton iterates of Radau5
+    // bounce between the two branches (contraction rate ≈ 1). After a bounded number of
+    // halvings the solver gives up with a typed error at t = 0.
+    let sys = FnSystem::new(|_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| {
+        dy[0] = -1e8 * (y[0] - 1.0).signum();
+    });
+    let err = solve(
+        &sys,
+        0.0,
+        Vector1::new(1.0),
+        1.0,
+        Method::Radau5,
+        &Options::default(),
+        &mut [],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, OdeError::NewtonDivergence { t, .. } if t == 0.0),
+        "{err}"
+    );
+}
+
+#[test]
+fn chattering_right_hand_side_ends_with_an_error_not_a_hang() {
+    // y' = −sign(y): after t = 1 the solution chatters around 0 and the implicit stage
+    // equations have no solution. Whatever the solver does there, it must stop with a typed
+    // error at t ≈ 1 within its step budget.
+    let sys = FnSystem::new(|_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| {
+        dy[0] = -y[0].signum();
+    });
+    let opts = Options::default().max_steps(20_000);
+    let err = solve(
+        &sys,
+        0.0,
+        Vector1::new(1.0),
+        3.0,
+        Method::Radau5,
+        &opts,
+        &mut [],
+    )
+    .unwrap_err();
+    let t = match err {
+        OdeError::NewtonDivergence { t, .. }
+        | OdeError::StepTooSmall { t, .. }
+        | OdeError::TooManySteps { t, .. } => t,
+        other => panic!("unexpected error {other}"),
+    };
+    assert!((t - 1.0).abs() < 1e-3, "t = {t}");
+}
