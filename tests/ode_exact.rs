@@ -193,3 +193,42 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
 }
+
+#[test]
+fn error_shrinks_in_proportion_to_tolerance() {
+    let sys = FnSystem::new(rhs::<nalgebra::U3>);
+    for m in Method::ALL {
+        // DOP853 is the method for tight tolerances; at loose ones it takes a handful of
+        // steps whose error is far below the tolerance and not yet controlled by it.
+        let tols = if m == Method::Dop853 {
+            [1e-8, 1e-10, 1e-12]
+        } else {
+            [1e-5, 1e-7, 1e-9]
+        };
+        let errs: Vec<f64> = tols
+            .iter()
+            .map(|&tol| {
+                let opts = Options::default().rtol(tol).atol(tol);
+                let sol = solve(
+                    &sys,
+                    0.0,
+                    Vector3::new(1.0, 1.0, 0.0),
+                    T_END,
+                    m,
+                    &opts,
+                    &mut [],
+                )
+                .unwrap();
+                max_err(sol.y_final(), T_END)
+            })
+            .collect();
+        println!("{m}: {errs:?}");
+        for w in errs.windows(2) {
+            // Tolerance down by 100: error down by at least 20 and at most 5000 (roughly
+            // proportional; an error-per-step controller of a method of order p with an
+            // estimator of order q scales like tol^(p/(q+1)), between 1 and 1.6 here).
+            let ratio = w[0] / w[1];
+            assert!((20.0..5000.0).contains(&ratio), "{m}: {errs:?}");
+        }
+    }
+}
