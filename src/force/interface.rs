@@ -63,6 +63,15 @@ struct Tabulated {
     segments: Vec<Table>,
 }
 
+/// Where a merged table takes its values from.
+enum Source<'a> {
+    /// Direct evaluation of the member terms.
+    Exact,
+    /// The sum of already built tables over the same segments (their nodes are a subset of the
+    /// merged table's dyadic grid, so the sum is reproduced to rounding).
+    Parts(&'a [Arc<Tabulated>]),
+}
+
 impl Tabulated {
     fn exact_one(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> Result<(f64, f64)> {
         let (mut v, mut s) = (0.0, 0.0);
@@ -78,23 +87,15 @@ impl Tabulated {
         Ok((v, s))
     }
 
+    /// Tabulates the sum of `members` on the segments between consecutive `edges`.
     fn build(
         terms: &[Box<dyn InterfaceTerm>],
         members: Vec<usize>,
         area: bool,
-        (lo, hi): (f64, f64),
+        edges: &[f64],
         opts: &TableOptions,
+        source: Source<'_>,
     ) -> Result<Self> {
-        let mut cuts: Vec<f64> = members
-            .iter()
-            .flat_map(|&i| terms[i].kinks())
-            .filter(|&k| k.is_finite() && k > lo && k < hi)
-            .collect();
-        cuts.sort_by(f64::total_cmp);
-        cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-30));
-        let mut edges = vec![lo];
-        edges.extend(cuts);
-        edges.push(hi);
         let mut me = Tabulated {
             members,
             area,
@@ -111,12 +112,26 @@ impl Tabulated {
             // At an interior kink evaluate one ulp inside the segment, so that each piece sees the
             // one-sided limit of a function that jumps there (smooth surface, flat footprint).
             let a_in = if k == 0 { a } else { next_toward(a, b) };
-            let b_in = if k + 2 == edges.len() {
-                b
-            } else {
-                next_toward(b, a)
+            let b_in = if k + 2 == edges.len() { b } else { next_toward(b, a) };
+            let f = |x: f64| -> Result<(f64, f64)> {
+                let x = x.clamp(a_in, b_in);
+                match source {
+                    Source::Exact => me.exact_one(terms, x),
+                    Source::Parts(parts) => {
+                        let (mut v, mut s) = (0.0, 0.0);
+                        for p in parts {
+                            let (pv, ps) = match p.lookup(x) {
+                                Some(e) => e,
+                                None => p.exact_one(terms, x)?,
+                            };
+                            v += pv;
+                            s += ps;
+                        }
+                        Ok((v, s))
+                    }
+                }
             };
-            let table = Table::build(|x| me.exact_one(terms, x.clamp(a_in, b_in)), a, b, opts)
+            let table = Table::build(f, a, b, opts)
                 .map_err(|e| Error::no_convergence(what.clone(), e.to_string()))?;
             me.segments.push(table);
         }
@@ -220,7 +235,7 @@ impl InterfaceForces {
         }
         let area_opts = TableOptions {
             abs_tol: opts.abs_tol * 1e-8,
-            ..opts.clone()
+            ..*opts
         };
         let gaps = [GapReference::Bulge, GapReference::Pad];
         let kinds = [
@@ -232,14 +247,31 @@ impl InterfaceForces {
         let select = |f: &dyn Fn(&dyn InterfaceTerm) -> bool| -> Vec<usize> {
             (0..terms.len()).filter(|&i| f(terms[i].as_ref())).collect()
         };
+        // Every table on one gap shares the same cuts (the union of the kinks of its terms), so
+        // that merged tables can be summed from per-kind tables node for node.
+        let edges_of = |gap: GapReference| -> Vec<f64> {
+            let mut cuts: Vec<f64> = terms
+                .iter()
+                .filter(|t| t.gap() == gap)
+                .flat_map(|t| t.kinks())
+                .filter(|&k| k.is_finite() && k > lo && k < hi)
+                .collect();
+            cuts.sort_by(f64::total_cmp);
+            cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-30));
+            let mut edges = vec![lo];
+            edges.extend(cuts);
+            edges.push(hi);
+            edges
+        };
+        let edges = [edges_of(GapReference::Bulge), edges_of(GapReference::Pad)];
         let mut by_kind = Vec::new();
         for gap in gaps {
             for kind in kinds {
                 for coupling in [Coupling::Static, Coupling::PerVoltSquared] {
-                    let m =
-                        select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
+                    let m = select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
                     if !m.is_empty() {
-                        let tab = Tabulated::build(&terms, m, false, range, opts)?;
+                        let e = &edges[gap.index()];
+                        let tab = Tabulated::build(&terms, m, false, e, opts, Source::Exact)?;
                         by_kind.push((kind, coupling, gap, Arc::new(tab)));
                     }
                 }
@@ -259,14 +291,19 @@ impl InterfaceForces {
                 if m.is_empty() {
                     continue;
                 }
-                // Reuse a per-kind table when the merged set is a single kind.
-                let reuse = by_kind
+                // A single kind reuses its table; several kinds are summed from theirs. Summing
+                // tables (not re-integrating the sum) keeps each term's accuracy where the terms
+                // cancel: a direct table of the sum would chase quadrature rounding there.
+                let parts: Vec<Arc<Tabulated>> = by_kind
                     .iter()
-                    .find(|(_, _, _, t)| t.members == m)
-                    .map(|(_, _, _, t)| Arc::clone(t));
-                *slot = Some(match reuse {
-                    Some(t) => t,
-                    None => Arc::new(Tabulated::build(&terms, m, false, range, opts)?),
+                    .filter(|(_, c, gp, _)| *c == coupling && *gp == gap)
+                    .map(|(_, _, _, t)| Arc::clone(t))
+                    .collect();
+                *slot = Some(if parts.len() == 1 {
+                    Arc::clone(&parts[0])
+                } else {
+                    let e = &edges[g];
+                    Arc::new(Tabulated::build(&terms, m, false, e, opts, Source::Parts(&parts))?)
                 });
             }
             contact[g] = by_kind
@@ -275,9 +312,9 @@ impl InterfaceForces {
                 .map(|(_, _, _, t)| Arc::clone(t));
             let m = select(&|t| t.gap() == gap && t.has_contact_area());
             if !m.is_empty() {
-                area[g] = Some(Arc::new(Tabulated::build(
-                    &terms, m, true, range, &area_opts,
-                )?));
+                let e = &edges[g];
+                let tab = Tabulated::build(&terms, m, true, e, &area_opts, Source::Exact)?;
+                area[g] = Some(Arc::new(tab));
             }
         }
         Ok(InterfaceForces {
