@@ -45,10 +45,7 @@ impl Footprint {
                 radius_of_curvature_m,
                 max_radius_m,
             } => {
-                check_positive(
-                    &format!("{field}.radius_of_curvature_m"),
-                    radius_of_curvature_m,
-                )?;
+                check_positive(&format!("{field}.radius_of_curvature_m"), radius_of_curvature_m)?;
                 if let Some(r) = max_radius_m {
                     check_positive(&format!("{field}.max_radius_m"), r)?;
                 }

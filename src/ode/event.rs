@@ -134,10 +134,7 @@ where
             tm = 0.5 * (ta + tb);
         }
         // Keep the bracket shrinking by at least tol/2 on each side.
-        tm = tm.clamp(
-            ta + 0.5 * tol.min(0.25 * (tb - ta)),
-            tb - 0.5 * tol.min(0.25 * (tb - ta)),
-        );
+        tm = tm.clamp(ta + 0.5 * tol.min(0.25 * (tb - ta)), tb - 0.5 * tol.min(0.25 * (tb - ta)));
         poly.eval_into(tm, work);
         let gm = ev.eval(tm, work);
         evals += 1;

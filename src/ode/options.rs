@@ -76,9 +76,7 @@ impl FromStr for Method {
             .ok_or_else(|| {
                 OdeError::invalid(
                     "method",
-                    format!(
-                        "unknown method {s:?}; expected tsit5, dop853, rodas5p, radau5 or auto"
-                    ),
+                    format!("unknown method {s:?}; expected tsit5, dop853, rodas5p, radau5 or auto"),
                 )
             })
     }
@@ -256,11 +254,7 @@ impl Options {
                         format!("has {} components, the state has {n}", v.len()),
                     ));
                 }
-                if let Some((i, a)) = v
-                    .iter()
-                    .enumerate()
-                    .find(|(_, a)| !(a.is_finite() && **a >= 0.0))
-                {
+                if let Some((i, a)) = v.iter().enumerate().find(|(_, a)| !(a.is_finite() && **a >= 0.0)) {
                     return Err(OdeError::invalid(
                         format!("options.atol[{i}]"),
                         format!("must be finite and >= 0, got {a}"),

@@ -163,10 +163,7 @@ impl Empirical {
             ));
         }
         if let Some((i, z)) = sample.iter().enumerate().find(|(_, z)| !z.is_finite()) {
-            return Err(Error::invalid(
-                field,
-                format!("height {i} is not finite: {z}"),
-            ));
+            return Err(Error::invalid(field, format!("height {i} is not finite: {z}")));
         }
         let mut sorted = sample.to_vec();
         sorted.sort_by(f64::total_cmp);
