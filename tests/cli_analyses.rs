@@ -108,3 +108,16 @@ fn bad_arguments_give_one_line_and_a_non_zero_exit() {
         assert!(!err.contains("panicked"));
     }
 }
+
+#[test]
+fn printed_paper_scene_reads_back_as_the_paper_scene() {
+    for (flag, ext) in [(None, "toml"), (Some("--json"), "json")] {
+        let mut args = vec!["scene", "--paper"];
+        args.extend(flag);
+        let out = hdi(&args);
+        assert!(out.status.success());
+        let path = std::env::temp_dir().join(format!("hdi_cli_scene_{}.{ext}", std::process::id()));
+        std::fs::write(&path, &out.stdout).unwrap();
+        assert_eq!(Scene::from_path(&path).unwrap(), Scene::paper());
+    }
+}

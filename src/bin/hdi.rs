@@ -35,6 +35,8 @@ commands:
       steps, wall_seconds. --csv writes the time series of spacing and forces.
   sweep (SCENE_FILE | --paper) [--v-ac V1,V2,...] [--triggered] [--method M] [--rtol R]
       one cycle per AC amplitude (default: the scene's sweep list), JSON list of cycle objects.
+  scene (SCENE_FILE | --paper) [--json]
+      the scene as TOML (or JSON), validated: a starting point for scenes of your own.
   help
       this text";
 
@@ -76,6 +78,7 @@ fn run(args: &[String]) -> Result<(), CliError> {
         "static" => static_analyses(rest),
         "cycle" => cycle(rest),
         "sweep" => sweep(rest),
+        "scene" => scene(rest),
         "help" | "--help" | "-h" => {
             print_text(USAGE)?;
             Ok(())
@@ -403,4 +406,16 @@ fn sweep(args: &[String]) -> Result<(), CliError> {
         .map(CycleReport::from)
         .collect();
     print_json(&rows)
+}
+
+fn scene(args: &[String]) -> Result<(), CliError> {
+    let parsed = parse_args(args, &[], &["json"])?;
+    let scene = parsed.load_scene()?;
+    scene.validate()?;
+    let text = if parsed.flag("json") {
+        scene.to_json_string()?
+    } else {
+        scene.to_toml_string()?
+    };
+    print_text(text.trim_end())
 }
