@@ -48,7 +48,11 @@ impl StepPoly {
     where
         DefaultAllocator: Allocator<D>,
     {
-        let theta = if self.h != 0.0 { (t - self.t0) / self.h } else { 0.0 };
+        let theta = if self.h != 0.0 {
+            (t - self.t0) / self.h
+        } else {
+            0.0
+        };
         horner(&self.coeffs, self.n, theta, out.as_mut_slice());
     }
 }
@@ -116,7 +120,9 @@ impl DenseOutput {
     /// Covered time range `(start, end)`, if any step is stored.
     pub fn range(&self) -> Option<(f64, f64)> {
         let first = *self.t_start.first()?;
-        let last = self.end_override.unwrap_or(*self.t_start.last()? + *self.h.last()?);
+        let last = self
+            .end_override
+            .unwrap_or(*self.t_start.last()? + *self.h.last()?);
         Some((first, last))
     }
 

@@ -118,7 +118,7 @@ where
     for j in 0..n {
         let yj = y[j];
         let mut delta = sqrt_eps * yj.abs().max(scale[j]);
-        if !(delta > 0.0) || !delta.is_finite() {
+        if delta.is_nan() || delta <= 0.0 || !delta.is_finite() {
             delta = sqrt_eps;
         }
         yp[j] = yj + delta;
@@ -170,7 +170,11 @@ pub fn complex_step_jacobian<D: Dim, F>(
     for j in 0..n {
         // Any tiny relative step works (no subtractive cancellation); scaling with |y_j|
         // keeps the imaginary parts representable for states of any magnitude.
-        let delta = if y[j] != 0.0 { 1e-20 * y[j].abs() } else { 1e-20 };
+        let delta = if y[j] != 0.0 {
+            1e-20 * y[j].abs()
+        } else {
+            1e-20
+        };
         yc[j].im = delta;
         f(t, &yc, &mut out);
         for i in 0..n {
