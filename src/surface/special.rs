@@ -11,6 +11,10 @@ pub const INV_SQRT_2PI: f64 = 0.398_942_280_401_432_677_939_946_059_934_381_87;
 #[inline]
 pub fn norm_pdf(x: f64) -> f64 {
     let sq = x * x;
+    if sq > 1.5e3 {
+        // exp(−750) underflows; also keeps the split below away from inf − inf.
+        return 0.0;
+    }
     let err = x.mul_add(x, -sq);
     INV_SQRT_2PI * (-0.5 * sq).exp() * (1.0 - 0.5 * err)
 }
