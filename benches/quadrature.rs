@@ -15,15 +15,26 @@ fn lookups(c: &mut Criterion) {
         max_nodes: 200_000,
     };
     let table = Table::build(
-        |d| Ok((law.partial_moment(d, 1.5), -1.5 * law.partial_moment(d, 0.5))),
+        |d| {
+            Ok((
+                law.partial_moment(d, 1.5),
+                -1.5 * law.partial_moment(d, 0.5),
+            ))
+        },
         lo,
         hi,
         &opts,
     )
     .unwrap();
-    println!("contact table: {} nodes, {} panels", table.len(), table.panels());
+    println!(
+        "contact table: {} nodes, {} panels",
+        table.len(),
+        table.panels()
+    );
     let mut rng = Xoshiro256::new(1);
-    let xs: Vec<f64> = (0..4096).map(|_| lo + (hi - lo) * rng.next_open01()).collect();
+    let xs: Vec<f64> = (0..4096)
+        .map(|_| lo + (hi - lo) * rng.next_open01())
+        .collect();
     c.bench_function("table eval (random points)", |b| {
         let mut i = 0;
         b.iter(|| {
@@ -52,7 +63,12 @@ fn lookups(c: &mut Criterion) {
     c.bench_function("table build (Gaussian M_1.5, 1e-9)", |b| {
         b.iter(|| {
             Table::build(
-                |d| Ok((law.partial_moment(d, 1.5), -1.5 * law.partial_moment(d, 0.5))),
+                |d| {
+                    Ok((
+                        law.partial_moment(d, 1.5),
+                        -1.5 * law.partial_moment(d, 0.5),
+                    ))
+                },
                 lo,
                 hi,
                 &opts,
@@ -94,7 +110,15 @@ fn moments(c: &mut Criterion) {
 fn quadrature(c: &mut Criterion) {
     let o = QuadOptions::default();
     c.bench_function("integrate exp(-x^2) over R, 1e-12", |b| {
-        b.iter(|| integrate(|x: f64| (-x * x).exp(), f64::NEG_INFINITY, f64::INFINITY, &o).unwrap())
+        b.iter(|| {
+            integrate(
+                |x: f64| (-x * x).exp(),
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                &o,
+            )
+            .unwrap()
+        })
     });
 }
 

@@ -132,7 +132,8 @@ impl Table {
     ) -> Result<Table> {
         crate::error::check_finite("table.lo", lo)?;
         crate::error::check_finite("table.hi", hi)?;
-        if !(hi > lo) {
+        // Both are finite here, so the comparison is total.
+        if hi <= lo {
             return Err(Error::invalid(
                 "table.hi",
                 format!("must be > table.lo = {lo}, got {hi}"),
@@ -234,7 +235,7 @@ impl Table {
                 nodes.push(p.mids[i]);
             }
             nodes.push(p.nodes[n]);
-            if !((p.b - p.a) / (2 * n) as f64 > f64::EPSILON * p.a.abs().max(p.b.abs())) {
+            if (p.b - p.a) / (2 * n) as f64 <= f64::EPSILON * p.a.abs().max(p.b.abs()) {
                 return Err(Error::no_convergence(
                     "table build",
                     format!("node spacing reaches rounding level near {}", p.a),
