@@ -506,3 +506,35 @@ fn far_below_the_support_moments_follow_the_binomial_expansion() {
         }
     }
 }
+
+#[test]
+fn moments_are_continuous_where_the_quadrature_changes_method() {
+    // Below the bulk the moments are integrated in z, inside it in v = √(z − d):
+    // the switch sits at −9σ (Gaussian), −9.5εσ (Rice maxima), ν − 9.5s (Rician).
+    // Across it M_p(x − δ) − M_p(x + δ) = 2δ·p·M_{p−1}(x) + O(δ³); with δ = 1e-3
+    // scales the O(δ³) term is ~1e-10 of the difference, i.e. ~1e-13 of M_p,
+    // so a jump above the promised 1e-12·M_p would show.
+    let cases: Vec<(Box<dyn PeakDistribution>, f64, f64)> = vec![
+        (Box::new(Gaussian::new(0.0, NM).unwrap()), -9.0 * NM, NM),
+        (
+            Box::new(RiceMaxima::new(NM, 0.4).unwrap()),
+            -9.5 * 0.4 * NM,
+            0.4 * NM,
+        ),
+        (Box::new(Rician::new(12.0 * NM, NM).unwrap()), 2.5 * NM, NM),
+    ];
+    for (law, x, scale) in cases {
+        let delta = 1e-3 * scale;
+        for p in [1.5, 2.5] {
+            let below = law.partial_moment(x - delta, p);
+            let above = law.partial_moment(x + delta, p);
+            let slope = 2.0 * delta * p * law.partial_moment(x, p - 1.0);
+            let m = law.partial_moment(x, p);
+            assert!(
+                (below - above - slope).abs() <= 1e-12 * m,
+                "{law:?} p={p}: jump {:e} of M = {m:e}",
+                (below - above - slope) / m
+            );
+        }
+    }
+}
