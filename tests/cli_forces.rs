@@ -199,7 +199,7 @@ fn write_scene(name: &str, text: &str) -> PathBuf {
 fn bad_scene_files_give_one_clear_line() {
     let paper = std::fs::read_to_string(scene_path("paper.toml")).unwrap();
     let cases: Vec<(&str, String, &str)> = vec![
-        ("missing.toml", paper.replace("nominal_clearance_m = 1e-8\n", ""), "nominal_clearance_m"),
+        ("missing.toml", paper.replace("nominal_clearance_m = 1e-8 ", "# "), "nominal_clearance_m"),
         ("negative.toml", paper.replace("height_sigma_m = 7e-10", "height_sigma_m = -7e-10"), "surface.height_sigma_m"),
         ("nan.toml", paper.replace("mass_kg = 1e-6", "mass_kg = nan"), "slider.mass_kg"),
         ("unknown.toml", format!("{paper}\n[magnetic]\nstrength = 1.0\n"), "magnetic"),
