@@ -158,7 +158,44 @@ impl Tabulated {
     fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
         match self.lookup(d) {
             Some(v) => v,
-            None => self.exact_one(terms, d).unwrap_or((f64::NAN, f64::NAN)),
+            None => fallback(self, terms, d),
+        }
+    }
+}
+
+/// The exact sum outside the tables (kept out of line: the hot path stays small).
+#[cold]
+#[inline(never)]
+fn fallback(tab: &Tabulated, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+    tab.exact_one(terms, d).unwrap_or((f64::NAN, f64::NAN))
+}
+
+/// A table on the hot path: a single-segment table is held by value, saving the pointer chase
+/// through the shared [`Tabulated`].
+#[derive(Clone, Debug)]
+struct Slot {
+    single: Option<Table>,
+    tab: Arc<Tabulated>,
+}
+
+impl Slot {
+    fn new(tab: Arc<Tabulated>) -> Self {
+        let single = match tab.segments.as_slice() {
+            [only] => Some(only.clone()),
+            _ => None,
+        };
+        Slot { single, tab }
+    }
+
+    #[inline]
+    fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+        let hit = match &self.single {
+            Some(t) => t.eval(d),
+            None => self.tab.lookup(d),
+        };
+        match hit {
+            Some(v) => v,
+            None => fallback(&self.tab, terms, d),
         }
     }
 }
@@ -172,7 +209,8 @@ fn next_toward(x: f64, toward: f64) -> f64 {
     }
 }
 
-type PerGap = [Option<Arc<Tabulated>>; 2];
+type ArcGap = [Option<Arc<Tabulated>>; 2];
+type PerGap = [Option<Slot>; 2];
 
 /// All enabled terms, tabulated over the separation.
 ///
@@ -277,10 +315,10 @@ impl InterfaceForces {
                 }
             }
         }
-        let mut static_part: PerGap = [None, None];
-        let mut per_volt2: PerGap = [None, None];
-        let mut contact: PerGap = [None, None];
-        let mut area: PerGap = [None, None];
+        let mut static_part: ArcGap = [None, None];
+        let mut per_volt2: ArcGap = [None, None];
+        let mut contact: ArcGap = [None, None];
+        let mut area: ArcGap = [None, None];
         for gap in gaps {
             let g = gap.index();
             for (coupling, slot) in [
@@ -317,13 +355,14 @@ impl InterfaceForces {
                 area[g] = Some(Arc::new(tab));
             }
         }
+        let hot = |a: ArcGap| a.map(|t| t.map(Slot::new));
         Ok(InterfaceForces {
             terms: Arc::new(terms),
             range,
-            static_part,
-            per_volt2,
-            contact,
-            area,
+            static_part: hot(static_part),
+            per_volt2: hot(per_volt2),
+            contact: hot(contact),
+            area: hot(area),
             by_kind,
         })
     }
@@ -433,6 +472,7 @@ impl InterfaceForces {
             .chain(&self.contact)
             .chain(&self.area)
             .flatten()
+            .map(|s| &s.tab)
             .chain(self.by_kind.iter().map(|(_, _, _, t)| t));
         let mut n = 0;
         for t in all {
