@@ -48,6 +48,19 @@ fn bench(c: &mut Criterion) {
             acc
         })
     });
+    // An ODE trajectory moves d a little per step: successive look-ups hit neighbouring nodes.
+    let path: Vec<f64> = (0..1024)
+        .map(|i| 5.0e-9 + 4.5e-9 * (2.0 * std::f64::consts::PI * i as f64 / 1024.0).sin())
+        .collect();
+    group.bench_function("tables along a trajectory", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &d in &path {
+                acc += full_eval(&forces, black_box(d));
+            }
+            acc
+        })
+    });
     let direct_points = gaps(16);
     group.throughput(Throughput::Elements(direct_points.len() as u64));
     group.bench_function("direct quadrature of every term", |b| {

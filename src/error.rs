@@ -95,7 +95,10 @@ pub fn check_finite(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(Error::invalid(field, format!("must be finite, got {value}")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite, got {value}"),
+        ))
     }
 }
 
@@ -110,7 +113,10 @@ pub fn check_positive(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(Error::invalid(field, format!("must be finite and > 0, got {value}")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite and > 0, got {value}"),
+        ))
     }
 }
 
@@ -125,6 +131,9 @@ pub fn check_non_negative(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(Error::invalid(field, format!("must be finite and >= 0, got {value}")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite and >= 0, got {value}"),
+        ))
     }
 }

@@ -45,7 +45,10 @@ impl Discrete {
             ));
         }
         if let Some((i, z)) = heights.iter().enumerate().find(|(_, z)| !z.is_finite()) {
-            return Err(Error::invalid(field, format!("height {i} is not finite: {z}")));
+            return Err(Error::invalid(
+                field,
+                format!("height {i} is not finite: {z}"),
+            ));
         }
         heights.sort_by(f64::total_cmp);
         let n = heights.len() as f64;

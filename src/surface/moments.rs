@@ -38,7 +38,10 @@ pub(crate) fn partial_moment(shape: &Shape<'_>, d: f64, p: f64) -> f64 {
         s * (14.0 + 2.0 * p.sqrt()).min((50.0 + 4.0 * p) / t)
     };
     let upper = d + reach;
-    if !(upper > shape.lower) {
+    if upper.is_nan() {
+        return f64::NAN;
+    }
+    if upper <= shape.lower {
         return 0.0;
     }
     let pdf = shape.pdf;

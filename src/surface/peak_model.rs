@@ -118,20 +118,21 @@ impl PeakModel {
                 Arc::new(renamed(RiceMaxima::new(*sigma_m, *epsilon), prefix)?)
             }
             PeakModel::Rician { nu_m, s_m } => Arc::new(renamed(Rician::new(*nu_m, *s_m), prefix)?),
-            PeakModel::Histogram { edges_m, counts } => Arc::new(renamed(
-                Empirical::from_histogram(edges_m, counts),
-                prefix,
-            )?),
+            PeakModel::Histogram { edges_m, counts } => {
+                Arc::new(renamed(Empirical::from_histogram(edges_m, counts), prefix)?)
+            }
             PeakModel::Sample { heights_m } => {
                 Arc::new(renamed(Empirical::from_sample(heights_m), prefix)?)
             }
-            PeakModel::Discrete { heights_m } => Arc::new(renamed(
-                Discrete::from_heights(heights_m.clone()),
-                prefix,
-            )?),
+            PeakModel::Discrete { heights_m } => {
+                Arc::new(renamed(Discrete::from_heights(heights_m.clone()), prefix)?)
+            }
             PeakModel::DiscreteSampled { from, n, seed } => {
                 let parent = from.build_at(&format!("{prefix}.from"))?;
-                Arc::new(renamed(Discrete::sample(parent.as_ref(), *n, *seed), prefix)?)
+                Arc::new(renamed(
+                    Discrete::sample(parent.as_ref(), *n, *seed),
+                    prefix,
+                )?)
             }
         })
     }

@@ -4,7 +4,7 @@
 use super::moments::{self, Shape};
 use super::special::{norm_cdf, norm_pdf, one_minus_x_mills, INV_SQRT_2PI};
 use super::PeakDistribution;
-use crate::error::{check_positive};
+use crate::error::check_positive;
 use crate::{Error, Result};
 
 /// Law of the maxima of a Gaussian process of rms height `sigma` (m) and

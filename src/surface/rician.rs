@@ -59,16 +59,7 @@ impl PeakDistribution for Rician {
     fn partial_moment(&self, d: f64, p: f64) -> f64 {
         let a = self.nu / self.s;
         let pdf = |x: f64| Self::standard_pdf(x, a);
-        let landmarks = [
-            a - 6.0,
-            a - 3.0,
-            a - 1.0,
-            a,
-            a + 1.0,
-            a + 3.0,
-            a + 6.0,
-            1.0,
-        ];
+        let landmarks = [a - 6.0, a - 3.0, a - 1.0, a, a + 1.0, a + 3.0, a + 6.0, 1.0];
         let shape = Shape {
             pdf: &pdf,
             lower: 0.0,
