@@ -35,7 +35,9 @@ fn direct_eval(f: &InterfaceForces, d: f64) -> f64 {
 }
 
 fn bench(c: &mut Criterion) {
-    let forces = Scene::paper().build_interface().expect("paper scene builds");
+    let forces = Scene::paper()
+        .build_interface()
+        .expect("paper scene builds");
     let mut group = c.benchmark_group("interface forces (paper scene)");
     let table_points = gaps(1024);
     group.throughput(Throughput::Elements(table_points.len() as u64));

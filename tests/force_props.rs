@@ -16,12 +16,14 @@ fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
 fn footprint() -> impl Strategy<Value = Footprint> {
     prop_oneof![
         log_uniform(1e-10, 1e-6).prop_map(|a| Footprint::Flat { area_m2: a }),
-        (log_uniform(1e-3, 1e-1), proptest::option::of(log_uniform(1e-6, 1e-3))).prop_map(
-            |(rc, r)| Footprint::Paraboloid {
+        (
+            log_uniform(1e-3, 1e-1),
+            proptest::option::of(log_uniform(1e-6, 1e-3))
+        )
+            .prop_map(|(rc, r)| Footprint::Paraboloid {
                 radius_of_curvature_m: rc,
                 max_radius_m: r,
-            }
-        ),
+            }),
     ]
 }
 

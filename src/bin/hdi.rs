@@ -133,7 +133,9 @@ impl Parsed {
             Some(SceneSource::Paper) => Ok(Scene::paper()),
             // parse errors already carry the file name; validation errors get it here
             Some(SceneSource::File(path)) => Scene::from_path(path).map_err(|e| match e {
-                hdi_tribology::Error::InvalidInput { .. } => CliError::Failed(format!("{path}: {e}")),
+                hdi_tribology::Error::InvalidInput { .. } => {
+                    CliError::Failed(format!("{path}: {e}"))
+                }
                 other => CliError::from(other),
             }),
         }

@@ -161,15 +161,20 @@ impl<L: PressureLaw> AveragedTerm<L> {
             rel_tol: QUAD_REL_TOL,
             max_intervals: 2000,
         };
-        let est = integrate_with_breaks(integrand, a, b, &breaks, &opts)
-            .map_err(|e| Error::no_convergence(format!("{} at d = {d} m", self.name), e.to_string()))?;
+        let est = integrate_with_breaks(integrand, a, b, &breaks, &opts).map_err(|e| {
+            Error::no_convergence(format!("{} at d = {d} m", self.name), e.to_string())
+        })?;
         Ok(est.value)
     }
 
     /// Mean pressure `p̄(d)`, Pa.
     pub fn mean_pressure(&self, d: f64) -> Result<f64> {
         if self.sigma == 0.0 {
-            return Ok(if d >= self.cutoff { self.law.pressure(d) } else { 0.0 });
+            return Ok(if d >= self.cutoff {
+                self.law.pressure(d)
+            } else {
+                0.0
+            });
         }
         self.weighted(d, |h| self.law.pressure(h))
     }
@@ -178,7 +183,11 @@ impl<L: PressureLaw> AveragedTerm<L> {
     pub fn mean_pressure_slope(&self, d: f64) -> Result<f64> {
         let hc = self.cutoff;
         if self.sigma == 0.0 {
-            return Ok(if d >= hc { self.law.pressure_slope(d) } else { 0.0 });
+            return Ok(if d >= hc {
+                self.law.pressure_slope(d)
+            } else {
+                0.0
+            });
         }
         let edge = self.gauss(d - hc) * self.law.pressure(hc);
         Ok(edge + self.weighted(d, |h| self.law.pressure_slope(h))?)

@@ -112,7 +112,11 @@ impl Tabulated {
             // At an interior kink evaluate one ulp inside the segment, so that each piece sees the
             // one-sided limit of a function that jumps there (smooth surface, flat footprint).
             let a_in = if k == 0 { a } else { next_toward(a, b) };
-            let b_in = if k + 2 == edges.len() { b } else { next_toward(b, a) };
+            let b_in = if k + 2 == edges.len() {
+                b
+            } else {
+                next_toward(b, a)
+            };
             let f = |x: f64| -> Result<(f64, f64)> {
                 let x = x.clamp(a_in, b_in);
                 match source {
@@ -306,7 +310,8 @@ impl InterfaceForces {
         for gap in gaps {
             for kind in kinds {
                 for coupling in [Coupling::Static, Coupling::PerVoltSquared] {
-                    let m = select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
+                    let m =
+                        select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
                     if !m.is_empty() {
                         let e = &edges[gap.index()];
                         let tab = Tabulated::build(&terms, m, false, e, opts, Source::Exact)?;
@@ -341,7 +346,14 @@ impl InterfaceForces {
                     Arc::clone(&parts[0])
                 } else {
                     let e = &edges[g];
-                    Arc::new(Tabulated::build(&terms, m, false, e, opts, Source::Parts(&parts))?)
+                    Arc::new(Tabulated::build(
+                        &terms,
+                        m,
+                        false,
+                        e,
+                        opts,
+                        Source::Parts(&parts),
+                    )?)
                 });
             }
             contact[g] = by_kind
