@@ -164,7 +164,13 @@ impl Parsed {
         match &self.scene {
             None => Err(CliError::Usage("missing scene: a file or --paper".into())),
             Some(SceneSource::Paper) => Ok(Scene::paper()),
-            Some(SceneSource::File(path)) => Ok(Scene::from_path(path)?),
+            // parse errors already carry the file name; validation errors get it here
+            Some(SceneSource::File(path)) => Scene::from_path(path).map_err(|e| match e {
+                hdi_tribology::Error::InvalidInput { .. } => {
+                    CliError::Failed(format!("{path}: {e}"))
+                }
+                other => CliError::from(other),
+            }),
         }
     }
 }

@@ -19,7 +19,10 @@ pub fn composite_modulus(e1: f64, nu1: f64, e2: f64, nu2: f64) -> Result<f64> {
     check_positive("e2", e2)?;
     for (field, nu) in [("nu1", nu1), ("nu2", nu2)] {
         if !(nu.is_finite() && nu > -1.0 && nu <= 0.5) {
-            return Err(Error::invalid(field, format!("must lie in (-1, 0.5], got {nu}")));
+            return Err(Error::invalid(
+                field,
+                format!("must lie in (-1, 0.5], got {nu}"),
+            ));
         }
     }
     Ok(1.0 / ((1.0 - nu1 * nu1) / e1 + (1.0 - nu2 * nu2) / e2))

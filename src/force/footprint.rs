@@ -45,7 +45,10 @@ impl Footprint {
                 radius_of_curvature_m,
                 max_radius_m,
             } => {
-                check_positive(&format!("{field}.radius_of_curvature_m"), radius_of_curvature_m)?;
+                check_positive(
+                    &format!("{field}.radius_of_curvature_m"),
+                    radius_of_curvature_m,
+                )?;
                 if let Some(r) = max_radius_m {
                     check_positive(&format!("{field}.max_radius_m"), r)?;
                 }

@@ -62,7 +62,12 @@ impl Scene {
             heater: HeaterSpec {
                 efficiency_m_per_w: 1.0e-7,
                 thermal_lag_s: 0.0,
-                programme: vec![[0.0, 0.060], [3.6e-3, 0.078], [4.0e-3, 0.078], [7.6e-3, 0.060]],
+                programme: vec![
+                    [0.0, 0.060],
+                    [3.6e-3, 0.078],
+                    [4.0e-3, 0.078],
+                    [7.6e-3, 0.060],
+                ],
                 triggered: TriggeredSpec {
                     start_power_w: 0.060,
                     ramp_rate_w_per_s: 5.0,

@@ -16,8 +16,14 @@ impl Scene {
             self.peaks().map(|_| ())?;
         }
         if let Some(m) = &self.intermolecular {
-            check_positive("intermolecular.hamaker_attractive_j", m.hamaker_attractive_j)?;
-            check_positive("intermolecular.hamaker_repulsive_j_m6", m.hamaker_repulsive_j_m6)?;
+            check_positive(
+                "intermolecular.hamaker_attractive_j",
+                m.hamaker_attractive_j,
+            )?;
+            check_positive(
+                "intermolecular.hamaker_repulsive_j_m6",
+                m.hamaker_repulsive_j_m6,
+            )?;
             if let Some(c) = m.cutoff_m {
                 check_positive("intermolecular.cutoff_m", c)?;
             }
@@ -25,7 +31,10 @@ impl Scene {
         }
         if let Some(e) = &self.electrostatic {
             check_finite("electrostatic.contact_potential_v", e.contact_potential_v)?;
-            check_non_negative("electrostatic.dielectric_thickness_m", e.dielectric_thickness_m)?;
+            check_non_negative(
+                "electrostatic.dielectric_thickness_m",
+                e.dielectric_thickness_m,
+            )?;
             match e.cutoff_m {
                 Some(c) => {
                     check_positive("electrostatic.cutoff_m", c)?;
@@ -54,12 +63,18 @@ impl Scene {
         check_finite("voltage.dc_v", v.dc_v)?;
         check_non_negative("voltage.ac_amplitude_v", v.ac_amplitude_v)?;
         check_positive("voltage.ac_frequency_hz", v.ac_frequency_hz)?;
-        check_positive("detector.contact_threshold_n", self.detector.contact_threshold_n)?;
+        check_positive(
+            "detector.contact_threshold_n",
+            self.detector.contact_threshold_n,
+        )?;
         check_positive("detector.window_s", self.detector.window_s)?;
         let f = &self.friction;
         check_non_negative("friction.coefficient", f.coefficient)?;
         check_non_negative("friction.disk_speed_m_per_s", f.disk_speed_m_per_s)?;
-        check_positive("friction.head_conductivity_w_per_m_k", f.head_conductivity_w_per_m_k)?;
+        check_positive(
+            "friction.head_conductivity_w_per_m_k",
+            f.head_conductivity_w_per_m_k,
+        )?;
         self.validate_solver()?;
         for (i, &a) in self.sweep.ac_amplitudes_v.iter().enumerate() {
             check_non_negative(&format!("sweep.ac_amplitudes_v[{i}]"), a)?;
@@ -74,7 +89,10 @@ impl Scene {
         if h.programme.len() < 2 {
             return Err(Error::invalid(
                 "heater.programme",
-                format!("needs at least 2 knots [t_s, power_w], got {}", h.programme.len()),
+                format!(
+                    "needs at least 2 knots [t_s, power_w], got {}",
+                    h.programme.len()
+                ),
             ));
         }
         for (i, &[t, p]) in h.programme.iter().enumerate() {
@@ -83,7 +101,10 @@ impl Scene {
             if i > 0 && t <= h.programme[i - 1][0] {
                 return Err(Error::invalid(
                     format!("heater.programme[{i}].t_s"),
-                    format!("times must increase strictly, got {t} after {}", h.programme[i - 1][0]),
+                    format!(
+                        "times must increase strictly, got {t} after {}",
+                        h.programme[i - 1][0]
+                    ),
                 ));
             }
         }
@@ -100,7 +121,10 @@ impl Scene {
             return Err(Error::invalid("solver.method", "must not be empty"));
         }
         if !(s.rtol > 0.0 && s.rtol < 1.0) {
-            return Err(Error::invalid("solver.rtol", format!("must lie in (0, 1), got {}", s.rtol)));
+            return Err(Error::invalid(
+                "solver.rtol",
+                format!("must lie in (0, 1), got {}", s.rtol),
+            ));
         }
         check_positive("solver.atol_m", s.atol_m)?;
         if let Some(h) = s.max_step_s {
@@ -111,7 +135,10 @@ impl Scene {
         }
         let t = &self.table;
         if !(t.rel_tol > 0.0 && t.rel_tol < 1e-2) {
-            return Err(Error::invalid("table.rel_tol", format!("must lie in (0, 0.01), got {}", t.rel_tol)));
+            return Err(Error::invalid(
+                "table.rel_tol",
+                format!("must lie in (0, 0.01), got {}", t.rel_tol),
+            ));
         }
         if let Some(lo) = t.d_min_m {
             check_finite("table.d_min_m", lo)?;
@@ -120,7 +147,7 @@ impl Scene {
             check_finite("table.d_max_m", hi)?;
         }
         let (lo, hi) = self.table_range();
-        if !(lo < hi) {
+        if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
             return Err(Error::invalid(
                 "table",
                 format!("d_min_m must be below d_max_m, got range ({lo}, {hi})"),
