@@ -44,7 +44,13 @@ fn cycles(c: &mut Criterion) {
             ac_amplitude: v_ac,
             ..s.model.voltage
         });
-        for method in [Method::Tsit5, Method::Rodas5P, Method::Radau5, Method::Auto] {
+        for method in [
+            Method::Tsit5,
+            Method::Dop853,
+            Method::Rodas5P,
+            Method::Radau5,
+            Method::Auto,
+        ] {
             let mut opts = CycleOptions::from_scene(&s.scene).expect("scene options");
             opts.solver.method = method;
             opts.solver.rtol = 1e-6;

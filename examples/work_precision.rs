@@ -292,7 +292,13 @@ fn sweep_report(slider: &Slider) -> Res<()> {
         rayon_threads(),
         resolved.iter().filter(|&&r| r).count()
     );
-    for method in [scene_opts.solver.method, Method::Tsit5, Method::Rodas5P, Method::Radau5] {
+    for method in [
+        scene_opts.solver.method,
+        Method::Tsit5,
+        Method::Dop853,
+        Method::Rodas5P,
+        Method::Radau5,
+    ] {
         let mut opts = scene_opts;
         opts.solver.method = method;
         let (res, wall) = timed(|| ac_sweep(&slider.model, &slider.programme, &opts, &amplitudes));
