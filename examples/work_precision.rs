@@ -103,7 +103,7 @@ fn run_problem<const N: usize>(p: &Problem<N>, rtols: &[f64], rows: &mut Vec<Row
                     error2: f64::NAN,
                     wall,
                     cpu,
-                    stats: sol.stats.clone(),
+                    stats: sol.stats,
                     status: "ok".into(),
                 },
                 Err(e) => Row {
@@ -192,7 +192,7 @@ fn run_slider(slider: &Slider, v_ac: f64, rtols: &[f64], rows: &mut Vec<Row>) ->
                         error2: (ptd - ptd_ref).abs(),
                         wall,
                         cpu,
-                        stats: r.stats.clone(),
+                        stats: r.stats,
                         status: "ok".into(),
                     },
                     None => Row {
@@ -203,7 +203,7 @@ fn run_slider(slider: &Slider, v_ac: f64, rtols: &[f64], rows: &mut Vec<Row>) ->
                         error2: f64::NAN,
                         wall,
                         cpu,
-                        stats: r.stats.clone(),
+                        stats: r.stats,
                         status: "failed: no touchdown or take-off detected".into(),
                     },
                 },
@@ -275,7 +275,11 @@ fn sweep_report(slider: &Slider) -> Res<()> {
             format!("{:.6e}", if first { v.0 } else { v.1 })
         })
     };
-    for ((r, rf), (rc, ok)) in scene_runs.iter().zip(&reference).zip(check.iter().zip(&resolved)) {
+    for ((r, rf), (rc, ok)) in scene_runs
+        .iter()
+        .zip(&reference)
+        .zip(check.iter().zip(&resolved))
+    {
         println!(
             "{:>5.1} {:>13} {:>13} {:>13} {:>13} {:>13}  {}",
             r.v_ac,
@@ -301,10 +305,16 @@ fn sweep_report(slider: &Slider) -> Res<()> {
     ] {
         let mut opts = scene_opts;
         opts.solver.method = method;
-        let (res, wall, _) = timed(|| ac_sweep(&slider.model, &slider.programme, &opts, &amplitudes));
+        let (res, wall, _) =
+            timed(|| ac_sweep(&slider.model, &slider.programme, &opts, &amplitudes));
         let runs = res?;
         let (mut e_dp, mut e_ptd) = (0.0_f64, 0.0_f64);
-        for ((r, rf), _) in runs.iter().zip(&reference).zip(&resolved).filter(|(_, ok)| **ok) {
+        for ((r, rf), _) in runs
+            .iter()
+            .zip(&reference)
+            .zip(&resolved)
+            .filter(|(_, ok)| **ok)
+        {
             match (outputs(r), outputs(rf)) {
                 (Some((dp, ptd)), Some((dp_ref, ptd_ref))) => {
                     e_dp = e_dp.max((dp - dp_ref).abs());
@@ -359,7 +369,13 @@ fn write_table(path: &Path, rows: &[Row]) -> Res<()> {
     let mut s = String::from(
         "problem,method,rtol,error,error2,wall_s,cpu_s,steps,rejected,rhs_evals,jac_evals,lu_decomps,status\n",
     );
-    let num = |v: f64| if v.is_finite() { format!("{v:e}") } else { String::new() };
+    let num = |v: f64| {
+        if v.is_finite() {
+            format!("{v:e}")
+        } else {
+            String::new()
+        }
+    };
     for r in rows {
         s.push_str(&format!(
             "{},{},{:e},{},{},{},{},{},{},{},{},{},{}\n",
@@ -383,7 +399,14 @@ fn write_table(path: &Path, rows: &[Row]) -> Res<()> {
 }
 
 /// One chart of `error` (or `error2`) against CPU time, one line per method.
-fn chart(out: &Path, problem: &str, file: &str, y_label: &str, rows: &[Row], second: bool) -> Res<()> {
+fn chart(
+    out: &Path,
+    problem: &str,
+    file: &str,
+    y_label: &str,
+    rows: &[Row],
+    second: bool,
+) -> Res<()> {
     let labels: Vec<String> = Method::ALL.iter().map(|m| m.name().to_string()).collect();
     let series: Vec<Series> = Method::ALL
         .iter()
@@ -457,8 +480,22 @@ fn main() -> Res<()> {
         chart(out, p, &format!("{p}.svg"), label, &rows, false)?;
     }
     for p in ["slider_0.0V", "slider_0.6V"] {
-        chart(out, p, &format!("{p}_dp.svg"), "|ΔP − ΔP_ref| (W)", &rows, false)?;
-        chart(out, p, &format!("{p}_ptd.svg"), "|P_TD − P_TD,ref| (W)", &rows, true)?;
+        chart(
+            out,
+            p,
+            &format!("{p}_dp.svg"),
+            "|ΔP − ΔP_ref| (W)",
+            &rows,
+            false,
+        )?;
+        chart(
+            out,
+            p,
+            &format!("{p}_ptd.svg"),
+            "|P_TD − P_TD,ref| (W)",
+            &rows,
+            true,
+        )?;
     }
     println!(
         "wrote {} rows to {} in {:.1} s",

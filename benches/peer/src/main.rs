@@ -62,7 +62,11 @@ const SOLVERS: [Solver; 6] = [
 ];
 
 /// Final state and accepted steps, or why the run failed.
-fn run<const N: usize>(p: &Problem<N>, solver: Solver, rtol: f64) -> Result<(Vec<f64>, usize), String> {
+fn run<const N: usize>(
+    p: &Problem<N>,
+    solver: Solver,
+    rtol: f64,
+) -> Result<(Vec<f64>, usize), String> {
     match solver {
         Solver::Ours(m) => {
             let opts = p.options(rtol).max_steps(PEER_STEP_CAP);
@@ -86,11 +90,12 @@ fn run_diffsol<const N: usize>(
         .atol((p.atol)(rtol).to_vec())
         .rhs_implicit(
             move |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| rhs(t, x, y),
-            move |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
-                p.jac_times(t, x, v, y)
-            },
+            move |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| p.jac_times(t, x, v, y),
         )
-        .init(move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(&y0), N)
+        .init(
+            move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(&y0),
+            N,
+        )
         .build()?;
     // The default floor on the step (1e-13, absolute) stops every diffsol method on Robertson in
     // its first steps, where the tight absolute tolerance on y₂ asks for steps near 1e-16.
@@ -211,7 +216,11 @@ fn compare<const N: usize>(p: &Problem<N>, rtols: &[f64], targets: &[f64]) {
     }
     for (s, c) in &curves {
         if c.windows(2).any(|w| w[1].error > w[0].error) {
-            println!("note: {} error not monotone in rtol on {}", s.name(), p.name);
+            println!(
+                "note: {} error not monotone in rtol on {}",
+                s.name(),
+                p.name
+            );
         }
     }
 }
