@@ -25,6 +25,7 @@
 #![cfg_attr(docsrs, feature(doc_cfg))]
 
 pub mod analysis;
+pub mod clearance;
 pub mod error;
 pub mod force;
 pub mod heater;

@@ -13,8 +13,16 @@ fn vdp(mu: f64) -> FnSystem<impl Fn(f64, &Vector2<f64>, &mut Vector2<f64>)> {
 #[test]
 fn explicit_method_on_stiff_problem_exhausts_step_budget() {
     let opts = Options::default().max_steps(2000);
-    let err = solve(&vdp(1e6), 0.0, Vector2::new(2.0, 0.0), 2e6, Method::Tsit5, &opts, &mut [])
-        .unwrap_err();
+    let err = solve(
+        &vdp(1e6),
+        0.0,
+        Vector2::new(2.0, 0.0),
+        2e6,
+        Method::Tsit5,
+        &opts,
+        &mut [],
+    )
+    .unwrap_err();
     match err {
         OdeError::TooManySteps { t, max_steps } => {
             assert_eq!(max_steps, 2000);
@@ -24,7 +32,15 @@ fn explicit_method_on_stiff_problem_exhausts_step_budget() {
     }
     // The stiff methods finish the same problem within the same budget.
     for m in [Method::Rodas5P, Method::Auto] {
-        let sol = solve(&vdp(1e6), 0.0, Vector2::new(2.0, 0.0), 2e6, m, &opts, &mut []);
+        let sol = solve(
+            &vdp(1e6),
+            0.0,
+            Vector2::new(2.0, 0.0),
+            2e6,
+            m,
+            &opts,
+            &mut [],
+        );
         assert!(sol.is_ok(), "{m}: {:?}", sol.err());
     }
 }
@@ -35,17 +51,38 @@ fn nan_right_hand_side_is_reported_with_its_time() {
         dy[0] = if t > 1.0 { f64::NAN } else { -y[0] };
     });
     for m in [Method::Tsit5, Method::Rodas5P, Method::Auto] {
-        let err = solve(&sys, 0.0, Vector1::new(1.0), 2.0, m, &Options::default(), &mut []).unwrap_err();
+        let err = solve(
+            &sys,
+            0.0,
+            Vector1::new(1.0),
+            2.0,
+            m,
+            &Options::default(),
+            &mut [],
+        )
+        .unwrap_err();
         match err {
             OdeError::NonFinite { t, .. } => assert!((t - 1.0).abs() < 1e-6, "{m}: t = {t}"),
             other => panic!("{m}: expected NonFinite, got {other}"),
         }
     }
     // Non-finite at the very start.
-    let bad = FnSystem::new(|_t: f64, _y: &Vector1<f64>, dy: &mut Vector1<f64>| dy[0] = f64::INFINITY);
-    let err = solve(&bad, 0.0, Vector1::new(1.0), 1.0, Method::Tsit5, &Options::default(), &mut [])
-        .unwrap_err();
-    assert!(matches!(err, OdeError::NonFinite { t, .. } if t == 0.0), "{err}");
+    let bad =
+        FnSystem::new(|_t: f64, _y: &Vector1<f64>, dy: &mut Vector1<f64>| dy[0] = f64::INFINITY);
+    let err = solve(
+        &bad,
+        0.0,
+        Vector1::new(1.0),
+        1.0,
+        Method::Tsit5,
+        &Options::default(),
+        &mut [],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, OdeError::NonFinite { t, .. } if t == 0.0),
+        "{err}"
+    );
 }
 
 #[test]
@@ -83,32 +120,76 @@ fn bad_input_names_the_field() {
     let d = Options::default();
     assert_eq!(field(run(1.0, y0, 0.0, &d)), "tf");
     assert_eq!(field(run(0.0, y0, f64::NAN, &d)), "t0, tf");
-    assert_eq!(field(run(0.0, Vector2::new(f64::NAN, 0.0), 1.0, &d)), "y0[0]");
-    assert_eq!(field(run(0.0, y0, 1.0, &d.clone().rtol(0.0))), "options.rtol");
-    assert_eq!(field(run(0.0, y0, 1.0, &d.clone().atol(-1.0))), "options.atol");
+    assert_eq!(
+        field(run(0.0, Vector2::new(f64::NAN, 0.0), 1.0, &d)),
+        "y0[0]"
+    );
+    assert_eq!(
+        field(run(0.0, y0, 1.0, &d.clone().rtol(0.0))),
+        "options.rtol"
+    );
+    assert_eq!(
+        field(run(0.0, y0, 1.0, &d.clone().atol(-1.0))),
+        "options.atol"
+    );
     assert_eq!(
         field(run(0.0, y0, 1.0, &d.clone().atol_per_component(vec![1e-6]))),
         "options.atol"
     );
     assert_eq!(
-        field(run(0.0, y0, 1.0, &d.clone().atol_per_component(vec![1e-6, f64::NAN]))),
+        field(run(
+            0.0,
+            y0,
+            1.0,
+            &d.clone().atol_per_component(vec![1e-6, f64::NAN])
+        )),
         "options.atol[1]"
     );
-    assert_eq!(field(run(0.0, y0, 1.0, &d.clone().h_max(0.0))), "options.h_max");
-    assert_eq!(field(run(0.0, y0, 1.0, &d.clone().max_steps(0))), "options.max_steps");
-    assert_eq!(field(run(0.0, y0, 1.0, &d.clone().adaptive(false))), "options.h_init");
     assert_eq!(
-        field(run(0.0, y0, 1.0, &d.clone().save(SaveAt::Times(vec![0.5, 2.0])))),
+        field(run(0.0, y0, 1.0, &d.clone().h_max(0.0))),
+        "options.h_max"
+    );
+    assert_eq!(
+        field(run(0.0, y0, 1.0, &d.clone().max_steps(0))),
+        "options.max_steps"
+    );
+    assert_eq!(
+        field(run(0.0, y0, 1.0, &d.clone().adaptive(false))),
+        "options.h_init"
+    );
+    assert_eq!(
+        field(run(
+            0.0,
+            y0,
+            1.0,
+            &d.clone().save(SaveAt::Times(vec![0.5, 2.0]))
+        )),
         "options.save"
     );
     assert_eq!(
-        field(run(0.0, y0, 1.0, &d.clone().save(SaveAt::Times(vec![0.5, 0.2])))),
+        field(run(
+            0.0,
+            y0,
+            1.0,
+            &d.clone().save(SaveAt::Times(vec![0.5, 0.2]))
+        )),
         "options.save"
     );
     // Empty dynamic state.
     let dsys = FnSystem::new(|_t: f64, _y: &DVector<f64>, _dy: &mut DVector<f64>| {});
-    let r = solve(&dsys, 0.0, DVector::zeros(0), 1.0, Method::Tsit5, &d, &mut []);
+    let r = solve(
+        &dsys,
+        0.0,
+        DVector::zeros(0),
+        1.0,
+        Method::Tsit5,
+        &d,
+        &mut [],
+    );
     assert!(matches!(r, Err(OdeError::InvalidInput { .. })));
     // Unknown method name.
-    assert!(matches!("rk4".parse::<Method>(), Err(OdeError::InvalidInput { .. })));
+    assert!(matches!(
+        "rk4".parse::<Method>(),
+        Err(OdeError::InvalidInput { .. })
+    ));
 }

@@ -100,8 +100,16 @@ fn max_rel_err<const N: usize>(y: &SVector<f64, N>, r: &[f64; N], floor: f64) ->
 
 fn vdp(method: Method, tol: f64) -> Solution<U2> {
     let opts = Options::default().rtol(tol).atol(tol).dense(false);
-    solve(&VanDerPol { mu: 1000.0 }, 0.0, Vector2::new(2.0, 0.0), 2000.0, method, &opts, &mut [])
-        .unwrap_or_else(|e| panic!("{method} at tol {tol}: {e}"))
+    solve(
+        &VanDerPol { mu: 1000.0 },
+        0.0,
+        Vector2::new(2.0, 0.0),
+        2000.0,
+        method,
+        &opts,
+        &mut [],
+    )
+    .unwrap_or_else(|e| panic!("{method} at tol {tol}: {e}"))
 }
 
 fn rober(method: Method, rtol: f64) -> Solution<U3> {
@@ -111,8 +119,16 @@ fn rober(method: Method, rtol: f64) -> Solution<U3> {
         .atol_per_component(vec![1e-4 * rtol * 1e-8, 1e-4 * rtol * 1e-13, 1e-4 * rtol])
         .dense(false)
         .max_steps(200_000);
-    solve(&Robertson, 0.0, Vector3::new(1.0, 0.0, 0.0), 1e11, method, &opts, &mut [])
-        .unwrap_or_else(|e| panic!("{method} at rtol {rtol}: {e}"))
+    solve(
+        &Robertson,
+        0.0,
+        Vector3::new(1.0, 0.0, 0.0),
+        1e11,
+        method,
+        &opts,
+        &mut [],
+    )
+    .unwrap_or_else(|e| panic!("{method} at rtol {rtol}: {e}"))
 }
 
 fn hires(method: Method, tol: f64) -> Solution<U8> {
@@ -147,7 +163,11 @@ fn robertson_to_1e11_conserves_mass_and_matches_reference() {
     for m in STIFF {
         let sol = rober(m, 1e-8);
         let y = sol.y_final();
-        let e = max_rel_err(&SVector::<f64, 3>::from([y[0], y[1], y[2]]), &ROBER_REF, 1e-30);
+        let e = max_rel_err(
+            &SVector::<f64, 3>::from([y[0], y[1], y[2]]),
+            &ROBER_REF,
+            1e-30,
+        );
         println!("rober {m}: rel err {e:.2e}, {:?}", sol.stats);
         // Relative error per component (even y2 ~ 1e-13) within 1e-4.
         assert!(e < 1e-4, "{m}: relative error {e}");
