@@ -138,6 +138,12 @@ impl CalibrationOptions {
                 "needs at least two samples per measurement window",
             ));
         }
+        if self.staircase.dwell() / self.sample_interval > 1e7 {
+            return Err(Error::invalid(
+                "sample_interval",
+                "more than 1e7 samples per heater level",
+            ));
+        }
         check_positive("rtol", self.rtol)?;
         check_positive("atol_displacement", self.atol_displacement)?;
         Ok(())
