@@ -69,7 +69,7 @@ fn calibrated_touchdown_and_clearance_match_the_static_model() {
         eta * k / at_cal.stiffness
     );
     // About 1.08 for the paper scene 10 mW below touchdown.
-    assert!(softening >= 1.0 && softening < 1.5, "k/k_tot = {softening}");
+    assert!((1.0..1.5).contains(&softening), "k/k_tot = {softening}");
     assert_eq!(cal.clearance, at_cal.d);
     assert!(
         (cal.clearance - at_static.d).abs() <= eta * STEP * softening,

@@ -87,7 +87,10 @@ fn relative_detector_waits_for_its_baseline() {
     let b = d.baseline().unwrap();
     // Baseline: RMS of a 0.1 nm sine after the high-pass (gain 0.995 at 50 kHz) ≈ 0.0704 nm,
     // with the ripple of the 20 µs mean-square window.
-    assert!((b / (1e-10 * 0.995 / 2f64.sqrt()) - 1.0).abs() < 0.1, "baseline {b}");
+    assert!(
+        (b / (1e-10 * 0.995 / 2f64.sqrt()) - 1.0).abs() < 0.1,
+        "baseline {b}"
+    );
     let t = first_fire.expect("fires after the amplitude triples");
     assert!(t > 250e-6 && t < 300e-6, "fired at {t}");
     assert!(Relative::new(VibrationRms::new(1e-12, 5e3, 2e-5).unwrap(), 1.0, 0.0, 1e-5).is_err());
@@ -134,7 +137,9 @@ fn a_user_detector_plugs_into_the_loop() {
     );
     // Zero margin: the clearance is the static gap at that level, just under d*: by at most
     // η·step·k/k_tot, with k_tot the total stiffness at the lower end (the branch softens as d falls).
-    let below = EquilibriumSolver::new(&model, 0.0).at_gap(cal.clearance).unwrap();
+    let below = EquilibriumSolver::new(&model, 0.0)
+        .at_gap(cal.clearance)
+        .unwrap();
     let softening = model.bearing().stiffness(0.0) / below.stiffness;
     assert!(cal.clearance < d_star);
     assert!(d_star - cal.clearance <= model.efficiency * step * softening);
