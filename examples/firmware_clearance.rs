@@ -11,7 +11,9 @@
 //!
 //! Run with `cargo run --release --example firmware_clearance`.
 
-use hdi_tribology::analysis::{static_hysteresis, touchdown_power, StaticOptions};
+use hdi_tribology::analysis::{
+    flying_equilibrium, static_hysteresis, touchdown_power, ScanGrid, StaticOptions,
+};
 use hdi_tribology::clearance::{
     calibrate, Calibration, CalibrationOptions, ContactForceRms, MeanContactForce, Relative,
     TouchdownDetector, VibrationRms, Zone,
@@ -57,6 +59,10 @@ fn main() -> Res<()> {
             ..model.voltage
         });
         let td_peak = touchdown_power(&peak, &StaticOptions::new(th))?;
+        // What the static model says the margin leaves (dither off, as in operation).
+        let dc2 = model.voltage.effective_dc().powi(2);
+        let set = stat.touchdown.power - MARGIN;
+        let target = flying_equilibrium(&model, set, dc2, &ScanGrid::default())?.d;
         println!(
             "\n## zone {} (r = {:.0} mm, v = {:.1} m/s, h0 = {:.1} nm, k = {:.2e} N/m)",
             zone.name,
@@ -73,6 +79,11 @@ fn main() -> Res<()> {
             stat.takeoff.power * 1e3,
             stat.hysteresis * 1e3,
             td_peak.power * 1e3
+        );
+        println!(
+            "static model at touchdown − margin = {:.2} mW: clearance {:.3} nm",
+            set * 1e3,
+            target * 1e9
         );
         // The search starts where the nominal clearance minus the protrusion would leave 5 nm,
         // a power the drive knows from its characterisation, not from the model.
