@@ -212,13 +212,19 @@ impl Calibration {
 /// Invalid options (named field); no contact up to `max_power`; a margin that leaves no power;
 /// the flying branch ending before the operating power; integration failures.
 ///
-/// ```no_run
+/// ```
+/// use hdi_tribology::analysis::{touchdown_power, StaticOptions};
 /// use hdi_tribology::clearance::{calibrate, CalibrationOptions, MeanContactForce};
 /// use hdi_tribology::{model::SliderModel, scene::Scene};
 /// let scene = Scene::paper();
 /// let model = SliderModel::from_scene(&scene)?;
-/// let mut det = MeanContactForce::new(scene.detector.contact_threshold_n, scene.detector.window_s)?;
-/// let cal = calibrate(&model, &mut det, &CalibrationOptions::new(0.080, 0.0005, 0.120, 0.010))?;
+/// let (th, window) = (scene.detector.contact_threshold_n, scene.detector.window_s);
+/// let mut det = MeanContactForce::new(th, window)?;
+/// let mut opts = CalibrationOptions::new(0.070, 0.001, 0.090, 0.010);
+/// opts.find_takeoff = false;
+/// let cal = calibrate(&model, &mut det, &opts)?;
+/// let p_static = touchdown_power(&model, &StaticOptions::new(th))?.power;
+/// assert!((cal.touchdown_power - p_static).abs() <= 0.001); // within one step
 /// println!("touchdown {:.1} mW, clearance {:.2} nm", cal.touchdown_power * 1e3, cal.clearance * 1e9);
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
