@@ -31,7 +31,7 @@ fn explicit_method_on_stiff_problem_exhausts_step_budget() {
         other => panic!("expected TooManySteps, got {other}"),
     }
     // The stiff methods finish the same problem within the same budget.
-    for m in [Method::Rodas5P, Method::Auto] {
+    for m in [Method::Rodas5P, Method::Radau5, Method::Auto] {
         let sol = solve(
             &vdp(1e6),
             0.0,
@@ -50,7 +50,7 @@ fn nan_right_hand_side_is_reported_with_its_time() {
     let sys = FnSystem::new(|t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| {
         dy[0] = if t > 1.0 { f64::NAN } else { -y[0] };
     });
-    for m in [Method::Tsit5, Method::Rodas5P, Method::Auto] {
+    for m in Method::ALL {
         let err = solve(
             &sys,
             0.0,
@@ -89,7 +89,12 @@ fn nan_right_hand_side_is_reported_with_its_time() {
 fn blow_up_hits_the_step_floor() {
     // y' = y², y(0) = 1: y = 1/(1 − t) blows up at t = 1.
     let sys = FnSystem::new(|_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| dy[0] = y[0] * y[0]);
-    for m in [Method::Tsit5, Method::Rodas5P] {
+    for m in [
+        Method::Tsit5,
+        Method::Dop853,
+        Method::Rodas5P,
+        Method::Radau5,
+    ] {
         let opts = Options::default().h_min(1e-9);
         let err = solve(&sys, 0.0, Vector1::new(1.0), 2.0, m, &opts, &mut []).unwrap_err();
         match err {
@@ -192,4 +197,57 @@ fn bad_input_names_the_field() {
         "rk4".parse::<Method>(),
         Err(OdeError::InvalidInput { .. })
     ));
+}
+
+#[test]
+fn newton_divergence_is_reported() {
+    // y' = −1e8·sign(y − 1) from y = 1: the state sits on a jump of the right-hand side and
+    // the stage equations have no solution at any step size; the Newton iterates of Radau5
+    // bounce between the two branches (contraction rate ≈ 1). After a bounded number of
+    // halvings the solver gives up with a typed error at t = 0.
+    let sys = FnSystem::new(|_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| {
+        dy[0] = -1e8 * (y[0] - 1.0).signum();
+    });
+    let err = solve(
+        &sys,
+        0.0,
+        Vector1::new(1.0),
+        1.0,
+        Method::Radau5,
+        &Options::default(),
+        &mut [],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, OdeError::NewtonDivergence { t, .. } if t == 0.0),
+        "{err}"
+    );
+}
+
+#[test]
+fn chattering_right_hand_side_ends_with_an_error_not_a_hang() {
+    // y' = −sign(y): after t = 1 the solution chatters around 0 and the implicit stage
+    // equations have no solution. Whatever the solver does there, it must stop with a typed
+    // error at t ≈ 1 within its step budget.
+    let sys = FnSystem::new(|_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| {
+        dy[0] = -y[0].signum();
+    });
+    let opts = Options::default().max_steps(20_000);
+    let err = solve(
+        &sys,
+        0.0,
+        Vector1::new(1.0),
+        3.0,
+        Method::Radau5,
+        &opts,
+        &mut [],
+    )
+    .unwrap_err();
+    let t = match err {
+        OdeError::NewtonDivergence { t, .. }
+        | OdeError::StepTooSmall { t, .. }
+        | OdeError::TooManySteps { t, .. } => t,
+        other => panic!("unexpected error {other}"),
+    };
+    assert!((t - 1.0).abs() < 1e-3, "t = {t}");
 }

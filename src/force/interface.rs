@@ -63,6 +63,15 @@ struct Tabulated {
     segments: Vec<Table>,
 }
 
+/// Where a merged table takes its values from.
+enum Source<'a> {
+    /// Direct evaluation of the member terms.
+    Exact,
+    /// The sum of already built tables over the same segments (their nodes are a subset of the
+    /// merged table's dyadic grid, so the sum is reproduced to rounding).
+    Parts(&'a [Arc<Tabulated>]),
+}
+
 impl Tabulated {
     fn exact_one(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> Result<(f64, f64)> {
         let (mut v, mut s) = (0.0, 0.0);
@@ -78,23 +87,15 @@ impl Tabulated {
         Ok((v, s))
     }
 
+    /// Tabulates the sum of `members` on the segments between consecutive `edges`.
     fn build(
         terms: &[Box<dyn InterfaceTerm>],
         members: Vec<usize>,
         area: bool,
-        (lo, hi): (f64, f64),
+        edges: &[f64],
         opts: &TableOptions,
+        source: Source<'_>,
     ) -> Result<Self> {
-        let mut cuts: Vec<f64> = members
-            .iter()
-            .flat_map(|&i| terms[i].kinks())
-            .filter(|&k| k.is_finite() && k > lo && k < hi)
-            .collect();
-        cuts.sort_by(f64::total_cmp);
-        cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-30));
-        let mut edges = vec![lo];
-        edges.extend(cuts);
-        edges.push(hi);
         let mut me = Tabulated {
             members,
             area,
@@ -116,7 +117,25 @@ impl Tabulated {
             } else {
                 next_toward(b, a)
             };
-            let table = Table::build(|x| me.exact_one(terms, x.clamp(a_in, b_in)), a, b, opts)
+            let f = |x: f64| -> Result<(f64, f64)> {
+                let x = x.clamp(a_in, b_in);
+                match source {
+                    Source::Exact => me.exact_one(terms, x),
+                    Source::Parts(parts) => {
+                        let (mut v, mut s) = (0.0, 0.0);
+                        for p in parts {
+                            let (pv, ps) = match p.lookup(x) {
+                                Some(e) => e,
+                                None => p.exact_one(terms, x)?,
+                            };
+                            v += pv;
+                            s += ps;
+                        }
+                        Ok((v, s))
+                    }
+                }
+            };
+            let table = Table::build(f, a, b, opts)
                 .map_err(|e| Error::no_convergence(what.clone(), e.to_string()))?;
             me.segments.push(table);
         }
@@ -143,7 +162,44 @@ impl Tabulated {
     fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
         match self.lookup(d) {
             Some(v) => v,
-            None => self.exact_one(terms, d).unwrap_or((f64::NAN, f64::NAN)),
+            None => fallback(self, terms, d),
+        }
+    }
+}
+
+/// The exact sum outside the tables (kept out of line: the hot path stays small).
+#[cold]
+#[inline(never)]
+fn fallback(tab: &Tabulated, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+    tab.exact_one(terms, d).unwrap_or((f64::NAN, f64::NAN))
+}
+
+/// A table on the hot path: a single-segment table is held by value, saving the pointer chase
+/// through the shared [`Tabulated`].
+#[derive(Clone, Debug)]
+struct Slot {
+    single: Option<Table>,
+    tab: Arc<Tabulated>,
+}
+
+impl Slot {
+    fn new(tab: Arc<Tabulated>) -> Self {
+        let single = match tab.segments.as_slice() {
+            [only] => Some(only.clone()),
+            _ => None,
+        };
+        Slot { single, tab }
+    }
+
+    #[inline]
+    fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+        let hit = match &self.single {
+            Some(t) => t.eval(d),
+            None => self.tab.lookup(d),
+        };
+        match hit {
+            Some(v) => v,
+            None => fallback(&self.tab, terms, d),
         }
     }
 }
@@ -157,7 +213,8 @@ fn next_toward(x: f64, toward: f64) -> f64 {
     }
 }
 
-type PerGap = [Option<Arc<Tabulated>>; 2];
+type ArcGap = [Option<Arc<Tabulated>>; 2];
+type PerGap = [Option<Slot>; 2];
 
 /// All enabled terms, tabulated over the separation.
 ///
@@ -220,7 +277,7 @@ impl InterfaceForces {
         }
         let area_opts = TableOptions {
             abs_tol: opts.abs_tol * 1e-8,
-            ..opts.clone()
+            ..*opts
         };
         let gaps = [GapReference::Bulge, GapReference::Pad];
         let kinds = [
@@ -232,6 +289,23 @@ impl InterfaceForces {
         let select = |f: &dyn Fn(&dyn InterfaceTerm) -> bool| -> Vec<usize> {
             (0..terms.len()).filter(|&i| f(terms[i].as_ref())).collect()
         };
+        // Every table on one gap shares the same cuts (the union of the kinks of its terms), so
+        // that merged tables can be summed from per-kind tables node for node.
+        let edges_of = |gap: GapReference| -> Vec<f64> {
+            let mut cuts: Vec<f64> = terms
+                .iter()
+                .filter(|t| t.gap() == gap)
+                .flat_map(|t| t.kinks())
+                .filter(|&k| k.is_finite() && k > lo && k < hi)
+                .collect();
+            cuts.sort_by(f64::total_cmp);
+            cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-30));
+            let mut edges = vec![lo];
+            edges.extend(cuts);
+            edges.push(hi);
+            edges
+        };
+        let edges = [edges_of(GapReference::Bulge), edges_of(GapReference::Pad)];
         let mut by_kind = Vec::new();
         for gap in gaps {
             for kind in kinds {
@@ -239,16 +313,17 @@ impl InterfaceForces {
                     let m =
                         select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
                     if !m.is_empty() {
-                        let tab = Tabulated::build(&terms, m, false, range, opts)?;
+                        let e = &edges[gap.index()];
+                        let tab = Tabulated::build(&terms, m, false, e, opts, Source::Exact)?;
                         by_kind.push((kind, coupling, gap, Arc::new(tab)));
                     }
                 }
             }
         }
-        let mut static_part: PerGap = [None, None];
-        let mut per_volt2: PerGap = [None, None];
-        let mut contact: PerGap = [None, None];
-        let mut area: PerGap = [None, None];
+        let mut static_part: ArcGap = [None, None];
+        let mut per_volt2: ArcGap = [None, None];
+        let mut contact: ArcGap = [None, None];
+        let mut area: ArcGap = [None, None];
         for gap in gaps {
             let g = gap.index();
             for (coupling, slot) in [
@@ -259,14 +334,26 @@ impl InterfaceForces {
                 if m.is_empty() {
                     continue;
                 }
-                // Reuse a per-kind table when the merged set is a single kind.
-                let reuse = by_kind
+                // A single kind reuses its table; several kinds are summed from theirs. Summing
+                // tables (not re-integrating the sum) keeps each term's accuracy where the terms
+                // cancel: a direct table of the sum would chase quadrature rounding there.
+                let parts: Vec<Arc<Tabulated>> = by_kind
                     .iter()
-                    .find(|(_, _, _, t)| t.members == m)
-                    .map(|(_, _, _, t)| Arc::clone(t));
-                *slot = Some(match reuse {
-                    Some(t) => t,
-                    None => Arc::new(Tabulated::build(&terms, m, false, range, opts)?),
+                    .filter(|(_, c, gp, _)| *c == coupling && *gp == gap)
+                    .map(|(_, _, _, t)| Arc::clone(t))
+                    .collect();
+                *slot = Some(if parts.len() == 1 {
+                    Arc::clone(&parts[0])
+                } else {
+                    let e = &edges[g];
+                    Arc::new(Tabulated::build(
+                        &terms,
+                        m,
+                        false,
+                        e,
+                        opts,
+                        Source::Parts(&parts),
+                    )?)
                 });
             }
             contact[g] = by_kind
@@ -275,18 +362,19 @@ impl InterfaceForces {
                 .map(|(_, _, _, t)| Arc::clone(t));
             let m = select(&|t| t.gap() == gap && t.has_contact_area());
             if !m.is_empty() {
-                area[g] = Some(Arc::new(Tabulated::build(
-                    &terms, m, true, range, &area_opts,
-                )?));
+                let e = &edges[g];
+                let tab = Tabulated::build(&terms, m, true, e, &area_opts, Source::Exact)?;
+                area[g] = Some(Arc::new(tab));
             }
         }
+        let hot = |a: ArcGap| a.map(|t| t.map(Slot::new));
         Ok(InterfaceForces {
             terms: Arc::new(terms),
             range,
-            static_part,
-            per_volt2,
-            contact,
-            area,
+            static_part: hot(static_part),
+            per_volt2: hot(per_volt2),
+            contact: hot(contact),
+            area: hot(area),
             by_kind,
         })
     }
@@ -396,6 +484,7 @@ impl InterfaceForces {
             .chain(&self.contact)
             .chain(&self.area)
             .flatten()
+            .map(|s| &s.tab)
             .chain(self.by_kind.iter().map(|(_, _, _, t)| t));
         let mut n = 0;
         for t in all {

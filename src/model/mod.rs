@@ -131,7 +131,27 @@ impl SliderModel {
     /// the air bearing.
     pub fn from_scene(scene: &Scene) -> Result<Self> {
         scene.validate()?;
-        let forces = scene.build_interface()?;
+        Self::assemble(scene, scene.build_interface()?)
+    }
+
+    /// Builds the model of a scene with interface forces assembled by the caller, e.g. the scene's
+    /// terms plus a term of one's own:
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{force::InterfaceForces, model::SliderModel, quadrature::TableOptions, scene::Scene};
+    /// let scene = Scene::paper();
+    /// let terms = scene.interface_terms()?;
+    /// // terms.push(Box::new(MyMeniscus::new(..)));
+    /// let forces = InterfaceForces::build(terms, scene.table_range(), &TableOptions::default())?;
+    /// let model = SliderModel::from_scene_with_forces(&scene, forces)?;
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_scene_with_forces(scene: &Scene, forces: InterfaceForces) -> Result<Self> {
+        scene.validate()?;
+        Self::assemble(scene, forces)
+    }
+
+    fn assemble(scene: &Scene, forces: InterfaceForces) -> Result<Self> {
         let bearing: Arc<dyn AirBearing> = Arc::from(scene.build_air_bearing()?);
         let contact_potential = scene
             .electrostatic

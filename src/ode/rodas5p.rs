@@ -326,8 +326,13 @@ where
         h: f64,
         y_new: &OVector<f64, D>,
         poly: &mut StepPoly,
-        _ctx: &mut Ctx<D>,
+        ctx: &mut Ctx<D>,
     ) {
+        self.f0_valid = false;
+        self.jac_valid = false;
+        if !ctx.need_poly {
+            return;
+        }
         poly.begin(t, h, 4);
         for i in 0..y.len() {
             let mut w = [0.0; 3];
@@ -342,8 +347,6 @@ where
             *poly.at(3, i) = w[2] - w[1];
             *poly.at(4, i) = -w[2];
         }
-        self.f0_valid = false;
-        self.jac_valid = false;
     }
 
     fn stiffness(&self) -> Option<f64> {
