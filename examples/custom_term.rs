@@ -8,13 +8,14 @@
 //! `4π Rc γ` of a wetted sphere. The edge at `d = h_m` is smoothed over `s` (softplus) so the
 //! force and its slope are continuous.
 //!
-//! `SliderModel` is built only from a `Scene` (its force tables are private), so the term cannot
-//! yet be put into the dynamic model; the example builds the tables with `InterfaceForces::build`
-//! and finds the folds of the static S-curve (linear air bearing) directly from them.
+//! The term joins the scene's own terms in `InterfaceForces::build`, and
+//! `SliderModel::from_scene_with_forces` makes a model of them, on which every analysis runs: here
+//! the static touchdown and take-off and one dynamic cycle, with and without the meniscus.
 //!
 //! Run with `cargo run --release --example custom_term`.
 
-use hdi_tribology::analysis::{touchdown_power, StaticOptions};
+use hdi_tribology::analysis::HeaterProgramme::Fixed;
+use hdi_tribology::analysis::{simulate_cycle, static_hysteresis, CycleOptions, StaticOptions};
 use hdi_tribology::force::{
     Coupling, GapReference, Gaps, InterfaceForces, InterfaceTerm, TermKind,
 };
@@ -56,26 +57,6 @@ impl InterfaceTerm for Meniscus {
     }
 }
 
-/// Folds of the S-curve of a linear air bearing `k`: scanning `d` down, where `k − F'(d)` changes
-/// sign. Returns (d, P) with `P = (h0 − d + F(d)/k)/η`.
-fn folds(f: &InterfaceForces, k: f64, h0: f64, eta: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
-    let n = ((hi - lo) / 1e-12) as usize;
-    // Every term of the paper scene sees the bulge gap, so the pad gap does not matter.
-    let eval = |d: f64| f.static_part(Gaps::same(d));
-    let mut out = Vec::new();
-    let mut prev = k - eval(hi).d_bulge;
-    for i in 1..=n {
-        let d = hi - i as f64 * (hi - lo) / n as f64;
-        let e = eval(d);
-        let stiff = k - e.d_bulge;
-        if (stiff > 0.0) != (prev > 0.0) {
-            out.push((d, (h0 - d + e.value / k) / eta));
-        }
-        prev = stiff;
-    }
-    out
-}
-
 fn main() -> hdi_tribology::Result<()> {
     let scene = Scene::paper();
     let meniscus = Meniscus {
@@ -113,36 +94,27 @@ fn main() -> hdi_tribology::Result<()> {
         assert!((b - (a + m)).abs() <= 1e-7 * (a.abs() + m.abs()));
     }
 
-    let (k, h0, eta) = (
-        3.0e5,
-        scene.nominal_clearance_m,
-        scene.heater.efficiency_m_per_w,
-    );
-    let (lo, _) = scene.table_range();
-    let model = SliderModel::from_scene(&scene)?;
-    let td = touchdown_power(
-        &model,
-        &StaticOptions::new(scene.detector.contact_threshold_n),
-    )?;
+    let programme = Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+    let cycle_opts = CycleOptions::from_scene(&scene)?;
+    let static_opts = StaticOptions::new(scene.detector.contact_threshold_n);
     println!(
-        "\nstatic touchdown of the paper scene (analysis): {:.3} mW ({:?})",
-        td.power * 1e3,
-        td.cause
+        "\n{:<14} {:>10} {:>10} {:>10} {:>12}",
+        "", "TD mW", "TO mW", "ΔP mW", "cycle ΔP mW"
     );
-    for (label, f) in [("paper scene", &base), ("with meniscus", &with)] {
-        let fs = folds(f, k, h0, eta, lo, 3e-9);
-        let list: Vec<String> = fs
-            .iter()
-            .map(|(d, p)| format!("{:.3} mW at d = {:.3} nm", p * 1e3, d * 1e9))
-            .collect();
-        println!("{label:<14} S-curve folds: {}", list.join("; "));
-        if let [(_, p_in), (_, p_out), ..] = fs.as_slice() {
-            println!(
-                "{:<14} fold-to-fold hysteresis {:.3} mW",
-                "",
-                (p_in - p_out) * 1e3
-            );
-        }
+    let plain = SliderModel::from_scene(&scene)?;
+    let wet = SliderModel::from_scene_with_forces(&scene, with)?;
+    for (label, model) in [("paper scene", &plain), ("with meniscus", &wet)] {
+        let s = static_hysteresis(model, &static_opts)?;
+        let c = simulate_cycle(model, &programme, &cycle_opts)?;
+        let dp = c
+            .hysteresis
+            .map_or("-".into(), |h| format!("{:.3}", h * 1e3));
+        println!(
+            "{label:<14} {:>10.3} {:>10.3} {:>10.3} {dp:>12}",
+            s.touchdown.power * 1e3,
+            s.takeoff.power * 1e3,
+            s.hysteresis * 1e3
+        );
     }
     Ok(())
 }
