@@ -4,7 +4,7 @@ use hdi_tribology::analysis::{simulate_cycle, static_hysteresis, CycleOptions, S
 use hdi_tribology::{analysis::HeaterProgramme::Fixed, model::SliderModel, scene::Scene};
 
 fn main() -> hdi_tribology::Result<()> {
-    let scene = Scene::paper(); // the built-in scene (PAPER_SCENE parameters)
+    let scene = Scene::paper(); // the built-in scene of the paper
     let model = SliderModel::from_scene(&scene)?;
     let mw = |p: f64| format!("{:.2} mW", p * 1e3);
     // Static: equilibria along the heater power, contact threshold F_th of the scene.

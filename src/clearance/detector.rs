@@ -57,7 +57,7 @@ pub trait TouchdownDetector: Debug {
 }
 
 /// The reference detector of the static model: the running mean of the contact force over a
-/// trailing window reaches a force threshold (`F_th` of MODEL.md section 6).
+/// trailing window reaches a force threshold (the `F_th` of the static and dynamic analyses).
 ///
 /// ```
 /// use hdi_tribology::clearance::{MeanContactForce, Sample, TouchdownDetector};
