@@ -118,3 +118,12 @@ fn main() -> hdi_tribology::Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    /// `cargo test` runs the example, so CI runs every example.
+    #[test]
+    fn example_runs() {
+        super::main().expect("the example runs to completion");
+    }
+}

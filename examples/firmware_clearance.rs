@@ -164,3 +164,12 @@ fn print_row(c: &Calibration, dither: &str, wall: f64) {
         wall
     );
 }
+
+#[cfg(test)]
+mod tests {
+    /// `cargo test` runs the example, so CI runs every example.
+    #[test]
+    fn example_runs() {
+        super::main().expect("the example runs to completion");
+    }
+}
