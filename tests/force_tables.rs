@@ -106,6 +106,15 @@ fn check_all(forces: &InterfaceForces, n: usize) {
             "area at d = {d}"
         );
         let b = forces.breakdown(g, 0.49);
+        // per-kind tables, each held to the strict bound against its own term
+        let kind = |k: TermKind| exact.sum(d, |t| t.kind() == k).0;
+        for (got, want) in [
+            (b.intermolecular, kind(TermKind::Intermolecular)),
+            (b.contact, kind(TermKind::Contact)),
+            (b.electrostatic_per_volt2, kind(TermKind::Electrostatic)),
+        ] {
+            assert!(value_ok(got, want, want, 1e-15), "per-kind table at d = {d}: {got} vs {want}");
+        }
         let total = exact.sum(d, stat).0 + 0.49 * exact.sum(d, volt).0;
         let scale = exact.magnitude(d, stat).0 + 0.49 * exact.magnitude(d, volt).0;
         assert!(
