@@ -113,7 +113,10 @@ fn check_all(forces: &InterfaceForces, n: usize) {
             (b.contact, kind(TermKind::Contact)),
             (b.electrostatic_per_volt2, kind(TermKind::Electrostatic)),
         ] {
-            assert!(value_ok(got, want, want, 1e-15), "per-kind table at d = {d}: {got} vs {want}");
+            assert!(
+                value_ok(got, want, want, 1e-15),
+                "per-kind table at d = {d}: {got} vs {want}"
+            );
         }
         let total = exact.sum(d, stat).0 + 0.49 * exact.sum(d, volt).0;
         let scale = exact.magnitude(d, stat).0 + 0.49 * exact.magnitude(d, volt).0;
