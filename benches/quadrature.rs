@@ -60,6 +60,36 @@ fn lookups(c: &mut Criterion) {
             black_box(table.eval(black_box(path[i])))
         })
     });
+    // A force evaluation reads three tables at the same d (contact, its
+    // derivative source, and a non-contact term).
+    let t2 = table.clone();
+    let t3 = Table::build(
+        |d| Ok((law.partial_moment(d, 1.0), -law.partial_moment(d, 0.0))),
+        lo,
+        hi,
+        &opts,
+    )
+    .unwrap();
+    c.bench_function("three table evals at one d (trajectory)", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            i = (i + 1) & 4095;
+            let d = black_box(path[i]);
+            black_box((table.eval(d), t2.eval(d), t3.eval(d)))
+        })
+    });
+    // Throughput: 4096 look-ups per iteration (divide the time by 4096).
+    c.bench_function("4096 table evals (trajectory, throughput)", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &d in &path {
+                if let Some((v, dv)) = table.eval(black_box(d)) {
+                    acc += v + dv;
+                }
+            }
+            black_box(acc)
+        })
+    });
     c.bench_function("table build (Gaussian M_1.5, 1e-9)", |b| {
         b.iter(|| {
             Table::build(

@@ -334,9 +334,11 @@ impl Table {
         }
         let p = self.panel(d);
         let s = (d - p.a) * p.inv_h;
-        // A negative `s` (rounding at a panel edge) saturates to interval 0.
-        let j = (s as usize).min(p.last as usize);
-        let t = s - j as f64;
+        // Clamp in floating point (a negative `s` from rounding at a panel edge
+        // goes to interval 0); the i32 conversion is then a single instruction.
+        let j = s.clamp(0.0, f64::from(p.last)) as i32;
+        let t = s - f64::from(j);
+        let j = j as usize;
         let k = p.start as usize + j;
         let pair = &self.nodes[k..k + 2];
         let (v, dt) = cubic(pair[0][0], pair[0][1], pair[1][0], pair[1][1], t);
@@ -346,7 +348,8 @@ impl Table {
     /// The panel covering `d` (which must be inside the range).
     #[inline(always)]
     fn panel(&self, d: f64) -> &Panel {
-        let cell = ((d - self.lo) * self.inv_cell) as usize;
+        // d is inside [lo, hi], so the index is in 0..=cells (cells ≤ 2^10).
+        let cell = ((d - self.lo) * self.inv_cell) as i32 as usize;
         &self.cells[cell.min(self.cells.len() - 1)]
     }
 
