@@ -221,7 +221,10 @@ type PerGap = [Option<Slot>; 2];
 /// indicator need them every step), and each kind has one for [`InterfaceForces::breakdown`].
 /// Tables are piecewise cubic Hermite in value and slope, built to the accuracy of
 /// [`TableOptions`] against the terms' direct quadrature (the area tables use an absolute tolerance
-/// 1e-8 times the force one, in m² instead of N).
+/// 1e-8 times the force one, in m² instead of N). A merged table of several kinds is the sum of
+/// the per-kind tables, re-tabulated on their common node grid: it is accurate to
+/// `rel_tol · Σ|F_i| + abs_tol` even where the terms cancel. Tables are split where a term reports
+/// a kink ([`InterfaceTerm::kinks`]).
 ///
 /// Outside the table range every hot-path function falls back to the exact term evaluation (slow
 /// but correct; nothing is clamped). The hot-path functions are infallible: if that fallback fails
