@@ -227,3 +227,15 @@ fn smooth_flat_electrostatics_jumps_at_the_cutoff_and_the_table_follows() {
     let p = -hdi_tribology::units::EPSILON_0 * 1e-8 / (2.0 * hc * hc);
     assert!((at - p).abs() < 1e-8 * p.abs() && (above - p).abs() < 1e-8 * p.abs());
 }
+
+#[test]
+fn interface_forces_can_be_shared_across_threads_and_may_be_empty() {
+    fn shareable<T: Send + Sync + Clone>() {}
+    shareable::<InterfaceForces>();
+    let none = InterfaceForces::build(Vec::new(), (-1e-9, 1e-8), &TableOptions::default()).unwrap();
+    let g = Gaps::same(1e-9);
+    assert_eq!(none.static_part(g).value, 0.0);
+    assert_eq!(none.breakdown(g, 1.0).total, 0.0);
+    assert!(!none.has_contact() && !none.has_voltage_terms() && !none.uses_pad_gap());
+    assert!(InterfaceForces::build(Vec::new(), (1e-8, -1e-9), &TableOptions::default()).is_err());
+}
