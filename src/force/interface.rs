@@ -253,6 +253,9 @@ type PerGap = [Option<Slot>; 2];
 /// let b = forces.breakdown(g, 1.0);
 /// assert!((f - b.total).abs() <= 1e-8 * f.abs());
 /// assert!(b.intermolecular < 0.0 && b.electrostatic < 0.0 && b.contact > 0.0);
+/// // the hot path: all three sums from one look-up
+/// let hot = forces.evaluate(g);
+/// assert!((hot.contact.value - b.contact).abs() <= 1e-8 * b.contact);
 /// # Ok(()) }
 /// ```
 #[derive(Clone, Debug)]
