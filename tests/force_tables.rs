@@ -263,3 +263,19 @@ fn interface_forces_can_be_shared_across_threads_and_may_be_empty() {
     assert!(!none.has_contact() && !none.has_voltage_terms() && !none.uses_pad_gap());
     assert!(InterfaceForces::build(Vec::new(), (1e-8, -1e-9), &TableOptions::default()).is_err());
 }
+
+#[test]
+fn shipped_scenes_tables_match_direct_quadrature() {
+    for name in [
+        "flat_gaussian.toml",
+        "dielectric.toml",
+        "finite_radius.toml",
+    ] {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name);
+        let forces = Scene::from_path(&path).unwrap().build_interface().unwrap();
+        eprintln!("{name}: {} table nodes", forces.table_nodes());
+        check_all(&forces, 150);
+    }
+}
