@@ -144,3 +144,36 @@ impl Fused {
         self.nodes.len()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fused_table_meets_its_tolerance_for_each_function() {
+        let f = |x: f64| {
+            [
+                (x.sin(), x.cos()),
+                ((-x).exp(), -(-x).exp()),
+                (x.powi(3), 3.0 * x * x),
+            ]
+        };
+        let opts = TableOptions::default();
+        let t = Fused::build(f, 0.0, 3.0, &opts).unwrap();
+        for i in 0..1000 {
+            let x = 3.0 * ((0.5 + i as f64 * 0.618_033_988_749_895) % 1.0);
+            let got = t.eval(x).unwrap();
+            for (k, (v, _)) in f(x).into_iter().enumerate() {
+                // the builder checks midpoints; elsewhere the cubic error is smaller or similar
+                assert!(
+                    (got[k].0 - v).abs() <= 2.0 * (opts.rel_tol * v.abs()).max(opts.abs_tol),
+                    "{k} at {x}"
+                );
+            }
+        }
+        // a cubic is reproduced exactly, slope included
+        let (v, s) = t.eval(1.234).unwrap()[2];
+        assert!((v - 1.234f64.powi(3)).abs() < 1e-14 && (s - 3.0 * 1.234 * 1.234).abs() < 1e-13);
+        assert!(t.eval(3.1).is_none() && t.eval(f64::NAN).is_none());
+    }
+}
