@@ -172,3 +172,20 @@ fn static_options_reject_bad_thresholds() {
     let e = takeoff_power(&model, f64::NAN, &StaticOptions::new(5e-5)).unwrap_err();
     assert!(e.to_string().contains("start_power"));
 }
+
+#[test]
+fn a_rougher_disk_has_no_folds_and_no_static_hysteresis() {
+    // The letter: "for high roughness the contact force dominates". With σ = 1 nm the contact
+    // stiffness grows before the adhesion can fold the branch: touchdown and take-off both come
+    // at the threshold, at the same gap.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/rough_disk.toml");
+    let scene = Scene::from_path(path).unwrap();
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let curve = s_curve(&model, None, &ScanGrid::default()).unwrap();
+    assert!(curve.folds.is_empty());
+    let h = static_hysteresis(&model, &StaticOptions::new(scene.detector.contact_threshold_n))
+        .unwrap();
+    assert_eq!(h.touchdown.cause, Cause::Threshold);
+    assert_eq!(h.takeoff.cause, Cause::Threshold);
+    assert!(h.hysteresis.abs() < 1e-12, "{}", h.hysteresis);
+}
