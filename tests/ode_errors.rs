@@ -23,7 +23,7 @@ fn explicit_method_on_stiff_problem_exhausts_step_budget() {
         other => panic!("expected TooManySteps, got {other}"),
     }
     // The stiff methods finish the same problem within the same budget.
-    for m in [Method::Rodas5P, Method::Auto] {
+    for m in [Method::Rodas5P, Method::Radau5, Method::Auto] {
         let sol = solve(&vdp(1e6), 0.0, Vector2::new(2.0, 0.0), 2e6, m, &opts, &mut []);
         assert!(sol.is_ok(), "{m}: {:?}", sol.err());
     }
@@ -34,7 +34,7 @@ fn nan_right_hand_side_is_reported_with_its_time() {
     let sys = FnSystem::new(|t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| {
         dy[0] = if t > 1.0 { f64::NAN } else { -y[0] };
     });
-    for m in [Method::Tsit5, Method::Rodas5P, Method::Auto] {
+    for m in Method::ALL {
         let err = solve(&sys, 0.0, Vector1::new(1.0), 2.0, m, &Options::default(), &mut []).unwrap_err();
         match err {
             OdeError::NonFinite { t, .. } => assert!((t - 1.0).abs() < 1e-6, "{m}: t = {t}"),
@@ -52,7 +52,7 @@ fn nan_right_hand_side_is_reported_with_its_time() {
 fn blow_up_hits_the_step_floor() {
     // y' = y², y(0) = 1: y = 1/(1 − t) blows up at t = 1.
     let sys = FnSystem::new(|_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| dy[0] = y[0] * y[0]);
-    for m in [Method::Tsit5, Method::Rodas5P] {
+    for m in [Method::Tsit5, Method::Dop853, Method::Rodas5P, Method::Radau5] {
         let opts = Options::default().h_min(1e-9);
         let err = solve(&sys, 0.0, Vector1::new(1.0), 2.0, m, &opts, &mut []).unwrap_err();
         match err {

@@ -13,7 +13,7 @@ fn oscillator() -> FnSystem<impl Fn(f64, &Vector2<f64>, &mut Vector2<f64>)> {
     })
 }
 
-const METHODS: [Method; 3] = [Method::Tsit5, Method::Rodas5P, Method::Auto];
+const METHODS: [Method; 5] = Method::ALL;
 
 #[test]
 fn sine_zero_crossings_located_to_1e_10() {

@@ -127,7 +127,7 @@ fn hires(method: Method, tol: f64) -> Solution<U8> {
         .unwrap_or_else(|e| panic!("{method} at tol {tol}: {e}"))
 }
 
-const STIFF: [Method; 2] = [Method::Rodas5P, Method::Auto];
+const STIFF: [Method; 3] = [Method::Rodas5P, Method::Radau5, Method::Auto];
 
 #[test]
 fn van_der_pol_matches_test_set_reference() {

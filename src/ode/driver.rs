@@ -73,6 +73,7 @@ where
         rtol: opts.rtol,
         stats: Stats::default(),
         want_stiffness: steppers.len() > 1,
+        need_poly: opts.dense || !events.is_empty() || matches!(opts.save, SaveAt::Times(_)),
     };
 
     // Kinks strictly inside (t0, tf), then tf itself.
@@ -340,8 +341,7 @@ where
             fac = fac.min(hint);
         }
         if opts.adaptive {
-            h *= fac.clamp(FAC_MIN, fac_max);
-            h = h.min(h_max);
+            h = stepper.propose(h, h * fac.clamp(FAC_MIN, fac_max)).min(h_max);
         } else if let Some(h0) = opts.h_init {
             h = h0.min(h_max);
         }

@@ -28,12 +28,14 @@
 //! ```
 
 mod dense;
+mod dop853;
 mod driver;
 mod error;
 mod event;
 mod jacobian;
 mod lu;
 mod options;
+mod radau5;
 mod rodas5p;
 mod solution;
 mod stepper;
@@ -108,8 +110,16 @@ where
             let mut m = tsit5::Tsit5::new(&problem.y0);
             driver::integrate(problem, &mut [&mut m])
         }
+        Method::Dop853 => {
+            let mut m = dop853::Dop853::new(&problem.y0);
+            driver::integrate(problem, &mut [&mut m])
+        }
         Method::Rodas5P => {
             let mut m = rodas5p::Rodas5P::new(&problem.y0);
+            driver::integrate(problem, &mut [&mut m])
+        }
+        Method::Radau5 => {
+            let mut m = radau5::Radau5::new(&problem.y0, opts.rtol);
             driver::integrate(problem, &mut [&mut m])
         }
         Method::Auto => {
@@ -117,9 +127,5 @@ where
             let mut stiff = rodas5p::Rodas5P::new(&problem.y0);
             driver::integrate(problem, &mut [&mut explicit, &mut stiff])
         }
-        other => Err(OdeError::invalid(
-            "method",
-            format!("{other} is not available yet"),
-        )),
     }
 }

@@ -15,6 +15,9 @@ where
     pub stats: Stats,
     /// Whether the method should estimate the spectral radius for stiffness switching.
     pub want_stiffness: bool,
+    /// Whether the step interpolant is used (dense output, events, output at given times);
+    /// methods whose interpolant costs extra function evaluations skip it otherwise.
+    pub need_poly: bool,
 }
 
 impl<D: Dim> Ctx<D>
@@ -104,6 +107,12 @@ where
     /// Step size multiplier suggested after a Newton or linear-algebra difficulty, if any.
     fn step_hint(&self) -> Option<f64> {
         None
+    }
+
+    /// Final say on the next step size after an accepted step of size `h_acc` for which the
+    /// controller proposes `h_new` (e.g. keep `h_acc` to reuse an LU factorisation).
+    fn propose(&self, _h_acc: f64, h_new: f64) -> f64 {
+        h_new
     }
 }
 
