@@ -110,7 +110,10 @@ impl Table {
     /// Tabulates `f` on `[lo, hi]`; `f(d)` must return the exact `(value, derivative)`.
     ///
     /// Nodes are refined until the interpolated value at the midpoint of every
-    /// interval agrees with `f` there to `max(rel_tol·|f|, abs_tol)`. The
+    /// interval agrees with `f` there to `max(rel_tol·|f|, abs_tol)`, with `|f|`
+    /// the largest magnitude among the interval's ends and midpoint (the cubic
+    /// Hermite error peaks at the midpoint, so this bounds the error on the whole
+    /// interval; near a sign change it is relative to the neighbouring values). The
     /// derivative is the derivative of the interpolant: its error is of order
     /// `tolerance / spacing` (it is exact at the nodes).
     ///
@@ -209,7 +212,10 @@ impl Table {
                 let [y1, m1] = p.nodes[i + 1];
                 let (v, _) = hermite(y0, m0, y1, m1, h, 0.5);
                 let exact = p.mids[i][0];
-                (v - exact).abs() <= (opts.rel_tol * exact.abs()).max(opts.abs_tol)
+                // Relative to the largest magnitude on the interval, so that a sign
+                // change inside it does not demand absolute accuracy near zero.
+                let scale = exact.abs().max(y0.abs()).max(y1.abs());
+                (v - exact).abs() <= (opts.rel_tol * scale).max(opts.abs_tol)
             });
             if ok {
                 done.push(p);
@@ -343,6 +349,15 @@ impl Table {
     /// True when the table holds no node (never the case for a built table).
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
+    }
+
+    /// Node spacing of the interval containing `d`, or `None` outside the range.
+    pub fn spacing_at(&self, d: f64) -> Option<f64> {
+        if !(d >= self.lo && d <= self.hi) {
+            return None;
+        }
+        let cell = (((d - self.lo) * self.inv_cell) as usize).min(self.cells.len() - 1);
+        Some(self.panels[self.cells[cell] as usize].h)
     }
 
     /// Number of panels of uniform spacing.
