@@ -60,7 +60,7 @@ pub fn gpa(x: f64) -> f64 {
 /// Milliseconds to seconds.
 ///
 /// ```
-/// assert_eq!(hdi_tribology::units::ms(3.6), 3.6e-3);
+/// assert!((hdi_tribology::units::ms(3.6) - 3.6e-3).abs() < 1e-18);
 /// ```
 pub fn ms(x: f64) -> f64 {
     x * 1e-3

@@ -16,7 +16,9 @@ use statrs::function::erf::erfc;
 const GAPS: [f64; 3] = [0.5e-9, 1e-9, 2e-9];
 
 fn scene_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
 }
 
 fn hdi(args: &[&str]) -> std::process::Output {
@@ -44,9 +46,10 @@ fn gauss(z: f64, s: f64) -> f64 {
 /// Peak-height density written out from MODEL.md 3.1 (not the crate's implementation).
 fn peak_pdf(model: &PeakModel) -> (Box<dyn Fn(f64) -> f64>, f64) {
     match *model {
-        PeakModel::Gaussian { mean_m, std_m } => {
-            (Box::new(move |z| gauss(z - mean_m, std_m)), mean_m + 40.0 * std_m)
-        }
+        PeakModel::Gaussian { mean_m, std_m } => (
+            Box::new(move |z| gauss(z - mean_m, std_m)),
+            mean_m + 40.0 * std_m,
+        ),
         PeakModel::RiceMaxima { sigma_m, epsilon } => {
             let c = (1.0 - epsilon * epsilon).sqrt();
             let f = move |z: f64| {
@@ -74,7 +77,9 @@ fn over_footprint(fp: Footprint, d: f64, pbar: &dyn Fn(f64) -> f64) -> f64 {
             match max_radius_m {
                 Some(r) => c * ts(pbar, d, d + r * r / (2.0 * rc), 1e-10),
                 // split so that tanh-sinh sees the near part at full resolution
-                None => c * (ts(pbar, d, d + 20e-9, 1e-10) + ts(pbar, d + 20e-9, f64::INFINITY, 1e-10)),
+                None => {
+                    c * (ts(pbar, d, d + 20e-9, 1e-10) + ts(pbar, d + 20e-9, f64::INFINITY, 1e-10))
+                }
             }
         }
     }
@@ -109,7 +114,8 @@ fn reference(scene: &Scene, d: f64) -> Reference {
     let el = |h: f64| -EPSILON_0 / (2.0 * (h + td).powi(2));
     let c = scene.contact.as_ref().unwrap();
     let (pdf, top) = peak_pdf(&scene.surface.peaks);
-    let k = 4.0 / 3.0 * c.composite_modulus_pa * c.asperity_radius_m.sqrt() * c.asperity_density_per_m2;
+    let k =
+        4.0 / 3.0 * c.composite_modulus_pa * c.asperity_radius_m.sqrt() * c.asperity_density_per_m2;
     let ka = PI * c.asperity_radius_m * c.asperity_density_per_m2;
     let pc = |s: f64| k * ts(|z| (z - s).powf(1.5) * pdf(z), s, top.max(s), 1e-12);
     let pa = |s: f64| ka * ts(|z| (z - s) * pdf(z), s, top.max(s), 1e-12);
@@ -131,7 +137,11 @@ fn check_scene(args: &[&str], scene: &Scene) {
     let mut all: Vec<&str> = args.to_vec();
     all.extend(["--gaps", &gaps]);
     let out = hdi(&all);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let rows = rows.as_array().unwrap();
     assert_eq!(rows.len(), GAPS.len());
@@ -140,14 +150,34 @@ fn check_scene(args: &[&str], scene: &Scene) {
         dv * dv
     };
     for (row, &d) in rows.iter().zip(&GAPS) {
-        let get = |k: &str| row[k].as_f64().unwrap_or_else(|| panic!("key {k} in {row}"));
+        let get = |k: &str| {
+            row[k]
+                .as_f64()
+                .unwrap_or_else(|| panic!("key {k} in {row}"))
+        };
         assert_eq!(get("d"), d);
         let r = reference(scene, d);
         let name = &scene.name;
-        assert!(close(get("intermolecular"), r.intermolecular), "{name} d={d}: LJ {} vs {}", get("intermolecular"), r.intermolecular);
-        assert!(close(get("electrostatic_per_volt2"), r.electrostatic_per_volt2), "{name} d={d}: G_e");
-        assert!(close(get("contact"), r.contact), "{name} d={d}: contact {} vs {}", get("contact"), r.contact);
-        assert!(close(get("real_contact_area"), r.area), "{name} d={d}: area");
+        assert!(
+            close(get("intermolecular"), r.intermolecular),
+            "{name} d={d}: LJ {} vs {}",
+            get("intermolecular"),
+            r.intermolecular
+        );
+        assert!(
+            close(get("electrostatic_per_volt2"), r.electrostatic_per_volt2),
+            "{name} d={d}: G_e"
+        );
+        assert!(
+            close(get("contact"), r.contact),
+            "{name} d={d}: contact {} vs {}",
+            get("contact"),
+            r.contact
+        );
+        assert!(
+            close(get("real_contact_area"), r.area),
+            "{name} d={d}: area"
+        );
         let fe = v * r.electrostatic_per_volt2;
         if v > 0.0 {
             assert!(close(get("electrostatic"), fe), "{name} d={d}: F_e");
@@ -156,7 +186,10 @@ fn check_scene(args: &[&str], scene: &Scene) {
         }
         let total = r.intermolecular + r.contact + fe;
         let scale = r.intermolecular.abs() + r.contact.abs() + fe.abs();
-        assert!((get("total") - total).abs() <= 1e-6 * scale, "{name} d={d}: total");
+        assert!(
+            (get("total") - total).abs() <= 1e-6 * scale,
+            "{name} d={d}: total"
+        );
     }
 }
 
@@ -172,7 +205,11 @@ fn paper_scene_forces_match_literal_double_integrals() {
 
 #[test]
 fn hand_written_scenes_match_literal_double_integrals() {
-    for name in ["flat_gaussian.toml", "dielectric.toml", "finite_radius.toml"] {
+    for name in [
+        "flat_gaussian.toml",
+        "dielectric.toml",
+        "finite_radius.toml",
+    ] {
         let path = scene_path(name);
         let scene = Scene::from_path(&path).unwrap();
         check_scene(&["forces", path.to_str().unwrap()], &scene);
@@ -180,11 +217,19 @@ fn hand_written_scenes_match_literal_double_integrals() {
 }
 
 fn one_line_error(out: &std::process::Output, code: i32) -> String {
-    assert_eq!(out.status.code(), Some(code), "stdout {}", String::from_utf8_lossy(&out.stdout));
+    assert_eq!(
+        out.status.code(),
+        Some(code),
+        "stdout {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
     let err = String::from_utf8_lossy(&out.stderr).to_string();
     assert_eq!(err.lines().count(), 1, "one line expected: {err:?}");
     assert!(err.starts_with("hdi: "), "{err}");
-    assert!(!err.contains("panicked") && !err.contains("backtrace"), "{err}");
+    assert!(
+        !err.contains("panicked") && !err.contains("backtrace"),
+        "{err}"
+    );
     assert!(out.stdout.is_empty());
     err
 }
@@ -199,10 +244,26 @@ fn write_scene(name: &str, text: &str) -> PathBuf {
 fn bad_scene_files_give_one_clear_line() {
     let paper = std::fs::read_to_string(scene_path("paper.toml")).unwrap();
     let cases: Vec<(&str, String, &str)> = vec![
-        ("missing.toml", paper.replace("nominal_clearance_m = 1e-8\n", ""), "nominal_clearance_m"),
-        ("negative.toml", paper.replace("height_sigma_m = 7e-10", "height_sigma_m = -7e-10"), "surface.height_sigma_m"),
-        ("nan.toml", paper.replace("mass_kg = 1e-6", "mass_kg = nan"), "slider.mass_kg"),
-        ("unknown.toml", format!("{paper}\n[magnetic]\nstrength = 1.0\n"), "magnetic"),
+        (
+            "missing.toml",
+            paper.replace("nominal_clearance_m = 1e-8 ", "# "),
+            "nominal_clearance_m",
+        ),
+        (
+            "negative.toml",
+            paper.replace("height_sigma_m = 7e-10", "height_sigma_m = -7e-10"),
+            "surface.height_sigma_m",
+        ),
+        (
+            "nan.toml",
+            paper.replace("mass_kg = 1e-6", "mass_kg = nan"),
+            "slider.mass_kg",
+        ),
+        (
+            "unknown.toml",
+            format!("{paper}\n[magnetic]\nstrength = 1.0\n"),
+            "magnetic",
+        ),
         (
             "histogram.toml",
             paper.replace(
@@ -220,9 +281,15 @@ fn bad_scene_files_give_one_clear_line() {
         assert!(err.contains(needle), "{file}: {err}");
     }
     let json = write_scene("bad.json", "{\"name\": \"x\"");
-    let err = one_line_error(&hdi(&["forces", json.to_str().unwrap(), "--gaps", "1e-9"]), 1);
+    let err = one_line_error(
+        &hdi(&["forces", json.to_str().unwrap(), "--gaps", "1e-9"]),
+        1,
+    );
     assert!(err.contains("bad.json"), "{err}");
-    let err = one_line_error(&hdi(&["forces", "/nonexistent/scene.toml", "--gaps", "1e-9"]), 1);
+    let err = one_line_error(
+        &hdi(&["forces", "/nonexistent/scene.toml", "--gaps", "1e-9"]),
+        1,
+    );
     assert!(err.contains("scene.toml"), "{err}");
 }
 

@@ -73,7 +73,10 @@ fn smooth_sphere_electrostatics_matches_closed_form_with_and_without_dielectric(
             let (f, df) = t.force(d).unwrap();
             let exact = -PI * RC * EPSILON_0 / (d + td);
             let slope = PI * RC * EPSILON_0 / (d + td).powi(2);
-            assert!(rel(f, exact) < 1e-13 && rel(df, slope) < 1e-13, "t_d = {td}, d = {d}");
+            assert!(
+                rel(f, exact) < 1e-13 && rel(df, slope) < 1e-13,
+                "t_d = {td}, d = {d}"
+            );
         }
     }
 }
@@ -98,12 +101,18 @@ fn lennard_jones_pressure_vanishes_at_h_e() {
     let he = lj_zero(A, B);
     assert!(rel(he, (2.0 * B / (15.0 * A)).powf(1.0 / 6.0)) < 1e-15);
     let plate = Footprint::Flat { area_m2: 1.0 };
-    let lj = Intermolecular::new(A, B, Some(0.5 * he), smooth(), plate, GapReference::Bulge)
-        .unwrap();
+    let lj =
+        Intermolecular::new(A, B, Some(0.5 * he), smooth(), plate, GapReference::Bulge).unwrap();
     let (f, df) = lj.force(he).unwrap();
     // each of the two parts is ~4e8 Pa; the sum cancels to rounding
-    assert!(f.abs() < 1e-15 * A / (6.0 * PI * he.powi(3)) * 8.0, "p(h_e) = {f}");
-    assert!(df < 0.0, "repulsion decreases through h_e, so the force rises as d falls");
+    assert!(
+        f.abs() < 1e-15 * A / (6.0 * PI * he.powi(3)) * 8.0,
+        "p(h_e) = {f}"
+    );
+    assert!(
+        df < 0.0,
+        "repulsion decreases through h_e, so the force rises as d falls"
+    );
     assert!(lj.force(0.9 * he).unwrap().0 > 0.0 && lj.force(1.1 * he).unwrap().0 < 0.0);
 }
 
@@ -127,7 +136,11 @@ fn small_roughness_converges_quadratically_to_the_smooth_sphere() {
     // checked in size (to the O(σ²/d²) ≈ 5e-4 next term) and in its order, at two σ.
     let (e1, e2) = (diff(2e-11), diff(4e-11));
     let f0pp = -A * RC / d.powi(4) + 72.0 * B * RC / (180.0 * d.powi(10));
-    assert!(rel(e1, 0.5 * 4e-22 * f0pp) < 1e-3, "{e1} vs {}", 0.5 * 4e-22 * f0pp);
+    assert!(
+        rel(e1, 0.5 * 4e-22 * f0pp) < 1e-3,
+        "{e1} vs {}",
+        0.5 * 4e-22 * f0pp
+    );
     assert!((e2 / e1 - 4.0).abs() < 1e-2, "ratio {}", e2 / e1);
     // and a tiny σ is indistinguishable from zero
     // (the two quadratures behind F agree to their 1e-12 tolerance)
@@ -146,7 +159,12 @@ fn rough_flat_terms_match_an_independent_tanh_sinh_integral() {
         let lo = -40.0 * s;
         let hi = (d - he).min(40.0 * s);
         let m = area * ts(|z| lj_p(d - z) * gauss(z, s), lo, hi);
-        let e = area * ts(|z| -EPSILON_0 / (2.0 * (d - z + 5e-10).powi(2)) * gauss(z, s), lo, hi);
+        let e = area
+            * ts(
+                |z| -EPSILON_0 / (2.0 * (d - z + 5e-10).powi(2)) * gauss(z, s),
+                lo,
+                hi,
+            );
         // both rules are asked for 1e-12..1e-13; 1e-9 leaves room for the two error estimates
         assert!(rel(lj.force(d).unwrap().0, m) < 1e-9, "LJ d = {d}");
         assert!(rel(el.force(d).unwrap().0, e) < 1e-9, "el d = {d}");
@@ -188,14 +206,25 @@ fn gw_with_gaussian_peaks_matches_independent_quadrature() {
     for d in [-1e-9, 0.0, 1e-9, 3e-9] {
         let pc = |s: f64| k * ts(|z| (z - s).powf(1.5) * pdf(z), s, top);
         let ar = |s: f64| PI * r * eta * ts(|z| (z - s) * pdf(z), s, top);
-        assert!(rel(flat.force(d).unwrap().0, area * pc(d)) < 1e-9, "flat d = {d}");
-        assert!(rel(flat.real_contact_area(d).unwrap(), area * ar(d)) < 1e-9, "{} vs {}", flat.real_contact_area(d).unwrap(), area * ar(d));
+        assert!(
+            rel(flat.force(d).unwrap().0, area * pc(d)) < 1e-9,
+            "flat d = {d}"
+        );
+        assert!(
+            rel(flat.real_contact_area(d).unwrap(), area * ar(d)) < 1e-9,
+            "{} vs {}",
+            flat.real_contact_area(d).unwrap(),
+            area * ar(d)
+        );
         // literal Derjaguin double integral over the truncated paraboloid
         let upper = (d + delta).min(top);
         let f = 2.0 * PI * RC * ts(pc, d, upper);
         let a = 2.0 * PI * RC * ts(ar, d, upper);
         assert!(rel(cap.force(d).unwrap().0, f) < 1e-8, "cap d = {d}");
-        assert!(rel(cap.real_contact_area(d).unwrap(), a) < 1e-8, "cap area d = {d}");
+        assert!(
+            rel(cap.real_contact_area(d).unwrap(), a) < 1e-8,
+            "cap area d = {d}"
+        );
     }
 }
 
@@ -230,11 +259,20 @@ fn derivatives_match_finite_differences() {
             let fd = (t.force(d + h).unwrap().0 - t.force(d - h).unwrap().0) / (2.0 * h);
             // step 1e-13 m against features of ~1e-10 m: truncation ~1e-6, quadrature noise
             // 1e-12 relative / 1e-3 step ratio ~1e-9
-            assert!((df - fd).abs() <= 1e-5 * df.abs().max(fd.abs()) + 1e-30, "{} at {d}: {df} vs {fd}", t.name());
+            assert!(
+                (df - fd).abs() <= 1e-5 * df.abs().max(fd.abs()) + 1e-30,
+                "{} at {d}: {df} vs {fd}",
+                t.name()
+            );
             if t.has_contact_area() {
                 let (_, da) = t.real_contact_area_and_slope(d).unwrap();
-                let fa = (t.real_contact_area(d + h).unwrap() - t.real_contact_area(d - h).unwrap()) / (2.0 * h);
-                assert!((da - fa).abs() <= 1e-5 * da.abs() + 1e-40, "area slope {da} vs {fa}");
+                let fa = (t.real_contact_area(d + h).unwrap()
+                    - t.real_contact_area(d - h).unwrap())
+                    / (2.0 * h);
+                assert!(
+                    (da - fa).abs() <= 1e-5 * da.abs() + 1e-40,
+                    "area slope {da} vs {fa}"
+                );
             }
         }
     }

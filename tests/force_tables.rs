@@ -67,24 +67,51 @@ fn check_all(forces: &InterfaceForces, n: usize) {
         let volt = |t: &dyn InterfaceTerm| t.coupling() == Coupling::PerVoltSquared;
         let cont = |t: &dyn InterfaceTerm| t.kind() == TermKind::Contact;
         let cases = [
-            (forces.static_part(g), exact.sum(d, stat), exact.magnitude(d, stat)),
-            (forces.per_volt2_part(g), exact.sum(d, volt), exact.magnitude(d, volt)),
-            (forces.contact(g), exact.sum(d, cont), exact.magnitude(d, cont)),
+            (
+                forces.static_part(g),
+                exact.sum(d, stat),
+                exact.magnitude(d, stat),
+            ),
+            (
+                forces.per_volt2_part(g),
+                exact.sum(d, volt),
+                exact.magnitude(d, volt),
+            ),
+            (
+                forces.contact(g),
+                exact.sum(d, cont),
+                exact.magnitude(d, cont),
+            ),
         ];
         for (k, (tab, (v, s), mag)) in cases.into_iter().enumerate() {
             let abs = 2e-15; // up to two terms, 1e-15 N each
-            assert!(value_ok(tab.value, v, mag.0, abs), "case {k} at d = {d}: table {} exact {v}", tab.value);
-            assert!(slope_ok(tab.d_bulge, s, mag, abs), "case {k} slope at d = {d}: table {} exact {s}", tab.d_bulge);
+            assert!(
+                value_ok(tab.value, v, mag.0, abs),
+                "case {k} at d = {d}: table {} exact {v}",
+                tab.value
+            );
+            assert!(
+                slope_ok(tab.d_bulge, s, mag, abs),
+                "case {k} slope at d = {d}: table {} exact {s}",
+                tab.d_bulge
+            );
             worst[k] = worst[k].max((tab.value - v).abs() / (mag.0 + abs / 1e-8));
-            worst[3] = worst[3].max((tab.d_bulge - s).abs() / (1e-6 * mag.1.max(mag.0 / 1e-10) + abs / 1e-10));
+            worst[3] = worst[3]
+                .max((tab.d_bulge - s).abs() / (1e-6 * mag.1.max(mag.0 / 1e-10) + abs / 1e-10));
         }
         let (a, _) = exact.area(d);
         // contact-area tables: the same relative bound, absolute 1e-8 × 1e-16 m²
-        assert!(value_ok(forces.real_contact_area(g), a, a, 1e-24), "area at d = {d}");
+        assert!(
+            value_ok(forces.real_contact_area(g), a, a, 1e-24),
+            "area at d = {d}"
+        );
         let b = forces.breakdown(g, 0.49);
         let total = exact.sum(d, stat).0 + 0.49 * exact.sum(d, volt).0;
         let scale = exact.magnitude(d, stat).0 + 0.49 * exact.magnitude(d, volt).0;
-        assert!(value_ok(b.total, total, scale, 3e-15), "breakdown total at d = {d}");
+        assert!(
+            value_ok(b.total, total, scale, 3e-15),
+            "breakdown total at d = {d}"
+        );
     }
     eprintln!("worst relative errors (static, per V², contact) and slope error / bound: {worst:?}");
 }
@@ -93,7 +120,11 @@ fn check_all(forces: &InterfaceForces, n: usize) {
 fn paper_scene_tables_match_direct_quadrature_over_the_whole_range() {
     let forces = Scene::paper().build_interface().unwrap();
     assert!(forces.has_contact() && forces.has_voltage_terms() && !forces.uses_pad_gap());
-    eprintln!("paper scene: {} table nodes over {:?}", forces.table_nodes(), forces.table_range());
+    eprintln!(
+        "paper scene: {} table nodes over {:?}",
+        forces.table_nodes(),
+        forces.table_range()
+    );
     check_all(&forces, 400);
 }
 
@@ -111,13 +142,18 @@ fn mixed_footprints_and_gaps_tabulate_correctly() {
         Box::new(Intermolecular::new(5e-20, 1e-76, None, h, plate, GapReference::Pad).unwrap()),
         Box::new(Electrostatic::new(1e-9, 2e-10, h, plate, GapReference::Pad).unwrap()),
         Box::new(Electrostatic::new(0.0, 2e-10, h, cap, GapReference::Bulge).unwrap()),
-        Box::new(GreenwoodWilliamson::new(1e11, 1e-7, 1.5e14, peaks, cap, GapReference::Bulge).unwrap()),
+        Box::new(
+            GreenwoodWilliamson::new(1e11, 1e-7, 1.5e14, peaks, cap, GapReference::Bulge).unwrap(),
+        ),
     ];
     let forces = InterfaceForces::build(terms, (-3e-9, 20e-9), &TableOptions::default()).unwrap();
     assert!(forces.uses_pad_gap());
     let exact = Exact(forces.terms());
     for d in points(-3e-9, 20e-9, 150) {
-        let g = Gaps { bulge: d, pad: d + 1e-9 };
+        let g = Gaps {
+            bulge: d,
+            pad: d + 1e-9,
+        };
         let st = forces.static_part(g);
         let pv = forces.per_volt2_part(g);
         let pick = |gap, c| move |t: &dyn InterfaceTerm| t.gap() == gap && t.coupling() == c;
@@ -126,10 +162,22 @@ fn mixed_footprints_and_gaps_tabulate_correctly() {
         let (sp, mp) = both(GapReference::Pad, Coupling::Static, d + 1e-9);
         let (vb, nb) = both(GapReference::Bulge, Coupling::PerVoltSquared, d);
         let (vp, np) = both(GapReference::Pad, Coupling::PerVoltSquared, d + 1e-9);
-        assert!(value_ok(st.value, sb.0 + sp.0, mb.0 + mp.0, 3e-15), "static at {d}");
-        assert!(value_ok(pv.value, vb.0 + vp.0, nb.0 + np.0, 2e-15), "per V² at {d}");
-        assert!(slope_ok(st.d_bulge, sb.1, mb, 2e-15) && slope_ok(st.d_pad, sp.1, mp, 1e-15), "static slopes at {d}");
-        assert!(slope_ok(pv.d_bulge, vb.1, nb, 1e-15) && slope_ok(pv.d_pad, vp.1, np, 1e-15), "per V² slopes at {d}");
+        assert!(
+            value_ok(st.value, sb.0 + sp.0, mb.0 + mp.0, 3e-15),
+            "static at {d}"
+        );
+        assert!(
+            value_ok(pv.value, vb.0 + vp.0, nb.0 + np.0, 2e-15),
+            "per V² at {d}"
+        );
+        assert!(
+            slope_ok(st.d_bulge, sb.1, mb, 2e-15) && slope_ok(st.d_pad, sp.1, mp, 1e-15),
+            "static slopes at {d}"
+        );
+        assert!(
+            slope_ok(pv.d_bulge, vb.1, nb, 1e-15) && slope_ok(pv.d_pad, vp.1, np, 1e-15),
+            "per V² slopes at {d}"
+        );
     }
 }
 
@@ -150,8 +198,16 @@ fn outside_the_range_the_exact_terms_are_used() {
 fn smooth_flat_electrostatics_jumps_at_the_cutoff_and_the_table_follows() {
     let hc = 3e-10;
     let plate = Footprint::Flat { area_m2: 1e-8 };
-    let t = Electrostatic::new(0.0, hc, GaussianHeights::new(0.0).unwrap(), plate, GapReference::Bulge).unwrap();
-    let forces = InterfaceForces::build(vec![Box::new(t)], (-1e-9, 5e-9), &TableOptions::default()).unwrap();
+    let t = Electrostatic::new(
+        0.0,
+        hc,
+        GaussianHeights::new(0.0).unwrap(),
+        plate,
+        GapReference::Bulge,
+    )
+    .unwrap();
+    let forces =
+        InterfaceForces::build(vec![Box::new(t)], (-1e-9, 5e-9), &TableOptions::default()).unwrap();
     let below = forces.per_volt2_part(Gaps::same(hc * (1.0 - 1e-9))).value;
     let at = forces.per_volt2_part(Gaps::same(hc)).value;
     let above = forces.per_volt2_part(Gaps::same(hc * (1.0 + 1e-9))).value;

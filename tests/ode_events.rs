@@ -22,13 +22,24 @@ fn sine_zero_crossings_located_to_1e_10() {
         // within ~1e-11 of kπ; event_tol 1e-13 adds nothing.
         let opts = Options::default().rtol(1e-12).atol(1e-12).event_tol(1e-13);
         let mut events = [Event::new(|_t, y: &Vector2<f64>| y[0])];
-        let sol = solve(&oscillator(), 0.0, Vector2::new(0.0, 1.0), 10.0, m, &opts, &mut events)
-            .unwrap();
+        let sol = solve(
+            &oscillator(),
+            0.0,
+            Vector2::new(0.0, 1.0),
+            10.0,
+            m,
+            &opts,
+            &mut events,
+        )
+        .unwrap();
         let times: Vec<f64> = sol.events.iter().map(|e| e.t).collect();
         assert_eq!(times.len(), 3, "{m}: {times:?}");
         for (k, (&te, hit)) in times.iter().zip(&sol.events).enumerate() {
             let exact = (k + 1) as f64 * PI;
-            assert!((te - exact).abs() < 1e-10, "{m}: event {k} at {te}, exact {exact}");
+            assert!(
+                (te - exact).abs() < 1e-10,
+                "{m}: event {k} at {te}, exact {exact}"
+            );
             assert!(hit.y[0].abs() < 1e-10);
             // sin falls through zero at π, 3π and rises at 2π.
             assert_eq!(hit.rising, k % 2 == 1);
@@ -45,10 +56,28 @@ fn direction_filter_keeps_only_rising_or_falling() {
         Event::new(|_t, y: &Vector2<f64>| y[0]).direction(Direction::Rising),
         Event::new(|_t, y: &Vector2<f64>| y[0]).direction(Direction::Falling),
     ];
-    let sol = solve(&oscillator(), 0.0, Vector2::new(0.0, 1.0), 10.0, Method::Tsit5, &opts, &mut events)
-        .unwrap();
-    let rising: Vec<f64> = sol.events.iter().filter(|e| e.index == 0).map(|e| e.t).collect();
-    let falling: Vec<f64> = sol.events.iter().filter(|e| e.index == 1).map(|e| e.t).collect();
+    let sol = solve(
+        &oscillator(),
+        0.0,
+        Vector2::new(0.0, 1.0),
+        10.0,
+        Method::Tsit5,
+        &opts,
+        &mut events,
+    )
+    .unwrap();
+    let rising: Vec<f64> = sol
+        .events
+        .iter()
+        .filter(|e| e.index == 0)
+        .map(|e| e.t)
+        .collect();
+    let falling: Vec<f64> = sol
+        .events
+        .iter()
+        .filter(|e| e.index == 1)
+        .map(|e| e.t)
+        .collect();
     assert_eq!(rising.len(), 1);
     assert_eq!(falling.len(), 2);
     assert!((rising[0] - 2.0 * PI).abs() < 1e-8);
@@ -73,12 +102,25 @@ fn terminal_event_stops_at_impact() {
         let mut events = [Event::new(|_t, y: &Vector2<f64>| y[0])
             .direction(Direction::Falling)
             .terminal(true)];
-        let sol = solve(&ball(), 0.0, Vector2::new(10.0, 0.0), 100.0, m, &opts, &mut events).unwrap();
+        let sol = solve(
+            &ball(),
+            0.0,
+            Vector2::new(10.0, 0.0),
+            100.0,
+            m,
+            &opts,
+            &mut events,
+        )
+        .unwrap();
         let t_hit = (2.0 * 10.0 / G).sqrt();
         assert_eq!(sol.terminated_by_event, Some(0));
         // The trajectory is a quadratic: every method of order ≥ 2 reproduces it to rounding,
         // so the event time is limited by event_tol only.
-        assert!((sol.t_final() - t_hit).abs() < 1e-12, "{m}: {}", sol.t_final());
+        assert!(
+            (sol.t_final() - t_hit).abs() < 1e-12,
+            "{m}: {}",
+            sol.t_final()
+        );
         assert!(sol.y_final()[0].abs() < 1e-11);
         assert_eq!(*sol.t.last().unwrap(), sol.t_final());
         assert!(sol.sample(sol.t_final() + 1e-3).is_none());
@@ -93,7 +135,10 @@ fn bouncing_ball_restarts_match_closed_form() {
     let e = 0.8;
     let h0 = 1.0;
     let t1 = (2.0 * h0 / G).sqrt();
-    let opts = Options::default().rtol(1e-10).atol(1e-12).save(SaveAt::Final);
+    let opts = Options::default()
+        .rtol(1e-10)
+        .atol(1e-12)
+        .save(SaveAt::Final);
     let mut t = 0.0;
     let mut y = Vector2::new(h0, 0.0);
     let mut impacts = Vec::new();
@@ -112,6 +157,9 @@ fn bouncing_ball_restarts_match_closed_form() {
         if k > 0 {
             expected += 2.0 * t1 * e.powi(k as i32);
         }
-        assert!((ti - expected).abs() < 1e-9, "impact {k}: {ti} vs {expected}");
+        assert!(
+            (ti - expected).abs() < 1e-9,
+            "impact {k}: {ti} vs {expected}"
+        );
     }
 }

@@ -2,7 +2,7 @@
 //! step and of the dense output, for every method; fixed-size and dynamic states agree.
 
 use hdi_tribology::ode::{solve, FnSystem, Method, OdeSystem, Options, SaveAt};
-use nalgebra::{DVector, Dim, OVector, Vector3, allocator::Allocator, DefaultAllocator};
+use nalgebra::{allocator::Allocator, DVector, DefaultAllocator, Dim, OVector, Vector3};
 
 /// u' = −2t u², p' = q, q' = −p: u = 1/(1+t²), p = cos t, q = −sin t.
 fn rhs<D: Dim>(t: f64, y: &OVector<f64, D>, dy: &mut OVector<f64, D>)
@@ -39,9 +39,21 @@ fn fixed_step_errors(method: Method, h: f64) -> (f64, f64) {
     let sys = FnSystem::new(rhs::<nalgebra::U3>);
     // Tight tolerances: with constant steps they only steer Radau5's Newton iteration, which
     // must converge far below the discretisation error.
-    let opts = Options::default().adaptive(false).h_init(h).rtol(1e-13).atol(1e-13);
-    let sol = solve(&sys, 0.0, Vector3::new(1.0, 1.0, 0.0), T_END, method, &opts, &mut [])
-        .expect("fixed-step run");
+    let opts = Options::default()
+        .adaptive(false)
+        .h_init(h)
+        .rtol(1e-13)
+        .atol(1e-13);
+    let sol = solve(
+        &sys,
+        0.0,
+        Vector3::new(1.0, 1.0, 0.0),
+        T_END,
+        method,
+        &opts,
+        &mut [],
+    )
+    .expect("fixed-step run");
     let end = max_err(sol.y_final(), sol.t_final());
     // Dense error within steps minus the error already present at the step ends: sample at
     // θ = 0.37 of each step and compare to the exact solution.
@@ -77,7 +89,10 @@ fn check_order(method: Method, h: f64, nominal: f64, dense_local: f64) {
     assert!((p - nominal).abs() <= 0.3, "{method}: observed order {p}");
     // The interpolant's local error is O(h^(q+1)) with q its order.
     let expect = dense_local;
-    assert!((pd - expect).abs() <= 0.3, "{method}: dense order {pd}, expected {expect}");
+    assert!(
+        (pd - expect).abs() <= 0.3,
+        "{method}: dense order {pd}, expected {expect}"
+    );
 }
 
 #[test]
@@ -110,9 +125,21 @@ fn adaptive_runs_meet_tolerance() {
         .chain([(Method::Dop853, 1e-12)])
     {
         let opts = Options::default().rtol(tol).atol(tol);
-        let sol = solve(&sys, 0.0, Vector3::new(1.0, 1.0, 0.0), T_END, m, &opts, &mut []).unwrap();
+        let sol = solve(
+            &sys,
+            0.0,
+            Vector3::new(1.0, 1.0, 0.0),
+            T_END,
+            m,
+            &opts,
+            &mut [],
+        )
+        .unwrap();
         let e = max_err(sol.y_final(), T_END);
-        println!("{m} tol {tol:e}: error {e:.2e}, {} steps", sol.stats.accepted);
+        println!(
+            "{m} tol {tol:e}: error {e:.2e}, {} steps",
+            sol.stats.accepted
+        );
         // Global error of a tolerance-driven integration is a modest multiple of the tolerance.
         assert!(e < 20.0 * tol, "{m} tol {tol}: error {e}");
         assert_eq!(sol.t_final(), T_END);
@@ -126,11 +153,31 @@ fn adaptive_runs_meet_tolerance() {
 fn fixed_and_dynamic_states_agree() {
     let sys3 = FnSystem::new(rhs::<nalgebra::U3>);
     let sysd = FnSystem::new(rhs::<nalgebra::Dyn>);
-    let opts = Options::default().rtol(1e-8).atol(1e-10).save(SaveAt::Times(vec![0.5, 1.0, 3.0]));
+    let opts = Options::default()
+        .rtol(1e-8)
+        .atol(1e-10)
+        .save(SaveAt::Times(vec![0.5, 1.0, 3.0]));
     for m in Method::ALL {
-        let a = solve(&sys3, 0.0, Vector3::new(1.0, 1.0, 0.0), T_END, m, &opts, &mut []).unwrap();
-        let b = solve(&sysd, 0.0, DVector::from_vec(vec![1.0, 1.0, 0.0]), T_END, m, &opts, &mut [])
-            .unwrap();
+        let a = solve(
+            &sys3,
+            0.0,
+            Vector3::new(1.0, 1.0, 0.0),
+            T_END,
+            m,
+            &opts,
+            &mut [],
+        )
+        .unwrap();
+        let b = solve(
+            &sysd,
+            0.0,
+            DVector::from_vec(vec![1.0, 1.0, 0.0]),
+            T_END,
+            m,
+            &opts,
+            &mut [],
+        )
+        .unwrap();
         assert_eq!(a.t, b.t);
         assert_eq!(a.stats, b.stats);
         for (ya, yb) in a.y.iter().zip(&b.y) {
@@ -145,4 +192,43 @@ fn assert_system<D: Dim, S: OdeSystem<D>>(_: &S)
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+}
+
+#[test]
+fn error_shrinks_in_proportion_to_tolerance() {
+    let sys = FnSystem::new(rhs::<nalgebra::U3>);
+    for m in Method::ALL {
+        // DOP853 is the method for tight tolerances; at loose ones it takes a handful of
+        // steps whose error is far below the tolerance and not yet controlled by it.
+        let tols = if m == Method::Dop853 {
+            [1e-8, 1e-10, 1e-12]
+        } else {
+            [1e-5, 1e-7, 1e-9]
+        };
+        let errs: Vec<f64> = tols
+            .iter()
+            .map(|&tol| {
+                let opts = Options::default().rtol(tol).atol(tol);
+                let sol = solve(
+                    &sys,
+                    0.0,
+                    Vector3::new(1.0, 1.0, 0.0),
+                    T_END,
+                    m,
+                    &opts,
+                    &mut [],
+                )
+                .unwrap();
+                max_err(sol.y_final(), T_END)
+            })
+            .collect();
+        println!("{m}: {errs:?}");
+        for w in errs.windows(2) {
+            // Tolerance down by 100: error down by at least 20 and at most 5000 (roughly
+            // proportional; an error-per-step controller of a method of order p with an
+            // estimator of order q scales like tol^(p/(q+1)), between 1 and 1.6 here).
+            let ratio = w[0] / w[1];
+            assert!((20.0..5000.0).contains(&ratio), "{m}: {errs:?}");
+        }
+    }
 }

@@ -61,7 +61,7 @@ impl OdeSystem<U3> for Robertson {
 const ROBER_REF: [f64; 3] = [
     0.208_334_014_970_125_5e-7,
     0.833_336_077_033_471_3e-13,
-    0.999_999_979_166_505_0,
+    0.999_999_979_166_505,
 ];
 
 /// HIRES (Schäfer 1975), 8 components; finite-difference Jacobian on purpose.
@@ -100,8 +100,16 @@ fn max_rel_err<const N: usize>(y: &SVector<f64, N>, r: &[f64; N], floor: f64) ->
 
 fn vdp(method: Method, tol: f64) -> Solution<U2> {
     let opts = Options::default().rtol(tol).atol(tol).dense(false);
-    solve(&VanDerPol { mu: 1000.0 }, 0.0, Vector2::new(2.0, 0.0), 2000.0, method, &opts, &mut [])
-        .unwrap_or_else(|e| panic!("{method} at tol {tol}: {e}"))
+    solve(
+        &VanDerPol { mu: 1000.0 },
+        0.0,
+        Vector2::new(2.0, 0.0),
+        2000.0,
+        method,
+        &opts,
+        &mut [],
+    )
+    .unwrap_or_else(|e| panic!("{method} at tol {tol}: {e}"))
 }
 
 fn rober(method: Method, rtol: f64) -> Solution<U3> {
@@ -111,8 +119,16 @@ fn rober(method: Method, rtol: f64) -> Solution<U3> {
         .atol_per_component(vec![1e-4 * rtol * 1e-8, 1e-4 * rtol * 1e-13, 1e-4 * rtol])
         .dense(false)
         .max_steps(200_000);
-    solve(&Robertson, 0.0, Vector3::new(1.0, 0.0, 0.0), 1e11, method, &opts, &mut [])
-        .unwrap_or_else(|e| panic!("{method} at rtol {rtol}: {e}"))
+    solve(
+        &Robertson,
+        0.0,
+        Vector3::new(1.0, 0.0, 0.0),
+        1e11,
+        method,
+        &opts,
+        &mut [],
+    )
+    .unwrap_or_else(|e| panic!("{method} at rtol {rtol}: {e}"))
 }
 
 fn hires(method: Method, tol: f64) -> Solution<U8> {
@@ -147,7 +163,11 @@ fn robertson_to_1e11_conserves_mass_and_matches_reference() {
     for m in STIFF {
         let sol = rober(m, 1e-8);
         let y = sol.y_final();
-        let e = max_rel_err(&SVector::<f64, 3>::from([y[0], y[1], y[2]]), &ROBER_REF, 1e-30);
+        let e = max_rel_err(
+            &SVector::<f64, 3>::from([y[0], y[1], y[2]]),
+            &ROBER_REF,
+            1e-30,
+        );
         println!("rober {m}: rel err {e:.2e}, {:?}", sol.stats);
         // Relative error per component (even y2 ~ 1e-13) within 1e-4.
         assert!(e < 1e-4, "{m}: relative error {e}");
@@ -190,3 +210,34 @@ fn error_shrinks_with_tolerance() {
 
 #[allow(dead_code)]
 fn _types(_: SMatrix<f64, 2, 2>) {}
+
+#[test]
+fn auto_switches_where_stiffness_changes() {
+    // Van der Pol (μ = 1000) alternates slow stiff phases and fast non-stiff jumps: Auto must
+    // use both methods and switch both ways; the stiff phases take most of the time.
+    let sol = vdp(Method::Auto, 1e-6);
+    let s = sol.stats;
+    println!("vdp auto: {s:?}");
+    assert!(s.stiffness_switches >= 2, "{s:?}");
+    assert!(s.stiff_steps > 0 && s.stiff_steps < s.accepted, "{s:?}");
+    // Robertson is stiff almost from the start: one switch, and most steps are stiff.
+    let s = rober(Method::Auto, 1e-6).stats;
+    println!("rober auto: {s:?}");
+    assert!(
+        s.stiffness_switches >= 1 && 2 * s.stiff_steps > s.accepted,
+        "{s:?}"
+    );
+    // The explicit method alone exhausts the default budget of 100 000 steps early on, where
+    // Auto needed a few hundred.
+    let opts = Options::default().rtol(1e-6).atol(1e-6).dense(false);
+    let r = solve(
+        &VanDerPol { mu: 1000.0 },
+        0.0,
+        Vector2::new(2.0, 0.0),
+        2000.0,
+        Method::Tsit5,
+        &opts,
+        &mut [],
+    );
+    assert!(matches!(r, Err(hdi_tribology::ode::OdeError::TooManySteps { t, .. }) if t < 1000.0));
+}

@@ -28,17 +28,77 @@ const RULES: [(&str, Rule); 2] = [("gauss-kronrod", gk), ("tanh-sinh", ts)];
 #[allow(clippy::type_complexity)]
 fn known() -> Vec<(&'static str, Box<dyn Fn(f64) -> f64>, f64, f64, f64)> {
     vec![
-        ("exp(-x^2) over R", Box::new(|x: f64| (-x * x).exp()), f64::NEG_INFINITY, f64::INFINITY, PI.sqrt()),
-        ("1/sqrt(x) on [0,1]", Box::new(|x: f64| 1.0 / x.sqrt()), 0.0, 1.0, 2.0),
+        (
+            "exp(-x^2) over R",
+            Box::new(|x: f64| (-x * x).exp()),
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            PI.sqrt(),
+        ),
+        (
+            "1/sqrt(x) on [0,1]",
+            Box::new(|x: f64| 1.0 / x.sqrt()),
+            0.0,
+            1.0,
+            2.0,
+        ),
         ("ln x on [0,1]", Box::new(|x: f64| x.ln()), 0.0, 1.0, -1.0),
-        ("cos(30x) on [0,1]", Box::new(|x: f64| (30.0 * x).cos()), 0.0, 1.0, (30.0f64).sin() / 30.0),
-        ("x sin(50x) on [0,pi]", Box::new(|x: f64| x * (50.0 * x).sin()), 0.0, PI, -PI / 50.0),
-        ("1/(1+x^2) on [0,inf)", Box::new(|x: f64| 1.0 / (1.0 + x * x)), 0.0, f64::INFINITY, PI / 2.0),
-        ("exp(x) on (-inf,0]", Box::new(|x: f64| x.exp()), f64::NEG_INFINITY, 0.0, 1.0),
-        ("x^2 exp(-x) on [0,inf)", Box::new(|x: f64| x * x * (-x).exp()), 0.0, f64::INFINITY, 2.0),
-        ("4/(1+x^2) on [0,1]", Box::new(|x: f64| 4.0 / (1.0 + x * x)), 0.0, 1.0, PI),
-        ("sqrt(x) on [0,1]", Box::new(|x: f64| x.sqrt()), 0.0, 1.0, 2.0 / 3.0),
-        ("1/(x^2+1e-4) on [-1,1]", Box::new(|x: f64| 1.0 / (x * x + 1e-4)), -1.0, 1.0, 2.0 / 1e-2 * (1.0f64 / 1e-2).atan()),
+        (
+            "cos(30x) on [0,1]",
+            Box::new(|x: f64| (30.0 * x).cos()),
+            0.0,
+            1.0,
+            (30.0f64).sin() / 30.0,
+        ),
+        (
+            "x sin(50x) on [0,pi]",
+            Box::new(|x: f64| x * (50.0 * x).sin()),
+            0.0,
+            PI,
+            -PI / 50.0,
+        ),
+        (
+            "1/(1+x^2) on [0,inf)",
+            Box::new(|x: f64| 1.0 / (1.0 + x * x)),
+            0.0,
+            f64::INFINITY,
+            PI / 2.0,
+        ),
+        (
+            "exp(x) on (-inf,0]",
+            Box::new(|x: f64| x.exp()),
+            f64::NEG_INFINITY,
+            0.0,
+            1.0,
+        ),
+        (
+            "x^2 exp(-x) on [0,inf)",
+            Box::new(|x: f64| x * x * (-x).exp()),
+            0.0,
+            f64::INFINITY,
+            2.0,
+        ),
+        (
+            "4/(1+x^2) on [0,1]",
+            Box::new(|x: f64| 4.0 / (1.0 + x * x)),
+            0.0,
+            1.0,
+            PI,
+        ),
+        (
+            "sqrt(x) on [0,1]",
+            Box::new(|x: f64| x.sqrt()),
+            0.0,
+            1.0,
+            2.0 / 3.0,
+        ),
+        (
+            "1/(x^2+1e-4) on [-1,1]",
+            Box::new(|x: f64| 1.0 / (x * x + 1e-4)),
+            -1.0,
+            1.0,
+            2.0 / 1e-2 * (1.0f64 / 1e-2).atan(),
+        ),
     ]
 }
 
@@ -46,7 +106,8 @@ fn known() -> Vec<(&'static str, Box<dyn Fn(f64) -> f64>, f64, f64, f64)> {
 fn known_integrals_are_accurate_and_error_estimates_are_honest() {
     for (rule_name, rule) in RULES {
         for (name, f, a, b, exact) in known() {
-            let est = rule(&*f, a, b, &opts(1e-12)).unwrap_or_else(|e| panic!("{rule_name} {name}: {e}"));
+            let est =
+                rule(&*f, a, b, &opts(1e-12)).unwrap_or_else(|e| panic!("{rule_name} {name}: {e}"));
             let true_err = (est.value - exact).abs();
             // Target 1e-12 relative; a few ulps of rounding on top are allowed.
             assert!(
@@ -74,7 +135,11 @@ fn polynomials_are_integrated_exactly_by_one_kronrod_panel() {
     for deg in 0..=31 {
         let f = |x: f64| x.powi(deg) * (deg as f64 + 1.0);
         let est = integrate(f, 0.0, 1.0, &opts(1e-14)).unwrap();
-        assert!((est.value - 1.0).abs() < 1e-15, "degree {deg}: {}", est.value);
+        assert!(
+            (est.value - 1.0).abs() < 1e-15,
+            "degree {deg}: {}",
+            est.value
+        );
         if deg <= 19 {
             assert_eq!(est.evaluations, 21, "degree {deg} needed subdivision");
         }
@@ -98,7 +163,9 @@ fn reversed_limits_negate() {
     let fwd = integrate(f, 0.0, 1.0, &opts(1e-13)).unwrap().value;
     let rev = integrate(f, 1.0, 0.0, &opts(1e-13)).unwrap().value;
     assert_eq!(fwd, -rev);
-    let rev_ts = integrate_tanh_sinh(f, 1.0, 0.0, &opts(1e-13)).unwrap().value;
+    let rev_ts = integrate_tanh_sinh(f, 1.0, 0.0, &opts(1e-13))
+        .unwrap()
+        .value;
     assert!((rev_ts + (1f64.exp() - 1.0)).abs() < 1e-13);
     assert_eq!(integrate(f, 2.0, 2.0, &opts(1e-13)).unwrap().value, 0.0);
 }
@@ -124,7 +191,12 @@ fn breaks_help_on_kinks() {
 
 #[test]
 fn nan_integrand_is_an_error() {
-    let r = integrate(|x: f64| if x > 0.5 { f64::NAN } else { 1.0 }, 0.0, 1.0, &opts(1e-12));
+    let r = integrate(
+        |x: f64| if x > 0.5 { f64::NAN } else { 1.0 },
+        0.0,
+        1.0,
+        &opts(1e-12),
+    );
     assert!(matches!(r, Err(Error::NoConvergence { .. })), "{r:?}");
     let r = integrate_tanh_sinh(|_x: f64| f64::NAN, 0.0, 1.0, &opts(1e-12));
     assert!(matches!(r, Err(Error::NoConvergence { .. })), "{r:?}");
@@ -192,7 +264,14 @@ fn gauss_kronrod_and_tanh_sinh_agree_on_tiny_scales() {
     // Physical scales: a Gaussian of width 1 nm integrated in metres.
     let s = 1e-9;
     let f = |z: f64| (-(z / s).powi(2) / 2.0).exp() / (s * (2.0 * PI).sqrt());
-    let a = integrate(f, -20.0 * s, 20.0 * s, &opts(1e-13)).unwrap().value;
-    let b = integrate_tanh_sinh(f, -20.0 * s, 20.0 * s, &opts(1e-13)).unwrap().value;
-    assert!((a - 1.0).abs() < 1e-13 && (b - 1.0).abs() < 1e-13, "{a} {b}");
+    let a = integrate(f, -20.0 * s, 20.0 * s, &opts(1e-13))
+        .unwrap()
+        .value;
+    let b = integrate_tanh_sinh(f, -20.0 * s, 20.0 * s, &opts(1e-13))
+        .unwrap()
+        .value;
+    assert!(
+        (a - 1.0).abs() < 1e-13 && (b - 1.0).abs() < 1e-13,
+        "{a} {b}"
+    );
 }

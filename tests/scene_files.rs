@@ -7,7 +7,9 @@ use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
 
 fn scene_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
 }
 
 fn paper_text() -> String {
@@ -16,12 +18,17 @@ fn paper_text() -> String {
 
 #[test]
 fn shipped_paper_toml_equals_the_built_in_scene() {
-    assert_eq!(Scene::from_path(scene_path("paper.toml")).unwrap(), Scene::paper());
+    assert_eq!(
+        Scene::from_path(scene_path("paper.toml")).unwrap(),
+        Scene::paper()
+    );
 }
 
 #[test]
 fn every_shipped_scene_loads_and_builds() {
-    for entry in std::fs::read_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes")).unwrap() {
+    for entry in
+        std::fs::read_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes")).unwrap()
+    {
         let path = entry.unwrap().path();
         let scene = Scene::from_path(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let forces = scene.build_interface().unwrap();
@@ -33,10 +40,19 @@ fn every_shipped_scene_loads_and_builds() {
 #[test]
 fn toml_and_json_round_trip() {
     let s = Scene::paper();
-    assert_eq!(Scene::from_toml_str(&s.to_toml_string().unwrap()).unwrap(), s);
-    assert_eq!(Scene::from_json_str(&s.to_json_string().unwrap()).unwrap(), s);
+    assert_eq!(
+        Scene::from_toml_str(&s.to_toml_string().unwrap()).unwrap(),
+        s
+    );
+    assert_eq!(
+        Scene::from_json_str(&s.to_json_string().unwrap()).unwrap(),
+        s
+    );
     let flat = Scene::from_path(scene_path("flat_gaussian.toml")).unwrap();
-    assert_eq!(Scene::from_json_str(&flat.to_json_string().unwrap()).unwrap(), flat);
+    assert_eq!(
+        Scene::from_json_str(&flat.to_json_string().unwrap()).unwrap(),
+        flat
+    );
 }
 
 #[test]
@@ -66,29 +82,78 @@ fn field_of(r: hdi_tribology::Result<()>) -> Option<String> {
 
 #[test]
 fn validation_names_the_field() {
-    let cases: Vec<(&str, Box<dyn Fn(&mut Scene)>)> = vec![
-        ("nominal_clearance_m", Box::new(|s| s.nominal_clearance_m = 0.0)),
-        ("surface.height_sigma_m", Box::new(|s| s.surface.height_sigma_m = -1e-10)),
-        ("intermolecular.hamaker_attractive_j", Box::new(|s| s.intermolecular.as_mut().unwrap().hamaker_attractive_j = f64::NAN)),
-        ("electrostatic.dielectric_thickness_m", Box::new(|s| s.electrostatic.as_mut().unwrap().dielectric_thickness_m = -1e-9)),
-        ("contact.footprint.max_radius_m", Box::new(|s| {
-            s.contact.as_mut().unwrap().footprint = Footprint::Paraboloid { radius_of_curvature_m: 0.02, max_radius_m: Some(0.0) }
-        })),
-        ("slider.mass_kg", Box::new(|s| s.slider.mass_kg = f64::INFINITY)),
-        ("heater.programme", Box::new(|s| s.heater.programme.truncate(1))),
-        ("heater.programme[2].t_s", Box::new(|s| s.heater.programme[2][0] = 1e-3)),
-        ("heater.programme[1].power_w", Box::new(|s| s.heater.programme[1][1] = -0.01)),
-        ("heater.triggered.ramp_rate_w_per_s", Box::new(|s| s.heater.triggered.ramp_rate_w_per_s = 0.0)),
-        ("voltage.ac_frequency_hz", Box::new(|s| s.voltage.ac_frequency_hz = 0.0)),
+    type Edit = Box<dyn Fn(&mut Scene)>;
+    let cases: Vec<(&str, Edit)> = vec![
+        (
+            "nominal_clearance_m",
+            Box::new(|s| s.nominal_clearance_m = 0.0),
+        ),
+        (
+            "surface.height_sigma_m",
+            Box::new(|s| s.surface.height_sigma_m = -1e-10),
+        ),
+        (
+            "intermolecular.hamaker_attractive_j",
+            Box::new(|s| s.intermolecular.as_mut().unwrap().hamaker_attractive_j = f64::NAN),
+        ),
+        (
+            "electrostatic.dielectric_thickness_m",
+            Box::new(|s| s.electrostatic.as_mut().unwrap().dielectric_thickness_m = -1e-9),
+        ),
+        (
+            "contact.footprint.max_radius_m",
+            Box::new(|s| {
+                s.contact.as_mut().unwrap().footprint = Footprint::Paraboloid {
+                    radius_of_curvature_m: 0.02,
+                    max_radius_m: Some(0.0),
+                }
+            }),
+        ),
+        (
+            "slider.mass_kg",
+            Box::new(|s| s.slider.mass_kg = f64::INFINITY),
+        ),
+        (
+            "heater.programme",
+            Box::new(|s| s.heater.programme.truncate(1)),
+        ),
+        (
+            "heater.programme[2].t_s",
+            Box::new(|s| s.heater.programme[2][0] = 1e-3),
+        ),
+        (
+            "heater.programme[1].power_w",
+            Box::new(|s| s.heater.programme[1][1] = -0.01),
+        ),
+        (
+            "heater.triggered.ramp_rate_w_per_s",
+            Box::new(|s| s.heater.triggered.ramp_rate_w_per_s = 0.0),
+        ),
+        (
+            "voltage.ac_frequency_hz",
+            Box::new(|s| s.voltage.ac_frequency_hz = 0.0),
+        ),
         ("detector.window_s", Box::new(|s| s.detector.window_s = 0.0)),
-        ("friction.head_conductivity_w_per_m_k", Box::new(|s| s.friction.head_conductivity_w_per_m_k = 0.0)),
+        (
+            "friction.head_conductivity_w_per_m_k",
+            Box::new(|s| s.friction.head_conductivity_w_per_m_k = 0.0),
+        ),
         ("solver.rtol", Box::new(|s| s.solver.rtol = 1.0)),
         ("solver.max_steps", Box::new(|s| s.solver.max_steps = 0)),
         ("table", Box::new(|s| s.table.d_min_m = Some(1.0))),
-        ("sweep.ac_amplitudes_v[1]", Box::new(|s| s.sweep.ac_amplitudes_v[1] = -0.1)),
-        ("air_bearing.stiffness_n_per_m", Box::new(|s| {
-            s.air_bearing = hdi_tribology::force::AirBearingModel::Linear { stiffness_n_per_m: -1.0, damping_n_s_per_m: 0.0 }
-        })),
+        (
+            "sweep.ac_amplitudes_v[1]",
+            Box::new(|s| s.sweep.ac_amplitudes_v[1] = -0.1),
+        ),
+        (
+            "air_bearing.stiffness_n_per_m",
+            Box::new(|s| {
+                s.air_bearing = hdi_tribology::force::AirBearingModel::Linear {
+                    stiffness_n_per_m: -1.0,
+                    damping_n_s_per_m: 0.0,
+                }
+            }),
+        ),
     ];
     for (field, edit) in cases {
         let mut s = Scene::paper();
@@ -102,10 +167,19 @@ fn validation_names_the_field() {
 fn parse_errors_name_the_field_and_fit_on_one_line() {
     let paper = paper_text();
     let cases = [
-        (paper.replace("nominal_clearance_m = 1e-8", ""), "nominal_clearance_m"),
+        (
+            paper.replace("nominal_clearance_m = 1e-8", ""),
+            "nominal_clearance_m",
+        ),
         (format!("{paper}\n[magnetic]\nstrength = 1.0\n"), "magnetic"),
-        (paper.replace("shape = \"paraboloid\"", "shape = \"cube\""), "cube"),
-        (paper.replace("mass_kg = 1e-6", "mass_kg = \"heavy\""), "line"),
+        (
+            paper.replace("shape = \"paraboloid\"", "shape = \"cube\""),
+            "cube",
+        ),
+        (
+            paper.replace("mass_kg = 1e-6", "mass_kg = \"heavy\""),
+            "line",
+        ),
     ];
     for (text, needle) in cases {
         assert_ne!(text, paper);

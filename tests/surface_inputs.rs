@@ -1,8 +1,7 @@
 //! Input validation of the peak laws and the serde scene description.
 
 use hdi_tribology::surface::{
-    Discrete, Empirical, Gaussian, GaussianHeights, PeakDistribution, PeakModel, RiceMaxima,
-    Rician,
+    Discrete, Empirical, Gaussian, GaussianHeights, PeakDistribution, PeakModel, RiceMaxima, Rician,
 };
 use hdi_tribology::{Error, Result};
 
@@ -42,7 +41,7 @@ fn histograms_reject_bad_input() {
     let big = vec![1.0; 10_000_001];
     let edges: Vec<f64> = (0..=big.len()).map(|i| i as f64).collect();
     assert_eq!(e(&edges, &big), "peaks.counts"); // oversized
-    // Zero-count bins inside are fine.
+                                                 // Zero-count bins inside are fine.
     assert!(Empirical::from_histogram(&[0.0, 1.0, 2.0, 3.0], &[1.0, 0.0, 1.0]).is_ok());
 }
 
@@ -62,7 +61,10 @@ fn samples_reject_bad_input() {
 #[test]
 fn discrete_rejects_bad_input() {
     assert_eq!(field(Discrete::from_heights(vec![])), "peaks.heights");
-    assert_eq!(field(Discrete::from_heights(vec![1.0, f64::INFINITY])), "peaks.heights");
+    assert_eq!(
+        field(Discrete::from_heights(vec![1.0, f64::INFINITY])),
+        "peaks.heights"
+    );
     let g = Gaussian::new(0.0, 1.0).unwrap();
     assert_eq!(field(Discrete::sample(&g, 0, 1)), "peaks.n");
     assert_eq!(field(Discrete::sample(&g, 10_000_001, 1)), "peaks.n");
@@ -71,14 +73,33 @@ fn discrete_rejects_bad_input() {
 #[test]
 fn peak_model_builds_every_family() {
     let models = vec![
-        PeakModel::Gaussian { mean_m: 1e-9, std_m: 1e-9 },
-        PeakModel::RiceMaxima { sigma_m: 1e-9, epsilon: 0.5 },
-        PeakModel::Rician { nu_m: 1e-9, s_m: 1e-9 },
-        PeakModel::Histogram { edges_m: vec![0.0, 1e-9, 2e-9], counts: vec![1.0, 2.0] },
-        PeakModel::Sample { heights_m: vec![0.0, 1e-9, 3e-9, 2e-9] },
-        PeakModel::Discrete { heights_m: vec![1e-9, 2e-9] },
+        PeakModel::Gaussian {
+            mean_m: 1e-9,
+            std_m: 1e-9,
+        },
+        PeakModel::RiceMaxima {
+            sigma_m: 1e-9,
+            epsilon: 0.5,
+        },
+        PeakModel::Rician {
+            nu_m: 1e-9,
+            s_m: 1e-9,
+        },
+        PeakModel::Histogram {
+            edges_m: vec![0.0, 1e-9, 2e-9],
+            counts: vec![1.0, 2.0],
+        },
+        PeakModel::Sample {
+            heights_m: vec![0.0, 1e-9, 3e-9, 2e-9],
+        },
+        PeakModel::Discrete {
+            heights_m: vec![1e-9, 2e-9],
+        },
         PeakModel::DiscreteSampled {
-            from: Box::new(PeakModel::Gaussian { mean_m: 0.0, std_m: 1e-9 }),
+            from: Box::new(PeakModel::Gaussian {
+                mean_m: 0.0,
+                std_m: 1e-9,
+            }),
             n: 50,
             seed: 3,
         },
@@ -90,26 +111,81 @@ fn peak_model_builds_every_family() {
         let json = serde_json::to_string(&m).unwrap();
         assert_eq!(serde_json::from_str::<PeakModel>(&json).unwrap(), m);
         let toml_text = toml::to_string(&m).unwrap();
-        assert_eq!(toml::from_str::<PeakModel>(&toml_text).unwrap(), m, "{toml_text}");
+        assert_eq!(
+            toml::from_str::<PeakModel>(&toml_text).unwrap(),
+            m,
+            "{toml_text}"
+        );
     }
 }
 
 #[test]
 fn peak_model_names_fields_and_rejects_unknown_ones() {
     let bad = [
-        (PeakModel::Gaussian { mean_m: 0.0, std_m: -1.0 }, "peaks.std_m"),
-        (PeakModel::Gaussian { mean_m: f64::NAN, std_m: 1.0 }, "peaks.mean_m"),
-        (PeakModel::RiceMaxima { sigma_m: 1e-9, epsilon: 2.0 }, "peaks.epsilon"),
-        (PeakModel::RiceMaxima { sigma_m: 0.0, epsilon: 0.5 }, "peaks.sigma_m"),
-        (PeakModel::Rician { nu_m: -1.0, s_m: 1.0 }, "peaks.nu_m"),
-        (PeakModel::Rician { nu_m: 1.0, s_m: 0.0 }, "peaks.s_m"),
-        (PeakModel::Histogram { edges_m: vec![1.0, 0.0], counts: vec![1.0] }, "peaks.edges_m"),
-        (PeakModel::Histogram { edges_m: vec![0.0, 1.0], counts: vec![0.0] }, "peaks.counts"),
+        (
+            PeakModel::Gaussian {
+                mean_m: 0.0,
+                std_m: -1.0,
+            },
+            "peaks.std_m",
+        ),
+        (
+            PeakModel::Gaussian {
+                mean_m: f64::NAN,
+                std_m: 1.0,
+            },
+            "peaks.mean_m",
+        ),
+        (
+            PeakModel::RiceMaxima {
+                sigma_m: 1e-9,
+                epsilon: 2.0,
+            },
+            "peaks.epsilon",
+        ),
+        (
+            PeakModel::RiceMaxima {
+                sigma_m: 0.0,
+                epsilon: 0.5,
+            },
+            "peaks.sigma_m",
+        ),
+        (
+            PeakModel::Rician {
+                nu_m: -1.0,
+                s_m: 1.0,
+            },
+            "peaks.nu_m",
+        ),
+        (
+            PeakModel::Rician {
+                nu_m: 1.0,
+                s_m: 0.0,
+            },
+            "peaks.s_m",
+        ),
+        (
+            PeakModel::Histogram {
+                edges_m: vec![1.0, 0.0],
+                counts: vec![1.0],
+            },
+            "peaks.edges_m",
+        ),
+        (
+            PeakModel::Histogram {
+                edges_m: vec![0.0, 1.0],
+                counts: vec![0.0],
+            },
+            "peaks.counts",
+        ),
         (PeakModel::Sample { heights_m: vec![] }, "peaks.heights_m"),
         (PeakModel::Discrete { heights_m: vec![] }, "peaks.heights_m"),
         (
             PeakModel::DiscreteSampled {
-                from: Box::new(PeakModel::Gaussian { mean_m: 0.0, std_m: 1e-9 }),
+                from: Box::new(PeakModel::Gaussian {
+                    mean_m: 0.0,
+                    std_m: 1e-9,
+                }),
                 n: 0,
                 seed: 1,
             },
@@ -117,7 +193,10 @@ fn peak_model_names_fields_and_rejects_unknown_ones() {
         ),
         (
             PeakModel::DiscreteSampled {
-                from: Box::new(PeakModel::Rician { nu_m: 0.0, s_m: -1.0 }),
+                from: Box::new(PeakModel::Rician {
+                    nu_m: 0.0,
+                    s_m: -1.0,
+                }),
                 n: 5,
                 seed: 1,
             },
@@ -128,7 +207,9 @@ fn peak_model_names_fields_and_rejects_unknown_ones() {
         assert_eq!(field(m.build()), want, "{m:?}");
     }
     let unknown = r#"{"family": "gaussian", "mean_m": 0.0, "std_m": 1e-9, "sdt_m": 1}"#;
-    let err = serde_json::from_str::<PeakModel>(unknown).unwrap_err().to_string();
+    let err = serde_json::from_str::<PeakModel>(unknown)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("sdt_m"), "{err}");
     let family = r#"{"family": "weibull", "k": 1.0}"#;
     assert!(serde_json::from_str::<PeakModel>(family).is_err());
@@ -147,7 +228,17 @@ fn partial_moments_are_finite_for_extreme_arguments() {
         Box::new(Discrete::from_heights(vec![0.0, 1e-9]).unwrap()),
     ];
     for law in &laws {
-        for d in [-1e3, -1.0, -1e-6, 0.0, 1e-6, 1.0, 1e3, f64::MAX / 4.0, -f64::MAX / 4.0] {
+        for d in [
+            -1e3,
+            -1.0,
+            -1e-6,
+            0.0,
+            1e-6,
+            1.0,
+            1e3,
+            f64::MAX / 4.0,
+            -f64::MAX / 4.0,
+        ] {
             for p in [0.0, 0.5, 1.5, 3.0] {
                 let m = law.partial_moment(d, p);
                 // Far below the support M_p ≈ |d|^p may overflow only for p·log|d| > 308.

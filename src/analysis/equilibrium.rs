@@ -258,7 +258,7 @@ pub struct SCurve {
 pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) -> Result<SCurve> {
     let volt2 = model.voltage.effective_dc().powi(2);
     let (lo, hi) = range.unwrap_or_else(|| model.forces().table_range());
-    if !(lo < hi) {
+    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
         return Err(Error::invalid(
             "range",
             format!("need d_lo < d_hi, got [{lo:e}, {hi:e}]"),

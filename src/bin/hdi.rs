@@ -7,7 +7,14 @@
 use std::io::Write;
 use std::process::ExitCode;
 
+use hdi_tribology::analysis::cycle::CycleResult;
+use hdi_tribology::analysis::{
+    ac_sweep, pull_in_voltage, s_curve, simulate_cycle, static_hysteresis, CycleOptions,
+    HeaterProgramme, ScanGrid, StaticOptions,
+};
 use hdi_tribology::force::{Breakdown, Gaps};
+use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::report::write_csv;
 use hdi_tribology::scene::Scene;
 use serde::Serialize;
 
@@ -19,6 +26,17 @@ commands:
       contact, electrostatic_per_volt2, electrostatic (at the scene's DC voltage minus the
       contact potential), other, real_contact_area, total (SI, positive = away from the disk).
       Pad-gap terms see D + DELTA (default DELTA = 0).
+  static (SCENE_FILE | --paper)
+      static analyses at the scene's DC voltage, JSON: touchdown_power, takeoff_power,
+      hysteresis (W), pull_in_voltage (V, at zero heater power), folds [{power, d}].
+  cycle (SCENE_FILE | --paper) [--v-ac V] [--triggered] [--csv FILE] [--method M] [--rtol R]
+      one touchdown/take-off cycle under the scene's fixed programme (or the touchdown-triggered
+      protocol), JSON: v_ac, touchdown_power, takeoff_power, hysteresis, mean_temperature_rise,
+      steps, wall_seconds. --csv writes the time series of spacing and forces.
+  sweep (SCENE_FILE | --paper) [--v-ac V1,V2,...] [--triggered] [--method M] [--rtol R]
+      one cycle per AC amplitude (default: the scene's sweep list), JSON list of cycle objects.
+  scene (SCENE_FILE | --paper) [--json]
+      the scene as TOML (or JSON), validated: a starting point for scenes of your own.
   help
       this text";
 
@@ -57,6 +75,10 @@ fn run(args: &[String]) -> Result<(), CliError> {
     };
     match command.as_str() {
         "forces" => forces(rest),
+        "static" => static_analyses(rest),
+        "cycle" => cycle(rest),
+        "sweep" => sweep(rest),
+        "scene" => scene(rest),
         "help" | "--help" | "-h" => {
             print_text(USAGE)?;
             Ok(())
@@ -75,19 +97,26 @@ enum SceneSource {
 struct Parsed {
     scene: Option<SceneSource>,
     values: Vec<(String, String)>,
+    flags: Vec<String>,
 }
 
 /// Splits `args` into the scene source (`--paper` or one positional file) and `--name value`
-/// pairs whose names are in `accepted`.
-fn parse_args(args: &[String], accepted: &[&str]) -> Result<Parsed, CliError> {
+/// pairs whose names are in `accepted`, and value-less `--name` flags whose names are in `flags`.
+fn parse_args(args: &[String], accepted: &[&str], flags: &[&str]) -> Result<Parsed, CliError> {
     let mut parsed = Parsed {
         scene: None,
         values: Vec::new(),
+        flags: Vec::new(),
     };
     let mut it = args.iter();
     while let Some(a) = it.next() {
         let source = if a == "--paper" {
             SceneSource::Paper
+        } else if let Some(flag) = a.strip_prefix("--").filter(|f| flags.contains(f)) {
+            if !parsed.flags.iter().any(|f| f == flag) {
+                parsed.flags.push(flag.to_string());
+            }
+            continue;
         } else if let Some(name) = a.strip_prefix("--") {
             let (name, value) = match name.split_once('=') {
                 Some((n, v)) => (n.to_string(), v.to_string()),
@@ -120,6 +149,10 @@ fn parse_args(args: &[String], accepted: &[&str]) -> Result<Parsed, CliError> {
 }
 
 impl Parsed {
+    fn flag(&self, name: &str) -> bool {
+        self.flags.iter().any(|f| f == name)
+    }
+
     fn value(&self, name: &str) -> Option<&str> {
         self.values
             .iter()
@@ -131,7 +164,13 @@ impl Parsed {
         match &self.scene {
             None => Err(CliError::Usage("missing scene: a file or --paper".into())),
             Some(SceneSource::Paper) => Ok(Scene::paper()),
-            Some(SceneSource::File(path)) => Ok(Scene::from_path(path)?),
+            // parse errors already carry the file name; validation errors get it here
+            Some(SceneSource::File(path)) => Scene::from_path(path).map_err(|e| match e {
+                hdi_tribology::Error::InvalidInput { .. } => {
+                    CliError::Failed(format!("{path}: {e}"))
+                }
+                other => CliError::from(other),
+            }),
         }
     }
 }
@@ -178,7 +217,7 @@ struct ForcesRow {
 }
 
 fn forces(args: &[String]) -> Result<(), CliError> {
-    let parsed = parse_args(args, &["gaps", "protrusion-m"])?;
+    let parsed = parse_args(args, &["gaps", "protrusion-m"], &[])?;
     let gaps = parse_list(
         "gaps",
         parsed
@@ -212,4 +251,177 @@ fn forces(args: &[String]) -> Result<(), CliError> {
         )));
     }
     print_json(&rows)
+}
+
+#[derive(Serialize)]
+struct FoldRow {
+    power: f64,
+    d: f64,
+}
+
+#[derive(Serialize)]
+struct StaticReport {
+    touchdown_power: f64,
+    takeoff_power: f64,
+    hysteresis: f64,
+    pull_in_voltage: Option<f64>,
+    folds: Vec<FoldRow>,
+}
+
+fn static_analyses(args: &[String]) -> Result<(), CliError> {
+    let parsed = parse_args(args, &[], &[])?;
+    let scene = parsed.load_scene()?;
+    let model = SliderModel::from_scene(&scene)?;
+    let opts = StaticOptions::new(scene.detector.contact_threshold_n);
+    let h = static_hysteresis(&model, &opts)?;
+    let pull_in_voltage = if model.forces().has_voltage_terms() {
+        Some(pull_in_voltage(&model, 0.0, &opts)?.voltage)
+    } else {
+        None
+    };
+    let curve = s_curve(&model, None, &ScanGrid::default())?;
+    print_json(&StaticReport {
+        touchdown_power: h.touchdown.power,
+        takeoff_power: h.takeoff.power,
+        hysteresis: h.hysteresis,
+        pull_in_voltage,
+        folds: curve
+            .folds
+            .iter()
+            .map(|f| FoldRow {
+                power: f.power,
+                d: f.d,
+            })
+            .collect(),
+    })
+}
+
+#[derive(Serialize)]
+struct CycleReport {
+    v_ac: f64,
+    touchdown_power: Option<f64>,
+    takeoff_power: Option<f64>,
+    hysteresis: Option<f64>,
+    mean_temperature_rise: f64,
+    steps: usize,
+    wall_seconds: f64,
+}
+
+impl From<&CycleResult> for CycleReport {
+    fn from(r: &CycleResult) -> Self {
+        CycleReport {
+            v_ac: r.v_ac,
+            touchdown_power: r.touchdown.map(|d| d.power),
+            takeoff_power: r.takeoff.map(|d| d.power),
+            hysteresis: r.hysteresis,
+            mean_temperature_rise: r.mean_temperature_rise,
+            steps: r.stats.accepted,
+            wall_seconds: r.wall_seconds,
+        }
+    }
+}
+
+/// Model, programme and cycle options of a scene, with the command line's overrides.
+fn cycle_setup(
+    parsed: &Parsed,
+    scene: &Scene,
+) -> Result<(SliderModel, HeaterProgramme, CycleOptions), CliError> {
+    let model = SliderModel::from_scene(scene)?;
+    let mut opts = CycleOptions::from_scene(scene)?;
+    if let Some(m) = parsed.value("method") {
+        opts.solver.method = m
+            .parse()
+            .map_err(|e: hdi_tribology::ode::OdeError| CliError::Usage(format!("--method: {e}")))?;
+    }
+    if let Some(r) = parsed.value("rtol") {
+        opts.solver.rtol = parse_number("rtol", r)?;
+    }
+    let programme = if parsed.flag("triggered") {
+        let t = &scene.heater.triggered;
+        HeaterProgramme::Triggered {
+            start_power: t.start_power_w,
+            ramp_rate: t.ramp_rate_w_per_s,
+            overshoot: t.overshoot_w,
+        }
+    } else {
+        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?)
+    };
+    Ok((model, programme, opts))
+}
+
+fn cycle(args: &[String]) -> Result<(), CliError> {
+    let parsed = parse_args(args, &["v-ac", "csv", "method", "rtol"], &["triggered"])?;
+    let scene = parsed.load_scene()?;
+    let (mut model, programme, mut opts) = cycle_setup(&parsed, &scene)?;
+    if let Some(v) = parsed.value("v-ac") {
+        model = model.with_voltage(Voltage {
+            ac_amplitude: parse_number("v-ac", v)?,
+            ..model.voltage
+        });
+    }
+    let csv = parsed.value("csv");
+    opts.keep_series = csv.is_some();
+    let r = simulate_cycle(&model, &programme, &opts)?;
+    if let (Some(path), Some(s)) = (csv, r.series.as_ref()) {
+        write_csv(
+            std::path::Path::new(path),
+            &[
+                "t_s",
+                "power_w",
+                "d_m",
+                "air_bearing_n",
+                "intermolecular_n",
+                "electrostatic_n",
+                "contact_n",
+                "total_n",
+                "temperature_rise_k",
+                "indicator_n",
+            ],
+            &[
+                &s.t,
+                &s.power,
+                &s.d,
+                &s.air_bearing,
+                &s.intermolecular,
+                &s.electrostatic,
+                &s.contact,
+                &s.total,
+                &s.temperature_rise,
+                &s.indicator,
+            ],
+        )?;
+    }
+    print_json(&CycleReport::from(&r))
+}
+
+fn sweep(args: &[String]) -> Result<(), CliError> {
+    let parsed = parse_args(args, &["v-ac", "method", "rtol"], &["triggered"])?;
+    let scene = parsed.load_scene()?;
+    let (model, programme, opts) = cycle_setup(&parsed, &scene)?;
+    let amplitudes = match parsed.value("v-ac") {
+        Some(list) => parse_list("v-ac", list)?,
+        None => scene.sweep.ac_amplitudes_v.clone(),
+    };
+    if amplitudes.is_empty() {
+        return Err(CliError::Usage(
+            "no amplitudes: give --v-ac or a [sweep] list in the scene".into(),
+        ));
+    }
+    let rows: Vec<CycleReport> = ac_sweep(&model, &programme, &opts, &amplitudes)?
+        .iter()
+        .map(CycleReport::from)
+        .collect();
+    print_json(&rows)
+}
+
+fn scene(args: &[String]) -> Result<(), CliError> {
+    let parsed = parse_args(args, &[], &["json"])?;
+    let scene = parsed.load_scene()?;
+    scene.validate()?;
+    let text = if parsed.flag("json") {
+        scene.to_json_string()?
+    } else {
+        scene.to_toml_string()?
+    };
+    print_text(text.trim_end())
 }

@@ -243,6 +243,11 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
         }
     }
     fn kinks(&self) -> Vec<f64> {
+        // With roughness the cutoff is smeared over σ and the force is smooth; only a smooth or
+        // nearly smooth surface (σ below 1 % of h_c) has a kink (or, flat, a jump) worth a cut.
+        if self.sigma >= 0.01 * self.cutoff {
+            return Vec::new();
+        }
         let delta = self.footprint.derjaguin_depth();
         let mut k = vec![self.cutoff];
         if delta > 0.0 && delta.is_finite() {

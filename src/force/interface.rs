@@ -112,7 +112,11 @@ impl Tabulated {
             // At an interior kink evaluate one ulp inside the segment, so that each piece sees the
             // one-sided limit of a function that jumps there (smooth surface, flat footprint).
             let a_in = if k == 0 { a } else { next_toward(a, b) };
-            let b_in = if k + 2 == edges.len() { b } else { next_toward(b, a) };
+            let b_in = if k + 2 == edges.len() {
+                b
+            } else {
+                next_toward(b, a)
+            };
             let f = |x: f64| -> Result<(f64, f64)> {
                 let x = x.clamp(a_in, b_in);
                 match source {
@@ -158,7 +162,44 @@ impl Tabulated {
     fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
         match self.lookup(d) {
             Some(v) => v,
-            None => self.exact_one(terms, d).unwrap_or((f64::NAN, f64::NAN)),
+            None => fallback(self, terms, d),
+        }
+    }
+}
+
+/// The exact sum outside the tables (kept out of line: the hot path stays small).
+#[cold]
+#[inline(never)]
+fn fallback(tab: &Tabulated, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+    tab.exact_one(terms, d).unwrap_or((f64::NAN, f64::NAN))
+}
+
+/// A table on the hot path: a single-segment table is held by value, saving the pointer chase
+/// through the shared [`Tabulated`].
+#[derive(Clone, Debug)]
+struct Slot {
+    single: Option<Table>,
+    tab: Arc<Tabulated>,
+}
+
+impl Slot {
+    fn new(tab: Arc<Tabulated>) -> Self {
+        let single = match tab.segments.as_slice() {
+            [only] => Some(only.clone()),
+            _ => None,
+        };
+        Slot { single, tab }
+    }
+
+    #[inline]
+    fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+        let hit = match &self.single {
+            Some(t) => t.eval(d),
+            None => self.tab.lookup(d),
+        };
+        match hit {
+            Some(v) => v,
+            None => fallback(&self.tab, terms, d),
         }
     }
 }
@@ -172,7 +213,8 @@ fn next_toward(x: f64, toward: f64) -> f64 {
     }
 }
 
-type PerGap = [Option<Arc<Tabulated>>; 2];
+type ArcGap = [Option<Arc<Tabulated>>; 2];
+type PerGap = [Option<Slot>; 2];
 
 /// All enabled terms, tabulated over the separation.
 ///
@@ -268,7 +310,8 @@ impl InterfaceForces {
         for gap in gaps {
             for kind in kinds {
                 for coupling in [Coupling::Static, Coupling::PerVoltSquared] {
-                    let m = select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
+                    let m =
+                        select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
                     if !m.is_empty() {
                         let e = &edges[gap.index()];
                         let tab = Tabulated::build(&terms, m, false, e, opts, Source::Exact)?;
@@ -277,10 +320,10 @@ impl InterfaceForces {
                 }
             }
         }
-        let mut static_part: PerGap = [None, None];
-        let mut per_volt2: PerGap = [None, None];
-        let mut contact: PerGap = [None, None];
-        let mut area: PerGap = [None, None];
+        let mut static_part: ArcGap = [None, None];
+        let mut per_volt2: ArcGap = [None, None];
+        let mut contact: ArcGap = [None, None];
+        let mut area: ArcGap = [None, None];
         for gap in gaps {
             let g = gap.index();
             for (coupling, slot) in [
@@ -303,7 +346,14 @@ impl InterfaceForces {
                     Arc::clone(&parts[0])
                 } else {
                     let e = &edges[g];
-                    Arc::new(Tabulated::build(&terms, m, false, e, opts, Source::Parts(&parts))?)
+                    Arc::new(Tabulated::build(
+                        &terms,
+                        m,
+                        false,
+                        e,
+                        opts,
+                        Source::Parts(&parts),
+                    )?)
                 });
             }
             contact[g] = by_kind
@@ -317,13 +367,14 @@ impl InterfaceForces {
                 area[g] = Some(Arc::new(tab));
             }
         }
+        let hot = |a: ArcGap| a.map(|t| t.map(Slot::new));
         Ok(InterfaceForces {
             terms: Arc::new(terms),
             range,
-            static_part,
-            per_volt2,
-            contact,
-            area,
+            static_part: hot(static_part),
+            per_volt2: hot(per_volt2),
+            contact: hot(contact),
+            area: hot(area),
             by_kind,
         })
     }
@@ -433,6 +484,7 @@ impl InterfaceForces {
             .chain(&self.contact)
             .chain(&self.area)
             .flatten()
+            .map(|s| &s.tab)
             .chain(self.by_kind.iter().map(|(_, _, _, t)| t));
         let mut n = 0;
         for t in all {

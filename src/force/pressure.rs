@@ -59,7 +59,7 @@ impl PressureLaw for LennardJones39 {
 ///
 /// ```
 /// let h = hdi_tribology::force::lj_zero(1e-19, 1e-76);
-/// assert!((h - 2.2596e-10).abs() < 1e-14);
+/// assert!((h - 2.2602e-10).abs() < 1e-14);
 /// ```
 pub fn lj_zero(hamaker_a: f64, hamaker_b: f64) -> f64 {
     (2.0 * hamaker_b / (15.0 * hamaker_a)).powf(1.0 / 6.0)

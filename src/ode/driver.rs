@@ -3,13 +3,13 @@
 use super::dense::{DenseOutput, StepPoly};
 use super::error::OdeError;
 use super::event::{crossing, locate, Event, EventHit};
+use super::jacobian::{eval_jacobian, spectral_radius};
 use super::options::{Options, SaveAt};
 use super::solution::{Solution, Stats};
 use super::stepper::{all_finite, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
 use super::tsit5::STABILITY_BOUNDARY;
 use super::Method;
-use super::jacobian::{eval_jacobian, spectral_radius};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 
 /// Controller constants: PI control `fac = SAFETY · err^(−α) · err_prev^β` with
@@ -194,7 +194,7 @@ where
         if h >= remaining || remaining - h < floor.max(1e-3 * h) {
             h = remaining;
             hit_stop = true;
-        } else if !(h >= floor) {
+        } else if h.is_nan() || h < floor {
             if recent_nonfinite > 0 {
                 return Err(OdeError::NonFinite {
                     t,
@@ -203,11 +203,7 @@ where
                     ),
                 });
             }
-            return Err(OdeError::StepTooSmall {
-                t,
-                h,
-                h_min: floor,
-            });
+            return Err(OdeError::StepTooSmall { t, h, h_min: floor });
         }
         let stepper = &mut *steppers[active];
         let k = stepper.error_order();
@@ -266,7 +262,16 @@ where
             let g_new = ev.eval(t_new, &y_new);
             ctx.stats.event_evals += 1;
             if let Some(rising) = crossing(ev.get_direction(), g_old[i], g_new) {
-                let (te, evals) = locate(ev, &poly, t, g_old[i], t_new, g_new, opts.event_tol, &mut work);
+                let (te, evals) = locate(
+                    ev,
+                    &poly,
+                    t,
+                    g_old[i],
+                    t_new,
+                    g_new,
+                    opts.event_tol,
+                    &mut work,
+                );
                 ctx.stats.event_evals += evals;
                 hits.push((i, te, rising));
             }
@@ -333,7 +338,11 @@ where
         let (alpha, beta) = (0.7 / k, 0.4 / k);
         let e = err.max(1e-10);
         let mut fac = SAFETY * e.powf(-alpha) * err_prev.powf(beta);
-        let fac_max = if stiff { FAC_MAX_STIFF } else { FAC_MAX_EXPLICIT };
+        let fac_max = if stiff {
+            FAC_MAX_STIFF
+        } else {
+            FAC_MAX_EXPLICIT
+        };
         if last_rejected {
             fac = fac.min(1.0);
         }
@@ -341,7 +350,9 @@ where
             fac = fac.min(hint);
         }
         if opts.adaptive {
-            h = stepper.propose(h, h * fac.clamp(FAC_MIN, fac_max)).min(h_max);
+            h = stepper
+                .propose(h, h * fac.clamp(FAC_MIN, fac_max))
+                .min(h_max);
         } else if let Some(h0) = opts.h_init {
             h = h0.min(h_max);
         }
@@ -369,7 +380,15 @@ where
                     .is_some_and(|h_rho| h_rho > STABILITY_BOUNDARY);
                 if flagged || since_check >= CHECK_INTERVAL {
                     since_check = 0;
-                    let rho = estimate_radius(sys, t, &y, steppers[active].f0(), &mut jac_work, &mut work, &mut ctx);
+                    let rho = estimate_radius(
+                        sys,
+                        t,
+                        &y,
+                        steppers[active].f0(),
+                        &mut jac_work,
+                        &mut work,
+                        &mut ctx,
+                    );
                     if h_acc * rho > STIFF_FRACTION * STABILITY_BOUNDARY {
                         stiff_count += 1;
                     } else {

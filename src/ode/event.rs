@@ -15,6 +15,9 @@ pub enum Direction {
     Both,
 }
 
+/// Boxed event function `g(t, y)`.
+type EventFn<'a, D> = Box<dyn FnMut(f64, &OVector<f64, D>) -> f64 + 'a>;
+
 /// An event function `g(t, y)`; a root of `g` in the chosen direction is an event.
 ///
 /// ```
@@ -28,7 +31,7 @@ pub struct Event<'a, D: Dim>
 where
     DefaultAllocator: Allocator<D>,
 {
-    f: Box<dyn FnMut(f64, &OVector<f64, D>) -> f64 + 'a>,
+    f: EventFn<'a, D>,
     direction: Direction,
     terminal: bool,
 }
@@ -105,6 +108,7 @@ pub(crate) fn crossing(d: Direction, g_old: f64, g_new: f64) -> Option<bool> {
 /// `gb`, opposite sign or zero) to `tol` in time, by the Illinois variant of regula falsi with
 /// bisection safeguards. Returns the right end of the final bracket (the first time at which
 /// the sign has changed), so stopping there never leaves the event undone.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn locate<D: Dim>(
     ev: &mut Event<'_, D>,
     poly: &StepPoly,

@@ -68,7 +68,7 @@ where
     const ITERS: usize = 16;
     for it in 0..ITERS {
         let nv = v.norm();
-        if !(nv > 0.0) || !nv.is_finite() {
+        if nv.is_nan() || nv <= 0.0 || !nv.is_finite() {
             return if it == 0 { 0.0 } else { f64::INFINITY };
         }
         v /= nv;
@@ -84,4 +84,24 @@ where
         std::mem::swap(&mut v, &mut w);
     }
     (log_growth / counted as f64).exp()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+
+    #[test]
+    fn spectral_radius_of_oscillator_and_stiff_diagonal() {
+        // Eigenvalues ±iω: the norm growth rate is ω although the direction never converges.
+        let w = 2.0 * std::f64::consts::PI * 87e3;
+        let r = spectral_radius(&Matrix2::new(0.0, 1.0, -w * w, 0.0), &Vector2::zeros());
+        // Power-iteration estimate of the growth rate: within 20 % (start-vector bias^(1/8)).
+        assert!((r / w - 1.0).abs() < 0.2, "{r} vs {w}");
+        let r = spectral_radius(
+            &Matrix3::from_diagonal(&Vector3::new(-1e4, -1.0, -3.0)),
+            &Vector3::zeros(),
+        );
+        assert!((r / 1e4 - 1.0).abs() < 1e-6, "{r}");
+    }
 }

@@ -47,7 +47,7 @@ where
                     p = i;
                 }
             }
-            if !(best > 0.0) || !best.is_finite() {
+            if best.is_nan() || best <= 0.0 || !best.is_finite() {
                 return false;
             }
             self.piv[k] = p;
@@ -91,5 +91,43 @@ where
             }
             b[i] = s / self.m[(i, i)].clone();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix4, Vector4, U4};
+    use num_complex::Complex64;
+
+    #[test]
+    fn solves_real_system_with_pivoting() {
+        // Zero leading pivot forces a row exchange.
+        let m = Matrix4::new(
+            0.0, 2.0, 1.0, 3.0, 4.0, 1.0, 0.5, 2.0, 1.0, 1.0, 5.0, 0.0, 2.0, 3.0, 1.0, 7.0,
+        );
+        let x = Vector4::new(1.0, -2.0, 0.5, 3.0);
+        let mut b = m * x;
+        let mut lu = Lu::<f64, U4>::new(U4);
+        lu.m.copy_from(&m);
+        assert!(lu.factor());
+        lu.solve_mut(&mut b);
+        assert!((b - x).amax() < 1e-13);
+    }
+
+    #[test]
+    fn solves_complex_system_and_flags_singular() {
+        let m = Matrix4::from_fn(|i, j| {
+            Complex64::new((i + 2 * j) as f64, if i == j { 3.0 } else { -0.5 })
+        });
+        let x = Vector4::from_fn(|i, _| Complex64::new(i as f64, 1.0 - i as f64));
+        let mut b = m * x;
+        let mut lu = Lu::<Complex64, U4>::new(U4);
+        lu.m.copy_from(&m);
+        assert!(lu.factor());
+        lu.solve_mut(&mut b);
+        assert!((b - x).iter().all(|d| d.norm() < 1e-12));
+        lu.m.fill(Complex64::new(1.0, 0.0));
+        assert!(!lu.factor());
     }
 }

@@ -53,7 +53,29 @@ use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
 /// Integrates `y' = f(t, y)` from `(t0, y0)` to `tf > t0` with `method`.
 ///
-/// `events` may be empty (`&mut []`). See the [module documentation](self) for an example.
+/// `events` may be empty (`&mut []`). See the [module documentation](self) for a stiff
+/// example; here a fixed-size state, a terminal event and dense output:
+///
+/// ```
+/// use hdi_tribology::ode::{solve, Direction, Event, FnSystem, Method, Options};
+/// use nalgebra::Vector2;
+///
+/// // A ball dropped from 10 m: stop when the height falls through zero.
+/// let ball = FnSystem::new(|_t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>| {
+///     dy[0] = y[1];
+///     dy[1] = -9.81;
+/// });
+/// let mut events = [Event::new(|_t, y: &Vector2<f64>| y[0])
+///     .direction(Direction::Falling)
+///     .terminal(true)];
+/// let opts = Options::default().rtol(1e-10).atol(1e-12);
+/// let sol = solve(&ball, 0.0, Vector2::new(10.0, 0.0), 5.0, Method::Tsit5, &opts, &mut events)?;
+/// assert_eq!(sol.terminated_by_event, Some(0));
+/// assert!((sol.t_final() - (2.0 * 10.0 / 9.81f64).sqrt()).abs() < 1e-10);
+/// let half = sol.sample(0.5).unwrap();
+/// assert!((half[0] - (10.0 - 0.5 * 9.81 * 0.25)).abs() < 1e-10);
+/// # Ok::<(), hdi_tribology::ode::OdeError>(())
+/// ```
 ///
 /// # Errors
 /// [`OdeError::InvalidInput`] for bad arguments or options; [`OdeError::StepTooSmall`],

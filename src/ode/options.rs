@@ -122,8 +122,14 @@ pub enum SaveAt {
 /// let opts = Options::default().rtol(1e-8).atol(1e-10).h_max(1e-3).save(SaveAt::Final);
 /// assert!(opts.validate(2).is_ok());
 /// assert!(Options::default().rtol(-1.0).validate(2).is_err());
+/// // Serde: missing fields take their defaults.
+/// let o: Options = serde_json::from_str(r#"{"rtol": 1e-9, "h_max": 2e-6}"#).unwrap();
+/// assert_eq!((o.rtol, o.h_max, o.max_steps), (1e-9, 2e-6, Options::default().max_steps));
+/// let back: Options = serde_json::from_str(&serde_json::to_string(&Options::default()).unwrap()).unwrap();
+/// assert_eq!(back, Options::default());
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Options {
     /// Relative tolerance (> 0, ≥ 100 ε).
     pub rtol: f64,
@@ -132,6 +138,8 @@ pub struct Options {
     /// Initial step size; `None` selects it automatically.
     pub h_init: Option<f64>,
     /// Largest step size allowed (> 0); keeps steps from jumping over short features.
+    /// Infinite by default (serialised as `null` / absent).
+    #[serde(with = "infinite_as_none")]
     pub h_max: f64,
     /// Smallest step size allowed (≥ 0); a smaller step request is an error.
     pub h_min: f64,
@@ -282,7 +290,7 @@ impl Options {
                 "constant steps (adaptive = false) need h_init",
             ));
         }
-        if !(self.h_max > 0.0) {
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
             return Err(OdeError::invalid(
                 "options.h_max",
                 format!("must be > 0, got {}", self.h_max),
@@ -324,5 +332,24 @@ impl Options {
             ));
         }
         Ok(())
+    }
+}
+
+/// Serde for a value that is infinite by default: `None`/`null` stands for +∞ (JSON has no
+/// infinity).
+mod infinite_as_none {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        let o = if v.is_infinite() && *v > 0.0 {
+            None
+        } else {
+            Some(*v)
+        };
+        o.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
     }
 }

@@ -69,7 +69,8 @@ fn build_consts() -> RadauConsts {
         r0.cross(&r1)
     };
     let lam = Complex64::new(alpha, beta);
-    let mc = a_inv.map(|v| Complex64::new(v, 0.0)) - Matrix3::identity().map(|v| Complex64::new(v, 0.0)) * lam;
+    let mc = a_inv.map(|v| Complex64::new(v, 0.0))
+        - Matrix3::identity().map(|v| Complex64::new(v, 0.0)) * lam;
     let r0 = [mc[(0, 0)], mc[(0, 1)], mc[(0, 2)]];
     let r1 = [mc[(1, 0)], mc[(1, 1)], mc[(1, 2)]];
     let w = [
@@ -79,7 +80,14 @@ fn build_consts() -> RadauConsts {
     ];
     // w = t2 − i t3 is the eigenvector of α + iβ for the real block [[α, −β], [β, α]].
     let t = Matrix3::new(
-        real_vec[0], w[0].re, -w[0].im, real_vec[1], w[1].re, -w[1].im, real_vec[2], w[2].re,
+        real_vec[0],
+        w[0].re,
+        -w[0].im,
+        real_vec[1],
+        w[1].re,
+        -w[1].im,
+        real_vec[2],
+        w[2].re,
         -w[2].im,
     );
     let t_inv = t.try_inverse().unwrap_or_else(Matrix3::identity);
@@ -138,6 +146,7 @@ where
     cx: OVector<Complex64, D>,
     tmp: OVector<f64, D>,
     cont: OVector<f64, D>,
+    f2: OVector<f64, D>,
     /// Stage increments and step of the last accepted step, for the starting guess.
     z_prev: [OVector<f64, D>; 3],
     h_prev: Option<f64>,
@@ -176,6 +185,7 @@ where
             cx: y.map(|_| Complex64::new(0.0, 0.0)),
             tmp: z.clone(),
             cont: z.clone(),
+            f2: z.clone(),
             z_prev: std::array::from_fn(|_| z.clone()),
             h_prev: None,
             theta: 1.0,
@@ -187,7 +197,13 @@ where
         }
     }
 
-    fn norm(&self, v: &OVector<f64, D>, y0: &OVector<f64, D>, y1: &OVector<f64, D>, ctx: &Ctx<D>) -> f64 {
+    fn norm(
+        &self,
+        v: &OVector<f64, D>,
+        y0: &OVector<f64, D>,
+        y1: &OVector<f64, D>,
+        ctx: &Ctx<D>,
+    ) -> f64 {
         ctx.err_norm(v, y0, y1) / self.tol_scale
     }
 
@@ -330,10 +346,13 @@ where
             let mut dnorm_sq = 0.0;
             for r in 0..n {
                 let fr = [self.f[0][r], self.f[1][r], self.f[2][r]];
-                let tf = |i: usize| k.t_inv[(i, 0)] * fr[0] + k.t_inv[(i, 1)] * fr[1] + k.t_inv[(i, 2)] * fr[2];
+                let tf = |i: usize| {
+                    k.t_inv[(i, 0)] * fr[0] + k.t_inv[(i, 1)] * fr[1] + k.t_inv[(i, 2)] * fr[2]
+                };
                 let (w1, w2, w3) = (self.w[0][r], self.w[1][r], self.w[2][r]);
                 self.tmp[r] = tf(0) - g * w1;
-                self.cx[r] = Complex64::new(tf(1) - (al * w2 - be * w3), tf(2) - (be * w2 + al * w3));
+                self.cx[r] =
+                    Complex64::new(tf(1) - (al * w2 - be * w3), tf(2) - (be * w2 + al * w3));
             }
             self.lu_re.solve_mut(&mut self.tmp);
             self.lu_cx.solve_mut(&mut self.cx);
@@ -341,8 +360,8 @@ where
             // Update W and Z; measure the increment in Z (independent of T's scaling).
             for r in 0..n {
                 let dw = [self.tmp[r], self.cx[r].re, self.cx[r].im];
-                for i in 0..3 {
-                    self.w[i][r] += dw[i];
+                for (wi, dwi) in self.w.iter_mut().zip(dw) {
+                    wi[r] += dwi;
                 }
                 for i in 0..3 {
                     let dz = k.t[(i, 0)] * dw[0] + k.t[(i, 1)] * dw[1] + k.t[(i, 2)] * dw[2];
@@ -400,11 +419,11 @@ where
 
         // Error estimate: (γ/h − J)⁻¹ (f0 + Σ dd_i Z_i / h), a second filtered pass when the
         // first is large after a rejection (it can be unreliable for very stiff components).
-        let mut f2 = zeros_like(y);
+        self.f2.fill(0.0);
         for i in 0..3 {
-            f2.axpy(k.dd[i] / h, &self.z[i], 1.0);
+            self.f2.axpy(k.dd[i] / h, &self.z[i], 1.0);
         }
-        self.cont.copy_from(&f2);
+        self.cont.copy_from(&self.f2);
         self.cont += &self.f0;
         self.lu_re.solve_mut(&mut self.cont);
         ctx.stats.lin_solves += 1;
@@ -414,7 +433,7 @@ where
             self.tmp += &self.cont;
             sys.rhs(t, &self.tmp, &mut self.cont);
             ctx.stats.rhs_evals += 1;
-            self.cont += &f2;
+            self.cont += &self.f2;
             self.lu_re.solve_mut(&mut self.cont);
             ctx.stats.lin_solves += 1;
             err = self.norm(&self.cont, y, y_new, ctx);
@@ -435,18 +454,20 @@ where
         h: f64,
         _y_new: &OVector<f64, D>,
         poly: &mut StepPoly,
-        _ctx: &mut Ctx<D>,
+        ctx: &mut Ctx<D>,
     ) {
         let k = consts();
-        poly.begin(t, h, 3);
-        for i in 0..y.len() {
-            *poly.at(0, i) = y[i];
-            for m in 1..=3 {
-                let mut a = 0.0;
-                for j in 0..3 {
-                    a += k.lag[j][m - 1] * self.z[j][i];
+        if ctx.need_poly {
+            poly.begin(t, h, 3);
+            for i in 0..y.len() {
+                *poly.at(0, i) = y[i];
+                for m in 1..=3 {
+                    let mut a = 0.0;
+                    for j in 0..3 {
+                        a += k.lag[j][m - 1] * self.z[j][i];
+                    }
+                    *poly.at(m, i) = a;
                 }
-                *poly.at(m, i) = a;
             }
         }
         // f at the new point is evaluated at the next attempt (the last Newton evaluation
@@ -504,7 +525,9 @@ mod tests {
         let k = consts();
         let a_inv = k.a.try_inverse().unwrap();
         let lam = k.t_inv * a_inv * k.t;
-        let expect = Matrix3::new(k.gamma, 0.0, 0.0, 0.0, k.alpha, -k.beta, 0.0, k.beta, k.alpha);
+        let expect = Matrix3::new(
+            k.gamma, 0.0, 0.0, 0.0, k.alpha, -k.beta, 0.0, k.beta, k.alpha,
+        );
         assert!((lam - expect).amax() < 1e-12, "{lam}");
     }
 

@@ -4,9 +4,9 @@
 
 use super::dense::StepPoly;
 use super::jacobian::{eval_jacobian, eval_time_derivative, spectral_radius};
+use super::lu::Lu;
 use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
-use super::lu::Lu;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 
 const GAMMA: f64 = 0.211_937_563_194_290_14;
@@ -39,8 +39,20 @@ const D_T: [f64; 8] = [
 const A: [[f64; 5]; 6] = [
     [0.0; 5],
     [3.0, 0.0, 0.0, 0.0, 0.0],
-    [2.849_394_379_747_939, 0.458_422_422_044_639_23, 0.0, 0.0, 0.0],
-    [-6.954_028_509_809_101, 2.489_845_061_869_568, -10.358_996_098_473_584, 0.0, 0.0],
+    [
+        2.849_394_379_747_939,
+        0.458_422_422_044_639_23,
+        0.0,
+        0.0,
+        0.0,
+    ],
+    [
+        -6.954_028_509_809_101,
+        2.489_845_061_869_568,
+        -10.358_996_098_473_584,
+        0.0,
+        0.0,
+    ],
     [
         2.802_998_627_562_896_4,
         0.507_246_473_622_820_6,
@@ -61,8 +73,24 @@ const A: [[f64; 5]; 6] = [
 const CC: [[f64; 7]; 8] = [
     [0.0; 7],
     [-14.155_112_264_123_755, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [-17.972_960_358_859_52, -2.859_693_295_451_294, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [147.121_502_757_117_16, -1.412_214_027_182_13, 71.689_402_513_023_58, 0.0, 0.0, 0.0, 0.0],
+    [
+        -17.972_960_358_859_52,
+        -2.859_693_295_451_294,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ],
+    [
+        147.121_502_757_117_16,
+        -1.412_214_027_182_13,
+        71.689_402_513_023_58,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ],
     [
         165.435_170_248_716_76,
         -0.459_282_345_649_112_6,
@@ -298,8 +326,13 @@ where
         h: f64,
         y_new: &OVector<f64, D>,
         poly: &mut StepPoly,
-        _ctx: &mut Ctx<D>,
+        ctx: &mut Ctx<D>,
     ) {
+        self.f0_valid = false;
+        self.jac_valid = false;
+        if !ctx.need_poly {
+            return;
+        }
         poly.begin(t, h, 4);
         for i in 0..y.len() {
             let mut w = [0.0; 3];
@@ -314,8 +347,6 @@ where
             *poly.at(3, i) = w[2] - w[1];
             *poly.at(4, i) = -w[2];
         }
-        self.f0_valid = false;
-        self.jac_valid = false;
     }
 
     fn stiffness(&self) -> Option<f64> {

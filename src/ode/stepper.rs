@@ -87,6 +87,7 @@ where
         ctx: &mut Ctx<D>,
     ) -> Trial;
 
+    #[allow(clippy::too_many_arguments)]
     /// Called after the last attempt was accepted: writes the step interpolant into `poly` and
     /// moves the method's state to the new point.
     fn accept(

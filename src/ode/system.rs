@@ -118,7 +118,7 @@ where
     for j in 0..n {
         let yj = y[j];
         let mut delta = sqrt_eps * yj.abs().max(scale[j]);
-        if !(delta > 0.0) || !delta.is_finite() {
+        if delta.is_nan() || delta <= 0.0 || !delta.is_finite() {
             delta = sqrt_eps;
         }
         yp[j] = yj + delta;

@@ -56,7 +56,7 @@ const A: [[f64; 6]; 7] = [
 
 /// b − b̂: the error estimate weights.
 const E: [f64; 7] = [
-    -0.001_780_011_052_225_777_1,
+    -0.001_780_011_052_225_777,
     -0.000_816_434_459_656_746_9,
     0.007_880_878_010_261_995,
     -0.144_711_007_173_262_9,
@@ -214,8 +214,13 @@ where
         h: f64,
         _y_new: &OVector<f64, D>,
         poly: &mut StepPoly,
-        _ctx: &mut Ctx<D>,
+        ctx: &mut Ctx<D>,
     ) {
+        // FSAL: the last stage is f at the new point.
+        if !ctx.need_poly {
+            self.k.swap(0, 6);
+            return;
+        }
         poly.begin(t, h, 4);
         let n = y.len();
         for i in 0..n {

@@ -8,6 +8,8 @@ use std::collections::BinaryHeap;
 
 /// Kronrod abscissae on [−1, 1] (positive half, decreasing; the last is the centre).
 /// Entries 1, 3, 5, 7, 9 are the 10-point Gauss–Legendre abscissae.
+// Published digits are kept in full; the compiler rounds them correctly.
+#[allow(clippy::excessive_precision)]
 pub(crate) const XGK: [f64; 11] = [
     0.995_657_163_025_808_080_735_527_280_689_003,
     0.973_906_528_517_171_720_077_964_012_084_452,
@@ -23,6 +25,8 @@ pub(crate) const XGK: [f64; 11] = [
 ];
 
 /// Kronrod weights matching [`XGK`].
+// Published digits are kept in full; the compiler rounds them correctly.
+#[allow(clippy::excessive_precision)]
 pub(crate) const WGK: [f64; 11] = [
     0.011_694_638_867_371_874_278_064_396_062_192,
     0.032_558_162_307_964_727_478_818_972_459_390,
@@ -38,6 +42,8 @@ pub(crate) const WGK: [f64; 11] = [
 ];
 
 /// 10-point Gauss weights for abscissae `XGK[1], XGK[3], …, XGK[9]`.
+// Published digits are kept in full; the compiler rounds them correctly.
+#[allow(clippy::excessive_precision)]
 pub(crate) const WG: [f64; 5] = [
     0.066_671_344_308_688_137_593_568_809_893_332,
     0.149_451_349_150_580_593_145_776_339_657_697,
@@ -250,9 +256,7 @@ fn adapt<F: FnMut(f64) -> f64>(
             (v + s.value, e + s.error, r + s.floor)
         });
         // Only the part of the error above the rounding level can be refined away.
-        if error - floor <= opts.target(value)
-            || (!strict && heap.len() >= opts.max_intervals)
-        {
+        if error - floor <= opts.target(value) || (!strict && heap.len() >= opts.max_intervals) {
             return Ok(Estimate {
                 value: sign * value,
                 error,
@@ -333,7 +337,7 @@ mod tests {
         for k in (0..=30).step_by(2) {
             let mut s = WGK[10] * if k == 0 { 1.0 } else { 0.0 };
             for j in 0..10 {
-                s += 2.0 * WGK[j] * XGK[j].powi(k as i32);
+                s += 2.0 * WGK[j] * XGK[j].powi(k);
             }
             let exact = 2.0 / (k as f64 + 1.0);
             assert!((s - exact).abs() < 4e-16, "degree {k}: {s} vs {exact}");

@@ -37,19 +37,20 @@ impl Default for TableOptions {
     }
 }
 
-/// A panel of uniformly spaced nodes.
+/// A panel of uniformly spaced nodes (32 bytes, copied into every index cell it
+/// covers so that a look-up needs one cell read and one node read).
 #[derive(Clone, Copy, Debug)]
 struct Panel {
     /// Left end.
     a: f64,
-    /// Node spacing.
-    h: f64,
     /// 1/h.
     inv_h: f64,
+    /// Node spacing h.
+    h: f64,
     /// Index of the first node of this panel in `Table::nodes`.
-    start: usize,
-    /// Number of intervals (nodes − 1).
-    n: usize,
+    start: u32,
+    /// Index of the last interval (intervals − 1).
+    last: u32,
 }
 
 /// Piecewise cubic Hermite table of a smooth function and its derivative.
@@ -73,9 +74,11 @@ pub struct Table {
     /// Number of index cells per unit length.
     inv_cell: f64,
     /// For each cell of the finest panel grid, the panel covering it.
-    cells: Vec<u32>,
-    panels: Vec<Panel>,
-    /// (value, derivative) at every node, panel after panel.
+    cells: Vec<Panel>,
+    /// Number of distinct panels.
+    panel_count: usize,
+    /// (value, h·derivative) at every node, panel after panel, with h the
+    /// spacing of the node's panel.
     nodes: Vec<[f64; 2]>,
 }
 
@@ -92,17 +95,19 @@ struct Pending {
     mids: Vec<[f64; 2]>,
 }
 
-#[inline]
-fn hermite(y0: f64, m0: f64, y1: f64, m1: f64, h: f64, t: f64) -> (f64, f64) {
-    let t2 = t * t;
-    let t3 = t2 * t;
-    let v = (2.0 * t3 - 3.0 * t2 + 1.0) * y0
-        + (t3 - 2.0 * t2 + t) * h * m0
-        + (3.0 * t2 - 2.0 * t3) * y1
-        + (t3 - t2) * h * m1;
-    let dv = (6.0 * t2 - 6.0 * t) * (y0 - y1) / h
-        + (3.0 * t2 - 4.0 * t + 1.0) * m0
-        + (3.0 * t2 - 2.0 * t) * m1;
+/// Cubic Hermite interpolant on one interval in the local variable t ∈ [0, 1],
+/// from values y and scaled slopes hm = h·f' at both ends: returns the value and
+/// the t-derivative (divide by h for d/dx). Written as linear interpolation plus
+/// a correction that vanishes at both ends, so node values are reproduced exactly.
+#[inline(always)]
+fn cubic(y0: f64, hm0: f64, y1: f64, hm1: f64, t: f64) -> (f64, f64) {
+    let delta = y1 - y0;
+    let a = hm0 - delta;
+    let b = hm1 - delta;
+    let u = 1.0 - t;
+    let bracket = u * a - t * b;
+    let v = u * y0 + t * y1 + t * u * bracket;
+    let dv = delta + (u - t) * bracket - t * u * (a + b);
     (v, dv)
 }
 
@@ -127,7 +132,8 @@ impl Table {
     ) -> Result<Table> {
         crate::error::check_finite("table.lo", lo)?;
         crate::error::check_finite("table.hi", hi)?;
-        if !(hi > lo) {
+        // Both are finite here, so the comparison is total.
+        if hi <= lo {
             return Err(Error::invalid(
                 "table.hi",
                 format!("must be > table.lo = {lo}, got {hi}"),
@@ -210,7 +216,7 @@ impl Table {
                 let h = p.xs[i + 1] - p.xs[i];
                 let [y0, m0] = p.nodes[i];
                 let [y1, m1] = p.nodes[i + 1];
-                let (v, _) = hermite(y0, m0, y1, m1, h, 0.5);
+                let (v, _) = cubic(y0, h * m0, y1, h * m1, 0.5);
                 let exact = p.mids[i][0];
                 // Relative to the largest magnitude on the interval, so that a sign
                 // change inside it does not demand absolute accuracy near zero.
@@ -229,7 +235,7 @@ impl Table {
                 nodes.push(p.mids[i]);
             }
             nodes.push(p.nodes[n]);
-            if !((p.b - p.a) / (2 * n) as f64 > f64::EPSILON * p.a.abs().max(p.b.abs())) {
+            if (p.b - p.a) / (2 * n) as f64 <= f64::EPSILON * p.a.abs().max(p.b.abs()) {
                 return Err(Error::no_convergence(
                     "table build",
                     format!("node spacing reaches rounding level near {}", p.a),
@@ -286,35 +292,36 @@ impl Table {
             }
         }
 
-        done.sort_by(|x, y| x.a.total_cmp(&y.a));
         let max_depth = done.iter().map(|p| p.depth).max().unwrap_or(INITIAL_DEPTH);
+        // Order by first covered cell of the finest grid (panels tile the range).
+        done.sort_by_key(|p| p.pos << (max_depth - p.depth));
         let ncells = 1usize << max_depth;
-        let mut cells = vec![0u32; ncells];
-        let mut panels = Vec::with_capacity(done.len());
+        if node_count > u32::MAX as usize {
+            return Err(too_many(node_count));
+        }
+        let mut cells = Vec::with_capacity(ncells);
         let mut nodes = Vec::with_capacity(node_count);
-        for (idx, p) in done.iter().enumerate() {
+        for p in &done {
             let n = p.xs.len() - 1;
             let h = (p.b - p.a) / n as f64;
-            panels.push(Panel {
+            let panel = Panel {
                 a: p.a,
-                h,
                 inv_h: 1.0 / h,
-                start: nodes.len(),
-                n,
-            });
-            nodes.extend_from_slice(&p.nodes);
+                h,
+                start: nodes.len() as u32,
+                last: (n - 1) as u32,
+            };
+            nodes.extend(p.nodes.iter().map(|&[y, m]| [y, h * m]));
+            // Panels are sorted by position, so cells are filled in order.
             let span = 1usize << (max_depth - p.depth);
-            let first = (p.pos as usize) * span;
-            for c in &mut cells[first..first + span] {
-                *c = idx as u32;
-            }
+            cells.extend(std::iter::repeat_n(panel, span));
         }
         Ok(Table {
             lo,
             hi,
             inv_cell: ncells as f64 / width,
             cells,
-            panels,
+            panel_count: done.len(),
             nodes,
         })
     }
@@ -325,15 +332,25 @@ impl Table {
         if !(d >= self.lo && d <= self.hi) {
             return None;
         }
-        let cell = (((d - self.lo) * self.inv_cell) as usize).min(self.cells.len() - 1);
-        let p = &self.panels[self.cells[cell] as usize];
+        let p = self.panel(d);
         let s = (d - p.a) * p.inv_h;
-        // A negative `s` (rounding at a panel edge) saturates to interval 0.
-        let j = (s as usize).min(p.n - 1);
-        let t = s - j as f64;
-        let [y0, m0] = self.nodes[p.start + j];
-        let [y1, m1] = self.nodes[p.start + j + 1];
-        Some(hermite(y0, m0, y1, m1, p.h, t))
+        // Clamp in floating point (a negative `s` from rounding at a panel edge
+        // goes to interval 0); the i32 conversion is then a single instruction.
+        let j = s.clamp(0.0, f64::from(p.last)) as i32;
+        let t = s - f64::from(j);
+        let j = j as usize;
+        let k = p.start as usize + j;
+        let pair = &self.nodes[k..k + 2];
+        let (v, dt) = cubic(pair[0][0], pair[0][1], pair[1][0], pair[1][1], t);
+        Some((v, dt * p.inv_h))
+    }
+
+    /// The panel covering `d` (which must be inside the range).
+    #[inline(always)]
+    fn panel(&self, d: f64) -> &Panel {
+        // d is inside [lo, hi], so the index is in 0..=cells (cells ≤ 2^10).
+        let cell = ((d - self.lo) * self.inv_cell) as i32 as usize;
+        &self.cells[cell.min(self.cells.len() - 1)]
     }
 
     /// The tabulated range `(lo, hi)`.
@@ -356,12 +373,11 @@ impl Table {
         if !(d >= self.lo && d <= self.hi) {
             return None;
         }
-        let cell = (((d - self.lo) * self.inv_cell) as usize).min(self.cells.len() - 1);
-        Some(self.panels[self.cells[cell] as usize].h)
+        Some(self.panel(d).h)
     }
 
     /// Number of panels of uniform spacing.
     pub fn panels(&self) -> usize {
-        self.panels.len()
+        self.panel_count
     }
 }

@@ -11,8 +11,9 @@
 //! paper.validate()?;
 //! let again = Scene::from_toml_str(&paper.to_toml_string()?)?;
 //! assert_eq!(again, paper);
-//! let bad = paper.to_toml_string()?.replace("height_sigma_m = 7e-10", "height_sigma_m = -1e-9");
-//! let err = Scene::from_toml_str(&bad).unwrap_err().to_string();
+//! let mut bad = paper.clone();
+//! bad.surface.height_sigma_m = -1e-9;
+//! let err = Scene::from_toml_str(&bad.to_toml_string()?).unwrap_err().to_string();
 //! assert!(err.contains("surface.height_sigma_m"), "{err}");
 //! # Ok(()) }
 //! ```

@@ -147,7 +147,7 @@ impl Scene {
             check_finite("table.d_max_m", hi)?;
         }
         let (lo, hi) = self.table_range();
-        if !(lo < hi) {
+        if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
             return Err(Error::invalid(
                 "table",
                 format!("d_min_m must be below d_max_m, got range ({lo}, {hi})"),

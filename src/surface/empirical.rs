@@ -87,7 +87,7 @@ impl Empirical {
                 format!("edge {i} is not finite: {e}"),
             ));
         }
-        if let Some(i) = edges.windows(2).position(|w| !(w[1] > w[0])) {
+        if let Some(i) = edges.windows(2).position(|w| w[1] <= w[0]) {
             return Err(Error::invalid(
                 edges_field,
                 format!(
@@ -172,7 +172,7 @@ impl Empirical {
         sorted.sort_by(f64::total_cmp);
         let n = sorted.len();
         let (lo, hi) = (sorted[0], sorted[n - 1]);
-        if !(hi > lo) {
+        if hi <= lo {
             return Err(Error::invalid(
                 field,
                 format!("all heights are equal ({lo}); a density needs spread"),
@@ -191,7 +191,7 @@ impl Empirical {
         let iqr = quantile(0.75) - quantile(0.25);
         let cbrt_n = (n as f64).cbrt();
         let mut width = 2.0 * iqr / cbrt_n;
-        if !(width > 0.0) {
+        if width <= 0.0 {
             let mean = sorted.iter().sum::<f64>() / n as f64;
             let var = sorted.iter().map(|z| (z - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
             width = 3.49 * var.sqrt() / cbrt_n;

@@ -3,6 +3,11 @@
 //!
 //! Every peak law implements [`PeakDistribution`], whose partial moments
 //! `M_p(d) = ∫_d^∞ (z − d)^p f_p(z) dz` feed the Greenwood–Williamson contact force.
+//! Gaussian moments use closed forms for p = 0, 1 (and integer p below the
+//! mean); the other continuous laws use adaptive Gauss–Kronrod quadrature of
+//! their density (relative target 1e-13) with break points spanning the bulk,
+//! in the variable `z = d + v²` when d is inside the bulk and in z itself when
+//! it is below; histograms and discrete ensembles are summed in closed form.
 //!
 //! ```
 //! use hdi_tribology::surface::{Gaussian, PeakDistribution, RiceMaxima};

@@ -89,12 +89,33 @@ impl PeakDistribution for RiceMaxima {
     }
 
     fn partial_moment(&self, d: f64, p: f64) -> f64 {
+        if let Some(m) = moments::far_below(self.mean(), self.std_dev(), d, p) {
+            return m;
+        }
         let e = self.epsilon;
         let pdf = |xi: f64| self.standard_pdf(xi);
-        let landmarks = [-6.0 * e, -3.0 * e, -e, 0.0, e, 1.0, 2.0, 3.0, 6.0];
+        // Lower tail on the scale ε, upper tail on the scale 1, out to the
+        // support ends so that no initial interval hides a sliver of mass.
+        let landmarks = [
+            -9.5 * e,
+            -6.0 * e,
+            -4.0 * e,
+            -2.0 * e,
+            -e,
+            0.0,
+            e,
+            0.5,
+            1.0,
+            2.0,
+            3.0,
+            4.5,
+            6.0,
+            9.5,
+        ];
         let shape = Shape {
             pdf: &pdf,
-            lower: -9.5 * e,
+            lower: f64::NEG_INFINITY,
+            negligible_below: -9.5 * e,
             centre: 0.0,
             scale: 1.0,
             landmarks: &landmarks,

@@ -57,12 +57,35 @@ impl PeakDistribution for Rician {
     }
 
     fn partial_moment(&self, d: f64, p: f64) -> f64 {
+        if let Some(m) = moments::far_below(self.mean(), self.std_dev(), d, p) {
+            return m;
+        }
         let a = self.nu / self.s;
         let pdf = |x: f64| Self::standard_pdf(x, a);
-        let landmarks = [a - 6.0, a - 3.0, a - 1.0, a, a + 1.0, a + 3.0, a + 6.0, 1.0];
+        // Around the Gaussian-like bulk at ν, out to ±9 scales, plus the
+        // Rayleigh peak near 1 for small ν.
+        let landmarks = [
+            a - 9.0,
+            a - 6.0,
+            a - 4.5,
+            a - 3.0,
+            a - 2.0,
+            a - 1.0,
+            a,
+            a + 1.0,
+            a + 2.0,
+            a + 3.0,
+            a + 4.5,
+            a + 6.0,
+            a + 9.0,
+            0.5,
+            1.0,
+        ];
         let shape = Shape {
             pdf: &pdf,
             lower: 0.0,
+            // Below ν − 9.5s the Gaussian-like bulk holds < 1e-20 of the mass.
+            negligible_below: a - 9.5,
             centre: a,
             scale: 1.0,
             landmarks: &landmarks,

@@ -4,6 +4,7 @@
 use std::f64::consts::PI;
 
 /// 1/√(2π).
+#[allow(clippy::excessive_precision)]
 pub const INV_SQRT_2PI: f64 = 0.398_942_280_401_432_677_939_946_059_934_381_87;
 
 /// Standard normal density φ(x). The square is split exactly (fused multiply-add)

@@ -1,0 +1,123 @@
+//! `hdi static`, `hdi cycle` and `hdi sweep`: their JSON agrees with the library, and bad input
+//! gives one line and a non-zero exit.
+#![cfg(feature = "cli")]
+
+use std::process::Command;
+
+use hdi_tribology::analysis::{static_hysteresis, StaticOptions};
+use hdi_tribology::model::SliderModel;
+use hdi_tribology::scene::Scene;
+use serde_json::Value;
+
+fn hdi(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_hdi"))
+        .args(args)
+        .output()
+        .expect("the hdi binary runs")
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = hdi(args);
+    assert!(
+        out.status.success(),
+        "hdi {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+#[test]
+fn static_reports_the_library_values() {
+    let v = json(&["static", "--paper"]);
+    let scene = Scene::paper();
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let h = static_hysteresis(
+        &model,
+        &StaticOptions::new(scene.detector.contact_threshold_n),
+    )
+    .unwrap();
+    assert_eq!(v["touchdown_power"].as_f64().unwrap(), h.touchdown.power);
+    assert_eq!(v["takeoff_power"].as_f64().unwrap(), h.takeoff.power);
+    assert_eq!(v["hysteresis"].as_f64().unwrap(), h.hysteresis);
+    let vpi = v["pull_in_voltage"].as_f64().unwrap();
+    assert!((2.0..10.0).contains(&vpi));
+    let folds = v["folds"].as_array().unwrap();
+    assert_eq!(folds.len(), 2);
+    assert!(folds.iter().all(|f| f["power"].is_f64() && f["d"].is_f64()));
+}
+
+#[test]
+fn static_answers_for_a_scene_file() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper.toml");
+    let from_file = json(&["static", path]);
+    let built_in = json(&["static", "--paper"]);
+    assert_eq!(from_file, built_in);
+}
+
+#[test]
+fn cycle_and_sweep_report_every_key_and_the_csv() {
+    let dir = std::env::temp_dir().join(format!("hdi_cli_cycle_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("series.csv");
+    let v = json(&[
+        "cycle",
+        "--paper",
+        "--v-ac",
+        "0.6",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    for key in [
+        "touchdown_power",
+        "takeoff_power",
+        "hysteresis",
+        "mean_temperature_rise",
+        "steps",
+        "wall_seconds",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    let h = v["hysteresis"].as_f64().unwrap();
+    assert!(h > 0.0 && h < 6e-3, "hysteresis {h}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("t_s,power_w,d_m,"));
+    assert!(text.lines().count() > 1000);
+
+    let rows = json(&["sweep", "--paper", "--v-ac", "0,0.6", "--triggered"]);
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[0]["v_ac"].as_f64(), Some(0.0));
+    assert_eq!(rows[1]["v_ac"].as_f64(), Some(0.6));
+    assert!(rows[0]["hysteresis"].as_f64().unwrap() > rows[1]["hysteresis"].as_f64().unwrap());
+}
+
+#[test]
+fn bad_arguments_give_one_line_and_a_non_zero_exit() {
+    for args in [
+        vec!["cycle", "--paper", "--method", "euler"],
+        vec!["sweep", "--paper", "--v-ac", "0,x"],
+        vec!["static"],
+        vec!["cycle", "--paper", "--rtol", "nan"],
+        vec!["static", "no-such-scene.toml"],
+    ] {
+        let out = hdi(&args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("hdi: "), "{err}");
+        assert!(!err.contains("panicked"));
+    }
+}
+
+#[test]
+fn printed_paper_scene_reads_back_as_the_paper_scene() {
+    for (flag, ext) in [(None, "toml"), (Some("--json"), "json")] {
+        let mut args = vec!["scene", "--paper"];
+        args.extend(flag);
+        let out = hdi(&args);
+        assert!(out.status.success());
+        let path = std::env::temp_dir().join(format!("hdi_cli_scene_{}.{ext}", std::process::id()));
+        std::fs::write(&path, &out.stdout).unwrap();
+        assert_eq!(Scene::from_path(&path).unwrap(), Scene::paper());
+    }
+}
