@@ -285,3 +285,34 @@ fn composite_modulus_of_one_rigid_like_body_is_plane_strain_modulus() {
     assert!(composite_modulus(-1.0, 0.3, 1e11, 0.3).is_err());
     assert!(composite_modulus(1e11, 0.7, 1e11, 0.3).is_err());
 }
+
+/// A footprint much shallower than σ (r_max = 1 µm: Δ = 25 pm against σ = 0.7 nm) against the
+/// literal Derjaguin double integral.
+#[test]
+fn thin_paraboloid_band_matches_the_literal_double_integral() {
+    let s = 7e-10;
+    let he = lj_zero(A, B);
+    let rmax = 1e-6;
+    let fp = Footprint::Paraboloid {
+        radius_of_curvature_m: RC,
+        max_radius_m: Some(rmax),
+    };
+    let t = Intermolecular::new(A, B, None, rough(s), fp, GapReference::Bulge).unwrap();
+    let delta = rmax * rmax / (2.0 * RC);
+    let pbar = |x: f64| {
+        ts(
+            |z| lj_p(x - z) * gauss(z, s),
+            -40.0 * s,
+            (x - he).min(40.0 * s),
+        )
+    };
+    for d in [-5e-10, 3e-10, 1e-9, 3e-9] {
+        let f = 2.0 * PI * RC * ts(pbar, d, d + delta);
+        // nested tanh-sinh at 1e-13 each; Gauss–Legendre exact to (Δ/2σ)^16
+        assert!(
+            rel(t.force(d).unwrap().0, f) < 1e-9,
+            "d = {d}: {} vs {f}",
+            t.force(d).unwrap().0
+        );
+    }
+}

@@ -106,6 +106,18 @@ fn check_all(forces: &InterfaceForces, n: usize) {
             "area at d = {d}"
         );
         let b = forces.breakdown(g, 0.49);
+        // per-kind tables, each held to the strict bound against its own term
+        let kind = |k: TermKind| exact.sum(d, |t| t.kind() == k).0;
+        for (got, want) in [
+            (b.intermolecular, kind(TermKind::Intermolecular)),
+            (b.contact, kind(TermKind::Contact)),
+            (b.electrostatic_per_volt2, kind(TermKind::Electrostatic)),
+        ] {
+            assert!(
+                value_ok(got, want, want, 1e-15),
+                "per-kind table at d = {d}: {got} vs {want}"
+            );
+        }
         let total = exact.sum(d, stat).0 + 0.49 * exact.sum(d, volt).0;
         let scale = exact.magnitude(d, stat).0 + 0.49 * exact.magnitude(d, volt).0;
         assert!(
@@ -214,4 +226,16 @@ fn smooth_flat_electrostatics_jumps_at_the_cutoff_and_the_table_follows() {
     assert_eq!(below, 0.0);
     let p = -hdi_tribology::units::EPSILON_0 * 1e-8 / (2.0 * hc * hc);
     assert!((at - p).abs() < 1e-8 * p.abs() && (above - p).abs() < 1e-8 * p.abs());
+}
+
+#[test]
+fn interface_forces_can_be_shared_across_threads_and_may_be_empty() {
+    fn shareable<T: Send + Sync + Clone>() {}
+    shareable::<InterfaceForces>();
+    let none = InterfaceForces::build(Vec::new(), (-1e-9, 1e-8), &TableOptions::default()).unwrap();
+    let g = Gaps::same(1e-9);
+    assert_eq!(none.static_part(g).value, 0.0);
+    assert_eq!(none.breakdown(g, 1.0).total, 0.0);
+    assert!(!none.has_contact() && !none.has_voltage_terms() && !none.uses_pad_gap());
+    assert!(InterfaceForces::build(Vec::new(), (1e-8, -1e-9), &TableOptions::default()).is_err());
 }

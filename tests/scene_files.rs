@@ -199,3 +199,55 @@ fn parse_errors_name_the_field_and_fit_on_one_line() {
     let e = Scene::from_json_str("{\"name\": 3}").unwrap_err();
     assert!(matches!(e, Error::Scene { .. }));
 }
+
+/// Other peak families go through the same tables: a discrete ensemble (kinked moments at every
+/// peak), a histogram and the Rician law all build, and the contact force stays non-negative and
+/// non-increasing in d.
+#[test]
+fn other_peak_families_build_and_behave() {
+    use hdi_tribology::force::Gaps;
+    use hdi_tribology::surface::PeakModel;
+    let families = [
+        PeakModel::DiscreteSampled {
+            from: Box::new(PeakModel::RiceMaxima {
+                sigma_m: 7e-10,
+                epsilon: 0.7,
+            }),
+            n: 200,
+            seed: 7,
+        },
+        PeakModel::Histogram {
+            edges_m: vec![-1e-9, 0.0, 1e-9, 2e-9, 3e-9],
+            counts: vec![1.0, 4.0, 3.0, 1.0],
+        },
+        PeakModel::Rician {
+            nu_m: 5e-10,
+            s_m: 4e-10,
+        },
+    ];
+    for flat in [false, true] {
+        for peaks in families.clone() {
+            let mut s = Scene::paper();
+            s.surface.peaks = peaks.clone();
+            if flat {
+                s.contact.as_mut().unwrap().footprint = Footprint::Flat { area_m2: 1e-8 };
+            }
+            let f = s
+                .build_interface()
+                .unwrap_or_else(|e| panic!("{peaks:?} flat={flat}: {e}"));
+            let mut last = f64::INFINITY;
+            for i in 0..200 {
+                let d = -3e-9 + 8e-9 * i as f64 / 199.0;
+                let g = Gaps::same(d);
+                let c = f.contact(g).value;
+                // the tables' absolute tolerance, 1e-16 N, bounds undershoots where F_c ≈ 0
+                assert!(
+                    c >= -1e-16 && c <= last * (1.0 + 1e-8) + 2e-16,
+                    "{peaks:?}: F_c({d}) = {c} after {last}"
+                );
+                assert!(f.real_contact_area(g) >= 0.0);
+                last = c;
+            }
+        }
+    }
+}

@@ -15,6 +15,14 @@ use crate::{Error, Result};
 /// outside contributes even against the 1/h⁹ growth of the repulsive law.
 const WINDOW_SIGMAS: f64 = 40.0;
 
+/// Gauss–Legendre nodes (positive half) and weights, 8 points on [−1, 1].
+const GAUSS_LEGENDRE_8: [(f64, f64); 4] = [
+    (0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
+    (0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
+    (0.796_666_477_413_626_7, 0.222_381_034_453_374_5),
+    (0.960_289_856_497_536_3, 0.101_228_536_290_376_3),
+];
+
 /// Relative tolerance of the direct quadrature: three decades below the default table tolerance,
 /// so that quadrature noise does not disturb the table builder.
 const QUAD_REL_TOL: f64 = 1e-12;
@@ -123,41 +131,46 @@ impl<L: PressureLaw> AveragedTerm<L> {
     }
 
     /// `∫_{h_c}^∞ k(h) φ_σ(d − h) dh` for σ > 0.
-    fn weighted(&self, d: f64, kernel: impl Fn(f64) -> f64) -> Result<f64> {
+    /// `part` selects the kernel's entry of [`PressureLaw::magnitudes`] (0: p, 1: p', 2: W).
+    fn weighted(&self, d: f64, kernel: impl Fn(f64) -> f64, part: usize) -> Result<f64> {
         let (s, hc) = (self.sigma, self.cutoff);
-        let a = hc.max(d - WINDOW_SIGMAS * s);
-        let b = d + WINDOW_SIGMAS * s;
+        // Integrate over the offset u = h − d from the Gaussian's centre: the Gaussian argument is
+        // then exact however large d is against σ (with h itself as variable, rounding of d − h
+        // would jitter the weight when d/σ is large).
+        let a = (hc - d).max(-WINDOW_SIGMAS * s);
+        let b = WINDOW_SIGMAS * s;
         if b <= a {
             return Ok(0.0);
         }
         let mut breaks: Vec<f64> = [
-            d - 8.0 * s,
-            d - 2.0 * s,
-            d,
-            d + 2.0 * s,
-            d + 8.0 * s,
-            1.5 * hc,
-            2.0 * hc,
-            4.0 * hc,
+            -8.0 * s,
+            -2.0 * s,
+            0.0,
+            2.0 * s,
+            8.0 * s,
+            1.5 * hc - d,
+            2.0 * hc - d,
+            4.0 * hc - d,
         ]
         .into_iter()
         .filter(|&x| x > a && x < b)
         .collect();
         breaks.sort_by(f64::total_cmp);
         breaks.dedup();
-        let integrand = |h: f64| kernel(h) * self.gauss(d - h);
+        let integrand = |u: f64| kernel(d + u) * self.gauss(u);
         // The size of the largest contributions sets the absolute tolerance: where positive and
         // negative parts cancel (a force passing through zero, the slope of the 3–9 law) rounding
         // limits the accuracy to about 1e-16 of them, so relative accuracy alone is unreachable.
         let scale = std::iter::once(a)
             .chain(breaks.iter().copied())
-            .map(|x| (integrand(x) * s).abs())
+            .map(|u| (self.law.magnitudes(d + u)[part] * self.gauss(u) * s).abs())
             .fold(0.0, f64::max);
         if scale == 0.0 {
             return Ok(0.0);
         }
         let opts = QuadOptions {
-            abs_tol: 1e-14 * scale,
+            // (floored far above the subnormals, where no relative accuracy exists)
+            abs_tol: (1e-14 * scale).max(1e-290),
             rel_tol: QUAD_REL_TOL,
             max_intervals: 2000,
         };
@@ -176,7 +189,7 @@ impl<L: PressureLaw> AveragedTerm<L> {
                 0.0
             });
         }
-        self.weighted(d, |h| self.law.pressure(h))
+        self.weighted(d, |h| self.law.pressure(h), 0)
     }
 
     /// `dp̄/dd`, Pa/m.
@@ -190,7 +203,7 @@ impl<L: PressureLaw> AveragedTerm<L> {
             });
         }
         let edge = self.gauss(d - hc) * self.law.pressure(hc);
-        Ok(edge + self.weighted(d, |h| self.law.pressure_slope(h))?)
+        Ok(edge + self.weighted(d, |h| self.law.pressure_slope(h), 1)?)
     }
 
     /// `∫_d^∞ p̄(s) ds = W(h_c) Φc((d − h_c)/σ) + ∫_{h_c}^∞ W(h) φ_σ(d − h) dh`, J/m².
@@ -200,7 +213,7 @@ impl<L: PressureLaw> AveragedTerm<L> {
             return Ok(self.law.energy(d.max(hc)));
         }
         let survival = 0.5 * erfc((d - hc) / (self.sigma * std::f64::consts::SQRT_2));
-        Ok(self.law.energy(hc) * survival + self.weighted(d, |h| self.law.energy(h))?)
+        Ok(self.law.energy(hc) * survival + self.weighted(d, |h| self.law.energy(h), 2)?)
     }
 }
 
@@ -234,6 +247,19 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
                 let delta = self.footprint.derjaguin_depth();
                 if delta.is_infinite() {
                     Ok((c * self.mean_energy(d)?, -c * self.mean_pressure(d)?))
+                } else if self.sigma > 0.0 && delta < 0.1 * self.sigma {
+                    // A band much thinner than σ: I(d) − I(d + Δ) would cancel; p̄ is smooth on
+                    // the scale σ, so 8-point Gauss–Legendre over the band is exact to
+                    // ~(Δ/2σ)¹⁶.
+                    let (mid, half) = (d + 0.5 * delta, 0.5 * delta);
+                    let mut f = 0.0;
+                    for (x, w) in GAUSS_LEGENDRE_8 {
+                        f += w
+                            * (self.mean_pressure(mid - half * x)?
+                                + self.mean_pressure(mid + half * x)?);
+                    }
+                    let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
+                    Ok((c * half * f, -c * df))
                 } else {
                     let f = self.mean_energy(d)? - self.mean_energy(d + delta)?;
                     let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
@@ -243,15 +269,25 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
         }
     }
     fn kinks(&self) -> Vec<f64> {
-        // With roughness the cutoff is smeared over σ and the force is smooth; only a smooth or
-        // nearly smooth surface (σ below 1 % of h_c) has a kink (or, flat, a jump) worth a cut.
+        // With roughness the cutoff is smeared over σ and the force is smooth on the scale of the
+        // table. Only a smooth or nearly smooth surface (σ below 1 % of h_c) has a kink (or, flat,
+        // a jump) at h_c, smeared over ±40σ at most: cut there, and at the edges of that window so
+        // that the narrow transition is tabulated on its own scale.
         if self.sigma >= 0.01 * self.cutoff {
             return Vec::new();
         }
+        let w = WINDOW_SIGMAS * self.sigma;
+        let mut centres = vec![self.cutoff];
         let delta = self.footprint.derjaguin_depth();
-        let mut k = vec![self.cutoff];
         if delta > 0.0 && delta.is_finite() {
-            k.push(self.cutoff - delta);
+            centres.push(self.cutoff - delta);
+        }
+        let mut k = Vec::new();
+        for c in centres {
+            k.push(c);
+            if w > 0.0 {
+                k.extend([c - w, c + w]);
+            }
         }
         k
     }

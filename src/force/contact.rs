@@ -55,6 +55,7 @@ pub struct GreenwoodWilliamson {
     peaks: Arc<dyn PeakDistribution>,
     footprint: Footprint,
     gap: GapReference,
+    peak_heights: Vec<f64>,
 }
 
 impl GreenwoodWilliamson {
@@ -78,7 +79,16 @@ impl GreenwoodWilliamson {
             peaks,
             footprint,
             gap,
+            peak_heights: Vec::new(),
         })
+    }
+
+    /// Declares the heights of a discrete peak ensemble. Its partial moments are not smooth at
+    /// the peak heights; on a flat footprint (force `∝ M_{3/2}`) the tables are split there.
+    /// The paraboloid integrates them once more (`M_{5/2}`) and needs no split.
+    pub fn with_discrete_peaks(mut self, heights: &[f64]) -> Self {
+        self.peak_heights = heights.iter().copied().filter(|h| h.is_finite()).collect();
+        self
     }
 
     /// The peak-height distribution.
@@ -147,6 +157,12 @@ impl InterfaceTerm for GreenwoodWilliamson {
     }
     fn real_contact_area(&self, d: f64) -> Result<f64> {
         Ok(self.real_contact_area_and_slope(d)?.0)
+    }
+    fn kinks(&self) -> Vec<f64> {
+        match self.footprint {
+            Footprint::Flat { .. } => self.peak_heights.clone(),
+            Footprint::Paraboloid { .. } => Vec::new(),
+        }
     }
     fn real_contact_area_and_slope(&self, d: f64) -> Result<(f64, f64)> {
         if !d.is_finite() {

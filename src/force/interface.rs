@@ -60,6 +60,8 @@ pub struct Breakdown {
 struct Tabulated {
     members: Vec<usize>,
     area: bool,
+    /// Interior cuts, ascending: segment k covers [cuts[k-1], cuts[k]).
+    cuts: Vec<f64>,
     segments: Vec<Table>,
 }
 
@@ -99,6 +101,7 @@ impl Tabulated {
         let mut me = Tabulated {
             members,
             area,
+            cuts: edges[1..edges.len() - 1].to_vec(),
             segments: Vec::with_capacity(edges.len() - 1),
         };
         let names: Vec<&str> = me.members.iter().map(|&i| terms[i].name()).collect();
@@ -148,13 +151,8 @@ impl Tabulated {
             return self.segments[0].eval(d);
         }
         // Right-continuous at the cuts, like the terms themselves (d ≥ h_c counts as non-contact).
-        let last = self.segments.len() - 1;
-        for t in &self.segments[..last] {
-            if d < t.range().1 {
-                return t.eval(d);
-            }
-        }
-        self.segments[last].eval(d)
+        let k = self.cuts.partition_point(|&c| c <= d);
+        self.segments[k].eval(d)
     }
 
     /// Table look-up; outside the range the exact sum; NaN if that fails.
@@ -223,7 +221,10 @@ type PerGap = [Option<Slot>; 2];
 /// indicator need them every step), and each kind has one for [`InterfaceForces::breakdown`].
 /// Tables are piecewise cubic Hermite in value and slope, built to the accuracy of
 /// [`TableOptions`] against the terms' direct quadrature (the area tables use an absolute tolerance
-/// 1e-8 times the force one, in m² instead of N).
+/// 1e-8 times the force one, in m² instead of N). A merged table of several kinds is the sum of
+/// the per-kind tables, re-tabulated on their common node grid: it is accurate to
+/// `rel_tol · Σ|F_i| + abs_tol` even where the terms cancel. Tables are split where a term reports
+/// a kink ([`InterfaceTerm::kinks`]).
 ///
 /// Outside the table range every hot-path function falls back to the exact term evaluation (slow
 /// but correct; nothing is clamped). The hot-path functions are infallible: if that fallback fails
@@ -407,16 +408,19 @@ impl InterfaceForces {
         self.sum(&self.per_volt2, g)
     }
 
-    /// Contact force only (N; included in [`InterfaceForces::static_part`]). Hot path.
+    /// Contact force only (N; included in [`InterfaceForces::static_part`]). Hot path. Where the
+    /// force is below the table's absolute tolerance it may undershoot zero by that much.
     #[inline]
     pub fn contact(&self, g: Gaps) -> ForceEval {
         self.sum(&self.contact, g)
     }
 
-    /// Real contact area, m².
+    /// Real contact area, m², never negative: where the area is below the table's absolute
+    /// tolerance an interpolation undershoot could make it slightly negative, and an area is not
+    /// (the flash temperature takes its square root).
     #[inline]
     pub fn real_contact_area(&self, g: Gaps) -> f64 {
-        self.sum(&self.area, g).value
+        self.sum(&self.area, g).value.max(0.0)
     }
 
     /// Every force by kind at the gaps `g` and squared voltage `volt2` (V²), through the tables.

@@ -18,6 +18,17 @@ pub trait PressureLaw: Debug + Send + Sync {
     fn pressure_slope(&self, h: f64) -> f64;
     /// Interaction energy per area `W(h) = ∫_h^∞ p(u) du`, J/m².
     fn energy(&self, h: f64) -> f64;
+    /// Size of the largest contribution to `[p, dp/dh, W]` at `h`. A law that is a difference of
+    /// large parts (the 3–9 law near its zero) returns the parts' size: double rounding limits
+    /// its accuracy to about 1e-16 of it, and the quadrature tolerances follow. Default: the
+    /// absolute values themselves.
+    fn magnitudes(&self, h: f64) -> [f64; 3] {
+        [
+            self.pressure(h).abs(),
+            self.pressure_slope(h).abs(),
+            self.energy(h).abs(),
+        ]
+    }
 }
 
 /// Lennard-Jones 3–9 law between half-spaces: `p(h) = −A/(6π h³) + B/(45π h⁹)`.
@@ -52,6 +63,15 @@ impl PressureLaw for LennardJones39 {
         let h2 = h * h;
         let h8 = h2 * h2 * h2 * h2;
         -self.a / (12.0 * PI * h2) + self.b / (360.0 * PI * h8)
+    }
+    fn magnitudes(&self, h: f64) -> [f64; 3] {
+        let (h2, h3) = (h * h, h * h * h);
+        let (h8, h9) = (h3 * h3 * h2, h3 * h3 * h3);
+        [
+            self.a / (6.0 * PI * h3) + self.b / (45.0 * PI * h9),
+            self.a / (2.0 * PI * h3 * h) + self.b / (5.0 * PI * h9 * h),
+            self.a / (12.0 * PI * h2) + self.b / (360.0 * PI * h8),
+        ]
     }
 }
 

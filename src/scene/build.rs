@@ -8,7 +8,7 @@ use crate::force::{
     Intermolecular,
 };
 use crate::quadrature::TableOptions;
-use crate::surface::{GaussianHeights, PeakDistribution};
+use crate::surface::{Discrete, GaussianHeights, PeakDistribution, PeakModel};
 use crate::{Error, Result};
 
 /// Prefixes the field of an input error with `prefix`.
@@ -33,6 +33,22 @@ impl Scene {
                 }
             }
             other => in_field(other, "surface.peaks."),
+        })
+    }
+
+    /// Heights of a discrete peak ensemble (given or sampled), `None` for continuous laws.
+    fn discrete_peak_heights(&self) -> Result<Option<Vec<f64>>> {
+        Ok(match &self.surface.peaks {
+            PeakModel::Discrete { heights_m } => Some(heights_m.clone()),
+            PeakModel::DiscreteSampled { from, n, seed } => {
+                let parent = from
+                    .build()
+                    .map_err(|e| in_field(e, "surface.peaks.from."))?;
+                let d = Discrete::sample(parent.as_ref(), *n, *seed)
+                    .map_err(|e| in_field(e, "surface.peaks."))?;
+                Some(d.heights().to_vec())
+            }
+            _ => None,
         })
     }
 
@@ -112,6 +128,10 @@ impl Scene {
                 c.gap,
             )
             .map_err(|e| in_field(e, "contact."))?;
+            let t = match self.discrete_peak_heights()? {
+                Some(h) => t.with_discrete_peaks(&h),
+                None => t,
+            };
             terms.push(Box::new(t));
         }
         Ok(terms)

@@ -134,10 +134,11 @@ impl Scene {
             return Err(Error::invalid("solver.max_steps", "must be at least 1"));
         }
         let t = &self.table;
-        if !(t.rel_tol > 0.0 && t.rel_tol < 1e-2) {
+        // the direct quadrature behind the tables is good to about 1e-12
+        if !(t.rel_tol >= 1e-11 && t.rel_tol <= 1e-2) {
             return Err(Error::invalid(
                 "table.rel_tol",
-                format!("must lie in (0, 0.01), got {}", t.rel_tol),
+                format!("must lie in [1e-11, 0.01], got {}", t.rel_tol),
             ));
         }
         if let Some(lo) = t.d_min_m {
