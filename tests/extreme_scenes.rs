@@ -25,6 +25,11 @@ use Expect::{Fails, Finite};
 /// (file, static analysis, dynamic cycle).
 const CASES: &[(&str, Expect, Expect)] = &[
     (
+        "roughness_0p01nm.toml",
+        Fails("stays in contact down to zero heater power"),
+        Finite,
+    ),
+    (
         "roughness_5nm.toml",
         Fails("in contact already at zero heater power"),
         Finite,
@@ -51,9 +56,11 @@ const CASES: &[(&str, Expect, Expect)] = &[
     ("ramp_1us.toml", Finite, Finite),
     ("ramp_1s.toml", Finite, Finite),
     ("near_fold.toml", Finite, Finite),
+    // At exactly the pull-in voltage the touchdown fold lies at 0 W to rounding: the error says
+    // either "in contact already at" or "stays in contact down to" zero heater power.
     (
         "pull_in.toml",
-        Fails("stays in contact down to zero heater power"),
+        Fails("zero heater power"),
         Fails("flying branch ends at a fold"),
     ),
     (
@@ -108,7 +115,6 @@ fn every_extreme_scene_is_covered_by_the_table() {
         .collect();
     files.sort();
     let mut listed: Vec<String> = CASES.iter().map(|c| c.0.to_string()).collect();
-    listed.push("roughness_0p01nm.toml".into());
     listed.sort();
     assert_eq!(files, listed);
 }
@@ -118,7 +124,7 @@ fn every_extreme_scene_is_covered_by_the_table() {
 /// non-negative to the table's absolute tolerance, and equal to direct evaluation.
 #[test]
 fn forces_are_finite_down_to_minus_five_sigma() {
-    for file in CASES.iter().map(|c| c.0).chain(["roughness_0p01nm.toml"]) {
+    for file in CASES.iter().map(|c| c.0) {
         let scene = load(file);
         let model = SliderModel::from_scene(&scene).unwrap();
         let (lo, hi) = model.forces().table_range();
