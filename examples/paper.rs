@@ -480,3 +480,12 @@ fn sweep_csv(path: &Path, rs: &[CycleResult]) -> Res<()> {
     )?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    /// `cargo test` runs the example, so CI runs every example.
+    #[test]
+    fn example_runs() {
+        super::main().expect("the example runs to completion");
+    }
+}

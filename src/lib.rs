@@ -78,9 +78,12 @@
 //! - `parallel` (default): AC sweeps on rayon; results do not depend on the thread count.
 //! - `cli`: the `hdi` command-line program.
 #![forbid(unsafe_code)]
+#![deny(missing_docs)]
+#![warn(rustdoc::all)]
 #![cfg_attr(docsrs, feature(doc_cfg))]
 
 pub mod analysis;
+pub mod clearance;
 pub mod error;
 pub mod force;
 pub mod heater;
