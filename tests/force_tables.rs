@@ -99,6 +99,30 @@ fn check_all(forces: &InterfaceForces, n: usize) {
             worst[3] = worst[3]
                 .max((tab.d_bulge - s).abs() / (1e-6 * mag.1.max(mag.0 / 1e-10) + abs / 1e-10));
         }
+        // the fused look-up, held to the same bounds
+        let hot = forces.evaluate(g);
+        let fused = [
+            (
+                hot.static_part,
+                exact.sum(d, stat),
+                exact.magnitude(d, stat),
+            ),
+            (hot.per_volt2, exact.sum(d, volt), exact.magnitude(d, volt)),
+            (hot.contact, exact.sum(d, cont), exact.magnitude(d, cont)),
+        ];
+        for (k, (tab, (v, s), mag)) in fused.into_iter().enumerate() {
+            let abs = 3e-15; // two tables in series, up to two terms each
+            assert!(
+                value_ok(tab.value, v, mag.0, abs),
+                "fused {k} at d = {d}: {} vs {v}",
+                tab.value
+            );
+            assert!(
+                slope_ok(tab.d_bulge, s, mag, abs),
+                "fused {k} slope at d = {d}: {} vs {s}",
+                tab.d_bulge
+            );
+        }
         let (a, _) = exact.area(d);
         // contact-area tables: the same relative bound, absolute 1e-8 × 1e-16 m²
         assert!(
@@ -238,4 +262,20 @@ fn interface_forces_can_be_shared_across_threads_and_may_be_empty() {
     assert_eq!(none.breakdown(g, 1.0).total, 0.0);
     assert!(!none.has_contact() && !none.has_voltage_terms() && !none.uses_pad_gap());
     assert!(InterfaceForces::build(Vec::new(), (1e-8, -1e-9), &TableOptions::default()).is_err());
+}
+
+#[test]
+fn shipped_scenes_tables_match_direct_quadrature() {
+    for name in [
+        "flat_gaussian.toml",
+        "dielectric.toml",
+        "finite_radius.toml",
+    ] {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name);
+        let forces = Scene::from_path(&path).unwrap().build_interface().unwrap();
+        eprintln!("{name}: {} table nodes", forces.table_nodes());
+        check_all(&forces, 150);
+    }
 }
