@@ -480,3 +480,40 @@ fn cycles_reject_bad_detectors_solvers_and_programmes() {
         "solver.max_steps"
     );
 }
+
+/// Analyses in heater power need `η > 0`; a heater too weak to reach touchdown fails the
+/// triggered protocol at once instead of ramping for ever.
+#[test]
+fn analyses_in_power_need_a_working_heater() {
+    let mut scene = Scene::paper();
+    scene.heater.efficiency_m_per_w = 0.0;
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let opts = StaticOptions::new(5e-5);
+    assert_eq!(
+        field(static_hysteresis(&model, &opts)),
+        "heater.efficiency_m_per_w"
+    );
+    assert_eq!(
+        field(s_curve(&model, None, &ScanGrid::default())),
+        "heater.efficiency_m_per_w"
+    );
+    let programme = HeaterProgramme::Fixed(Programme::constant(0.06, 1e-4).unwrap());
+    let copts = CycleOptions::from_scene(&scene).unwrap();
+    assert_eq!(
+        field(simulate_cycle(&model, &programme, &copts)),
+        "heater.efficiency_m_per_w"
+    );
+    // Pull-in at zero power needs no heater.
+    assert!(pull_in_voltage(&model, 0.0, &opts).is_ok());
+    scene.heater.efficiency_m_per_w = 1e-30;
+    let weak = SliderModel::from_scene(&scene).unwrap();
+    let triggered = HeaterProgramme::Triggered {
+        start_power: 0.06,
+        ramp_rate: 5.0,
+        overshoot: 1e-3,
+    };
+    match simulate_cycle(&weak, &triggered, &copts) {
+        Err(Error::Analysis { reason, .. }) => assert!(reason.contains("segments"), "{reason}"),
+        other => panic!("expected the segment bound, got {other:?}"),
+    }
+}

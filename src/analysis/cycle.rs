@@ -18,6 +18,10 @@ use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector, U4, U5,
 use serde::Serialize;
 use std::time::Instant;
 
+/// Largest number of segments of the touchdown-triggered search (each `overshoot / ramp_rate`
+/// long; the paper scene needs 200).
+const MAX_TRIGGERED_SEGMENTS: f64 = 1e5;
+
 /// The heater programme of a cycle.
 #[derive(Clone, Debug, PartialEq)]
 pub enum HeaterProgramme {
@@ -191,6 +195,7 @@ pub fn simulate_cycle(
     opts: &CycleOptions,
 ) -> Result<CycleResult> {
     opts.validate()?;
+    super::equilibrium::check_heater(model)?;
     let layout = StateLayout::new(model.thermal_lag > 0.0, model.interface_lag > 0.0, true);
     match layout.len() {
         4 => run::<U4>(model, programme, opts),
@@ -316,6 +321,19 @@ where
             crate::error::check_non_negative("programme.start_power", start_power)?;
             // Search up to the power whose protrusion is twice the nominal clearance.
             let span = 2.0 * model.nominal_clearance / model.efficiency;
+            // The search runs in segments of `overshoot`; bound their number so that a heater
+            // too weak to ever reach touchdown fails at once instead of running for ever.
+            let segments = span / overshoot;
+            if !(segments <= MAX_TRIGGERED_SEGMENTS) {
+                return Err(Error::analysis(
+                    "triggered cycle",
+                    format!(
+                        "reaching a protrusion of 2 h0 takes {span:e} W, {segments:.3e} segments of \
+                         the overshoot {overshoot:e} W (at most {MAX_TRIGGERED_SEGMENTS:e}): raise the \
+                         overshoot or the heater efficiency"
+                    ),
+                ));
+            }
             let ramp = Programme::new(vec![
                 (0.0, start_power),
                 (span / ramp_rate, start_power + span),

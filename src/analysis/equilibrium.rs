@@ -136,6 +136,12 @@ impl ScanGrid {
     }
 }
 
+/// Analyses in heater power need a heater that moves the bulge: `η > 0` (with `η = 0` every
+/// power gives the same protrusion, and powers found from protrusions would be ±∞ or NaN).
+pub(crate) fn check_heater(model: &SliderModel) -> Result<()> {
+    crate::error::check_positive("heater.efficiency_m_per_w", model.efficiency).map(|_| ())
+}
+
 /// Evaluates equilibria of one model at one `V²`, tabulated or exact.
 #[derive(Clone, Copy, Debug)]
 pub struct EquilibriumSolver<'a> {
@@ -256,6 +262,7 @@ pub struct SCurve {
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) -> Result<SCurve> {
+    check_heater(model)?;
     let volt2 = model.voltage.effective_dc().powi(2);
     let (lo, hi) = range.unwrap_or_else(|| model.forces().table_range());
     if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {

@@ -162,6 +162,7 @@ pub fn clearance_change(
     dc_voltages: &[f64],
     opts: &StaticOptions,
 ) -> Result<Vec<ClearanceChange>> {
+    super::equilibrium::check_heater(model)?;
     let phi = model.voltage.contact_potential;
     let reference = touchdown_at(model, 0.0, opts)?.power;
     dc_voltages

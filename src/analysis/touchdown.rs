@@ -87,6 +87,7 @@ pub struct StaticHysteresis {
 /// ```
 pub fn touchdown_power(model: &SliderModel, opts: &StaticOptions) -> Result<Transition> {
     opts.validate()?;
+    super::equilibrium::check_heater(model)?;
     let volt2 = model.voltage.effective_dc().powi(2);
     touchdown_at(model, volt2, opts)
 }
@@ -217,6 +218,7 @@ pub fn takeoff_power(
     opts: &StaticOptions,
 ) -> Result<Transition> {
     opts.validate()?;
+    super::equilibrium::check_heater(model)?;
     crate::error::check_finite("start_power", start_power)?;
     let volt2 = model.voltage.effective_dc().powi(2);
     takeoff_at(model, volt2, start_power, opts)
