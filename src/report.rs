@@ -54,6 +54,34 @@ pub fn write_file(path: &Path, contents: &str) -> Result<()> {
         })
 }
 
+/// A short tick label: powers of ten on log axes, up to four significant digits otherwise.
+///
+/// ```
+/// use hdi_tribology::report::tick_label;
+/// assert_eq!(tick_label(9.999999998e-5, true), "1e-4");
+/// assert_eq!(tick_label(0.25, false), "0.25");
+/// assert_eq!(tick_label(123456.0, false), "1.235e5");
+/// assert_eq!(tick_label(-3.0, false), "-3");
+/// ```
+pub fn tick_label(v: f64, log: bool) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if log {
+        return format!("{:.0e}", v);
+    }
+    let a = v.abs();
+    if !(1e-3..1e4).contains(&a) {
+        return format!("{:.3e}", v).replace(".000e", "e");
+    }
+    let s = format!("{:.*}", (3 - a.log10().floor() as i32).max(0) as usize, v);
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// One line (or set of markers) of a chart.
 #[derive(Clone, Debug)]
 pub struct Series<'a> {
@@ -151,6 +179,8 @@ impl Chart<'_> {
                     .configure_mesh()
                     .x_desc(self.x_label)
                     .y_desc(self.y_label)
+                    .x_label_formatter(&|v| tick_label(*v, self.log.0))
+                    .y_label_formatter(&|v| tick_label(*v, self.log.1))
                     .draw()
                     .map_err(|e| e.to_string())?;
                 for (i, s) in self.series.iter().enumerate() {
