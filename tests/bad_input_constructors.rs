@@ -517,3 +517,32 @@ fn analyses_in_power_need_a_working_heater() {
         other => panic!("expected the segment bound, got {other:?}"),
     }
 }
+
+/// A table budget so large that refinement to an unreachable tolerance would exhaust memory, and
+/// a tolerance of exactly zero, are refused before any node is made (a build with both once
+/// grew past 24 GB).
+#[test]
+fn oversized_tables_and_zero_tolerances_are_refused() {
+    let f = |x: f64| Ok((x.sin(), x.cos()));
+    let huge = TableOptions {
+        max_nodes: usize::MAX,
+        ..TableOptions::default()
+    };
+    assert_eq!(field(Table::build(f, 0.0, 10.0, &huge)), "table.max_nodes");
+    let zero = TableOptions {
+        rel_tol: 0.0,
+        abs_tol: 0.0,
+        max_nodes: 1000,
+    };
+    assert_eq!(field(Table::build(f, 0.0, 10.0, &zero)), "table.rel_tol");
+    // The largest allowed budget with a tolerance that cannot be met stops at the budget.
+    let tight = TableOptions {
+        rel_tol: 1e-300,
+        abs_tol: 0.0,
+        max_nodes: 100_000,
+    };
+    assert!(matches!(
+        Table::build(f, 0.0, 10.0, &tight),
+        Err(Error::NoConvergence { .. })
+    ));
+}
