@@ -324,7 +324,7 @@ where
             // The search runs in segments of `overshoot`; bound their number so that a heater
             // too weak to ever reach touchdown fails at once instead of running for ever.
             let segments = span / overshoot;
-            if !(segments <= MAX_TRIGGERED_SEGMENTS) {
+            if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
                 return Err(Error::analysis(
                     "triggered cycle",
                     format!(

@@ -326,7 +326,7 @@ pub fn flying_equilibrium(
             return Err(Error::analysis(
                 "flying equilibrium",
                 format!(
-                    "the flying branch ends at a fold (d = {d:e} m) below {power} W: the head is in contact there"
+                    "the flying branch ends at a fold (d = {d:e} m) before the protrusion of {power} W is reached: the head is in contact there"
                 ),
             ));
         }
