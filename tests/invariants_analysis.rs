@@ -122,8 +122,8 @@ fn hysteresis_of(s: &Scene) -> hdi_tribology::Result<(f64, f64)> {
 }
 
 proptest! {
-    // 10 cases × 2 models: about 10 s.
-    #![proptest_config(ProptestConfig { cases: 10, ..ProptestConfig::default() })]
+    // 24 cases × 2 models: about 10 s.
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
     /// Touchdown ≥ take-off ≥ 0, or a typed analysis error that says why; the same powers when
     /// the unit of force is changed (to 1e-9 relative: the scan grids are in metres and do not
@@ -180,8 +180,8 @@ proptest! {
 }
 
 proptest! {
-    // 4 cases × 2 models.
-    #![proptest_config(ProptestConfig { cases: 4, ..ProptestConfig::default() })]
+    // 8 cases × 2 models.
+    #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
 
     /// The same touchdown and take-off powers when the unit of length changes by `l`, to 1e-6
     /// relative: the scan grid is in metres and does not scale, so the brackets of folds and

@@ -111,7 +111,7 @@ proptest! {
 
 proptest! {
     // Each case tabulates three terms (about 0.05–0.3 s): few cases.
-    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
 
     /// The merged tables agree with direct quadrature to the table tolerance, relative to the
     /// largest term magnitude at that gap (terms of opposite sign cancel in the sum, so the
