@@ -239,3 +239,34 @@ fn cycles_are_finite_and_converged_or_say_why() {
         );
     }
 }
+
+/// A hair below the fold of the flying branch the equilibrium is still found, stable and above
+/// the fold's gap; a hair above, the analysis says that the branch has ended.
+#[test]
+fn equilibria_next_to_the_fold_are_found_or_refused_cleanly() {
+    use hdi_tribology::analysis::{flying_equilibrium, touchdown_power, Cause, ScanGrid};
+    let scene = load("near_fold.toml");
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let td = touchdown_power(
+        &model,
+        &StaticOptions::new(scene.detector.contact_threshold_n),
+    )
+    .unwrap();
+    assert_eq!(td.cause, Cause::Fold);
+    for rel in [1e-3, 1e-6, 1e-9] {
+        let e = flying_equilibrium(&model, td.power * (1.0 - rel), 0.0, &ScanGrid::default())
+            .unwrap_or_else(|e| panic!("{rel}: {e}"));
+        assert!(
+            e.is_stable() && e.d > td.at.d,
+            "{rel}: {e:?} vs fold {:?}",
+            td.at
+        );
+        assert!((e.power - td.power * (1.0 - rel)).abs() <= 1e-9 * td.power);
+    }
+    for rel in [1e-9, 1e-6, 1e-3] {
+        match flying_equilibrium(&model, td.power * (1.0 + rel), 0.0, &ScanGrid::default()) {
+            Err(Error::Analysis { reason, .. }) => assert!(reason.contains("fold"), "{reason}"),
+            other => panic!("{rel}: expected the end of the branch, got {other:?}"),
+        }
+    }
+}

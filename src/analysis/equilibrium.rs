@@ -323,6 +323,26 @@ pub fn flying_equilibrium(
     for d in grid.descending(lo, hi)? {
         let e = solver.at_gap(d)?;
         if !e.is_stable() {
+            // The fold lies between this grid point and the last stable one: locate it, and if
+            // the power asked for is reached before it, the equilibrium lies in that last
+            // stretch (the power is nearly stationary there, so only direct forces decide).
+            if let Some(p) = prev {
+                let fold = solver.refine_fold(e.d, p.d)?;
+                if fold.protrusion >= target {
+                    let tol = fold_tolerance(fold.d, p.d, model.nominal_clearance);
+                    let d = brent(
+                        |x| {
+                            solver
+                                .at_gap_exact(x)
+                                .map_or(f64::NAN, |q| q.protrusion - target)
+                        },
+                        fold.d,
+                        p.d,
+                        tol,
+                    )?;
+                    return solver.at_gap_exact(d);
+                }
+            }
             return Err(Error::analysis(
                 "flying equilibrium",
                 format!(
