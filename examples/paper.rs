@@ -155,7 +155,7 @@ fn main() -> Res<()> {
         ("fig3c_forces_0.6V", &c6, "Fig. 3(c) forces, V_ac = 0.6 V"),
     ] {
         let s = series(cyc)?;
-        series_csv(&out.join(format!("{name}.csv")), s)?;
+        s.write_csv(&out.join(format!("{name}.csv")))?;
         forces_chart(title, s, 0.0, f64::INFINITY).to_svg(
             &out.join(format!("{name}.svg")),
             1000,
@@ -315,7 +315,7 @@ fn main() -> Res<()> {
     for v in [0.0, 0.6] {
         let r = simulate_cycle(&at(v), &triggered, &with_series)?;
         let s = series(&r)?;
-        series_csv(&out.join(format!("fig1_triggered_{v:.1}V.csv")), s)?;
+        s.write_csv(&out.join(format!("fig1_triggered_{v:.1}V.csv")))?;
         trig_series.push((v, r));
     }
     let mut fig1 = Vec::new();
@@ -457,37 +457,6 @@ fn forces_chart<'a>(title: &'a str, s: &TimeSeries, t0: f64, t1: f64) -> Chart<'
         ],
         log: (false, false),
     }
-}
-
-fn series_csv(path: &Path, s: &TimeSeries) -> Res<()> {
-    write_csv(
-        path,
-        &[
-            "t_s",
-            "power_w",
-            "d_m",
-            "air_bearing_n",
-            "intermolecular_n",
-            "electrostatic_n",
-            "contact_n",
-            "total_n",
-            "temperature_rise_k",
-            "indicator_n",
-        ],
-        &[
-            &s.t,
-            &s.power,
-            &s.d,
-            &s.air_bearing,
-            &s.intermolecular,
-            &s.electrostatic,
-            &s.contact,
-            &s.total,
-            &s.temperature_rise,
-            &s.indicator,
-        ],
-    )?;
-    Ok(())
 }
 
 fn sweep_csv(path: &Path, rs: &[CycleResult]) -> Res<()> {

@@ -122,6 +122,31 @@ proptest! {
         check_outcome(Scene::from_toml_str(&out.join("\n")))?;
     }
 
+    /// One value of the paper scene as JSON replaced by an extreme number, a wrong type or
+    /// garbage, or the text cut short.
+    #[test]
+    fn edited_paper_json_is_accepted_or_rejected_by_field(
+        line in any::<prop::sample::Index>(),
+        v in value(),
+        cut in proptest::option::of(any::<prop::sample::Index>()),
+    ) {
+        let text = Scene::paper().to_json_string().unwrap();
+        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+        let i = line.index(lines.len());
+        if let Some((k, rest)) = lines[i].clone().split_once("\": ") {
+            let comma = if rest.ends_with(',') { "," } else { "" };
+            // JSON has no nan/inf literals: those edits are parse errors, as they should be.
+            lines[i] = format!("{k}\": {v}{comma}");
+        }
+        let mut out = lines.join("\n");
+        if let Some(c) = cut {
+            let at = c.index(out.len() + 1);
+            let at = (0..=at).rev().find(|&k| out.is_char_boundary(k)).unwrap_or(0);
+            out.truncate(at);
+        }
+        check_outcome(Scene::from_json_str(&out))?;
+    }
+
     /// Several numeric fields of the paper scene replaced at once by arbitrary numbers.
     #[test]
     fn many_numeric_edits(

@@ -151,6 +151,47 @@ pub struct TimeSeries {
     pub indicator: Vec<f64>,
 }
 
+impl TimeSeries {
+    /// Writes the series as CSV, one row per step, SI units in the column names.
+    ///
+    /// ```no_run
+    /// # fn f(r: &hdi_tribology::analysis::CycleResult) -> hdi_tribology::Result<()> {
+    /// if let Some(s) = &r.series {
+    ///     s.write_csv(std::path::Path::new("cycle.csv"))?;
+    /// }
+    /// # Ok(()) }
+    /// ```
+    pub fn write_csv(&self, path: &std::path::Path) -> Result<()> {
+        crate::report::write_csv(
+            path,
+            &[
+                "t_s",
+                "power_w",
+                "d_m",
+                "air_bearing_n",
+                "intermolecular_n",
+                "electrostatic_n",
+                "contact_n",
+                "total_n",
+                "temperature_rise_k",
+                "indicator_n",
+            ],
+            &[
+                &self.t,
+                &self.power,
+                &self.d,
+                &self.air_bearing,
+                &self.intermolecular,
+                &self.electrostatic,
+                &self.contact,
+                &self.total,
+                &self.temperature_rise,
+                &self.indicator,
+            ],
+        )
+    }
+}
+
 /// The outcome of one cycle.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CycleResult {
@@ -379,7 +420,7 @@ where
             .terminal(true)];
         let sol = ode::solve(sys, a, y, b, opts.solver.method, o, &mut guard)
             .map_err(|e| explain_ode_error(model, opts, e))?;
-        add_stats(&mut stats, &sol.stats);
+        stats += &sol.stats;
         if sol.terminated_by_event.is_some() {
             return Err(left_the_model(model, sys, &sol));
         }
@@ -586,20 +627,6 @@ fn fastest_rate(model: &SliderModel) -> f64 {
         }
     }
     r
-}
-
-fn add_stats(total: &mut Stats, s: &Stats) {
-    total.accepted += s.accepted;
-    total.rejected += s.rejected;
-    total.rhs_evals += s.rhs_evals;
-    total.jac_evals += s.jac_evals;
-    total.lu_decomps += s.lu_decomps;
-    total.lin_solves += s.lin_solves;
-    total.newton_iters += s.newton_iters;
-    total.newton_failures += s.newton_failures;
-    total.stiffness_switches += s.stiffness_switches;
-    total.stiff_steps += s.stiff_steps;
-    total.event_evals += s.event_evals;
 }
 
 fn series_of<D: DimName>(sys: &SliderSystem, traj: &Trajectory<D>, det: &Detecting<D>) -> TimeSeries

@@ -14,7 +14,6 @@ use hdi_tribology::analysis::{
 };
 use hdi_tribology::force::{Breakdown, Gaps};
 use hdi_tribology::model::{SliderModel, Voltage};
-use hdi_tribology::report::write_csv;
 use hdi_tribology::scene::Scene;
 use serde::Serialize;
 
@@ -363,33 +362,7 @@ fn cycle(args: &[String]) -> Result<(), CliError> {
     opts.keep_series = csv.is_some();
     let r = simulate_cycle(&model, &programme, &opts)?;
     if let (Some(path), Some(s)) = (csv, r.series.as_ref()) {
-        write_csv(
-            std::path::Path::new(path),
-            &[
-                "t_s",
-                "power_w",
-                "d_m",
-                "air_bearing_n",
-                "intermolecular_n",
-                "electrostatic_n",
-                "contact_n",
-                "total_n",
-                "temperature_rise_k",
-                "indicator_n",
-            ],
-            &[
-                &s.t,
-                &s.power,
-                &s.d,
-                &s.air_bearing,
-                &s.intermolecular,
-                &s.electrostatic,
-                &s.contact,
-                &s.total,
-                &s.temperature_rise,
-                &s.indicator,
-            ],
-        )?;
+        s.write_csv(std::path::Path::new(path))?;
     }
     print_json(&CycleReport::from(&r))
 }

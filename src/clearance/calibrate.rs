@@ -366,7 +366,7 @@ impl Run<'_> {
             &self.ode_options(&programme, times),
             &mut [],
         )?;
-        add_stats(&mut self.stats, &sol.stats);
+        self.stats += &sol.stats;
 
         let m = self.model;
         let judge_from = t0 + sc.settle_time;
@@ -431,18 +431,4 @@ impl Run<'_> {
             .save(SaveAt::Times(times))
             .dense(false)
     }
-}
-
-fn add_stats(total: &mut Stats, s: &Stats) {
-    total.accepted += s.accepted;
-    total.rejected += s.rejected;
-    total.rhs_evals += s.rhs_evals;
-    total.jac_evals += s.jac_evals;
-    total.lu_decomps += s.lu_decomps;
-    total.lin_solves += s.lin_solves;
-    total.newton_iters += s.newton_iters;
-    total.newton_failures += s.newton_failures;
-    total.stiffness_switches += s.stiffness_switches;
-    total.stiff_steps += s.stiff_steps;
-    total.event_evals += s.event_evals;
 }

@@ -9,7 +9,7 @@ mod system;
 pub use system::{SliderSystem, StateLayout};
 
 use crate::error::{Error, Result};
-use crate::force::{AirBearing, Breakdown, ForceEval, Gaps, InterfaceForces};
+use crate::force::{AirBearing, Breakdown, ForceEval, Gaps, HotForces, InterfaceForces};
 use crate::heater::Programme;
 use crate::scene::Scene;
 use std::f64::consts::PI;
@@ -217,11 +217,14 @@ impl SliderModel {
 
     /// Interface force `F_if = F_static + V² G_e` and its partial derivatives.
     pub fn interface_force(&self, g: Gaps, volt2: f64) -> ForceEval {
-        let s = self.forces.static_part(g);
-        if volt2 == 0.0 || !self.forces.has_voltage_terms() {
-            return s;
-        }
-        add_scaled(s, self.forces.per_volt2_part(g), volt2)
+        self.hot_forces(g, volt2).0
+    }
+
+    /// `F_if` and the three tabulated sums it is made of (static, per V², contact), from one
+    /// look-up of the fused table where the scene allows it.
+    pub fn hot_forces(&self, g: Gaps, volt2: f64) -> (ForceEval, HotForces) {
+        let h = self.forces.evaluate(g);
+        (add_scaled(h.static_part, h.per_volt2, volt2), h)
     }
 
     /// The static part and the per-V² part of the interface force from direct (untabulated)

@@ -83,9 +83,10 @@ pub struct SliderSystem<'a> {
 struct Local {
     g: Gaps,
     delta: f64,
-    volt2: f64,
     /// `F_if` and partials.
     f: crate::force::ForceEval,
+    /// The tabulated sums behind `f`, with the contact force.
+    hot: crate::force::HotForces,
 }
 
 impl<'a> SliderSystem<'a> {
@@ -161,8 +162,8 @@ impl<'a> SliderSystem<'a> {
         let delta = self.protrusion(t, s);
         let g = self.model.gaps(s[0], delta);
         let volt2 = self.model.voltage.squared(t);
-        let f = self.model.interface_force(g, volt2);
-        Local { g, delta, volt2, f }
+        let (f, hot) = self.model.hot_forces(g, volt2);
+        Local { g, delta, f, hot }
     }
 
     /// Flash temperature and its derivative with respect to the bulge gap (central difference:
@@ -202,10 +203,11 @@ where
             ds[i] = (l.f.value - s[i]) / m.interface_lag;
         }
         if let Some(i) = self.layout.contact_impulse {
-            ds[i] = m.contact_force(l.g);
+            ds[i] = l.hot.contact.value;
         }
         if let Some(i) = self.layout.heat {
-            ds[i] = m.flash_temperature(l.g);
+            let area = m.forces().real_contact_area(l.g);
+            ds[i] = m.friction.flash_temperature(l.hot.contact.value, area);
         }
     }
 
@@ -239,7 +241,7 @@ where
             j[(k, k)] = -1.0 / m.thermal_lag;
         }
         if let Some(i) = self.layout.contact_impulse {
-            let c = m.forces().contact(l.g);
+            let c = l.hot.contact;
             j[(i, 0)] = c.d_bulge + c.d_pad;
             if let Some(k) = self.layout.delta {
                 j[(i, k)] = -c.d_bulge;
@@ -265,12 +267,7 @@ where
             Some(_) => 0.0,
             None => m.protrusion(p_rate),
         };
-        let e = if m.forces().has_voltage_terms() {
-            m.forces().per_volt2_part(l.g).value
-        } else {
-            0.0
-        };
-        let f_t = -l.f.d_bulge * delta_rate + m.voltage.squared_rate(t) * e;
+        let f_t = -l.f.d_bulge * delta_rate + m.voltage.squared_rate(t) * l.hot.per_volt2.value;
         match self.layout.lagged_force {
             Some(i) => dfdt[i] = f_t / m.interface_lag,
             None => dfdt[1] = f_t / m.mass,
@@ -279,13 +276,12 @@ where
             dfdt[k] = m.protrusion(p_rate) / m.thermal_lag;
         }
         if let Some(i) = self.layout.contact_impulse {
-            dfdt[i] = -m.forces().contact(l.g).d_bulge * delta_rate;
+            dfdt[i] = -l.hot.contact.d_bulge * delta_rate;
         }
         if let Some(i) = self.layout.heat {
             let (_, dd) = self.heat_rate(l.g);
             dfdt[i] = -dd * delta_rate;
         }
-        let _ = l.volt2;
         true
     }
 }

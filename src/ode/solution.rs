@@ -33,6 +33,23 @@ pub struct Stats {
     pub event_evals: usize,
 }
 
+impl std::ops::AddAssign<&Stats> for Stats {
+    /// Adds the counts of another integration (e.g. one segment of a longer run).
+    fn add_assign(&mut self, s: &Stats) {
+        self.accepted += s.accepted;
+        self.rejected += s.rejected;
+        self.rhs_evals += s.rhs_evals;
+        self.jac_evals += s.jac_evals;
+        self.lu_decomps += s.lu_decomps;
+        self.lin_solves += s.lin_solves;
+        self.newton_iters += s.newton_iters;
+        self.newton_failures += s.newton_failures;
+        self.stiffness_switches += s.stiffness_switches;
+        self.stiff_steps += s.stiff_steps;
+        self.event_evals += s.event_evals;
+    }
+}
+
 /// Saved output of [`solve`](super::solve).
 #[derive(Debug, Clone)]
 pub struct Solution<D: Dim>
