@@ -18,6 +18,10 @@ use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector, U4, U5,
 use serde::Serialize;
 use std::time::Instant;
 
+/// Largest number of segments of the touchdown-triggered search (each `overshoot / ramp_rate`
+/// long; the paper scene needs 200).
+const MAX_TRIGGERED_SEGMENTS: f64 = 1e5;
+
 /// The heater programme of a cycle.
 #[derive(Clone, Debug, PartialEq)]
 pub enum HeaterProgramme {
@@ -232,6 +236,7 @@ pub fn simulate_cycle(
     opts: &CycleOptions,
 ) -> Result<CycleResult> {
     opts.validate()?;
+    super::equilibrium::check_heater(model)?;
     let layout = StateLayout::new(model.thermal_lag > 0.0, model.interface_lag > 0.0, true);
     match layout.len() {
         4 => run::<U4>(model, programme, opts),
@@ -357,6 +362,19 @@ where
             crate::error::check_non_negative("programme.start_power", start_power)?;
             // Search up to the power whose protrusion is twice the nominal clearance.
             let span = 2.0 * model.nominal_clearance / model.efficiency;
+            // The search runs in segments of `overshoot`; bound their number so that a heater
+            // too weak to ever reach touchdown fails at once instead of running for ever.
+            let segments = span / overshoot;
+            if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
+                return Err(Error::analysis(
+                    "triggered cycle",
+                    format!(
+                        "reaching a protrusion of 2 h0 takes {span:e} W, {segments:.3e} segments of \
+                         the overshoot {overshoot:e} W (at most {MAX_TRIGGERED_SEGMENTS:e}): raise the \
+                         overshoot or the heater efficiency"
+                    ),
+                ));
+            }
             let ramp = Programme::new(vec![
                 (0.0, start_power),
                 (span / ramp_rate, start_power + span),
@@ -394,8 +412,18 @@ where
                      b: f64,
                      o: &Options|
      -> Result<Solution<D>> {
-        let sol = ode::solve(sys, a, y, b, opts.solver.method, o, &mut [])?;
+        // Stop where the lumped model ends: the pad gap h0 + y reaching zero puts the slider body
+        // into the disk (no pad contact is modelled; a power-law bearing is singular there).
+        let h0 = model.nominal_clearance;
+        let mut guard = [ode::Event::new(move |_t, s: &OVector<f64, D>| h0 + s[0])
+            .direction(ode::Direction::Falling)
+            .terminal(true)];
+        let sol = ode::solve(sys, a, y, b, opts.solver.method, o, &mut guard)
+            .map_err(|e| explain_ode_error(model, opts, e))?;
         stats += &sol.stats;
+        if sol.terminated_by_event.is_some() {
+            return Err(left_the_model(model, sys, &sol));
+        }
         Ok(sol)
     };
 
@@ -539,6 +567,66 @@ fn ode_options(
     o.validate(layout.len())
         .map_err(|e| Error::invalid("solver", e.to_string()))?;
     Ok(o)
+}
+
+/// The error for a trajectory that left the lumped model (the pad gap reached zero), with the
+/// likely cause when an interface lag makes the contact branch self-excited.
+fn left_the_model<D: DimName>(model: &SliderModel, sys: &SliderSystem, sol: &Solution<D>) -> Error
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let (t, s) = (sol.t_final(), sol.y_final());
+    let g = sys.gaps(t, s);
+    let mut reason = format!(
+        "at t = {t:.6e} s the pad gap h0 + y fell to zero (bulge gap d = {:.4e} m, velocity {:.3e} \
+         m/s): the slider body would enter the disk, outside the lumped model",
+        g.bulge, s[1]
+    );
+    if model.interface_lag > 0.0 {
+        let k_contact = -model.forces().contact(g).d_bulge;
+        let c = model.bearing().damping(s[0]);
+        if k_contact > 0.0 && model.interface_lag > c / k_contact {
+            reason.push_str(&format!(
+                "; the interface lag {:e} s exceeds c/K_contact = {:.3e} s, so each contact feeds \
+                 energy into the bounce (self-excited contact branch)",
+                model.interface_lag,
+                c / k_contact
+            ));
+        }
+    }
+    Error::analysis("cycle", reason)
+}
+
+/// ODE errors of an explicit method on a stiff cycle get the advice to use a stiff method.
+fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError) -> Error {
+    let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
+    match e {
+        ode::OdeError::TooManySteps { t, max_steps } if explicit => Error::analysis(
+            "cycle",
+            format!(
+                "the explicit method {} used up its {max_steps} steps at t = {t:e} s: the system \
+                 is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact and \
+                 lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
+                opts.solver.method,
+                fastest_rate(model)
+            ),
+        ),
+        other => Error::Ode(other),
+    }
+}
+
+/// A bound on the fastest rate of the slider (1/s): the bearing mode, the damping rate and the
+/// inverse lags (the contact stiffness only raises the first, see `docs/validity.md`).
+fn fastest_rate(model: &SliderModel) -> f64 {
+    let k = model.bearing().stiffness(0.0);
+    let c = model.bearing().damping(0.0);
+    let mut r = (k / model.mass).sqrt().max(c / model.mass);
+    for tau in [model.interface_lag, model.thermal_lag] {
+        if tau > 0.0 {
+            r = r.max(1.0 / tau);
+        }
+    }
+    r
 }
 
 fn series_of<D: DimName>(sys: &SliderSystem, traj: &Trajectory<D>, det: &Detecting<D>) -> TimeSeries

@@ -76,14 +76,54 @@ impl Default for ScanGrid {
     }
 }
 
+/// Largest number of points a scan may have: about 80 MB of gaps and far more equilibria than
+/// any scene needs. A finer grid is refused rather than allowed to exhaust memory.
+pub const MAX_SCAN_POINTS: usize = 10_000_000;
+
 impl ScanGrid {
-    /// Gaps from `hi` down to `lo`, decreasing.
-    pub fn descending(&self, lo: f64, hi: f64) -> Vec<f64> {
+    /// Checks that the steps are finite and positive, `fine_until` finite, and that the scan of
+    /// `[lo, hi]` has at most [`MAX_SCAN_POINTS`] points. Errors name `grid.<field>`.
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::equilibrium::ScanGrid;
+    /// assert!(ScanGrid::default().validate(-4e-9, 3e-8).is_ok());
+    /// let g = ScanGrid { fine_step: 0.0, ..ScanGrid::default() };
+    /// assert!(g.validate(0.0, 1e-8).unwrap_err().to_string().contains("grid.fine_step"));
+    /// ```
+    pub fn validate(&self, lo: f64, hi: f64) -> Result<()> {
+        crate::error::check_positive("grid.fine_step", self.fine_step)?;
+        crate::error::check_positive("grid.coarse_step", self.coarse_step)?;
+        crate::error::check_finite("grid.fine_until", self.fine_until)?;
+        crate::error::check_finite("grid.lo", lo)?;
+        crate::error::check_finite("grid.hi", hi)?;
+        // Points below and above `fine_until`, counted in floating point (no overflow).
+        let fine_span = (self.fine_until.min(hi) - lo).max(0.0);
+        let coarse_span = (hi - self.fine_until.max(lo)).max(0.0);
+        let points = fine_span / self.fine_step + coarse_span / self.coarse_step + 2.0;
+        if points > MAX_SCAN_POINTS as f64 {
+            let (name, step) = if fine_span / self.fine_step >= coarse_span / self.coarse_step {
+                ("grid.fine_step", self.fine_step)
+            } else {
+                ("grid.coarse_step", self.coarse_step)
+            };
+            return Err(Error::invalid(
+                name,
+                format!(
+                    "{step:e} m makes {points:.3e} points on [{lo:e}, {hi:e}] m, more than \
+                     {MAX_SCAN_POINTS}"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Gaps from `hi` down to `lo`, decreasing; fails when [`ScanGrid::validate`] does.
+    pub fn descending(&self, lo: f64, hi: f64) -> Result<Vec<f64>> {
+        self.validate(lo, hi)?;
         let mut out = Vec::new();
         let mut d = hi;
-        // Bounded: the grid has at most (hi − lo)/fine_step + 1 points.
-        let max_points = ((hi - lo) / self.fine_step).ceil() as usize + 2;
-        while d > lo && out.len() < max_points {
+        // Bounded: validate() capped the number of points.
+        while d > lo && out.len() < MAX_SCAN_POINTS {
             out.push(d);
             d -= if d > self.fine_until {
                 self.coarse_step
@@ -92,8 +132,14 @@ impl ScanGrid {
             };
         }
         out.push(lo);
-        out
+        Ok(out)
     }
+}
+
+/// Analyses in heater power need a heater that moves the bulge: `η > 0` (with `η = 0` every
+/// power gives the same protrusion, and powers found from protrusions would be ±∞ or NaN).
+pub(crate) fn check_heater(model: &SliderModel) -> Result<()> {
+    crate::error::check_positive("heater.efficiency_m_per_w", model.efficiency).map(|_| ())
 }
 
 /// Evaluates equilibria of one model at one `V²`, tabulated or exact.
@@ -216,6 +262,7 @@ pub struct SCurve {
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) -> Result<SCurve> {
+    check_heater(model)?;
     let volt2 = model.voltage.effective_dc().powi(2);
     let (lo, hi) = range.unwrap_or_else(|| model.forces().table_range());
     if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
@@ -226,7 +273,7 @@ pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) 
     }
     let solver = EquilibriumSolver::new(model, volt2);
     let mut points = Vec::new();
-    for d in grid.descending(lo, hi) {
+    for d in grid.descending(lo, hi)? {
         points.push(solver.at_gap(d)?);
     }
     let mut folds = Vec::new();
@@ -273,13 +320,33 @@ pub fn flying_equilibrium(
     let target = model.protrusion(power);
     let (lo, hi) = model.forces().table_range();
     let mut prev: Option<Equilibrium> = None;
-    for d in grid.descending(lo, hi) {
+    for d in grid.descending(lo, hi)? {
         let e = solver.at_gap(d)?;
         if !e.is_stable() {
+            // The fold lies between this grid point and the last stable one: locate it, and if
+            // the power asked for is reached before it, the equilibrium lies in that last
+            // stretch (the power is nearly stationary there, so only direct forces decide).
+            if let Some(p) = prev {
+                let fold = solver.refine_fold(e.d, p.d)?;
+                if fold.protrusion >= target {
+                    let tol = fold_tolerance(fold.d, p.d, model.nominal_clearance);
+                    let d = brent(
+                        |x| {
+                            solver
+                                .at_gap_exact(x)
+                                .map_or(f64::NAN, |q| q.protrusion - target)
+                        },
+                        fold.d,
+                        p.d,
+                        tol,
+                    )?;
+                    return solver.at_gap_exact(d);
+                }
+            }
             return Err(Error::analysis(
                 "flying equilibrium",
                 format!(
-                    "the flying branch ends at a fold (d = {d:e} m) below {power} W: the head is in contact there"
+                    "the flying branch ends at a fold (d = {d:e} m) before the protrusion of {power} W is reached: the head is in contact there"
                 ),
             ));
         }

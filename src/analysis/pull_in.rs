@@ -8,7 +8,7 @@
 
 use super::equilibrium::EquilibriumSolver;
 use super::roots::brent;
-use super::touchdown::{touchdown_at, Cause, StaticOptions};
+use super::touchdown::{touchdown_at, touchdown_signed, Cause, StaticOptions};
 use crate::error::{check_finite, Error, Result};
 use crate::force::Gaps;
 use crate::model::{SliderModel, Voltage};
@@ -71,7 +71,7 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
     }
     // Past touchdown without voltage, pull-in is at zero volts. Without any touchdown in the
     // table range (e.g. electrostatics alone) the scan below decides.
-    match touchdown_at(model, 0.0, opts) {
+    match touchdown_signed(model, 0.0, opts) {
         Ok(td0) if power >= td0.power => {
             return Ok(PullIn {
                 voltage: 0.0,
@@ -87,7 +87,7 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
     // Zero-voltage equilibrium at this power: the flying one, on the tables.
     let d0 = EquilibriumSolver::new(model, 0.0);
     let (lo, hi) = model.forces().table_range();
-    let grid = opts.grid.descending(lo, hi);
+    let grid = opts.grid.descending(lo, hi)?;
     let mut started = false;
     let mut prev: Option<(f64, f64, f64, f64)> = None; // (d, V², k, F_c)
     for d in grid {
@@ -162,6 +162,7 @@ pub fn clearance_change(
     dc_voltages: &[f64],
     opts: &StaticOptions,
 ) -> Result<Vec<ClearanceChange>> {
+    super::equilibrium::check_heater(model)?;
     let phi = model.voltage.contact_potential;
     let reference = touchdown_at(model, 0.0, opts)?.power;
     dc_voltages

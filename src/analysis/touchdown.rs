@@ -87,39 +87,80 @@ pub struct StaticHysteresis {
 /// ```
 pub fn touchdown_power(model: &SliderModel, opts: &StaticOptions) -> Result<Transition> {
     opts.validate()?;
+    super::equilibrium::check_heater(model)?;
     let volt2 = model.voltage.effective_dc().powi(2);
     touchdown_at(model, volt2, opts)
 }
 
 /// Touchdown at a given `V²` (V²).
+///
+/// The head follows the stable equilibrium from large gaps down (power rising). At a fold it jumps
+/// towards the disk and lands on the next stable equilibrium at the same power; the fold is the
+/// touchdown when the contact force there reaches `F_th` (the usual case), otherwise the scan
+/// goes on from the landing point. A transition at negative power means the head is in contact
+/// already at zero heater power: an error.
 pub(crate) fn touchdown_at(
+    model: &SliderModel,
+    volt2: f64,
+    opts: &StaticOptions,
+) -> Result<Transition> {
+    let t = touchdown_signed(model, volt2, opts)?;
+    transition("touchdown", t.at, t.cause, true)
+}
+
+/// As [`touchdown_at`], but a transition at negative power is returned as it is (the pull-in
+/// analysis reads it as "in contact at zero voltage").
+pub(crate) fn touchdown_signed(
     model: &SliderModel,
     volt2: f64,
     opts: &StaticOptions,
 ) -> Result<Transition> {
     let solver = EquilibriumSolver::new(model, volt2);
     let (lo, hi) = model.forces().table_range();
+    let th = opts.contact_threshold;
     let mut prev: Option<Equilibrium> = None;
-    for d in opts.grid.descending(lo, hi) {
+    // A fold passed, not yet landed: (fold, its power).
+    let mut jump: Option<Equilibrium> = None;
+    for d in opts.grid.descending(lo, hi)? {
         let e = solver.at_gap(d)?;
+        if let Some(fold) = jump {
+            // The contact side rises again through the fold's power on a stable part.
+            if e.is_stable() && e.power >= fold.power {
+                if e.contact_force >= th {
+                    return Ok(Transition {
+                        power: fold.power,
+                        at: fold,
+                        cause: Cause::Fold,
+                    });
+                }
+                jump = None;
+            }
+            prev = Some(e);
+            continue;
+        }
         if let Some(p) = prev {
             if !e.is_stable() {
                 let at = solver.refine_fold(e.d, p.d)?;
-                return Ok(Transition {
-                    power: at.power,
-                    at,
-                    cause: Cause::Fold,
-                });
+                if at.power < 0.0 {
+                    return Ok(Transition {
+                        power: at.power,
+                        at,
+                        cause: Cause::Fold,
+                    });
+                }
+                jump = Some(at);
+                prev = Some(e);
+                continue;
             }
-            if e.contact_force >= opts.contact_threshold {
-                let at = solver.refine_threshold(e.d, p.d, opts.contact_threshold)?;
+            if e.contact_force >= th {
+                let at = solver.refine_threshold(e.d, p.d, th)?;
                 return Ok(Transition {
                     power: at.power,
                     at,
                     cause: Cause::Threshold,
                 });
             }
-        } else if !e.is_stable() || e.contact_force >= opts.contact_threshold {
+        } else if !e.is_stable() || e.contact_force >= th {
             return Err(Error::analysis(
                 "touchdown",
                 format!("the equilibrium at the largest tabulated gap ({d:e} m) is already unstable or in contact: widen the table range"),
@@ -127,10 +168,46 @@ pub(crate) fn touchdown_at(
         }
         prev = Some(e);
     }
+    if let Some(fold) = jump {
+        // The landing lies beyond the table range: the jump goes deep into contact.
+        return Ok(Transition {
+            power: fold.power,
+            at: fold,
+            cause: Cause::Fold,
+        });
+    }
     Err(Error::analysis(
         "touchdown",
         "the flying branch neither reaches the contact threshold nor folds inside the table range",
     ))
+}
+
+/// A transition, or the error that says the head never leaves (or is already in) contact at
+/// non-negative heater power.
+fn transition(what: &str, at: Equilibrium, cause: Cause, touchdown: bool) -> Result<Transition> {
+    if at.power < 0.0 {
+        let reason = if touchdown {
+            format!(
+                "the head is in contact already at zero heater power (the {} at d = {:e} m lies at \
+                 {:e} W < 0)",
+                if cause == Cause::Fold { "fold" } else { "threshold crossing" },
+                at.d,
+                at.power
+            )
+        } else {
+            format!(
+                "the head stays in contact down to zero heater power (the contact branch ends at \
+                 d = {:e} m, {:e} W < 0): adhesion holds it",
+                at.d, at.power
+            )
+        };
+        return Err(Error::analysis(what, reason));
+    }
+    Ok(Transition {
+        power: at.power,
+        at,
+        cause,
+    })
 }
 
 /// Take-off power at the model's DC voltage, starting on the contact branch at
@@ -141,11 +218,19 @@ pub fn takeoff_power(
     opts: &StaticOptions,
 ) -> Result<Transition> {
     opts.validate()?;
+    super::equilibrium::check_heater(model)?;
     crate::error::check_finite("start_power", start_power)?;
     let volt2 = model.voltage.effective_dc().powi(2);
     takeoff_at(model, volt2, start_power, opts)
 }
 
+/// Take-off at a given `V²`, from the contact equilibrium at `start_power`.
+///
+/// The head follows the stable contact equilibrium up in gap (power falling). At a fold it jumps
+/// away from the disk and lands on the next stable equilibrium at the same power; the fold is the
+/// take-off when the contact force there is below `F_th` (the usual case), otherwise the scan
+/// goes on from the landing point. Reaching negative power first means the head stays in contact
+/// at zero heater power: an error.
 pub(crate) fn takeoff_at(
     model: &SliderModel,
     volt2: f64,
@@ -154,6 +239,7 @@ pub(crate) fn takeoff_at(
 ) -> Result<Transition> {
     let solver = EquilibriumSolver::new(model, volt2);
     let (mut lo, hi) = model.forces().table_range();
+    let th = opts.contact_threshold;
     let target = model.protrusion(start_power);
     // The start lies deeper than the scan's lower end if the protrusion there is too small:
     // extend the scan downwards (the forces fall back to direct evaluation outside the table).
@@ -172,10 +258,11 @@ pub(crate) fn takeoff_at(
             ));
         }
     }
-    let mut ascending = opts.grid.descending(lo, hi);
+    let mut ascending = opts.grid.descending(lo, hi)?;
     ascending.reverse();
     let mut started = false;
     let mut prev: Option<Equilibrium> = None;
+    let mut jump: Option<Equilibrium> = None;
     for d in ascending {
         let e = solver.at_gap(d)?;
         if !started {
@@ -194,25 +281,39 @@ pub(crate) fn takeoff_at(
                 continue;
             }
         }
+        if let Some(fold) = jump {
+            // The flying side falls again through the fold's power on a stable part.
+            if e.is_stable() && e.power <= fold.power {
+                if e.contact_force < th {
+                    return transition("take-off", fold, Cause::Fold, false);
+                }
+                jump = None;
+            }
+            prev = Some(e);
+            continue;
+        }
         if let Some(p) = prev {
             if !e.is_stable() {
                 let at = solver.refine_fold(p.d, e.d)?;
-                return Ok(Transition {
-                    power: at.power,
-                    at,
-                    cause: Cause::Fold,
-                });
+                if at.power < 0.0 {
+                    return transition("take-off", at, Cause::Fold, false);
+                }
+                jump = Some(at);
+                prev = Some(e);
+                continue;
             }
-            if e.contact_force < opts.contact_threshold {
-                let at = solver.refine_threshold(p.d, e.d, opts.contact_threshold)?;
-                return Ok(Transition {
-                    power: at.power,
-                    at,
-                    cause: Cause::Threshold,
-                });
+            if e.contact_force < th {
+                let at = solver.refine_threshold(p.d, e.d, th)?;
+                return transition("take-off", at, Cause::Threshold, false);
+            }
+            if e.power < 0.0 {
+                return transition("take-off", e, Cause::Fold, false);
             }
         }
         prev = Some(e);
+    }
+    if let Some(fold) = jump {
+        return transition("take-off", fold, Cause::Fold, false);
     }
     Err(Error::analysis(
         "take-off",

@@ -306,7 +306,19 @@ impl SliderModel {
         }
         for _ in 0..200 {
             let (r, dr, f) = eval(y);
-            if !r.is_finite() || !dr.is_finite() || dr >= 0.0 {
+            if !r.is_finite() || !dr.is_finite() {
+                // Say which term failed rather than that no balance exists.
+                let g = Gaps {
+                    bulge: d,
+                    pad: h0 + y,
+                };
+                self.interface_force_exact(g, volt2)?;
+                return Err(Error::no_convergence(
+                    "air-bearing balance",
+                    format!("the forces are not finite at d = {d:e} m, y = {y:e} m"),
+                ));
+            }
+            if dr >= 0.0 {
                 break;
             }
             let step = -r / dr;

@@ -12,6 +12,9 @@ const MAX_DEPTH: u32 = 10;
 /// Depth of the initial uniform split (2^INITIAL_DEPTH panels), so that features
 /// narrower than the whole range are sampled from the start.
 const INITIAL_DEPTH: u32 = 3;
+/// Largest node budget a table may be given: 10⁷ nodes take about 400 MB while building. A larger
+/// budget with an unreachable tolerance would exhaust memory before failing.
+pub const MAX_NODES: usize = 10_000_000;
 /// Intervals per panel before any doubling (even, so panels split on nodes).
 const INITIAL_INTERVALS: usize = 4;
 
@@ -141,6 +144,22 @@ impl Table {
         }
         crate::error::check_non_negative("table.rel_tol", opts.rel_tol)?;
         crate::error::check_non_negative("table.abs_tol", opts.abs_tol)?;
+        if opts.rel_tol == 0.0 && opts.abs_tol == 0.0 {
+            // Refinement would go on down to rounding-level spacing: ~1e16 nodes.
+            return Err(Error::invalid(
+                "table.rel_tol",
+                "rel_tol and abs_tol are both 0; at least one must be > 0",
+            ));
+        }
+        if opts.max_nodes > MAX_NODES {
+            return Err(Error::invalid(
+                "table.max_nodes",
+                format!(
+                    "must be at most {MAX_NODES} (about 40 bytes each while building), got {}",
+                    opts.max_nodes
+                ),
+            ));
+        }
 
         let mut eval = |x: f64| -> Result<[f64; 2]> {
             let (v, d) = f(x)?;

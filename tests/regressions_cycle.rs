@@ -1,0 +1,50 @@
+//! Dynamic-cycle cases that once failed, kept as regression tests.
+
+use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
+use hdi_tribology::model::SliderModel;
+use hdi_tribology::scene::Scene;
+use hdi_tribology::Error;
+
+/// A 100 ns interface lag on the paper scene (c/K_contact ≈ 0.1 ns) makes the contact branch
+/// self-excited: the head bounced ever higher and harder and the integration ended with
+/// `Ode(NonFinite)` at t ≈ 3.67 ms, 26 nm deep in the disk. It now stops where the pad reaches
+/// the disk, with an error that says why.
+#[test]
+fn self_excited_contact_stops_with_a_reason_instead_of_nan() {
+    let mut scene = Scene::paper();
+    scene.slider.interface_lag_s = 1e-7;
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let programme =
+        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme).unwrap());
+    match simulate_cycle(
+        &model,
+        &programme,
+        &CycleOptions::from_scene(&scene).unwrap(),
+    ) {
+        Err(Error::Analysis { what, reason }) => {
+            assert_eq!(what, "cycle");
+            assert!(reason.contains("pad gap h0 + y fell to zero"), "{reason}");
+            assert!(reason.contains("self-excited"), "{reason}");
+            assert!(!reason.contains('\n'));
+        }
+        other => panic!("expected the self-excitation error, got {other:?}"),
+    }
+}
+
+/// A lag below c/K_contact keeps the contact branch stable: the same programme runs through.
+#[test]
+fn a_short_interface_lag_runs_through() {
+    let mut scene = Scene::paper();
+    scene.slider.interface_lag_s = 1e-11;
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let programme =
+        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme).unwrap());
+    let r = simulate_cycle(
+        &model,
+        &programme,
+        &CycleOptions::from_scene(&scene).unwrap(),
+    )
+    .unwrap();
+    let h = r.hysteresis.unwrap();
+    assert!(h > 0.0 && h.is_finite(), "{r:?}");
+}
