@@ -183,8 +183,11 @@ fn a_rougher_disk_has_no_folds_and_no_static_hysteresis() {
     let model = SliderModel::from_scene(&scene).unwrap();
     let curve = s_curve(&model, None, &ScanGrid::default()).unwrap();
     assert!(curve.folds.is_empty());
-    let h = static_hysteresis(&model, &StaticOptions::new(scene.detector.contact_threshold_n))
-        .unwrap();
+    let h = static_hysteresis(
+        &model,
+        &StaticOptions::new(scene.detector.contact_threshold_n),
+    )
+    .unwrap();
     assert_eq!(h.touchdown.cause, Cause::Threshold);
     assert_eq!(h.takeoff.cause, Cause::Threshold);
     assert!(h.hysteresis.abs() < 1e-12, "{}", h.hysteresis);
