@@ -162,6 +162,26 @@ fn bad_scenes() -> Vec<(&'static str, String, &'static str)> {
             "surface.peaks.n",
         ),
         (
+            "table below the flying gap",
+            edit(&p, "table", "rel_tol", "1e-9\nd_max_m = 5e-9"),
+            "table.d_max_m",
+        ),
+        (
+            "table above the asperity peaks",
+            edit(&p, "table", "rel_tol", "1e-9\nd_min_m = 2e-9"),
+            "table.d_min_m",
+        ),
+        (
+            "overflowing roughness",
+            edit(&p, "surface", "height_sigma_m", "1e308"),
+            "table",
+        ),
+        (
+            "wrong type",
+            edit(&p, "slider", "mass_kg", "\"heavy\""),
+            "slider.mass_kg",
+        ),
+        (
             "unknown field",
             p.replacen("[slider]\n", "[slider]\nmass_g = 1.0\n", 1),
             "mass_g",
@@ -209,5 +229,30 @@ fn every_subcommand_rejects_bad_scene_files_on_one_line_naming_the_field() {
             );
         }
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A scene file larger than any scene (64 MiB) is refused before it is read.
+#[test]
+fn an_oversized_scene_file_is_refused_before_it_is_read() {
+    let dir = std::env::temp_dir().join(format!("hdi-big-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("big.toml");
+    let f = std::fs::File::create(&path).unwrap();
+    f.set_len(65 << 20).unwrap(); // sparse: no data written
+    let err = Scene::from_path(&path).unwrap_err().to_string();
+    assert!(err.contains("bytes"), "{err}");
+    let out = Command::new(env!("CARGO_BIN_EXE_hdi"))
+        .args(["scene", path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr)
+            .trim_end()
+            .lines()
+            .count(),
+        1
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -3,7 +3,7 @@
 //! and arbitrary structured scenes. The reader must never panic: it returns a scene that
 //! validates, or a typed error on one line that names the field (input errors) or the line
 //! (parse errors). Accepted scenes must also survive building their interface terms and
-//! evaluating them without a panic.
+//! evaluating them: finite forces or a typed error.
 //!
 //! The case count is `HDI_FUZZ_CASES` (default 300 per property, for CI time); a long run is done
 //! by hand with a large count and its failures are kept in `tests/regressions_fuzz.rs`.
@@ -24,12 +24,18 @@ fn check_outcome(r: hdi_tribology::Result<Scene>) -> Result<(), TestCaseError> {
     match r {
         Ok(scene) => {
             prop_assert!(scene.validate().is_ok());
-            // Build and evaluate the enabled terms at a few gaps: no panic, whatever the values.
+            // Build and evaluate the enabled terms at a few gaps: finite, or a typed error.
             if let Ok(terms) = scene.interface_terms() {
                 let (lo, hi) = scene.table_range();
                 for d in [lo, 0.5 * (lo + hi), hi] {
                     for t in &terms {
-                        let _ = t.force(d);
+                        if let Ok((f, s)) = t.force(d) {
+                            prop_assert!(
+                                f.is_finite() && s.is_finite(),
+                                "{} at {d}: {f} {s}",
+                                t.name()
+                            );
+                        }
                     }
                 }
             }

@@ -5,6 +5,7 @@ use std::f64::consts::PI;
 
 use statrs::function::erf::erfc;
 
+use super::term::finite_eval;
 use super::{Coupling, Footprint, GapReference, InterfaceTerm, PressureLaw, TermKind};
 use crate::error::check_positive;
 use crate::quadrature::{integrate_with_breaks, QuadOptions};
@@ -231,42 +232,45 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
         self.gap
     }
     fn force(&self, d: f64) -> Result<(f64, f64)> {
-        if !d.is_finite() {
-            return Err(Error::invalid("d", format!("must be finite, got {d}")));
-        }
-        match self.footprint {
-            Footprint::Flat { area_m2 } => Ok((
-                area_m2 * self.mean_pressure(d)?,
-                area_m2 * self.mean_pressure_slope(d)?,
-            )),
-            Footprint::Paraboloid {
-                radius_of_curvature_m,
-                ..
-            } => {
-                let c = 2.0 * PI * radius_of_curvature_m;
-                let delta = self.footprint.derjaguin_depth();
-                if delta.is_infinite() {
-                    Ok((c * self.mean_energy(d)?, -c * self.mean_pressure(d)?))
-                } else if self.sigma > 0.0 && delta < 0.1 * self.sigma {
-                    // A band much thinner than σ: I(d) − I(d + Δ) would cancel; p̄ is smooth on
-                    // the scale σ, so 8-point Gauss–Legendre over the band is exact to
-                    // ~(Δ/2σ)¹⁶.
-                    let (mid, half) = (d + 0.5 * delta, 0.5 * delta);
-                    let mut f = 0.0;
-                    for (x, w) in GAUSS_LEGENDRE_8 {
-                        f += w
-                            * (self.mean_pressure(mid - half * x)?
-                                + self.mean_pressure(mid + half * x)?);
+        let r = (|| -> Result<(f64, f64)> {
+            if !d.is_finite() {
+                return Err(Error::invalid("d", format!("must be finite, got {d}")));
+            }
+            match self.footprint {
+                Footprint::Flat { area_m2 } => Ok((
+                    area_m2 * self.mean_pressure(d)?,
+                    area_m2 * self.mean_pressure_slope(d)?,
+                )),
+                Footprint::Paraboloid {
+                    radius_of_curvature_m,
+                    ..
+                } => {
+                    let c = 2.0 * PI * radius_of_curvature_m;
+                    let delta = self.footprint.derjaguin_depth();
+                    if delta.is_infinite() {
+                        Ok((c * self.mean_energy(d)?, -c * self.mean_pressure(d)?))
+                    } else if self.sigma > 0.0 && delta < 0.1 * self.sigma {
+                        // A band much thinner than σ: I(d) − I(d + Δ) would cancel; p̄ is smooth on
+                        // the scale σ, so 8-point Gauss–Legendre over the band is exact to
+                        // ~(Δ/2σ)¹⁶.
+                        let (mid, half) = (d + 0.5 * delta, 0.5 * delta);
+                        let mut f = 0.0;
+                        for (x, w) in GAUSS_LEGENDRE_8 {
+                            f += w
+                                * (self.mean_pressure(mid - half * x)?
+                                    + self.mean_pressure(mid + half * x)?);
+                        }
+                        let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
+                        Ok((c * half * f, -c * df))
+                    } else {
+                        let f = self.mean_energy(d)? - self.mean_energy(d + delta)?;
+                        let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
+                        Ok((c * f, -c * df))
                     }
-                    let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
-                    Ok((c * half * f, -c * df))
-                } else {
-                    let f = self.mean_energy(d)? - self.mean_energy(d + delta)?;
-                    let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
-                    Ok((c * f, -c * df))
                 }
             }
-        }
+        })()?;
+        finite_eval(self.name(), "force", d, r)
     }
     fn kinks(&self) -> Vec<f64> {
         // With roughness the cutoff is smeared over σ and the force is smooth on the scale of the

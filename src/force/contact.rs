@@ -3,6 +3,7 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+use super::term::finite_eval;
 use super::{Coupling, Footprint, GapReference, InterfaceTerm, TermKind};
 use crate::error::check_positive;
 use crate::surface::PeakDistribution;
@@ -133,27 +134,30 @@ impl InterfaceTerm for GreenwoodWilliamson {
         self.gap
     }
     fn force(&self, d: f64) -> Result<(f64, f64)> {
-        if !d.is_finite() {
-            return Err(Error::invalid("d", format!("must be finite, got {d}")));
-        }
-        let k = 4.0 / 3.0 * self.modulus * self.radius.sqrt() * self.density;
-        match self.footprint {
-            Footprint::Flat { area_m2 } => Ok((
-                area_m2 * k * self.moment(d, 1.5)?,
-                -area_m2 * k * 1.5 * self.moment(d, 0.5)?,
-            )),
-            Footprint::Paraboloid {
-                radius_of_curvature_m,
-                ..
-            } => {
-                let c = 2.0 * PI * radius_of_curvature_m * k;
-                let delta = self.footprint.derjaguin_depth();
-                Ok((
-                    c * 0.4 * self.moment_band(d, 2.5, delta)?,
-                    -c * self.moment_band(d, 1.5, delta)?,
-                ))
+        let r = (|| -> Result<(f64, f64)> {
+            if !d.is_finite() {
+                return Err(Error::invalid("d", format!("must be finite, got {d}")));
             }
-        }
+            let k = 4.0 / 3.0 * self.modulus * self.radius.sqrt() * self.density;
+            match self.footprint {
+                Footprint::Flat { area_m2 } => Ok((
+                    area_m2 * k * self.moment(d, 1.5)?,
+                    -area_m2 * k * 1.5 * self.moment(d, 0.5)?,
+                )),
+                Footprint::Paraboloid {
+                    radius_of_curvature_m,
+                    ..
+                } => {
+                    let c = 2.0 * PI * radius_of_curvature_m * k;
+                    let delta = self.footprint.derjaguin_depth();
+                    Ok((
+                        c * 0.4 * self.moment_band(d, 2.5, delta)?,
+                        -c * self.moment_band(d, 1.5, delta)?,
+                    ))
+                }
+            }
+        })()?;
+        finite_eval(self.name(), "force", d, r)
     }
     fn real_contact_area(&self, d: f64) -> Result<f64> {
         Ok(self.real_contact_area_and_slope(d)?.0)
@@ -165,26 +169,29 @@ impl InterfaceTerm for GreenwoodWilliamson {
         }
     }
     fn real_contact_area_and_slope(&self, d: f64) -> Result<(f64, f64)> {
-        if !d.is_finite() {
-            return Err(Error::invalid("d", format!("must be finite, got {d}")));
-        }
-        let k = PI * self.radius * self.density;
-        match self.footprint {
-            Footprint::Flat { area_m2 } => Ok((
-                area_m2 * k * self.moment(d, 1.0)?,
-                -area_m2 * k * self.moment(d, 0.0)?,
-            )),
-            Footprint::Paraboloid {
-                radius_of_curvature_m,
-                ..
-            } => {
-                let c = 2.0 * PI * radius_of_curvature_m * k;
-                let delta = self.footprint.derjaguin_depth();
-                Ok((
-                    c * 0.5 * self.moment_band(d, 2.0, delta)?,
-                    -c * self.moment_band(d, 1.0, delta)?,
-                ))
+        let r = (|| -> Result<(f64, f64)> {
+            if !d.is_finite() {
+                return Err(Error::invalid("d", format!("must be finite, got {d}")));
             }
-        }
+            let k = PI * self.radius * self.density;
+            match self.footprint {
+                Footprint::Flat { area_m2 } => Ok((
+                    area_m2 * k * self.moment(d, 1.0)?,
+                    -area_m2 * k * self.moment(d, 0.0)?,
+                )),
+                Footprint::Paraboloid {
+                    radius_of_curvature_m,
+                    ..
+                } => {
+                    let c = 2.0 * PI * radius_of_curvature_m * k;
+                    let delta = self.footprint.derjaguin_depth();
+                    Ok((
+                        c * 0.5 * self.moment_band(d, 2.0, delta)?,
+                        -c * self.moment_band(d, 1.0, delta)?,
+                    ))
+                }
+            }
+        })()?;
+        finite_eval(self.name(), "real contact area", d, r)
     }
 }

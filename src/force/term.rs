@@ -108,3 +108,19 @@ pub trait InterfaceTerm: Debug + Send + Sync {
         Vec::new()
     }
 }
+
+/// A term's value and slope at `d`, or an error when parameters too large for `f64` made them
+/// overflow (±∞ or NaN): no term returns a non-finite result as `Ok`.
+pub(crate) fn finite_eval(name: &str, what: &str, d: f64, r: (f64, f64)) -> Result<(f64, f64)> {
+    if r.0.is_finite() && r.1.is_finite() {
+        Ok(r)
+    } else {
+        Err(crate::Error::invalid(
+            name,
+            format!(
+                "the {what} at d = {d:e} m overflows ({}, slope {}): the term's parameters are too large",
+                r.0, r.1
+            ),
+        ))
+    }
+}

@@ -148,11 +148,41 @@ impl Scene {
             check_finite("table.d_max_m", hi)?;
         }
         let (lo, hi) = self.table_range();
+        if !(lo.is_finite() && hi.is_finite()) {
+            return Err(Error::invalid(
+                "table",
+                format!("the range ({lo}, {hi}) is not finite: the lengths of the scene overflow"),
+            ));
+        }
         if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
             return Err(Error::invalid(
                 "table",
                 format!("d_min_m must be below d_max_m, got range ({lo}, {hi})"),
             ));
+        }
+        // The range must cover the scene: the flying gap at zero heater power (about h0), and
+        // with contact on, the asperity peaks (where contact starts).
+        if hi < self.nominal_clearance_m {
+            return Err(Error::invalid(
+                "table.d_max_m",
+                format!(
+                    "must reach the nominal clearance {} m (the flying gap at zero heater power), got {hi}",
+                    self.nominal_clearance_m
+                ),
+            ));
+        }
+        if self.contact.is_some() {
+            if let Ok(p) = self.peaks() {
+                if lo > p.mean() {
+                    return Err(Error::invalid(
+                        "table.d_min_m",
+                        format!(
+                            "must reach down to the mean asperity peak height {:e} m, where contact starts, got {lo}",
+                            p.mean()
+                        ),
+                    ));
+                }
+            }
         }
         Ok(())
     }
