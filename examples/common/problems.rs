@@ -1,8 +1,8 @@
 //! Test problems for the work–precision report and the peer comparison, with their reference
 //! solutions: one non-stiff problem with a closed-form solution, and three stiff problems of the
 //! Test Set for IVP Solvers (F. Mazzia, C. Magherini et al., Univ. Bari): Van der Pol (μ = 1000),
-//! Robertson to t = 1e11 and HIRES. The reference values are those of the test set, the same as
-//! in the crate's stiff validation tests.
+//! Robertson to t = 1e11 and HIRES. The reference values are those of the test set; the crate's
+//! stiff validation tests (`tests/ode_stiff.rs`) use these same definitions.
 //!
 //! Right-hand sides and Jacobians work on plain slices so that any solver can call them.
 #![allow(dead_code)]
