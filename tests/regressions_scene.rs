@@ -44,3 +44,30 @@ fn json_and_toml_round_trips_keep_every_bit_of_many_numbers() {
         }
     }
 }
+
+/// A single discrete asperity below the mean plane (so the peak heights have zero spread, and
+/// the surface heights too) used to get a default table range that stopped above the peak, and
+/// the scene refused itself (found by `invariants_scene`: peak at −1.52 nm, h0 = 1.05 nm). The
+/// default range now starts below the mean peak height whatever the spread.
+#[test]
+fn default_table_range_covers_a_single_peak_below_the_mean_plane() {
+    use hdi_tribology::force::Gaps;
+    use hdi_tribology::surface::PeakModel;
+    let mut s = Scene::paper();
+    s.nominal_clearance_m = 1.053923788566322e-9;
+    s.surface.height_sigma_m = 0.0;
+    s.surface.peaks = PeakModel::Discrete {
+        heights_m: vec![-1.516751910554614e-9],
+    };
+    s.intermolecular = None;
+    s.electrostatic = None;
+    assert!(s.validate().is_ok(), "{:?}", s.validate());
+    let (lo, hi) = s.table_range();
+    assert!(lo < -1.516751910554614e-9 && hi > s.nominal_clearance_m);
+    let forces = s.build_interface().unwrap();
+    // The peak is touched only below d = −1.52 nm: no contact above it, contact below.
+    let above = forces.evaluate(Gaps::same(-1.5e-9));
+    let below = forces.evaluate(Gaps::same(-1.55e-9));
+    assert!(above.contact.value.abs() < 1e-15, "{above:?}");
+    assert!(below.contact.value > 1e-12, "{below:?}");
+}

@@ -140,8 +140,8 @@ impl Scene {
     /// Range of separations `d` (m) that the force tables cover.
     ///
     /// Default: from `min(0, mean peak height) − 5 s` (s the larger of the surface-height and
-    /// peak-height standard deviations; `−0.1 h0` when both are zero), which reaches well into
-    /// hard contact, up to `3 h0`. `table.d_min_m` / `table.d_max_m` override either end. Outside
+    /// peak-height standard deviations; `min(0, mean peak height) − 0.1 h0` when both are zero,
+    /// as for a single discrete peak), which reaches well into hard contact, up to `3 h0`. `table.d_min_m` / `table.d_max_m` override either end. Outside
     /// the range the forces are still exact (direct quadrature), only slower.
     pub fn table_range(&self) -> (f64, f64) {
         let (mut mean, mut std) = (0.0_f64, 0.0_f64);
@@ -155,7 +155,7 @@ impl Scene {
         let lo = if s > 0.0 && s.is_finite() {
             mean.min(0.0) - 5.0 * s
         } else {
-            -0.1 * self.nominal_clearance_m
+            mean.min(0.0) - 0.1 * self.nominal_clearance_m
         };
         let hi = 3.0 * self.nominal_clearance_m;
         (
