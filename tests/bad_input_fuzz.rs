@@ -8,6 +8,9 @@
 //! The case count is `HDI_FUZZ_CASES` (default 300 per property, for CI time); a long run is done
 //! by hand with a large count and its failures are kept in `tests/regressions_fuzz.rs`.
 
+#[path = "common/seeded.rs"]
+mod seeded;
+
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
 use proptest::prelude::*;
@@ -83,7 +86,7 @@ fn value() -> impl Strategy<Value = String> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: cases(), ..ProptestConfig::default() })]
+    #![proptest_config(seeded::config(cases()))]
 
     /// Arbitrary bytes (lossily decoded) as TOML and JSON.
     #[test]

@@ -1,5 +1,8 @@
 //! Property tests over wide parameter ranges: finite values, signs, monotonicity.
 
+#[path = "common/seeded.rs"]
+mod seeded;
+
 use std::sync::Arc;
 
 use hdi_tribology::force::{
@@ -32,7 +35,7 @@ fn sigma() -> impl Strategy<Value = f64> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+    #![proptest_config(seeded::config(64))]
 
     /// With the default cutoff h_e every non-contacting point is attracted (p < 0 for h > h_e),
     /// so the averaged 3–9 force is attractive or zero at any separation, on any footprint.

@@ -4,6 +4,9 @@
 //!
 //! Each case builds force tables (0.2–0.5 s): case counts are small and stated per property.
 
+#[path = "common/seeded.rs"]
+mod seeded;
+
 use hdi_tribology::analysis::cycle::{CycleOptions, HeaterProgramme};
 use hdi_tribology::analysis::{
     ac_sweep, flying_equilibrium, static_hysteresis, ScanGrid, StaticOptions,
@@ -123,7 +126,7 @@ fn hysteresis_of(s: &Scene) -> hdi_tribology::Result<(f64, f64)> {
 
 proptest! {
     // 24 cases × 2 models: about 10 s.
-    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+    #![proptest_config(seeded::config(24))]
 
     /// Touchdown ≥ take-off ≥ 0, or a typed analysis error that says why; the same powers when
     /// the unit of force is changed (to 1e-9 relative: the scan grids are in metres and do not
@@ -181,7 +184,7 @@ proptest! {
 
 proptest! {
     // 8 cases × 2 models.
-    #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+    #![proptest_config(seeded::config(8))]
 
     /// The same touchdown and take-off powers when the unit of length changes by `l`, to 1e-6
     /// relative: the scan grid is in metres and does not scale, so the brackets of folds and

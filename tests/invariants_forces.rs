@@ -5,6 +5,9 @@
 //! Case counts are chosen for run time (each table build costs tens of milliseconds); the counts
 //! are reported in `docs/validity.md`.
 
+#[path = "common/seeded.rs"]
+mod seeded;
+
 use hdi_tribology::force::{
     Electrostatic, Footprint, GapReference, GreenwoodWilliamson, InterfaceForces, InterfaceTerm,
     Intermolecular,
@@ -49,7 +52,7 @@ fn footprint() -> impl Strategy<Value = Footprint> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+    #![proptest_config(seeded::config(256))]
 
     /// Greenwood–Williamson contact: finite, ≥ 0, slope ≤ 0, non-increasing in d, area ≥ 0,
     /// from far outside the peaks down to deep interference (−10 σ).
@@ -111,7 +114,7 @@ proptest! {
 
 proptest! {
     // Each case tabulates three terms (about 0.05–0.3 s): few cases.
-    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+    #![proptest_config(seeded::config(32))]
 
     /// The merged tables agree with direct quadrature to the table tolerance, relative to the
     /// largest term magnitude at that gap (terms of opposite sign cancel in the sum, so the

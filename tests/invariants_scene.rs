@@ -1,6 +1,9 @@
 //! Property tests of scene serialisation: any valid scene written as TOML or JSON and read back
 //! is the same scene, bit for bit, and gives the same forces.
 
+#[path = "common/seeded.rs"]
+mod seeded;
+
 use hdi_tribology::force::{AirBearingModel, Footprint, GapReference};
 use hdi_tribology::scene::{ContactSpec, ElectrostaticSpec, IntermolecularSpec, Scene};
 use hdi_tribology::surface::PeakModel;
@@ -130,7 +133,7 @@ fn force_bits(s: &Scene) -> Vec<u64> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+    #![proptest_config(seeded::config(200))]
 
     #[test]
     fn toml_and_json_round_trips_are_exact(s in scene()) {

@@ -1,5 +1,8 @@
 //! Properties of the peak laws and the quadrature over wide parameter ranges.
 
+#[path = "common/seeded.rs"]
+mod seeded;
+
 use hdi_tribology::quadrature::{integrate, QuadOptions, Table, TableOptions};
 use hdi_tribology::surface::{Gaussian, PeakDistribution, RiceMaxima, Rician};
 use proptest::prelude::*;
@@ -13,7 +16,7 @@ fn law(kind: u8, scale: f64, shape: f64) -> Box<dyn PeakDistribution> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    #![proptest_config(seeded::config(64))]
 
     /// Partial moments are finite, non-negative, and non-increasing in d.
     #[test]
