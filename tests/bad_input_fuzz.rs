@@ -60,6 +60,11 @@ fn paper_toml() -> String {
     Scene::paper().to_toml_string().unwrap()
 }
 
+fn paper_engineering_toml() -> String {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper_engineering.toml");
+    std::fs::read_to_string(path).unwrap()
+}
+
 /// Replacement values for a `key = value` line: extremes, wrong types, garbage.
 fn value() -> impl Strategy<Value = String> {
     prop_oneof![
@@ -96,15 +101,18 @@ proptest! {
         check_outcome(Scene::from_json_str(&text))?;
     }
 
-    /// One line of the paper scene with its value replaced, removed, duplicated or cut short.
+    /// One line of the paper scene (in SI or in engineering units) with its value replaced,
+    /// removed, duplicated or cut short, or its key given an engineering-unit suffix.
     #[test]
     fn edited_paper_scene_is_accepted_or_rejected_by_field(
+        engineering in any::<bool>(),
         line in any::<prop::sample::Index>(),
         v in value(),
-        how in 0..4u8,
+        how in 0..5u8,
         cut in any::<prop::sample::Index>(),
+        suffix in prop::sample::select(&["_nm", "_mw", "_khz", "_gpa", "_ms", "_per_um2", "_um2"][..]),
     ) {
-        let text = paper_toml();
+        let text = if engineering { paper_engineering_toml() } else { paper_toml() };
         let lines: Vec<&str> = text.lines().collect();
         let i = line.index(lines.len());
         let mut out: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
@@ -120,6 +128,12 @@ proptest! {
             2 => {
                 let dup = out[i].clone();
                 out.insert(i, dup);
+            }
+            3 => {
+                if let Some((k, rest)) = lines[i].split_once(" = ") {
+                    let stem = k.rsplit_once('_').map_or(k, |(stem, _)| stem);
+                    out[i] = format!("{stem}{suffix} = {rest}");
+                }
             }
             _ => {
                 let joined = out.join("\n");

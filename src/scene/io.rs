@@ -2,6 +2,9 @@
 
 use std::path::Path;
 
+use serde::Deserialize;
+
+use super::eng_units::{json_doc, toml_doc, Renames};
 use super::Scene;
 use crate::{Error, Result};
 
@@ -10,24 +13,25 @@ use crate::{Error, Result};
 const MAX_SCENE_BYTES: u64 = 64 << 20;
 
 impl Scene {
-    /// Parses a TOML scene and validates it.
+    /// Parses a TOML scene and validates it. Fields may be given in engineering units (see
+    /// the [module docs](crate::scene#engineering-units)).
+    ///
+    /// ```
+    /// use hdi_tribology::scene::Scene;
+    /// let mut text = Scene::paper().to_toml_string()?;
+    /// text = text.replace("nominal_clearance_m = 0.00000001", "nominal_clearance_nm = 12.5");
+    /// let s = Scene::from_toml_str(&text)?;
+    /// assert!((s.nominal_clearance_m - 12.5e-9).abs() < 1e-23);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     pub fn from_toml_str(s: &str) -> Result<Scene> {
-        let scene = parse_toml(s).map_err(|reason| Error::Scene {
-            origin: "<string>".into(),
-            reason,
-        })?;
-        scene.validate()?;
-        Ok(scene)
+        validated(read_toml(s, "<string>")?)
     }
 
-    /// Parses a JSON scene and validates it.
+    /// Parses a JSON scene and validates it. Fields may be given in engineering units, as in
+    /// [`Scene::from_toml_str`].
     pub fn from_json_str(s: &str) -> Result<Scene> {
-        let scene: Scene = serde_json::from_str(s).map_err(|e| Error::Scene {
-            origin: "<string>".into(),
-            reason: e.to_string(),
-        })?;
-        scene.validate()?;
-        Ok(scene)
+        validated(read_json(s, "<string>")?)
     }
 
     /// Reads a scene file (`.toml` or `.json`, by extension) and validates it. Parse errors are
@@ -55,14 +59,17 @@ impl Scene {
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
-        let parsed = match ext.as_deref() {
-            Some("toml") => parse_toml(&text),
-            Some("json") => serde_json::from_str::<Scene>(&text).map_err(|e| e.to_string()),
-            _ => Err("unknown file type (expected a .toml or .json extension)".to_string()),
+        let read = match ext.as_deref() {
+            Some("toml") => read_toml(&text, &origin)?,
+            Some("json") => read_json(&text, &origin)?,
+            _ => {
+                return Err(Error::Scene {
+                    origin,
+                    reason: "unknown file type (expected a .toml or .json extension)".into(),
+                })
+            }
         };
-        let scene = parsed.map_err(|reason| Error::Scene { origin, reason })?;
-        scene.validate()?;
-        Ok(scene)
+        validated(read)
     }
 
     /// The scene as TOML.
@@ -82,23 +89,79 @@ impl Scene {
     }
 }
 
-/// TOML parse with the parser's message on one line, prefixed by its line and column.
-fn parse_toml(s: &str) -> std::result::Result<Scene, String> {
-    toml::from_str::<Scene>(s).map_err(|e| {
-        let msg = e.message().trim().replace('\n', "; ");
-        match e.span() {
-            Some(span) => {
-                let before = s.get(..span.start).unwrap_or(s);
-                let line = before.matches('\n').count() + 1;
-                let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-                match field_at(s, span.start) {
-                    Some(field) => format!("line {line}, column {col}, {field}: {msg}"),
-                    None => format!("line {line}, column {col}: {msg}"),
-                }
+/// The scene once validated; an error on a field given in engineering units says so.
+fn validated((scene, renames): (Scene, Renames)) -> Result<Scene> {
+    scene.validate().map_err(|e| renames.annotate(e))?;
+    Ok(scene)
+}
+
+fn scene_error(origin: &str, reason: String) -> Error {
+    Error::Scene {
+        origin: origin.into(),
+        reason,
+    }
+}
+
+/// A TOML scene, with engineering-unit fields converted by editing the text; the parser's
+/// errors are mapped back to the line, column and field as written in the file.
+fn read_toml(s: &str, origin: &str) -> Result<(Scene, Renames)> {
+    let doc =
+        toml::de::DeTable::parse(s).map_err(|e| scene_error(origin, toml_message(s, &e, None)))?;
+    let mut renames = Renames::default();
+    let mut edits = toml_doc::Edits::default();
+    toml_doc::convert_table(doc.get_ref(), "", &mut renames, &mut edits)?;
+    if edits.is_empty() {
+        return Scene::deserialize(toml::de::Deserializer::from(doc))
+            .map(|scene| (scene, renames))
+            .map_err(|e| scene_error(origin, toml_message(s, &e, None)));
+    }
+    let edited = edits.apply(s);
+    match toml::from_str(&edited) {
+        Ok(scene) => Ok((scene, renames)),
+        Err(e) => Err(scene_error(
+            origin,
+            renames.respell(toml_message(s, &e, Some(&edits))),
+        )),
+    }
+}
+
+/// A JSON scene, with engineering-unit fields converted. Without such fields it is read
+/// straight from the text, so the parser's errors keep their line and column.
+fn read_json(s: &str, origin: &str) -> Result<(Scene, Renames)> {
+    let mut value: serde_json::Value =
+        serde_json::from_str(s).map_err(|e| scene_error(origin, e.to_string()))?;
+    let mut renames = Renames::default();
+    if let serde_json::Value::Object(o) = &mut value {
+        json_doc::convert_object(o, "", &mut renames)?;
+    }
+    let scene = if renames.is_empty() {
+        serde_json::from_str::<Scene>(s)
+    } else {
+        serde_json::from_value::<Scene>(value)
+    };
+    match scene {
+        Ok(scene) => Ok((scene, renames)),
+        Err(e) => Err(scene_error(origin, renames.respell(e.to_string()))),
+    }
+}
+
+/// The TOML parser's message on one line, prefixed by its line and column in `s`. With `edits`,
+/// the error is in the edited text and its position is mapped back to `s`.
+fn toml_message(s: &str, e: &toml::de::Error, edits: Option<&toml_doc::Edits>) -> String {
+    let msg = e.message().trim().replace('\n', "; ");
+    match e.span() {
+        Some(span) => {
+            let start = edits.map_or(span.start, |ed| ed.original_offset(span.start));
+            let before = s.get(..start).unwrap_or(s);
+            let line = before.matches('\n').count() + 1;
+            let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            match field_at(s, start) {
+                Some(field) => format!("line {line}, column {col}, {field}: {msg}"),
+                None => format!("line {line}, column {col}: {msg}"),
             }
-            None => msg,
         }
-    })
+        None => msg,
+    }
 }
 
 /// The dotted field of the `key = value` line holding byte `at`: the last `[table]` header above

@@ -1,7 +1,8 @@
 //! Scenes: a serde description of a whole head–disk interface (surfaces, enabled terms, air
 //! bearing, heater, voltages, detector, solver settings), read from TOML or JSON and validated.
 //!
-//! Every dimensional field is SI with its unit in its name. A scene builds only what it enables:
+//! Every dimensional field is SI with its unit in its name (files may use engineering units, see
+//! [below](#engineering-units)). A scene builds only what it enables:
 //! a missing `intermolecular`, `electrostatic` or `contact` section switches that term off.
 //!
 //! ```
@@ -17,8 +18,46 @@
 //! assert!(err.contains("surface.height_sigma_m"), "{err}");
 //! # Ok(()) }
 //! ```
+//!
+//! # Engineering units
+//!
+//! A scene file may give any dimensional field in an engineering unit instead, with that unit in
+//! its name: the reader replaces the suffix and scales the value (numbers and lists of numbers)
+//! before anything else sees it, so the scene in memory, and every file it writes, is SI.
+//!
+//! | SI suffix | may be given as |
+//! |---|---|
+//! | `_m` | `_nm`, `_um` (µm), `_mm` |
+//! | `_m2` | `_um2`, `_mm2` |
+//! | `_per_m2` | `_per_um2` |
+//! | `_s` | `_ms`, `_us` (µs), `_ns` |
+//! | `_w` | `_mw` |
+//! | `_hz` | `_khz`, `_mhz` |
+//! | `_pa` | `_gpa` |
+//! | `_n` | `_un` (µN) |
+//! | `_m_per_w` | `_nm_per_mw` |
+//! | `_w_per_s` | `_mw_per_s`, `_mw_per_ms` |
+//! | `heater.programme` (s, W) | `heater.programme_ms_mw` (ms, mW) |
+//!
+//! A field given in both forms, or an engineering-unit field that is not a number, is refused by
+//! name; a validation error on a converted field names both spellings.
+//!
+//! ```
+//! use hdi_tribology::scene::Scene;
+//! # fn main() -> hdi_tribology::Result<()> {
+//! let text = Scene::paper()
+//!     .to_toml_string()?
+//!     .replace("height_sigma_m = 0.0000000007", "height_sigma_nm = 0.5");
+//! let s = Scene::from_toml_str(&text)?;
+//! assert!((s.surface.height_sigma_m - 0.5e-9).abs() < 1e-24);
+//! let bad = text.replace("height_sigma_nm = 0.5", "height_sigma_nm = -0.5");
+//! let err = Scene::from_toml_str(&bad).unwrap_err().to_string();
+//! assert!(err.contains("surface.height_sigma_m (given as surface.height_sigma_nm)"), "{err}");
+//! # Ok(()) }
+//! ```
 
 mod build;
+mod eng_units;
 mod io;
 mod paper;
 mod spec;

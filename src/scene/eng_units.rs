@@ -1,0 +1,375 @@
+//! Engineering units in scene files: a field may be given in nm, mW, kHz, GPa, … instead of SI,
+//! with the unit in its name (`height_sigma_nm = 0.5` for `height_sigma_m = 0.5e-9`). The keys
+//! are renamed to their SI form, and the values scaled, before the scene is deserialised.
+
+use std::collections::BTreeMap;
+
+use crate::{Error, Result};
+
+/// Engineering suffix, SI suffix, factor to SI, and the unit's name. Longest suffixes first, so
+/// `_per_um2` is not read as `_um2`, nor `_nm_per_mw` as `_mw`.
+const SUFFIXES: &[(&str, &str, f64, &str)] = &[
+    ("_nm_per_mw", "_m_per_w", 1e-6, "nm/mW"),
+    ("_mw_per_ms", "_w_per_s", 1.0, "mW/ms"),
+    ("_mw_per_s", "_w_per_s", 1e-3, "mW/s"),
+    ("_per_um2", "_per_m2", 1e12, "µm⁻²"),
+    ("_um2", "_m2", 1e-12, "µm²"),
+    ("_mm2", "_m2", 1e-6, "mm²"),
+    ("_nm", "_m", 1e-9, "nm"),
+    ("_um", "_m", 1e-6, "µm"),
+    ("_mm", "_m", 1e-3, "mm"),
+    ("_mw", "_w", 1e-3, "mW"),
+    ("_khz", "_hz", 1e3, "kHz"),
+    ("_mhz", "_hz", 1e6, "MHz"),
+    ("_gpa", "_pa", 1e9, "GPa"),
+    ("_ms", "_s", 1e-3, "ms"),
+    ("_us", "_s", 1e-6, "µs"),
+    ("_ns", "_s", 1e-9, "ns"),
+    ("_un", "_n", 1e-6, "µN"),
+];
+
+/// The heater programme in (ms, mW) pairs: renamed to `programme`, in (s, W).
+const PROGRAMME: (&str, &str, [f64; 2], &str) =
+    ("programme_ms_mw", "programme", [1e-3, 1e-3], "ms, mW");
+
+/// How to convert one key: its SI name, and the factor for each column of the value.
+struct Rule {
+    si_key: String,
+    factors: Factors,
+    unit: &'static str,
+}
+
+enum Factors {
+    /// A number, or a list of numbers: every one scaled alike.
+    All(f64),
+    /// A list of pairs, each column scaled by its own factor.
+    Pairs([f64; 2]),
+}
+
+fn rule(key: &str) -> Option<Rule> {
+    if key == PROGRAMME.0 {
+        return Some(Rule {
+            si_key: PROGRAMME.1.to_string(),
+            factors: Factors::Pairs(PROGRAMME.2),
+            unit: PROGRAMME.3,
+        });
+    }
+    SUFFIXES.iter().find_map(|&(eng, si, f, unit)| {
+        let stem = key.strip_suffix(eng)?;
+        (!stem.is_empty()).then(|| Rule {
+            si_key: format!("{stem}{si}"),
+            factors: Factors::All(f),
+            unit,
+        })
+    })
+}
+
+/// The renames made, as dotted paths: SI field → the field as the file gave it.
+#[derive(Debug, Default)]
+pub(super) struct Renames(BTreeMap<String, String>);
+
+impl Renames {
+    fn insert(&mut self, prefix: &str, si_key: &str, eng_key: &str) {
+        self.0.insert(path(prefix, si_key), path(prefix, eng_key));
+    }
+
+    pub(super) fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// A deserialiser's "unknown field" message names the key as the file spelt it.
+    pub(super) fn respell(&self, msg: String) -> String {
+        let last = |p: &str| p.rsplit('.').next().unwrap_or(p).to_string();
+        self.0.iter().fold(msg, |m, (si, eng)| {
+            m.replace(
+                &format!("unknown field `{}`", last(si)),
+                &format!("unknown field `{}`", last(eng)),
+            )
+        })
+    }
+
+    /// A validation error on a renamed field also names the field as the file gave it (the
+    /// reason is in SI units, as the field it names).
+    pub(super) fn annotate(&self, e: Error) -> Error {
+        match e {
+            Error::InvalidInput { field, reason } => {
+                let given = self.0.iter().find(|(si, _)| {
+                    field == **si
+                        || field
+                            .strip_prefix(si.as_str())
+                            .is_some_and(|rest| rest.starts_with(['[', '.']))
+                });
+                match given {
+                    Some((_, eng)) => Error::InvalidInput {
+                        field: format!("{field} (given as {eng})"),
+                        reason,
+                    },
+                    None => Error::InvalidInput { field, reason },
+                }
+            }
+            other => other,
+        }
+    }
+}
+
+fn path(prefix: &str, key: &str) -> String {
+    if prefix.is_empty() {
+        key.to_string()
+    } else {
+        format!("{prefix}.{key}")
+    }
+}
+
+/// Scales `x` (from the file, in the engineering unit) to SI, refusing overflow.
+fn scale(x: f64, f: f64, field: &str, unit: &str) -> Result<f64> {
+    let y = x * f;
+    if x.is_finite() && !y.is_finite() {
+        return Err(Error::invalid(
+            field,
+            format!("{x} {unit} overflows in SI units"),
+        ));
+    }
+    Ok(y)
+}
+
+fn not_number(field: &str, unit: &str, what: &str) -> Error {
+    Error::invalid(field, format!("must be {what} in {unit}"))
+}
+
+fn both(field_eng: &str, si_key: &str) -> Error {
+    Error::invalid(
+        field_eng,
+        format!("give the field in one unit only, not together with `{si_key}`"),
+    )
+}
+
+/// TOML: the engineering-unit keys of a parsed document, and their values, as text edits of the
+/// file, so the edited file is parsed as usual and the parser's errors can be mapped back to the
+/// file as written.
+pub(super) mod toml_doc {
+    use std::ops::Range;
+
+    use toml::de::{DeTable, DeValue};
+    use toml::Spanned;
+
+    use super::*;
+
+    /// Replacements of byte ranges of the original text, in no particular order.
+    #[derive(Default)]
+    pub(in crate::scene) struct Edits(Vec<(Range<usize>, String)>);
+
+    impl Edits {
+        /// The text with the edits applied, and the edits sorted for [`Edits::original_offset`].
+        pub(in crate::scene) fn apply(&mut self, s: &str) -> String {
+            self.0.sort_by_key(|(r, _)| r.start);
+            let mut out = String::with_capacity(s.len());
+            let mut at = 0;
+            for (r, text) in &self.0 {
+                out.push_str(s.get(at..r.start).unwrap_or(""));
+                out.push_str(text);
+                at = r.end;
+            }
+            out.push_str(s.get(at..).unwrap_or(""));
+            out
+        }
+
+        /// The offset in the original text of offset `p` in the edited text (the start of an
+        /// edit for an offset inside it).
+        pub(in crate::scene) fn original_offset(&self, p: usize) -> usize {
+            let mut shift = 0_isize; // edited − original, before the current edit
+            for (r, text) in &self.0 {
+                let start = (r.start as isize + shift) as usize;
+                if p < start {
+                    break;
+                }
+                if p < start + text.len() {
+                    return r.start;
+                }
+                shift += text.len() as isize - r.len() as isize;
+            }
+            (p as isize - shift).max(0) as usize
+        }
+
+        pub(in crate::scene) fn is_empty(&self) -> bool {
+            self.0.is_empty()
+        }
+    }
+
+    fn number(v: &DeValue<'_>) -> Option<f64> {
+        match v {
+            DeValue::Float(x) => match x.as_str() {
+                "nan" | "+nan" | "-nan" => Some(f64::NAN),
+                t => t.replace('_', "").parse().ok(),
+            },
+            DeValue::Integer(i) => i64::from_str_radix(&i.as_str().replace('_', ""), i.radix())
+                .ok()
+                .map(|i| i as f64),
+            _ => None,
+        }
+    }
+
+    /// `x` as a TOML float that reads back exactly.
+    fn float_text(x: f64) -> String {
+        if x.is_nan() {
+            "nan".into()
+        } else if x.is_infinite() {
+            if x > 0.0 { "inf" } else { "-inf" }.into()
+        } else {
+            format!("{x:?}")
+        }
+    }
+
+    fn convert(
+        v: &Spanned<DeValue<'_>>,
+        factors: &Factors,
+        field: &str,
+        unit: &str,
+        edits: &mut Edits,
+    ) -> Result<()> {
+        match (v.get_ref(), factors) {
+            (DeValue::Array(items), _) => {
+                for (i, item) in items.iter().enumerate() {
+                    let field = format!("{field}[{i}]");
+                    match factors {
+                        Factors::All(f) => convert(item, &Factors::All(*f), &field, unit, edits)?,
+                        Factors::Pairs(p) => match item.get_ref() {
+                            DeValue::Array(pair) if pair.len() == 2 => {
+                                for (c, f) in pair.iter().zip(p) {
+                                    convert(c, &Factors::All(*f), &field, unit, edits)?;
+                                }
+                            }
+                            _ => return Err(not_number(&field, unit, "a pair of numbers")),
+                        },
+                    }
+                }
+            }
+            (x, Factors::All(f)) => {
+                let x = number(x).ok_or_else(|| not_number(field, unit, "a number"))?;
+                edits
+                    .0
+                    .push((v.span(), float_text(scale(x, *f, field, unit)?)));
+            }
+            (_, Factors::Pairs(_)) => {
+                return Err(not_number(field, unit, "a list of pairs of numbers"))
+            }
+        }
+        Ok(())
+    }
+
+    /// The edits that rename and convert the engineering-unit keys of `table` and of the tables
+    /// inside it.
+    pub(in crate::scene) fn convert_table(
+        table: &DeTable<'_>,
+        prefix: &str,
+        renames: &mut Renames,
+        edits: &mut Edits,
+    ) -> Result<()> {
+        for (k, v) in table.iter() {
+            let key = k.get_ref().as_ref();
+            let field = path(prefix, key);
+            match rule(key) {
+                Some(r) => {
+                    if table.contains_key(r.si_key.as_str()) {
+                        return Err(both(&field, &r.si_key));
+                    }
+                    convert(v, &r.factors, &field, r.unit, edits)?;
+                    edits.0.push((k.span(), r.si_key.clone()));
+                    renames.insert(prefix, &r.si_key, key);
+                }
+                None => {
+                    if let DeValue::Table(t) = v.get_ref() {
+                        convert_table(t, &field, renames, edits)?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// JSON: the same renaming on a parsed value.
+pub(super) mod json_doc {
+    use serde_json::{Map, Number, Value};
+
+    use super::*;
+
+    fn convert(v: &mut Value, factors: &Factors, field: &str, unit: &str) -> Result<()> {
+        match (v, factors) {
+            (Value::Array(items), _) => {
+                for (i, item) in items.iter_mut().enumerate() {
+                    let field = format!("{field}[{i}]");
+                    match factors {
+                        Factors::All(f) => convert(item, &Factors::All(*f), &field, unit)?,
+                        Factors::Pairs(p) => match item {
+                            Value::Array(pair) if pair.len() == 2 => {
+                                for (c, f) in pair.iter_mut().zip(p) {
+                                    convert(c, &Factors::All(*f), &field, unit)?;
+                                }
+                            }
+                            _ => return Err(not_number(&field, unit, "a pair of numbers")),
+                        },
+                    }
+                }
+                Ok(())
+            }
+            (x, Factors::All(f)) => {
+                let n = x
+                    .as_f64()
+                    .ok_or_else(|| not_number(field, unit, "a number"))?;
+                let y = scale(n, *f, field, unit)?;
+                *x = Number::from_f64(y).map_or(Value::Null, Value::Number);
+                Ok(())
+            }
+            (_, Factors::Pairs(_)) => Err(not_number(field, unit, "a list of pairs of numbers")),
+        }
+    }
+
+    /// Renames and converts the engineering-unit keys of `obj` and of the objects inside it.
+    pub(in crate::scene) fn convert_object(
+        obj: &mut Map<String, Value>,
+        prefix: &str,
+        renames: &mut Renames,
+    ) -> Result<()> {
+        let keys: Vec<String> = obj.keys().cloned().collect();
+        for key in keys {
+            let field = path(prefix, &key);
+            match rule(&key) {
+                Some(r) => {
+                    if obj.contains_key(&r.si_key) {
+                        return Err(both(&field, &r.si_key));
+                    }
+                    let Some(mut v) = obj.remove(&key) else {
+                        continue;
+                    };
+                    convert(&mut v, &r.factors, &field, r.unit)?;
+                    renames.insert(prefix, &r.si_key, &key);
+                    obj.insert(r.si_key, v);
+                }
+                None => {
+                    if let Some(Value::Object(o)) = obj.get_mut(&key) {
+                        convert_object(o, &field, renames)?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn longest_suffix_wins() {
+        let r = rule("asperity_density_per_um2").unwrap();
+        assert_eq!(r.si_key, "asperity_density_per_m2");
+        let r = rule("efficiency_nm_per_mw").unwrap();
+        assert_eq!(r.si_key, "efficiency_m_per_w");
+        let r = rule("area_um2").unwrap();
+        assert_eq!(r.si_key, "area_m2");
+        assert!(rule("max_steps").is_none());
+        assert!(rule("nominal_clearance_m").is_none());
+        assert!(rule("_nm").is_none());
+    }
+}
