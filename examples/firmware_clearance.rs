@@ -20,12 +20,13 @@ use hdi_tribology::clearance::{
 };
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::scene::Scene;
+use hdi_tribology::units::{mw, to_mw};
 use std::time::Instant;
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
-const STEP: f64 = 0.5e-3; // heater increment (W): 0.05 nm of protrusion at 0.1 nm/mW
-const MARGIN: f64 = 15e-3; // back-off (W): 1.5 nm of clearance at 0.1 nm/mW
+const STEP_MW: f64 = 0.5; // heater increment: 0.05 nm of protrusion at 0.1 nm/mW
+const MARGIN_MW: f64 = 15.0; // back-off: 1.5 nm of clearance at 0.1 nm/mW
 const DITHER_V: f64 = 0.5; // AC dither amplitude (V)
 const DITHER_HZ: f64 = 10.5e3; // dither frequency (Hz): the force acts at 21 kHz
 
@@ -39,8 +40,8 @@ fn main() -> Res<()> {
     ];
     println!(
         "step {:.2} mW, margin {:.1} mW, dither {DITHER_V} V at {:.1} kHz",
-        STEP * 1e3,
-        MARGIN * 1e3,
+        STEP_MW,
+        MARGIN_MW,
         DITHER_HZ * 1e-3
     );
     for zone in &zones {
@@ -61,7 +62,7 @@ fn main() -> Res<()> {
         let td_peak = touchdown_power(&peak, &StaticOptions::new(th))?;
         // What the static model says the margin leaves (dither off, as in operation).
         let dc2 = model.voltage.effective_dc().powi(2);
-        let set = stat.touchdown.power - MARGIN;
+        let set = stat.touchdown.power - mw(MARGIN_MW);
         let target = flying_equilibrium(&model, set, dc2, &ScanGrid::default())?.d;
         println!(
             "\n## zone {} (r = {:.0} mm, v = {:.1} m/s, h0 = {:.1} nm, k = {:.2e} N/m)",
@@ -87,8 +88,8 @@ fn main() -> Res<()> {
         );
         // The search starts where the nominal clearance minus the protrusion would leave 5 nm,
         // a power the drive knows from its characterisation, not from the model.
-        let start = (zone.nominal_clearance - 5e-9) / scene.heater.efficiency_m_per_w;
-        let opts = CalibrationOptions::new(start, STEP, start + 0.06, MARGIN);
+        let start_mw = to_mw((zone.nominal_clearance - 5e-9) / scene.heater.efficiency_m_per_w);
+        let opts = CalibrationOptions::from_mw(start_mw, STEP_MW, start_mw + 60.0, MARGIN_MW);
         println!(
             "{:<46} {:>9} {:>9} {:>9} {:>8} {:>9} {:>9} {:>9} {:>6}",
             "detector",

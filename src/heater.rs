@@ -127,6 +127,26 @@ impl Programme {
     }
 }
 
+impl Programme {
+    /// [`Programme::new`] from `(time in ms, power in mW)` knots, as a drive's heater table
+    /// is usually written.
+    ///
+    /// ```
+    /// use hdi_tribology::heater::Programme;
+    /// let p = Programme::from_ms_mw(&[(0.0, 60.0), (3.6, 78.0), (4.0, 78.0), (7.6, 60.0)])?;
+    /// assert!((p.power(1.8e-3) - 69e-3).abs() < 1e-15);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_ms_mw(knots_ms_mw: &[(f64, f64)]) -> Result<Self> {
+        Programme::new(
+            knots_ms_mw
+                .iter()
+                .map(|&(t, p)| (crate::units::ms(t), crate::units::mw(p)))
+                .collect(),
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

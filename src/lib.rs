@@ -46,8 +46,8 @@
 //! assert!(h.touchdown.power > h.takeoff.power);
 //! println!(
 //!     "touchdown {:.2} mW, take-off {:.2} mW, pull-in at 0 mW: {:.2} V",
-//!     h.touchdown.power * 1e3,
-//!     h.takeoff.power * 1e3,
+//!     h.touchdown.power_mw(),
+//!     h.takeoff.power_mw(),
 //!     pull_in_voltage(&model, 0.0, &opts)?.voltage
 //! );
 //! # Ok::<(), hdi_tribology::Error>(())

@@ -218,6 +218,13 @@ pub struct CycleResult {
     pub series: Option<TimeSeries>,
 }
 
+impl CycleResult {
+    /// The hysteresis `P_TD − P_TO` in milliwatts, when both were detected.
+    pub fn hysteresis_mw(&self) -> Option<f64> {
+        self.hysteresis.map(crate::units::to_mw)
+    }
+}
+
 /// Simulates one touchdown/take-off cycle.
 ///
 /// ```no_run

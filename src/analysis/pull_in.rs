@@ -147,6 +147,19 @@ pub struct ClearanceChange {
     pub clearance_change: f64,
 }
 
+impl ClearanceChange {
+    /// The clearance change `ΔFH` in nanometres.
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::pull_in::ClearanceChange;
+    /// let c = ClearanceChange { dc_voltage: 1.0, touchdown_power: 0.064, clearance_change: -1.0e-9 };
+    /// assert!((c.clearance_change_nm() + 1.0).abs() < 1e-12);
+    /// ```
+    pub fn clearance_change_nm(&self) -> f64 {
+        crate::units::to_nm(self.clearance_change)
+    }
+}
+
 /// Clearance change `ΔFH(V_dc) = η (P_TD(V_dc) − P_TD(φ))` at each DC voltage (paper Fig. 2b).
 ///
 /// ```no_run

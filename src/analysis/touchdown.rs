@@ -31,6 +31,21 @@ pub struct Transition {
     pub cause: Cause,
 }
 
+impl Transition {
+    /// The heater power in milliwatts.
+    ///
+    /// ```
+    /// # use hdi_tribology::analysis::{equilibrium::Equilibrium, touchdown::{Cause, Transition}};
+    /// # let at = Equilibrium { d: 0.0, y: 0.0, protrusion: 0.0, power: 0.0, stiffness: 0.0,
+    /// #     interface_force: 0.0, contact_force: 0.0 };
+    /// let t = Transition { power: 0.0743, at, cause: Cause::Fold };
+    /// assert!((t.power_mw() - 74.3).abs() < 1e-12);
+    /// ```
+    pub fn power_mw(&self) -> f64 {
+        crate::units::to_mw(self.power)
+    }
+}
+
 /// Options of the static touchdown/take-off analysis.
 ///
 /// ```
@@ -74,6 +89,13 @@ pub struct StaticHysteresis {
     pub takeoff: Transition,
     /// `P_TD − P_TO` (W).
     pub hysteresis: f64,
+}
+
+impl StaticHysteresis {
+    /// `P_TD − P_TO` in milliwatts.
+    pub fn hysteresis_mw(&self) -> f64 {
+        crate::units::to_mw(self.hysteresis)
+    }
 }
 
 /// Touchdown power at the model's DC voltage.

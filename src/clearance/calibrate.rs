@@ -128,6 +128,20 @@ impl CalibrationOptions {
         }
     }
 
+    /// [`CalibrationOptions::new`] with every power in milliwatts, as firmware tables hold
+    /// them.
+    ///
+    /// ```
+    /// use hdi_tribology::clearance::CalibrationOptions;
+    /// let o = CalibrationOptions::from_mw(60.0, 0.5, 90.0, 5.0);
+    /// use hdi_tribology::units::mw;
+    /// assert_eq!(o, CalibrationOptions::new(mw(60.0), mw(0.5), mw(90.0), mw(5.0)));
+    /// ```
+    pub fn from_mw(start_mw: f64, step_mw: f64, max_mw: f64, margin_mw: f64) -> Self {
+        use crate::units::mw;
+        CalibrationOptions::new(mw(start_mw), mw(step_mw), mw(max_mw), mw(margin_mw))
+    }
+
     fn validate(&self) -> Result<()> {
         self.staircase.validate()?;
         check_non_negative("margin", self.margin)?;
@@ -192,6 +206,11 @@ pub struct Calibration {
 }
 
 impl Calibration {
+    /// The clearance set, in nanometres.
+    pub fn clearance_nm(&self) -> f64 {
+        crate::units::to_nm(self.clearance)
+    }
+
     /// `touchdown_power − takeoff_power` (W), when the take-off was found.
     pub fn hysteresis(&self) -> Option<f64> {
         self.takeoff_power.map(|p| self.touchdown_power - p)

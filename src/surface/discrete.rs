@@ -193,3 +193,17 @@ impl PeakDistribution for Discrete {
         Some(&self.heights)
     }
 }
+
+impl Discrete {
+    /// [`Discrete::from_heights`] with the heights in nanometres.
+    ///
+    /// ```
+    /// use hdi_tribology::surface::Discrete;
+    /// let d = Discrete::from_heights_nm(&[0.5, -0.25, 1.0])?;
+    /// assert_eq!(d, Discrete::from_heights(vec![0.5e-9, -0.25e-9, 1e-9])?);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_heights_nm(heights_nm: &[f64]) -> Result<Self> {
+        Discrete::from_heights(heights_nm.iter().map(|&h| crate::units::nm(h)).collect())
+    }
+}

@@ -274,3 +274,19 @@ impl PeakDistribution for Empirical {
         Some(self.edges[0])
     }
 }
+
+impl Empirical {
+    /// [`Empirical::from_sample`] with the measured peak heights in nanometres, as a profiler
+    /// exports them.
+    ///
+    /// ```
+    /// use hdi_tribology::surface::{Empirical, PeakDistribution};
+    /// let e = Empirical::from_sample_nm(&[0.1, 0.4, 0.5, 0.9, 1.3, 0.7, 0.2])?;
+    /// assert!((e.mean() - 0.55e-9).abs() < 0.2e-9);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_sample_nm(sample_nm: &[f64]) -> Result<Self> {
+        let sample: Vec<f64> = sample_nm.iter().map(|&h| crate::units::nm(h)).collect();
+        Empirical::from_sample(&sample)
+    }
+}

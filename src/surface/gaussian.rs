@@ -112,3 +112,17 @@ impl PeakDistribution for Gaussian {
         Some(self.mean + self.std * x)
     }
 }
+
+impl Gaussian {
+    /// [`Gaussian::new`] with the mean and standard deviation in nanometres.
+    ///
+    /// ```
+    /// use hdi_tribology::surface::{Gaussian, PeakDistribution};
+    /// let g = Gaussian::from_nm(0.5, 1.2)?;
+    /// assert_eq!(g, Gaussian::new(0.5e-9, 1.2e-9)?);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_nm(mean_nm: f64, std_nm: f64) -> Result<Self> {
+        Gaussian::new(crate::units::nm(mean_nm), crate::units::nm(std_nm))
+    }
+}

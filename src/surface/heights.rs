@@ -66,3 +66,16 @@ impl GaussianHeights {
         (-9.0 * self.sigma, 9.0 * self.sigma)
     }
 }
+
+impl GaussianHeights {
+    /// [`GaussianHeights::new`] with the standard deviation in nanometres.
+    ///
+    /// ```
+    /// use hdi_tribology::surface::GaussianHeights;
+    /// assert_eq!(GaussianHeights::from_nm(0.5)?, GaussianHeights::new(0.5e-9)?);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_nm(sigma_nm: f64) -> Result<Self> {
+        GaussianHeights::new(crate::units::nm(sigma_nm))
+    }
+}

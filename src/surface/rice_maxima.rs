@@ -140,3 +140,16 @@ impl PeakDistribution for RiceMaxima {
         self.sigma * var.max(0.0).sqrt()
     }
 }
+
+impl RiceMaxima {
+    /// [`RiceMaxima::new`] with the surface's standard deviation in nanometres.
+    ///
+    /// ```
+    /// use hdi_tribology::surface::RiceMaxima;
+    /// assert_eq!(RiceMaxima::from_nm(0.7, 0.7)?, RiceMaxima::new(0.7e-9, 0.7)?);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_nm(sigma_nm: f64, epsilon: f64) -> Result<Self> {
+        RiceMaxima::new(crate::units::nm(sigma_nm), epsilon)
+    }
+}

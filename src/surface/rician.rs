@@ -112,3 +112,16 @@ impl PeakDistribution for Rician {
         (second - m * m).max(0.0).sqrt()
     }
 }
+
+impl Rician {
+    /// [`Rician::new`] with `ν` and `s` in nanometres.
+    ///
+    /// ```
+    /// use hdi_tribology::surface::Rician;
+    /// assert_eq!(Rician::from_nm(2.0, 1.0)?, Rician::new(2e-9, 1e-9)?);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_nm(nu_nm: f64, s_nm: f64) -> Result<Self> {
+        Rician::new(crate::units::nm(nu_nm), crate::units::nm(s_nm))
+    }
+}
