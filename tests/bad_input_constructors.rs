@@ -63,7 +63,10 @@ fn peak_laws_and_heights_name_their_fields() {
         assert_eq!(field(GaussianHeights::from_nm(x)), "surface.sigma");
     }
     assert_eq!(field(Discrete::from_heights_nm(&[])), "peaks.heights");
-    assert_eq!(field(Empirical::from_sample_nm(&[1.0, f64::NAN])), "peaks.sample");
+    assert_eq!(
+        field(Empirical::from_sample_nm(&[1.0, f64::NAN])),
+        "peaks.sample"
+    );
     assert_eq!(field(Gaussian::new(f64::NAN, 1e-9)), "peaks.mean");
     assert_eq!(field(Gaussian::new(0.0, 0.0)), "peaks.std");
     for eps in [0.0, -0.1, 1.0 + 1e-12, f64::NAN] {
@@ -278,7 +281,10 @@ fn air_bearings_name_their_fields() {
 #[test]
 fn heater_programmes_reject_empty_unordered_and_non_finite_knots() {
     assert_eq!(field(Programme::new(vec![])), "heater.programme");
-    assert_eq!(field(Programme::from_ms_mw(&[(0.0, 60.0)])), "heater.programme");
+    assert_eq!(
+        field(Programme::from_ms_mw(&[(0.0, 60.0)])),
+        "heater.programme"
+    );
     assert_eq!(field(Programme::new(vec![(0.0, 0.06)])), "heater.programme");
     assert_eq!(
         field(Programme::new(vec![(0.0, 0.06), (0.0, 0.07)])),
