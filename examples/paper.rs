@@ -182,75 +182,76 @@ fn main() -> Res<()> {
     }
     .to_svg(&out.join("fig3b_zoom_spacing_0.6V.svg"), 1000, 400)?;
 
-    // Fig. 3(d) and Fig. 4: sweeps under both programmes.
+    // Fig. 3(d) and Fig. 4: sweeps under both programmes. Where the AC makes contact
+    // intermittent, the running mean hovers near F_th and the detected powers depend on the
+    // tolerance: each amplitude is rerun with a tenfold tighter tolerance until touchdown and
+    // take-off move by less than 1 % of the static hysteresis.
+    let refine = Refinement::new(0.01 * stat.hysteresis);
     let sweep_clock = Instant::now();
-    let fixed_sweep = ac_sweep(&model, &fixed, &opts, &amplitudes)?;
+    let fixed_refined = ac_sweep_refined(&model, &fixed, &opts, &amplitudes, &refine)?;
     let fixed_wall = sweep_clock.elapsed().as_secs_f64();
-    let trig_sweep = ac_sweep(&model, &triggered, &opts, &amplitudes)?;
-    // The same sweep with a tenfold tighter tolerance: where the detected hysteresis moves, it is
-    // ill-conditioned (intermittent contact, the running mean hovering near the threshold).
-    let mut tight = opts;
-    tight.solver.rtol *= 0.1;
-    tight.solver.atol_displacement *= 0.1;
-    let tight_sweep = ac_sweep(&model, &fixed, &tight, &amplitudes)?;
-    let ill = |a: &CycleResult, b: &CycleResult| match (a.hysteresis, b.hysteresis) {
-        (Some(x), Some(y)) => (x - y).abs() > 0.01 * stat.hysteresis,
-        _ => true,
-    };
+    let trig_refined = ac_sweep_refined(&model, &triggered, &opts, &amplitudes, &refine)?;
     println!(
-        "\n# Fig. 3(d) / Fig. 4: cycles against AC amplitude (f = {} kHz, rtol = {:e}, {})",
+        "\n# Fig. 3(d) / Fig. 4: cycles against AC amplitude (f = {} kHz, {}, rtol from {:e})",
         scene.voltage.ac_frequency_hz / 1e3,
+        opts.solver.method,
         opts.solver.rtol,
-        opts.solver.method
     );
     println!("detection lags the running mean's window T_w = {:.1} µs: dynamic hysteresis is biased up by ≈ ramp × T_w", scene.detector.window_s * 1e6);
     println!(
-        "{:>6} | {:>9} {:>9} {:>9} {:>11} {:>9} {:>7} | {:>9} {:>9} {:>9} {:>7}",
+        "{:>6} | {:>9} {:>9} {:>9} {:>7} {:>9} {:>7} | {:>9} {:>9} {:>7} {:>9} {:>7}",
         "V_ac",
         "P_TD",
         "P_TO",
         "ΔP",
-        "ΔP rtol/10",
+        "rtol",
         "mean ΔT",
         "steps",
         "P_TD trig",
         "ΔP trig",
+        "rtol",
         "ΔT trig",
         "ms"
     );
-    for ((f, t), g) in fixed_sweep.iter().zip(&trig_sweep).zip(&tight_sweep) {
+    let rtol = |r: &RefinedCycle| format!("{:.0e}{}", r.rtol, if r.converged { " " } else { "?" });
+    for (fr, tr) in fixed_refined.iter().zip(&trig_refined) {
+        let (f, t) = (&fr.cycle, &tr.cycle);
         println!(
-            "{:>6.2} | {:>9} {:>9} {:>9} {:>10}{} {:>9.3} {:>7} | {:>9} {:>9} {:>9.3} {:>7.1}",
+            "{:>6.2} | {:>9} {:>9} {:>9} {:>7} {:>9.3} {:>7} | {:>9} {:>9} {:>7} {:>9.3} {:>7.1}",
             f.v_ac,
             opt_mw(f.touchdown.map(|d| d.power)),
             opt_mw(f.takeoff.map(|d| d.power)),
             opt_mw(f.hysteresis),
-            opt_mw(g.hysteresis),
-            if ill(f, g) { "*" } else { " " },
+            rtol(fr),
             f.mean_temperature_rise,
-            f.stats.accepted,
+            fr.stats.accepted,
             opt_mw(t.touchdown.map(|d| d.power)),
             opt_mw(t.hysteresis),
+            rtol(tr),
             t.mean_temperature_rise,
-            1e3 * (f.wall_seconds + t.wall_seconds),
+            1e3 * (fr.wall_seconds + tr.wall_seconds),
         );
     }
     println!(
-        "* ΔP moves by more than 1 % of the static hysteresis when the tolerance is tightened \
-         tenfold: ill-conditioned there (intermittent contact, the running mean near F_th)"
+        "rtol: the tolerance at which touchdown and take-off moved by less than {:.3} mW from the \
+         run before (\"?\": still moving at the last of {} runs: intermittent contact, the running \
+         mean near F_th); steps and ms over all runs",
+        mw(refine.power_tol),
+        refine.max_runs
     );
     println!(
-        "fixed-programme sweep of {} amplitudes: {:.1} ms wall",
+        "fixed-programme refined sweep of {} amplitudes: {:.1} ms wall",
         amplitudes.len(),
         1e3 * fixed_wall
     );
     println!("(powers in mW, ΔT in K)");
-    sweep_csv(&out.join("fig3d_hysteresis_vs_ac_fixed.csv"), &fixed_sweep)?;
+    let cycles = |s: &[RefinedCycle]| s.iter().map(|r| r.cycle.clone()).collect::<Vec<_>>();
+    let (fixed_sweep, trig_sweep) = (cycles(&fixed_refined), cycles(&trig_refined));
     sweep_csv(
-        &out.join("fig3d_hysteresis_vs_ac_fixed_tight.csv"),
-        &tight_sweep,
+        &out.join("fig3d_hysteresis_vs_ac_fixed.csv"),
+        &fixed_refined,
     )?;
-    sweep_csv(&out.join("fig4_triggered_sweep.csv"), &trig_sweep)?;
+    sweep_csv(&out.join("fig4_triggered_sweep.csv"), &trig_refined)?;
     let hyst = |s: &[CycleResult]| -> Vec<(f64, f64)> {
         s.iter()
             .filter_map(|r| r.hysteresis.map(|h| (r.v_ac, mw(h))))
@@ -269,11 +270,6 @@ fn main() -> Res<()> {
             Series {
                 label: "touchdown-triggered",
                 points: hyst(&trig_sweep),
-                markers: true,
-            },
-            Series {
-                label: "fixed programme, rtol/10",
-                points: hyst(&tight_sweep),
                 markers: true,
             },
             Series {
@@ -459,8 +455,8 @@ fn forces_chart<'a>(title: &'a str, s: &TimeSeries, t0: f64, t1: f64) -> Chart<'
     }
 }
 
-fn sweep_csv(path: &Path, rs: &[CycleResult]) -> Res<()> {
-    let col = |f: &dyn Fn(&CycleResult) -> f64| rs.iter().map(f).collect::<Vec<f64>>();
+fn sweep_csv(path: &Path, rs: &[RefinedCycle]) -> Res<()> {
+    let col = |f: &dyn Fn(&RefinedCycle) -> f64| rs.iter().map(f).collect::<Vec<f64>>();
     write_csv(
         path,
         &[
@@ -469,15 +465,23 @@ fn sweep_csv(path: &Path, rs: &[CycleResult]) -> Res<()> {
             "takeoff_power_w",
             "hysteresis_w",
             "mean_temperature_rise_k",
+            "rtol",
+            "power_change_w",
+            "converged",
+            "runs",
             "steps",
             "wall_seconds",
         ],
         &[
-            &col(&|r| r.v_ac),
-            &col(&|r| r.touchdown.map_or(f64::NAN, |d| d.power)),
-            &col(&|r| r.takeoff.map_or(f64::NAN, |d| d.power)),
-            &col(&|r| r.hysteresis.unwrap_or(f64::NAN)),
-            &col(&|r| r.mean_temperature_rise),
+            &col(&|r| r.cycle.v_ac),
+            &col(&|r| r.cycle.touchdown.map_or(f64::NAN, |d| d.power)),
+            &col(&|r| r.cycle.takeoff.map_or(f64::NAN, |d| d.power)),
+            &col(&|r| r.cycle.hysteresis.unwrap_or(f64::NAN)),
+            &col(&|r| r.cycle.mean_temperature_rise),
+            &col(&|r| r.rtol),
+            &col(&|r| r.change),
+            &col(&|r| f64::from(u8::from(r.converged))),
+            &col(&|r| r.runs as f64),
             &col(&|r| r.stats.accepted as f64),
             &col(&|r| r.wall_seconds),
         ],

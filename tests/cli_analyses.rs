@@ -89,6 +89,17 @@ fn cycle_and_sweep_report_every_key_and_the_csv() {
     assert_eq!(rows[0]["v_ac"].as_f64(), Some(0.0));
     assert_eq!(rows[1]["v_ac"].as_f64(), Some(0.6));
     assert!(rows[0]["hysteresis"].as_f64().unwrap() > rows[1]["hysteresis"].as_f64().unwrap());
+
+    // --refine: the 0.7 V amplitude needs a tighter tolerance than the scene's to settle.
+    let rows = json(&["sweep", "--paper", "--v-ac", "0,0.7", "--refine", "6e-5"]);
+    let rows = rows.as_array().unwrap();
+    for r in rows {
+        let change = r["power_change"].as_f64().unwrap();
+        assert_eq!(r["converged"].as_bool(), Some(change <= 6e-5), "{r}");
+        assert!((2..=4).contains(&r["runs"].as_u64().unwrap()), "{r}");
+    }
+    assert_eq!(rows[0]["rtol"].as_f64(), Some(1e-7));
+    assert!(rows[1]["rtol"].as_f64().unwrap() < 1e-7, "{}", rows[1]);
 }
 
 #[test]
@@ -98,6 +109,7 @@ fn bad_arguments_give_one_line_and_a_non_zero_exit() {
         vec!["sweep", "--paper", "--v-ac", "0,x"],
         vec!["static"],
         vec!["cycle", "--paper", "--rtol", "nan"],
+        vec!["sweep", "--paper", "--v-ac", "0", "--refine", "0"],
         vec!["static", "no-such-scene.toml"],
     ] {
         let out = hdi(&args);

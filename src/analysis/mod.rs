@@ -16,7 +16,7 @@ pub use cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme, Time
 pub use equilibrium::{flying_equilibrium, s_curve, Equilibrium, Fold, SCurve, ScanGrid};
 pub use pull_in::{clearance_change, pull_in_voltage, ClearanceChange, PullIn};
 pub use response::{linear_response, LinearResponse};
-pub use sweep::ac_sweep;
+pub use sweep::{ac_sweep, ac_sweep_refined, RefinedCycle, Refinement};
 pub use touchdown::{
     static_hysteresis, takeoff_power, touchdown_power, Cause, StaticHysteresis, StaticOptions,
     Transition,

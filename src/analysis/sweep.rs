@@ -2,10 +2,19 @@
 //!
 //! Each cycle is independent and deterministic, and results are returned in the order of the
 //! amplitudes, so the sweep gives the same numbers whatever the thread count.
+//!
+//! Where the AC drive makes contact intermittent, the running mean of the contact force hovers
+//! near its threshold and the detected touchdown and take-off become sensitive to the solver
+//! tolerance. [`ac_sweep_refined`] tightens the tolerance at each amplitude until the detected
+//! powers stop moving, and says where they did not.
+
+use serde::Serialize;
 
 use super::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
-use crate::error::{check_finite, Result};
+use crate::error::{check_finite, check_positive, Result};
 use crate::model::{SliderModel, Voltage};
+use crate::ode::Stats;
+use crate::Error;
 
 /// Runs `programme` once per AC amplitude (V), at the model's frequency and DC voltage.
 ///
@@ -29,15 +38,24 @@ pub fn ac_sweep(
     opts: &CycleOptions,
     amplitudes: &[f64],
 ) -> Result<Vec<CycleResult>> {
+    per_amplitude(model, amplitudes, |m| simulate_cycle(m, programme, opts))
+}
+
+/// `run` on the model at each AC amplitude, in parallel with the `parallel` feature, results in
+/// the order of the amplitudes.
+fn per_amplitude<T: Send>(
+    model: &SliderModel,
+    amplitudes: &[f64],
+    run: impl Fn(&SliderModel) -> Result<T> + Sync,
+) -> Result<Vec<T>> {
     for (i, &a) in amplitudes.iter().enumerate() {
         check_finite(&format!("amplitudes[{i}]"), a)?;
     }
     let one = |&v_ac: &f64| {
-        let m = model.with_voltage(Voltage {
+        run(&model.with_voltage(Voltage {
             ac_amplitude: v_ac,
             ..model.voltage
-        });
-        simulate_cycle(&m, programme, opts)
+        }))
     };
     #[cfg(feature = "parallel")]
     {
@@ -48,4 +66,138 @@ pub fn ac_sweep(
     {
         amplitudes.iter().map(one).collect()
     }
+}
+
+/// How [`ac_sweep_refined`] tightens the solver tolerance.
+///
+/// ```
+/// use hdi_tribology::analysis::sweep::Refinement;
+/// let r = Refinement::new(6e-5);
+/// assert_eq!((r.factor, r.max_runs), (0.1, 4));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Refinement {
+    /// Largest change of the detected touchdown and take-off powers between two successive
+    /// tolerances that counts as converged (W).
+    pub power_tol: f64,
+    /// Factor applied to the relative and absolute tolerances at each round, in (0, 1).
+    pub factor: f64,
+    /// Most cycles run per amplitude, the first included, 2 to 12.
+    pub max_runs: usize,
+}
+
+impl Refinement {
+    /// Converged when the powers move by at most `power_tol` (W) under a tenfold tighter
+    /// tolerance; at most four runs (the tolerance tightened down to a thousandth).
+    pub fn new(power_tol: f64) -> Self {
+        Refinement {
+            power_tol,
+            factor: 0.1,
+            max_runs: 4,
+        }
+    }
+
+    fn validate(&self) -> Result<()> {
+        check_positive("refinement.power_tol", self.power_tol)?;
+        if !(self.factor > 0.0 && self.factor < 1.0) {
+            return Err(Error::invalid(
+                "refinement.factor",
+                format!("must lie in (0, 1), got {}", self.factor),
+            ));
+        }
+        if !(2..=12).contains(&self.max_runs) {
+            return Err(Error::invalid(
+                "refinement.max_runs",
+                format!("must lie in 2..=12, got {}", self.max_runs),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One amplitude of [`ac_sweep_refined`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RefinedCycle {
+    /// The cycle at the tightest tolerance run.
+    pub cycle: CycleResult,
+    /// The relative tolerance of that cycle.
+    pub rtol: f64,
+    /// Largest change of the touchdown and take-off powers between the last two runs (W); ∞
+    /// when one of them was detected in one run and not in the other.
+    pub change: f64,
+    /// Whether `change ≤ power_tol`.
+    pub converged: bool,
+    /// Cycles run.
+    pub runs: usize,
+    /// Solver work over all the runs.
+    pub stats: Stats,
+    /// Wall time over all the runs (s).
+    pub wall_seconds: f64,
+}
+
+/// Largest change of the detected powers between two cycles (∞ if a detection comes or goes).
+fn power_change(a: &CycleResult, b: &CycleResult) -> f64 {
+    let one = |x: Option<f64>, y: Option<f64>| match (x, y) {
+        (Some(x), Some(y)) => (x - y).abs(),
+        (None, None) => 0.0,
+        _ => f64::INFINITY,
+    };
+    let p = |d: Option<super::cycle::Detection>| d.map(|d| d.power);
+    one(p(a.touchdown), p(b.touchdown)).max(one(p(a.takeoff), p(b.takeoff)))
+}
+
+/// [`ac_sweep`], with the tolerance at each amplitude tightened by `refine.factor` until the
+/// detected touchdown and take-off powers move by at most `refine.power_tol`, or
+/// `refine.max_runs` cycles have run. The cycle kept is the last (most accurate) one; the
+/// change from the one before is its error estimate, conservative.
+///
+/// ```no_run
+/// use hdi_tribology::analysis::sweep::{ac_sweep_refined, Refinement};
+/// use hdi_tribology::analysis::{CycleOptions, HeaterProgramme};
+/// use hdi_tribology::{model::SliderModel, scene::Scene};
+/// let scene = Scene::paper();
+/// let model = SliderModel::from_scene(&scene)?;
+/// let programme = HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+/// let opts = CycleOptions::from_scene(&scene)?;
+/// for r in ac_sweep_refined(&model, &programme, &opts, &[0.0, 0.7], &Refinement::new(6e-5))? {
+///     let mark = if r.converged { "" } else { " (not converged)" };
+///     println!("{} V: {:?} mW at rtol {:e}{mark}", r.cycle.v_ac, r.cycle.hysteresis_mw(), r.rtol);
+/// }
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn ac_sweep_refined(
+    model: &SliderModel,
+    programme: &HeaterProgramme,
+    opts: &CycleOptions,
+    amplitudes: &[f64],
+    refine: &Refinement,
+) -> Result<Vec<RefinedCycle>> {
+    refine.validate()?;
+    per_amplitude(model, amplitudes, |m| {
+        let mut o = *opts;
+        let mut last = simulate_cycle(m, programme, &o)?;
+        let (mut stats, mut wall) = (last.stats, last.wall_seconds);
+        let mut runs = 1;
+        loop {
+            o.solver.rtol *= refine.factor;
+            o.solver.atol_displacement *= refine.factor;
+            let next = simulate_cycle(m, programme, &o)?;
+            runs += 1;
+            stats += &next.stats;
+            wall += next.wall_seconds;
+            let change = power_change(&last, &next);
+            last = next;
+            if change <= refine.power_tol || runs >= refine.max_runs {
+                return Ok(RefinedCycle {
+                    cycle: last,
+                    rtol: o.solver.rtol,
+                    change,
+                    converged: change <= refine.power_tol,
+                    runs,
+                    stats,
+                    wall_seconds: wall,
+                });
+            }
+        }
+    })
 }

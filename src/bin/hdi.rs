@@ -9,8 +9,8 @@ use std::process::ExitCode;
 
 use hdi_tribology::analysis::cycle::CycleResult;
 use hdi_tribology::analysis::{
-    ac_sweep, pull_in_voltage, s_curve, simulate_cycle, static_hysteresis, CycleOptions,
-    HeaterProgramme, ScanGrid, StaticOptions,
+    ac_sweep, ac_sweep_refined, pull_in_voltage, s_curve, simulate_cycle, static_hysteresis,
+    CycleOptions, HeaterProgramme, Refinement, ScanGrid, StaticOptions,
 };
 use hdi_tribology::force::{Breakdown, Gaps};
 use hdi_tribology::model::{SliderModel, Voltage};
@@ -33,7 +33,11 @@ commands:
       protocol), JSON: v_ac, touchdown_power, takeoff_power, hysteresis, mean_temperature_rise,
       steps, wall_seconds. --csv writes the time series of spacing and forces.
   sweep (SCENE_FILE | --paper) [--v-ac V1,V2,...] [--triggered] [--method M] [--rtol R]
+        [--refine POWER_TOL_W]
       one cycle per AC amplitude (default: the scene's sweep list), JSON list of cycle objects.
+      --refine reruns each amplitude with a tenfold tighter tolerance (at most 4 runs) until
+      touchdown and take-off move by at most POWER_TOL_W, and adds rtol, power_change,
+      converged and runs to each object.
   scene (SCENE_FILE | --paper) [--json]
       the scene as TOML (or JSON), validated: a starting point for scenes of your own.
   help
@@ -368,7 +372,7 @@ fn cycle(args: &[String]) -> Result<(), CliError> {
 }
 
 fn sweep(args: &[String]) -> Result<(), CliError> {
-    let parsed = parse_args(args, &["v-ac", "method", "rtol"], &["triggered"])?;
+    let parsed = parse_args(args, &["v-ac", "method", "rtol", "refine"], &["triggered"])?;
     let scene = parsed.load_scene()?;
     let (model, programme, opts) = cycle_setup(&parsed, &scene)?;
     let amplitudes = match parsed.value("v-ac") {
@@ -380,11 +384,42 @@ fn sweep(args: &[String]) -> Result<(), CliError> {
             "no amplitudes: give --v-ac or a [sweep] list in the scene".into(),
         ));
     }
+    if let Some(tol) = parsed.value("refine") {
+        let refine = Refinement::new(parse_number("refine", tol)?);
+        let rows: Vec<RefinedReport> =
+            ac_sweep_refined(&model, &programme, &opts, &amplitudes, &refine)?
+                .iter()
+                .map(|r| RefinedReport {
+                    cycle: CycleReport {
+                        steps: r.stats.accepted,
+                        wall_seconds: r.wall_seconds,
+                        ..CycleReport::from(&r.cycle)
+                    },
+                    rtol: r.rtol,
+                    power_change: r.change,
+                    converged: r.converged,
+                    runs: r.runs,
+                })
+                .collect();
+        return print_json(&rows);
+    }
     let rows: Vec<CycleReport> = ac_sweep(&model, &programme, &opts, &amplitudes)?
         .iter()
         .map(CycleReport::from)
         .collect();
     print_json(&rows)
+}
+
+/// A row of `sweep --refine`: the last cycle (steps and wall time over all runs) and how the
+/// tolerance was refined.
+#[derive(Serialize)]
+struct RefinedReport {
+    #[serde(flatten)]
+    cycle: CycleReport,
+    rtol: f64,
+    power_change: f64,
+    converged: bool,
+    runs: usize,
 }
 
 fn scene(args: &[String]) -> Result<(), CliError> {

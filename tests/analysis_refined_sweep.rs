@@ -1,0 +1,103 @@
+//! The refined AC sweep: where it says converged, its hysteresis agrees with a reference run at
+//! a far tighter tolerance with another method; the refinement options are checked by field.
+
+use hdi_tribology::analysis::sweep::{ac_sweep_refined, Refinement};
+use hdi_tribology::analysis::{simulate_cycle, CycleOptions, HeaterProgramme};
+use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::ode::Method;
+use hdi_tribology::scene::Scene;
+use hdi_tribology::Error;
+
+fn paper() -> (SliderModel, HeaterProgramme, CycleOptions) {
+    let scene = Scene::paper();
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let knots = SliderModel::programme_from_knots(&scene.heater.programme).unwrap();
+    (
+        model,
+        HeaterProgramme::Fixed(knots),
+        CycleOptions::from_scene(&scene).unwrap(),
+    )
+}
+
+/// Touchdown and take-off powers of one cycle with Radau5 at rtol 1e-10.
+fn reference(
+    model: &SliderModel,
+    programme: &HeaterProgramme,
+    opts: &CycleOptions,
+    v_ac: f64,
+) -> (f64, f64) {
+    let m = model.with_voltage(Voltage {
+        ac_amplitude: v_ac,
+        ..model.voltage
+    });
+    let mut o = *opts;
+    o.solver.method = Method::Radau5;
+    o.solver.atol_displacement *= 1e-10 / o.solver.rtol;
+    o.solver.rtol = 1e-10;
+    let r = simulate_cycle(&m, programme, &o).unwrap();
+    (r.touchdown.unwrap().power, r.takeoff.unwrap().power)
+}
+
+#[test]
+fn converged_amplitudes_agree_with_a_tight_reference() {
+    let (model, programme, opts) = paper();
+    let refine = Refinement::new(2e-5);
+    let amplitudes = [0.0, 0.4, 0.7];
+    let sweep = ac_sweep_refined(&model, &programme, &opts, &amplitudes, &refine).unwrap();
+    let mut converged = 0;
+    for r in &sweep {
+        let (td, to) = reference(&model, &programme, &opts, r.cycle.v_ac);
+        let (rtd, rto) = (
+            r.cycle.touchdown.unwrap().power,
+            r.cycle.takeoff.unwrap().power,
+        );
+        println!(
+            "{} V: runs {} rtol {:e} change {:e} | TD {:e} (ref {:e}) TO {:e} (ref {:e})",
+            r.cycle.v_ac, r.runs, r.rtol, r.change, rtd, td, rto, to
+        );
+        assert!(r.runs >= 2 && r.runs <= refine.max_runs);
+        assert_eq!(r.converged, r.change <= refine.power_tol);
+        if r.converged {
+            converged += 1;
+            // The change between the last two runs bounds the error of the earlier one; the
+            // last one is the more accurate, so twice the tolerance is a safe bound.
+            assert!(
+                (rtd - td).abs() <= 2.0 * refine.power_tol,
+                "{} V: TD {rtd} vs {td}",
+                r.cycle.v_ac
+            );
+            assert!(
+                (rto - to).abs() <= 2.0 * refine.power_tol,
+                "{} V: TO {rto} vs {to}",
+                r.cycle.v_ac
+            );
+        }
+    }
+    // 0 V and 0.4 V converge at the first tightening (measured: change < 1e-6 W).
+    assert!(converged >= 2, "{converged} of {} converged", sweep.len());
+}
+
+#[test]
+fn refinement_options_are_checked_by_field() {
+    let (model, programme, opts) = paper();
+    let field = |r: Refinement| match ac_sweep_refined(&model, &programme, &opts, &[0.0], &r) {
+        Err(Error::InvalidInput { field, .. }) => field,
+        other => panic!("expected an input error, got {other:?}"),
+    };
+    let ok = Refinement::new(1e-5);
+    for tol in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert_eq!(
+            field(Refinement {
+                power_tol: tol,
+                ..ok
+            }),
+            "refinement.power_tol"
+        );
+    }
+    for factor in [0.0, 1.0, 2.0, f64::NAN] {
+        assert_eq!(field(Refinement { factor, ..ok }), "refinement.factor");
+    }
+    for max_runs in [0, 1, 13] {
+        assert_eq!(field(Refinement { max_runs, ..ok }), "refinement.max_runs");
+    }
+}
