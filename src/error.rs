@@ -100,7 +100,7 @@ pub fn check_finite(field: &str, value: f64) -> Result<f64> {
     } else {
         Err(Error::invalid(
             field,
-            format!("must be finite, got {value}"),
+            format!("must be finite, got {value:?}"),
         ))
     }
 }
@@ -118,7 +118,7 @@ pub fn check_positive(field: &str, value: f64) -> Result<f64> {
     } else {
         Err(Error::invalid(
             field,
-            format!("must be finite and > 0, got {value}"),
+            format!("must be finite and > 0, got {value:?}"),
         ))
     }
 }
@@ -136,7 +136,7 @@ pub fn check_non_negative(field: &str, value: f64) -> Result<f64> {
     } else {
         Err(Error::invalid(
             field,
-            format!("must be finite and >= 0, got {value}"),
+            format!("must be finite and >= 0, got {value:?}"),
         ))
     }
 }

@@ -96,7 +96,7 @@ fn json_takes_engineering_units_too() {
 #[test]
 fn lists_of_heights_are_scaled_element_by_element() {
     let text = Scene::paper().to_toml_string().unwrap().replace(
-        "family = \"rice_maxima\"\nsigma_m = 0.0000000007\nepsilon = 0.7",
+        "family = \"rice_maxima\"\nsigma_m = 7e-10\nepsilon = 0.7",
         "family = \"discrete\"\nheights_nm = [0.5, -0.25, 1]",
     );
     let s = Scene::from_toml_str(&text).unwrap();

@@ -147,77 +147,11 @@ fn both(field_eng: &str, si_key: &str) -> Error {
 /// file, so the edited file is parsed as usual and the parser's errors can be mapped back to the
 /// file as written.
 pub(super) mod toml_doc {
-    use std::ops::Range;
-
     use toml::de::{DeTable, DeValue};
     use toml::Spanned;
 
     use super::*;
-
-    /// Replacements of byte ranges of the original text, in no particular order.
-    #[derive(Default)]
-    pub(in crate::scene) struct Edits(Vec<(Range<usize>, String)>);
-
-    impl Edits {
-        /// The text with the edits applied, and the edits sorted for [`Edits::original_offset`].
-        pub(in crate::scene) fn apply(&mut self, s: &str) -> String {
-            self.0.sort_by_key(|(r, _)| r.start);
-            let mut out = String::with_capacity(s.len());
-            let mut at = 0;
-            for (r, text) in &self.0 {
-                out.push_str(s.get(at..r.start).unwrap_or(""));
-                out.push_str(text);
-                at = r.end;
-            }
-            out.push_str(s.get(at..).unwrap_or(""));
-            out
-        }
-
-        /// The offset in the original text of offset `p` in the edited text (the start of an
-        /// edit for an offset inside it).
-        pub(in crate::scene) fn original_offset(&self, p: usize) -> usize {
-            let mut shift = 0_isize; // edited − original, before the current edit
-            for (r, text) in &self.0 {
-                let start = (r.start as isize + shift) as usize;
-                if p < start {
-                    break;
-                }
-                if p < start + text.len() {
-                    return r.start;
-                }
-                shift += text.len() as isize - r.len() as isize;
-            }
-            (p as isize - shift).max(0) as usize
-        }
-
-        pub(in crate::scene) fn is_empty(&self) -> bool {
-            self.0.is_empty()
-        }
-    }
-
-    fn number(v: &DeValue<'_>) -> Option<f64> {
-        match v {
-            DeValue::Float(x) => match x.as_str() {
-                "nan" | "+nan" | "-nan" => Some(f64::NAN),
-                t => t.replace('_', "").parse().ok(),
-            },
-            DeValue::Integer(i) => i64::from_str_radix(&i.as_str().replace('_', ""), i.radix())
-                .ok()
-                .map(|i| i as f64),
-            _ => None,
-        }
-    }
-
-    /// `x` as a TOML float that reads back exactly.
-    fn float_text(x: f64) -> String {
-        if x.is_nan() {
-            "nan".into()
-        } else if x.is_infinite() {
-            if x > 0.0 { "inf" } else { "-inf" }.into()
-        } else {
-            format!("{x:?}")
-        }
-    }
+    use crate::scene::toml_text::{float_text, number, Edits};
 
     fn convert(
         v: &Spanned<DeValue<'_>>,
@@ -245,9 +179,7 @@ pub(super) mod toml_doc {
             }
             (x, Factors::All(f)) => {
                 let x = number(x).ok_or_else(|| not_number(field, unit, "a number"))?;
-                edits
-                    .0
-                    .push((v.span(), float_text(scale(x, *f, field, unit)?)));
+                edits.push(v.span(), float_text(scale(x, *f, field, unit)?));
             }
             (_, Factors::Pairs(_)) => {
                 return Err(not_number(field, unit, "a list of pairs of numbers"))
@@ -273,7 +205,7 @@ pub(super) mod toml_doc {
                         return Err(both(&field, &r.si_key));
                     }
                     convert(v, &r.factors, &field, r.unit, edits)?;
-                    edits.0.push((k.span(), r.si_key.clone()));
+                    edits.push(k.span(), r.si_key.clone());
                     renames.insert(prefix, &r.si_key, key);
                 }
                 None => {

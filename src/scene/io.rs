@@ -5,6 +5,7 @@ use std::path::Path;
 use serde::Deserialize;
 
 use super::eng_units::{json_doc, toml_doc, Renames};
+use super::toml_text::Edits;
 use super::Scene;
 use crate::{Error, Result};
 
@@ -19,7 +20,7 @@ impl Scene {
     /// ```
     /// use hdi_tribology::scene::Scene;
     /// let mut text = Scene::paper().to_toml_string()?;
-    /// text = text.replace("nominal_clearance_m = 0.00000001", "nominal_clearance_nm = 12.5");
+    /// text = text.replace("nominal_clearance_m = 1e-8", "nominal_clearance_nm = 12.5");
     /// let s = Scene::from_toml_str(&text)?;
     /// assert!((s.nominal_clearance_m - 12.5e-9).abs() < 1e-23);
     /// # Ok::<(), hdi_tribology::Error>(())
@@ -74,10 +75,12 @@ impl Scene {
 
     /// The scene as TOML.
     pub fn to_toml_string(&self) -> Result<String> {
-        toml::to_string(self).map_err(|e| Error::Scene {
-            origin: self.name.clone(),
-            reason: format!("cannot write TOML: {e}"),
-        })
+        toml::to_string(self)
+            .map(|text| super::toml_text::tidy_floats(&text))
+            .map_err(|e| Error::Scene {
+                origin: self.name.clone(),
+                reason: format!("cannot write TOML: {e}"),
+            })
     }
 
     /// The scene as pretty-printed JSON.
@@ -108,7 +111,7 @@ fn read_toml(s: &str, origin: &str) -> Result<(Scene, Renames)> {
     let doc =
         toml::de::DeTable::parse(s).map_err(|e| scene_error(origin, toml_message(s, &e, None)))?;
     let mut renames = Renames::default();
-    let mut edits = toml_doc::Edits::default();
+    let mut edits = Edits::default();
     toml_doc::convert_table(doc.get_ref(), "", &mut renames, &mut edits)?;
     if edits.is_empty() {
         return Scene::deserialize(toml::de::Deserializer::from(doc))
@@ -147,7 +150,7 @@ fn read_json(s: &str, origin: &str) -> Result<(Scene, Renames)> {
 
 /// The TOML parser's message on one line, prefixed by its line and column in `s`. With `edits`,
 /// the error is in the edited text and its position is mapped back to `s`.
-fn toml_message(s: &str, e: &toml::de::Error, edits: Option<&toml_doc::Edits>) -> String {
+fn toml_message(s: &str, e: &toml::de::Error, edits: Option<&Edits>) -> String {
     let msg = e.message().trim().replace('\n', "; ");
     match e.span() {
         Some(span) => {

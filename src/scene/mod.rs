@@ -47,7 +47,7 @@
 //! # fn main() -> hdi_tribology::Result<()> {
 //! let text = Scene::paper()
 //!     .to_toml_string()?
-//!     .replace("height_sigma_m = 0.0000000007", "height_sigma_nm = 0.5");
+//!     .replace("height_sigma_m = 7e-10", "height_sigma_nm = 0.5");
 //! let s = Scene::from_toml_str(&text)?;
 //! assert!((s.surface.height_sigma_m - 0.5e-9).abs() < 1e-24);
 //! let bad = text.replace("height_sigma_nm = 0.5", "height_sigma_nm = -0.5");
@@ -61,6 +61,7 @@ mod eng_units;
 mod io;
 mod paper;
 mod spec;
+mod toml_text;
 mod validate;
 
 pub use spec::{
