@@ -126,6 +126,22 @@ fn a_field_in_two_units_is_refused_by_name() {
     let (field, reason) = invalid_field(Scene::from_toml_str(&text));
     assert_eq!(field, "surface.height_sigma_nm");
     assert!(reason.contains("height_sigma_m"), "{reason}");
+
+    // Two engineering spellings of one field, in TOML and in JSON.
+    let text = paper_in_engineering_units().replace(
+        "height_sigma_nm = 0.7",
+        "height_sigma_nm = 0.7\nheight_sigma_um = 0.0007",
+    );
+    let (field, reason) = invalid_field(Scene::from_toml_str(&text));
+    assert!(field.starts_with("surface.height_sigma_"), "{field}");
+    assert!(reason.contains("height_sigma_"), "{reason}");
+    let mut v = as_value(&Scene::paper());
+    let surface = v["surface"].as_object_mut().unwrap();
+    surface.remove("height_sigma_m");
+    surface.insert("height_sigma_nm".into(), 0.7.into());
+    surface.insert("height_sigma_um".into(), 0.0007.into());
+    let (field, _) = invalid_field(Scene::from_json_str(&v.to_string()));
+    assert!(field.starts_with("surface.height_sigma_"), "{field}");
 }
 
 #[test]

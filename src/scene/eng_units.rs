@@ -196,6 +196,8 @@ pub(super) mod toml_doc {
         renames: &mut Renames,
         edits: &mut Edits,
     ) -> Result<()> {
+        // SI key → the engineering key renamed to it, to refuse two spellings of one field.
+        let mut produced = BTreeMap::new();
         for (k, v) in table.iter() {
             let key = k.get_ref().as_ref();
             let field = path(prefix, key);
@@ -203,6 +205,9 @@ pub(super) mod toml_doc {
                 Some(r) => {
                     if table.contains_key(r.si_key.as_str()) {
                         return Err(both(&field, &r.si_key));
+                    }
+                    if let Some(other) = produced.insert(r.si_key.clone(), key) {
+                        return Err(both(&field, other));
                     }
                     convert(v, &r.factors, &field, r.unit, edits)?;
                     edits.push(k.span(), r.si_key.clone());

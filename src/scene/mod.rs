@@ -39,7 +39,7 @@
 //! | `_w_per_s` | `_mw_per_s`, `_mw_per_ms` |
 //! | `heater.programme` (s, W) | `heater.programme_ms_mw` (ms, mW) |
 //!
-//! A field given in both forms, or an engineering-unit field that is not a number, is refused by
+//! A field given in two units, or an engineering-unit field that is not a number, is refused by
 //! name; a validation error on a converted field names both spellings.
 //!
 //! ```
