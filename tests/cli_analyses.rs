@@ -1,5 +1,5 @@
-//! `hdi static`, `hdi cycle` and `hdi sweep`: their JSON agrees with the library, and bad input
-//! gives one line and a non-zero exit.
+//! `hdi static`, `hdi cycle`, `hdi sweep` and `hdi calibrate`: their JSON agrees with the
+//! library, and bad input gives one line and a non-zero exit.
 #![cfg(feature = "cli")]
 
 use std::process::Command;
@@ -103,6 +103,41 @@ fn cycle_and_sweep_report_every_key_and_the_csv() {
 }
 
 #[test]
+fn calibrate_finds_the_static_touchdown_within_one_step() {
+    let scene = Scene::paper();
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let th = scene.detector.contact_threshold_n;
+    let stat = static_hysteresis(&model, &StaticOptions::new(th)).unwrap();
+    let v = json(&[
+        "calibrate",
+        "--paper",
+        "--start-mw",
+        "65",
+        "--step-mw",
+        "0.5",
+        "--margin-mw",
+        "10",
+    ]);
+    let td = v["touchdown_power"].as_f64().unwrap();
+    // The staircase fires at the first level at or above the static touchdown (the mean-force
+    // detector with the scene's threshold is the static model's criterion).
+    assert!(
+        td >= stat.touchdown.power - 1e-12 && td <= stat.touchdown.power + 0.5e-3,
+        "{v}"
+    );
+    let set = v["set_power"].as_f64().unwrap();
+    assert!((set - (td - 10e-3)).abs() < 1e-12, "{v}");
+    let to = v["takeoff_power"].as_f64().unwrap();
+    assert!((to - stat.takeoff.power).abs() <= 0.5e-3 + 1e-12, "{v}");
+    let clearance = v["clearance"].as_f64().unwrap();
+    assert!(
+        clearance > 0.0 && clearance < scene.nominal_clearance_m,
+        "{v}"
+    );
+    assert_eq!(v["detector"].as_str(), Some("mean contact force"));
+}
+
+#[test]
 fn bad_arguments_give_one_line_and_a_non_zero_exit() {
     for args in [
         vec!["cycle", "--paper", "--method", "euler"],
@@ -110,6 +145,8 @@ fn bad_arguments_give_one_line_and_a_non_zero_exit() {
         vec!["static"],
         vec!["cycle", "--paper", "--rtol", "nan"],
         vec!["sweep", "--paper", "--v-ac", "0", "--refine", "0"],
+        vec!["calibrate", "--paper", "--detector", "microphone"],
+        vec!["calibrate", "--paper", "--step-mw", "-1"],
         vec!["static", "no-such-scene.toml"],
     ] {
         let out = hdi(&args);

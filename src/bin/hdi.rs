@@ -38,6 +38,18 @@ commands:
       --refine reruns each amplitude with a tenfold tighter tolerance (at most 4 runs) until
       touchdown and take-off move by at most POWER_TOL_W, and adds rtol, power_change,
       converged and runs to each object.
+  calibrate (SCENE_FILE | --paper) [--start-mw P] [--step-mw S] [--max-mw M] [--margin-mw G]
+        [--detector mean|ae|vibration] [--dither-v V] [--no-takeoff]
+      touchdown calibration as drive firmware does it: heater steps of S mW (default 0.5) from
+      P (default: the power whose protrusion leaves 5 nm of the nominal clearance) up to M
+      (default P + 60) until the detector fires, then back down to take-off; the heater is set
+      G mW (default 15) below touchdown. Detectors: mean contact force over the scene's window
+      and threshold (default), `ae` (high-passed contact-force RMS above 10 uN, 5 kHz corner,
+      50 us RMS: an acoustic-emission proxy), `vibration` (high-passed displacement RMS above
+      0.02 nm and 3x its level at the start). --dither-v adds an AC dither of V volts at the
+      scene's frequency while calibrating. JSON: detector, touchdown_power, takeoff_power,
+      hysteresis, set_power, clearance (m, static model at the set power without dither),
+      contrast, levels, simulated_time, wall_seconds.
   scene (SCENE_FILE | --paper) [--json]
       the scene as TOML (or JSON), validated: a starting point for scenes of your own.
   help
@@ -81,6 +93,7 @@ fn run(args: &[String]) -> Result<(), CliError> {
         "static" => static_analyses(rest),
         "cycle" => cycle(rest),
         "sweep" => sweep(rest),
+        "calibrate" => calibrate_cmd(rest),
         "scene" => scene(rest),
         "help" | "--help" | "-h" => {
             print_text(USAGE)?;
@@ -420,6 +433,95 @@ struct RefinedReport {
     power_change: f64,
     converged: bool,
     runs: usize,
+}
+
+#[derive(Serialize)]
+struct CalibrationReport {
+    detector: String,
+    touchdown_power: f64,
+    takeoff_power: Option<f64>,
+    hysteresis: Option<f64>,
+    set_power: f64,
+    clearance: f64,
+    contrast: f64,
+    levels: usize,
+    simulated_time: f64,
+    wall_seconds: f64,
+}
+
+fn calibrate_cmd(args: &[String]) -> Result<(), CliError> {
+    use hdi_tribology::clearance::{
+        calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Relative,
+        TouchdownDetector, VibrationRms,
+    };
+    let parsed = parse_args(
+        args,
+        &[
+            "start-mw",
+            "step-mw",
+            "max-mw",
+            "margin-mw",
+            "detector",
+            "dither-v",
+        ],
+        &["no-takeoff"],
+    )?;
+    let scene = parsed.load_scene()?;
+    let mut model = SliderModel::from_scene(&scene)?;
+    let mw_option = |name: &str| {
+        parsed
+            .value(name)
+            .map(|v| parse_number(name, v))
+            .transpose()
+    };
+    let start_mw = match mw_option("start-mw")? {
+        Some(p) => p,
+        None => {
+            1e3 * ((scene.nominal_clearance_m - 5e-9) / scene.heater.efficiency_m_per_w).max(0.0)
+        }
+    };
+    let step_mw = mw_option("step-mw")?.unwrap_or(0.5);
+    let max_mw = mw_option("max-mw")?.unwrap_or(start_mw + 60.0);
+    let margin_mw = mw_option("margin-mw")?.unwrap_or(15.0);
+    let mut opts = CalibrationOptions::from_mw(start_mw, step_mw, max_mw, margin_mw);
+    opts.find_takeoff = !parsed.flag("no-takeoff");
+    if let Some(v) = parsed.value("dither-v") {
+        model = model.with_voltage(Voltage {
+            ac_amplitude: parse_number("dither-v", v)?,
+            ..model.voltage
+        });
+    }
+    let (th, window) = (scene.detector.contact_threshold_n, scene.detector.window_s);
+    let mut detector: Box<dyn TouchdownDetector> = match parsed.value("detector").unwrap_or("mean")
+    {
+        "mean" => Box::new(MeanContactForce::new(th, window)?),
+        "ae" => Box::new(ContactForceRms::new(1e-5, 5e3, 5e-5)?),
+        "vibration" => Box::new(Relative::new(
+            VibrationRms::new(2e-11, 5e3, 5e-5)?,
+            3.0,
+            1e-4,
+            2e-4,
+        )?),
+        other => {
+            return Err(CliError::Usage(format!(
+                "--detector: `{other}` is not one of mean, ae, vibration"
+            )))
+        }
+    };
+    let clock = std::time::Instant::now();
+    let c = calibrate(&model, detector.as_mut(), &opts)?;
+    print_json(&CalibrationReport {
+        hysteresis: c.hysteresis(),
+        detector: c.detector,
+        touchdown_power: c.touchdown_power,
+        takeoff_power: c.takeoff_power,
+        set_power: c.set_power,
+        clearance: c.clearance,
+        contrast: c.contrast,
+        levels: c.steps.len(),
+        simulated_time: c.simulated_time,
+        wall_seconds: clock.elapsed().as_secs_f64(),
+    })
 }
 
 fn scene(args: &[String]) -> Result<(), CliError> {
