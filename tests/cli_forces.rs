@@ -304,8 +304,41 @@ fn bad_command_lines_are_usage_errors() {
         vec!["forces", "--gaps", "1e-9"],
         vec!["forces", "--paper", "--gaps", "1e-9", "--colour", "red"],
         vec!["forces", "--paper", "x.toml", "--gaps", "1e-9"],
+        vec!["forces", "--paper", "--gaps", "1e-9", "--gaps-nm", "1"],
+        vec![
+            "forces",
+            "--paper",
+            "--gaps-nm",
+            "1",
+            "--protrusion-m",
+            "0",
+            "--protrusion-nm",
+            "0",
+        ],
     ] {
         one_line_error(&hdi(&args), 2);
     }
     assert!(hdi(&["help"]).status.success());
+}
+
+#[test]
+fn gaps_in_nanometres_give_the_same_answer() {
+    let m = hdi(&[
+        "forces",
+        "--paper",
+        "--gaps",
+        "5e-10,1e-9,2.5e-9",
+        "--protrusion-m",
+        "2e-9",
+    ]);
+    let nm = hdi(&[
+        "forces",
+        "--paper",
+        "--gaps-nm",
+        "0.5,1,2.5",
+        "--protrusion-nm",
+        "2",
+    ]);
+    assert!(m.status.success() && nm.status.success());
+    assert_eq!(m.stdout, nm.stdout);
 }

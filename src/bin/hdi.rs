@@ -20,8 +20,9 @@ use serde::Serialize;
 const USAGE: &str = "usage: hdi <command> [options]
 
 commands:
-  forces (SCENE_FILE | --paper) --gaps D1,D2,...  [--protrusion-m DELTA]
-      interface forces at bulge gaps D (m), JSON, one object per gap: d, intermolecular,
+  forces (SCENE_FILE | --paper) (--gaps D1,D2,... | --gaps-nm D1,D2,...)
+        [--protrusion-m DELTA | --protrusion-nm DELTA]
+      interface forces at bulge gaps D (m; nm with --gaps-nm), JSON, one object per gap: d, intermolecular,
       contact, electrostatic_per_volt2, electrostatic (at the scene's DC voltage minus the
       contact potential), other, real_contact_area, total (SI, positive = away from the disk).
       Pad-gap terms see D + DELTA (default DELTA = 0).
@@ -233,16 +234,37 @@ struct ForcesRow {
 }
 
 fn forces(args: &[String]) -> Result<(), CliError> {
-    let parsed = parse_args(args, &["gaps", "protrusion-m"], &[])?;
-    let gaps = parse_list(
-        "gaps",
-        parsed
-            .value("gaps")
-            .ok_or_else(|| CliError::Usage("forces needs --gaps D1,D2,...".into()))?,
+    let parsed = parse_args(
+        args,
+        &["gaps", "gaps-nm", "protrusion-m", "protrusion-nm"],
+        &[],
     )?;
-    let protrusion = match parsed.value("protrusion-m") {
-        Some(s) => parse_number("protrusion-m", s)?,
-        None => 0.0,
+    let gaps = match (parsed.value("gaps"), parsed.value("gaps-nm")) {
+        (Some(m), None) => parse_list("gaps", m)?,
+        (None, Some(nm)) => parse_list("gaps-nm", nm)?
+            .into_iter()
+            .map(hdi_tribology::units::nm)
+            .collect(),
+        (Some(_), Some(_)) => {
+            return Err(CliError::Usage(
+                "give the gaps once: --gaps (m) or --gaps-nm".into(),
+            ))
+        }
+        (None, None) => {
+            return Err(CliError::Usage(
+                "forces needs --gaps D1,D2,... (m) or --gaps-nm D1,D2,...".into(),
+            ))
+        }
+    };
+    let protrusion = match (parsed.value("protrusion-m"), parsed.value("protrusion-nm")) {
+        (Some(m), None) => parse_number("protrusion-m", m)?,
+        (None, Some(nm)) => hdi_tribology::units::nm(parse_number("protrusion-nm", nm)?),
+        (None, None) => 0.0,
+        (Some(_), Some(_)) => {
+            return Err(CliError::Usage(
+                "give the protrusion once: --protrusion-m or --protrusion-nm".into(),
+            ))
+        }
     };
     let scene = parsed.load_scene()?;
     let interface = scene.build_interface()?;
