@@ -296,3 +296,40 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
         k
     }
 }
+
+/// Implements [`InterfaceTerm`] for a term that wraps an [`AveragedTerm`] in its field `inner`,
+/// forwarding every method.
+macro_rules! forward_term {
+    ($term:ty) => {
+        impl $crate::force::InterfaceTerm for $term {
+            fn name(&self) -> &str {
+                self.inner.name()
+            }
+            fn kind(&self) -> $crate::force::TermKind {
+                self.inner.kind()
+            }
+            fn coupling(&self) -> $crate::force::Coupling {
+                self.inner.coupling()
+            }
+            fn gap(&self) -> $crate::force::GapReference {
+                self.inner.gap()
+            }
+            fn force(&self, d: f64) -> $crate::Result<(f64, f64)> {
+                self.inner.force(d)
+            }
+            fn real_contact_area(&self, d: f64) -> $crate::Result<f64> {
+                self.inner.real_contact_area(d)
+            }
+            fn real_contact_area_and_slope(&self, d: f64) -> $crate::Result<(f64, f64)> {
+                self.inner.real_contact_area_and_slope(d)
+            }
+            fn has_contact_area(&self) -> bool {
+                self.inner.has_contact_area()
+            }
+            fn kinks(&self) -> Vec<f64> {
+                self.inner.kinks()
+            }
+        }
+    };
+}
+pub(crate) use forward_term;

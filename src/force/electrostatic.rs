@@ -1,6 +1,6 @@
 //! The electrostatic term, per V² of the instantaneous voltage.
 
-use super::{AveragedTerm, Coulomb, Coupling, Footprint, GapReference, InterfaceTerm, TermKind};
+use super::{AveragedTerm, Coulomb, Coupling, Footprint, GapReference, TermKind};
 use crate::surface::GaussianHeights;
 use crate::Result;
 
@@ -55,23 +55,4 @@ impl Electrostatic {
     }
 }
 
-impl InterfaceTerm for Electrostatic {
-    fn name(&self) -> &str {
-        self.inner.name()
-    }
-    fn kind(&self) -> TermKind {
-        self.inner.kind()
-    }
-    fn coupling(&self) -> Coupling {
-        self.inner.coupling()
-    }
-    fn gap(&self) -> GapReference {
-        self.inner.gap()
-    }
-    fn force(&self, d: f64) -> Result<(f64, f64)> {
-        self.inner.force(d)
-    }
-    fn kinks(&self) -> Vec<f64> {
-        self.inner.kinks()
-    }
-}
+super::averaged::forward_term!(Electrostatic);

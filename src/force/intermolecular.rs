@@ -1,9 +1,6 @@
 //! The intermolecular (Lennard-Jones 3–9, Hamaker) term.
 
-use super::{
-    lj_zero, AveragedTerm, Coupling, Footprint, GapReference, InterfaceTerm, LennardJones39,
-    TermKind,
-};
+use super::{lj_zero, AveragedTerm, Coupling, Footprint, GapReference, LennardJones39, TermKind};
 use crate::surface::GaussianHeights;
 use crate::Result;
 
@@ -57,23 +54,4 @@ impl Intermolecular {
     }
 }
 
-impl InterfaceTerm for Intermolecular {
-    fn name(&self) -> &str {
-        self.inner.name()
-    }
-    fn kind(&self) -> TermKind {
-        self.inner.kind()
-    }
-    fn coupling(&self) -> Coupling {
-        self.inner.coupling()
-    }
-    fn gap(&self) -> GapReference {
-        self.inner.gap()
-    }
-    fn force(&self, d: f64) -> Result<(f64, f64)> {
-        self.inner.force(d)
-    }
-    fn kinks(&self) -> Vec<f64> {
-        self.inner.kinks()
-    }
-}
+super::averaged::forward_term!(Intermolecular);
