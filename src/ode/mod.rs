@@ -36,6 +36,7 @@ mod integrator;
 mod jacobian;
 mod lu;
 mod options;
+mod problem;
 mod radau5;
 mod rodas5p;
 mod solution;
@@ -48,8 +49,11 @@ pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
 pub use integrator::{Integrator, StepStatus};
 pub use options::{Method, Options, SaveAt, Tolerance};
+pub use problem::OdeProblem;
 pub use solution::{Solution, Stats};
-pub use system::{complex_step_jacobian, finite_difference_jacobian, FnSystem, OdeSystem};
+pub use system::{
+    complex_step_jacobian, finite_difference_jacobian, FnSystem, NoJacobian, OdeSystem,
+};
 
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
