@@ -85,6 +85,7 @@
 pub mod analysis;
 pub mod clearance;
 pub mod error;
+pub mod fit;
 pub mod force;
 pub mod heater;
 pub mod model;
