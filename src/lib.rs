@@ -84,6 +84,7 @@
 
 pub mod analysis;
 pub mod clearance;
+pub mod drive;
 pub mod error;
 pub mod fit;
 pub mod force;
