@@ -54,28 +54,30 @@ fn pleiades_converges_with_the_tolerance() {
 }
 
 #[test]
-fn e5_with_radau5_keeps_the_invariant_and_three_digits() {
+fn e5_with_radau5_and_tight_auto_keeps_the_invariant_and_three_digits() {
     // y₂ and y₃ end near 8.9e-22 and equal 1/(MCt) only while y₂ − y₃ − y₄ = 0 holds far below
     // that: rounding of y₂ at its peak (1.5e-10) alone is 3e-26, i.e. 3e-4 of the end values,
     // so about three digits is what double precision allows whatever the tolerance. Radau5's
     // Newton residual uses f only, and f keeps the invariant in floating point (see the
     // problem's definition): the invariant holds to 1e-24 and the end values to 1e-2.
+    // Auto takes Radau5 as its stiff method below rtol 1e-6 and passes there too.
     let p = problems::e5();
     let opts = |rtol: f64| p.options(rtol).max_steps(200_000);
-    for rtol in [1e-4, 1e-6, 1e-8] {
-        let sol = solve(
-            &p,
-            0.0,
-            p.y0_vector(),
-            p.t_end,
-            Method::Radau5,
-            &opts(rtol),
-            &mut [],
-        )
-        .unwrap();
+    let runs = [
+        (Method::Radau5, 1e-4),
+        (Method::Radau5, 1e-6),
+        (Method::Radau5, 1e-8),
+        (Method::Auto, 1e-7),
+        (Method::Auto, 1e-9),
+    ];
+    for (m, rtol) in runs {
+        let sol = solve(&p, 0.0, p.y0_vector(), p.t_end, m, &opts(rtol), &mut []).unwrap();
         let y = sol.y_final();
         let e = p.error(y.as_slice());
-        assert!(e < 1e-2, "rtol {rtol}: error {e}");
-        assert!((y[1] - y[2] - y[3]).abs() < 1e-24, "rtol {rtol}: invariant");
+        assert!(e < 1e-2, "{m} rtol {rtol}: error {e}");
+        assert!(
+            (y[1] - y[2] - y[3]).abs() < 1e-24,
+            "{m} rtol {rtol}: invariant"
+        );
     }
 }
