@@ -321,7 +321,11 @@ fn bad_command_lines_are_usage_errors() {
         assert!(out.stdout.is_empty(), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         // no command at all: the overview of the commands, on stderr
-        let expected = if args.is_empty() { "Usage: hdi" } else { "error: " };
+        let expected = if args.is_empty() {
+            "Usage: hdi"
+        } else {
+            "error: "
+        };
         assert!(err.contains(expected), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
     }
