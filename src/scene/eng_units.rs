@@ -64,6 +64,29 @@ fn rule(key: &str) -> Option<Rule> {
     })
 }
 
+/// The SI name of a field key given in an engineering unit, the factor that takes its value to
+/// SI, and the unit's name; `None` for a key in SI (or not a unit at all). Lists of pairs
+/// (`heater.programme_ms_mw`) are not single-factor keys and give `None` too.
+///
+/// ```
+/// use hdi_tribology::scene::engineering_unit;
+/// assert_eq!(engineering_unit("height_sigma_nm"), Some(("height_sigma_m".to_string(), 1e-9, "nm")));
+/// assert_eq!(engineering_unit("height_sigma_m"), None);
+/// ```
+pub fn engineering_unit(key: &str) -> Option<(String, f64, &'static str)> {
+    match rule(key)? {
+        Rule {
+            si_key,
+            factors: Factors::All(f),
+            unit,
+        } => Some((si_key, f, unit)),
+        Rule {
+            factors: Factors::Pairs(_),
+            ..
+        } => None,
+    }
+}
+
 /// A renamed field: its path as the file gave it, and for a field scaled by one factor, that
 /// factor to SI and the unit's name.
 #[derive(Debug)]

@@ -66,6 +66,8 @@ mod spec;
 mod toml_text;
 mod validate;
 
+pub use eng_units::engineering_unit;
+
 pub use spec::{
     ContactSpec, DetectorSpec, ElectrostaticSpec, FrictionSpec, HeaterSpec, IntermolecularSpec,
     Scene, SliderSpec, SolverSpec, SurfaceSpec, SweepSpec, TableSpec, TriggeredSpec, VoltageSpec,
