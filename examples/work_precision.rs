@@ -419,11 +419,7 @@ fn chart(
                 .filter(|&(_, e)| e > 0.0)
                 .map(|(t, e)| (t.log10(), e.log10()))
                 .collect();
-            (!points.is_empty()).then(|| Series {
-                label,
-                points,
-                markers: false,
-            })
+            (!points.is_empty()).then(|| Series::line(label, points))
         })
         .collect();
     if series.is_empty() {
@@ -437,7 +433,7 @@ fn chart(
         x_label: "log10 CPU time of the thread (ms)",
         y_label: &y_label,
         series,
-        log: (false, false),
+        ..Chart::default()
     }
     .to_svg(&out.join(file), 720, 480)?;
     Ok(())
