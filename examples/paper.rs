@@ -434,6 +434,23 @@ fn status_series<'a>(
     out
 }
 
+/// [`status_series`] of both sweeps (fixed, then triggered), the first labelled `names`.
+fn sweep_series<'a>(
+    sweeps: &[Sweep<'a>; 2],
+    names: [&'a str; 2],
+    point: impl Fn(&CycleResult, f64) -> (f64, f64) + Copy,
+) -> Vec<Series<'a>> {
+    let labels = [
+        [names[0], "fixed, not converged", "fixed, negative"],
+        [names[1], "triggered, not converged", "triggered, negative"],
+    ];
+    sweeps
+        .iter()
+        .zip(labels)
+        .flat_map(|(sweep, labels)| status_series(sweep, labels, point))
+        .collect()
+}
+
 /// The name of a marker symbol, for notes on a figure.
 fn marker_name(m: Marker) -> &'static str {
     match m {
@@ -457,14 +474,6 @@ fn status_notes() -> Vec<String> {
 
 /// Fig. 3(d): hysteresis (mW) against AC amplitude under both programmes, with the static value.
 fn fig3d_chart<'a>(sweeps: &'a [Sweep<'a>; 2], static_hysteresis: f64) -> Chart<'a> {
-    let labels = [
-        ["fixed programme", "fixed, not converged", "fixed, negative"],
-        [
-            "touchdown-triggered",
-            "triggered, not converged",
-            "triggered, negative",
-        ],
-    ];
     let mut series = vec![Series::line(
         "static, V_ac = 0",
         vec![(0.0, mw(static_hysteresis)), (1.0, mw(static_hysteresis))],
@@ -472,9 +481,11 @@ fn fig3d_chart<'a>(sweeps: &'a [Sweep<'a>; 2], static_hysteresis: f64) -> Chart<
     .colour(palette::BLACK)
     .width(1)
     .dashed()];
-    for (sweep, labels) in sweeps.iter().zip(labels) {
-        series.extend(status_series(sweep, labels, |c, h| (c.v_ac, mw(h))));
-    }
+    series.extend(sweep_series(
+        sweeps,
+        ["fixed programme", "touchdown-triggered"],
+        |c, h| (c.v_ac, mw(h)),
+    ));
     let mut notes = vec![format!(
         "The letter's Fig. 3(d) uses the fixed programme ({}); the experiment's protocol is \
              the touchdown-triggered programme ({}).",
@@ -494,20 +505,11 @@ fn fig3d_chart<'a>(sweeps: &'a [Sweep<'a>; 2], static_hysteresis: f64) -> Chart<
 
 /// Fig. 4: mean temperature rise (K) against hysteresis (mW) under both programmes.
 fn fig4_chart<'a>(sweeps: &'a [Sweep<'a>; 2]) -> Chart<'a> {
-    let labels = [
-        ["fixed programme", "fixed, not converged", "fixed, negative"],
-        [
-            "touchdown-triggered (letter)",
-            "triggered, not converged",
-            "triggered, negative",
-        ],
-    ];
-    let mut series = Vec::new();
-    for (sweep, labels) in sweeps.iter().zip(labels) {
-        series.extend(status_series(sweep, labels, |c, h| {
-            (mw(h), c.mean_temperature_rise)
-        }));
-    }
+    let series = sweep_series(
+        sweeps,
+        ["fixed programme", "touchdown-triggered (letter)"],
+        |c, h| (mw(h), c.mean_temperature_rise),
+    );
     let mut notes = vec![format!(
         "The letter's Fig. 4 uses the {} ({}); the {} ({}) is shown for comparison.",
         sweeps[1].name,

@@ -332,6 +332,17 @@ pub struct Series<'a> {
     pub secondary: bool,
 }
 
+/// Builder methods that switch one `bool` field of [`Series`] on.
+macro_rules! flag_setters {
+    ($($(#[$doc:meta])* $name:ident => $field:ident,)*) => {$(
+        $(#[$doc])*
+        pub fn $name(mut self) -> Self {
+            self.$field = true;
+            self
+        }
+    )*};
+}
+
 impl<'a> Series<'a> {
     /// A solid line through `points`.
     pub fn line(label: &'a str, points: Vec<(f64, f64)>) -> Self {
@@ -358,25 +369,18 @@ impl<'a> Series<'a> {
         self.marker = m;
         self
     }
-    /// Markers as outlines only.
-    pub fn hollow(mut self) -> Self {
-        self.hollow = true;
-        self
-    }
     /// With this line width (marker size) in pixels.
     pub fn width(mut self, px: u32) -> Self {
         self.width = px;
         self
     }
-    /// Dashed line.
-    pub fn dashed(mut self) -> Self {
-        self.dashed = true;
-        self
-    }
-    /// On the second y axis.
-    pub fn on_secondary(mut self) -> Self {
-        self.secondary = true;
-        self
+    flag_setters! {
+        /// Markers as outlines only.
+        hollow => hollow,
+        /// Dashed line.
+        dashed => dashed,
+        /// On the second y axis.
+        on_secondary => secondary,
     }
 }
 
@@ -704,6 +708,18 @@ impl Chart<'_> {
                 }
             }};
         }
+        // The series on one axis: lines first, then markers on top.
+        macro_rules! draw_all {
+            ($chart:ident . $method:ident, $secondary:expr) => {
+                for pass in [false, true] {
+                    for (s, c) in self.series.iter().zip(&colours) {
+                        if s.secondary == $secondary && s.markers == pass {
+                            series_into!($chart.$method, s, *c);
+                        }
+                    }
+                }
+            };
+        }
         macro_rules! primary {
             ($chart:ident) => {{
                 $chart
@@ -718,14 +734,7 @@ impl Chart<'_> {
                     .label_style(("sans-serif", 13))
                     .draw()
                     .map_err(|e| err(&e))?;
-                // Lines first, then markers on top.
-                for pass in [false, true] {
-                    for (s, c) in self.series.iter().zip(&colours) {
-                        if !s.secondary && s.markers == pass {
-                            series_into!($chart.draw_series, s, *c);
-                        }
-                    }
-                }
+                draw_all!($chart.draw_series, false);
             }};
         }
         macro_rules! build {
@@ -747,13 +756,7 @@ impl Chart<'_> {
                         .label_style(("sans-serif", 13))
                         .draw()
                         .map_err(|e| err(&e))?;
-                    for pass in [false, true] {
-                        for (s, c) in self.series.iter().zip(&colours) {
-                            if s.secondary && s.markers == pass {
-                                series_into!(chart.draw_secondary_series, s, *c);
-                            }
-                        }
-                    }
+                    draw_all!(chart.draw_secondary_series, true);
                 } else {
                     primary!(chart);
                 }
