@@ -58,14 +58,28 @@ fn run(args: &[String], out: &Path) -> Res<()> {
 
     s.write_csv(&out.join("series.csv"))?;
     let all = (f64::NEG_INFINITY, f64::INFINITY);
-    figures::forces_chart(&scene.name, s, all, None).to_svg(&out.join("forces.svg"), 1000, 550)?;
+    let what = format!(
+        "{}, V_ac = {} V, {} programme",
+        scene.name,
+        model.voltage.ac_amplitude,
+        if flag("--triggered").is_some() {
+            "touchdown-triggered"
+        } else {
+            "fixed"
+        }
+    );
+    let title = |t: &str| format!("{t}: {what}");
+    figures::forces_chart(&title("forces"), s, all, None).to_svg(
+        &out.join("forces.svg"),
+        1000,
+        550,
+    )?;
     Chart {
-        title: &scene.name,
+        title: &title("spacing"),
         x_label: "t (ms)",
         y_label: "bulge gap d (nm)",
         series: vec![
-            Series::line("d", figures::window(s, all, |s, i| s.d[i] * 1e9))
-                .colour(figures::SPACING),
+            Series::line("", figures::window(s, all, |s, i| s.d[i] * 1e9)).colour(figures::SPACING),
         ],
         ..Chart::default()
     }
@@ -82,7 +96,7 @@ fn run(args: &[String], out: &Path) -> Res<()> {
             (a.min(p * 1e3), b.max(p * 1e3))
         });
     Chart {
-        title: &scene.name,
+        title: &title("contact indicator"),
         x_label: "heater power (mW)",
         y_label: "running mean of F_c (µN)",
         series: vec![
