@@ -25,7 +25,7 @@ use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, 
 use hdi_tribology::analysis::sweep::ac_sweep;
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::ode::{solve, Method, OdeError, Stats};
-use hdi_tribology::report::{Chart, Series};
+use hdi_tribology::report::{palette, Chart, Series};
 use hdi_tribology::scene::Scene;
 use problems::Problem;
 use std::path::Path;
@@ -413,10 +413,12 @@ fn chart(
     second: bool,
 ) -> Res<()> {
     let labels: Vec<String> = Method::ALL.iter().map(|m| m.name().to_string()).collect();
+    // Each method keeps its colour in every chart, whichever methods have points.
     let series: Vec<Series> = Method::ALL
         .iter()
         .zip(&labels)
-        .filter_map(|(&m, label)| {
+        .zip(palette::SERIES.iter().cycle())
+        .filter_map(|((&m, label), &colour)| {
             let points: Vec<(f64, f64)> = rows
                 .iter()
                 .filter(|r| r.problem == problem && r.method == m && r.status == "ok")
@@ -424,7 +426,7 @@ fn chart(
                 .filter(|&(_, e)| e > 0.0)
                 .map(|(t, e)| (t.log10(), e.log10()))
                 .collect();
-            (!points.is_empty()).then(|| Series::line(label, points))
+            (!points.is_empty()).then(|| Series::line(label, points).colour(colour))
         })
         .collect();
     if series.is_empty() {
