@@ -12,8 +12,10 @@
 //! Radau5; the difference of the two is printed).
 //!
 //! Run with `cargo run --release --example work_precision`; `-- --quick` runs every second
-//! tolerance only.
+//! tolerance only, `-- --out DIR` writes into `DIR`. Progress goes to stderr.
 
+#[path = "common/output.rs"]
+mod output;
 #[path = "common/problems.rs"]
 mod problems;
 #[path = "common/timing.rs"]
@@ -23,7 +25,7 @@ use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, 
 use hdi_tribology::analysis::sweep::ac_sweep;
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::ode::{solve, Method, OdeError, Stats};
-use hdi_tribology::report::{Chart, Series};
+use hdi_tribology::report::{palette, Chart, Series};
 use hdi_tribology::scene::Scene;
 use problems::Problem;
 use std::path::Path;
@@ -87,6 +89,7 @@ fn failure_status(method: Method, stiff: bool, e: &OdeError) -> String {
 
 fn run_problem<const N: usize>(p: &Problem<N>, rtols: &[f64], rows: &mut Vec<Row>) {
     for method in Method::ALL {
+        eprintln!("work_precision: {} with {} …", p.name, method.name());
         for &rtol in rtols {
             let mut opts = p.options(rtol).max_steps(2_000_000);
             if p.stiff && explicit(method) {
@@ -167,6 +170,7 @@ fn outputs(r: &CycleResult) -> Option<(f64, f64)> {
 
 fn run_slider(slider: &Slider, v_ac: f64, rtols: &[f64], rows: &mut Vec<Row>) -> Res<()> {
     let name = format!("slider_{v_ac:.1}V");
+    eprintln!("work_precision: {name}, references and every method …");
     let clock = Instant::now();
     let reference = slider.cycle(v_ac, Method::Tsit5, SLIDER_REF_RTOL)?;
     let (dp_ref, ptd_ref) = outputs(&reference).ok_or("reference cycle without touchdown")?;
@@ -241,6 +245,7 @@ const RESOLVED: f64 = 1e-8;
 /// against reference sweeps at rtol 1e-11 (Tsit5 and Radau5): wall time and largest errors over
 /// the amplitudes where the two references agree.
 fn sweep_report(slider: &Slider) -> Res<()> {
+    eprintln!("work_precision: AC sweeps of the slider …");
     let amplitudes: Vec<f64> = (0..=10).map(|i| f64::from(i) * 0.1).collect();
     let reference_sweep = |method: Method| -> Res<Vec<CycleResult>> {
         let mut o = CycleOptions::from_scene(&slider.scene)?;
@@ -408,10 +413,12 @@ fn chart(
     second: bool,
 ) -> Res<()> {
     let labels: Vec<String> = Method::ALL.iter().map(|m| m.name().to_string()).collect();
+    // Each method keeps its colour in every chart, whichever methods have points.
     let series: Vec<Series> = Method::ALL
         .iter()
         .zip(&labels)
-        .filter_map(|(&m, label)| {
+        .zip(palette::SERIES.iter().cycle())
+        .filter_map(|((&m, label), &colour)| {
             let points: Vec<(f64, f64)> = rows
                 .iter()
                 .filter(|r| r.problem == problem && r.method == m && r.status == "ok")
@@ -419,11 +426,7 @@ fn chart(
                 .filter(|&(_, e)| e > 0.0)
                 .map(|(t, e)| (t.log10(), e.log10()))
                 .collect();
-            (!points.is_empty()).then(|| Series {
-                label,
-                points,
-                markers: false,
-            })
+            (!points.is_empty()).then(|| Series::line(label, points).colour(colour))
         })
         .collect();
     if series.is_empty() {
@@ -437,7 +440,7 @@ fn chart(
         x_label: "log10 CPU time of the thread (ms)",
         y_label: &y_label,
         series,
-        log: (false, false),
+        ..Chart::default()
     }
     .to_svg(&out.join(file), 720, 480)?;
     Ok(())
@@ -445,9 +448,9 @@ fn chart(
 
 fn main() -> Res<()> {
     let clock = Instant::now();
-    let out = Path::new("out/work_precision");
-    std::fs::create_dir_all(out)?;
-    let quick = std::env::args().any(|a| a == "--quick");
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let out = &output::out_dir("work_precision", &args)?;
+    let quick = args.iter().any(|a| a == "--quick");
     let all: Vec<f64> = (3..=12).map(|k| 10f64.powi(-k)).collect();
     let rtols: Vec<f64> = if quick {
         all.iter().copied().step_by(2).collect()
