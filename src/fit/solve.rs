@@ -626,6 +626,23 @@ fn analyse(
             }
         })
         .collect();
+    // Other starts that ended as good a fit (χ² within n·s² of the best) but elsewhere: the
+    // linearisation at one minimum cannot see them, so the parameters that differ by more than
+    // three of their error bars are not determined.
+    let mut parameters = parameters;
+    let mut elsewhere: Vec<String> = Vec::new();
+    for o in starts.iter().filter(|o| o.cost <= chi2 + n as f64 * s * s && o.end.len() == n) {
+        for (j, p) in parameters.iter_mut().enumerate() {
+            let far = (o.end[j] - x[j]).abs() > 3.0 * p.linear_error;
+            if far && p.determined {
+                p.determined = false;
+                p.standard_error = None;
+            }
+            if far && !elsewhere.contains(&p.name) {
+                elsewhere.push(p.name.clone());
+            }
+        }
+    }
     let correlation: Vec<Vec<f64>> = (0..n)
         .map(|a| {
             (0..n)
@@ -633,7 +650,16 @@ fn analyse(
                 .collect()
         })
         .collect();
-    let statements = identifiability_words(&parameters, &directions, params, tol);
+    let mut statements = Vec::new();
+    if !elsewhere.is_empty() {
+        statements.push(format!(
+            "starts that ended elsewhere fit as well (χ² within {n}·s² of the best): {} differ(s) \
+             between them by more than three error bars, so the data do not determine {}",
+            elsewhere.join(", "),
+            if elsewhere.len() == 1 { "it" } else { "them" }
+        ));
+    }
+    statements.extend(identifiability_words(&parameters, &directions, params, tol));
     let condition = if sv.iter().any(|&v| v <= 0.0) {
         f64::INFINITY
     } else {
