@@ -120,7 +120,17 @@ impl<'a> Evaluator<'a> {
                         static_model = Some(self.model(&s)?);
                     }
                     let m = static_model.as_ref().expect("built above");
-                    predict_static(m, &scene, ds)?
+                    match predict_static(m, &scene, ds) {
+                        Ok(c) => c,
+                        // The coarse tables can lose a bracket of the scan: the scene's own.
+                        Err(_) => {
+                            if dynamic_model.is_none() {
+                                dynamic_model = Some(self.model(&scene)?);
+                            }
+                            let m = dynamic_model.as_ref().expect("built above");
+                            predict_static(m, &scene, ds)?
+                        }
+                    }
                 }
                 CurveKind::CycleVsAc => {
                     if dynamic_model.is_none() {
