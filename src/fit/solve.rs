@@ -72,7 +72,10 @@ impl FitOptions {
             ("static_table_rel_tol", self.static_table_rel_tol, 0.01),
         ] {
             if !(v > 0.0 && v <= hi) {
-                return Err(Error::invalid(f, format!("must lie in (0, {hi}], got {v:?}")));
+                return Err(Error::invalid(
+                    f,
+                    format!("must lie in (0, {hi}], got {v:?}"),
+                ));
             }
         }
         Ok(())
@@ -298,7 +301,9 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
             // A trial point the model cannot evaluate: far worse than the last good one, so the
             // optimiser shrinks its step instead of stopping.
             (None, Some(g)) => Some(LmVector::from_vec(
-                g.iter().map(|v| 10.0 * v + v.signum() * 1e3 + 1e3).collect(),
+                g.iter()
+                    .map(|v| 10.0 * v + v.signum() * 1e3 + 1e3)
+                    .collect(),
             )),
             (None, None) => None,
         }
@@ -357,7 +362,11 @@ fn jacobian_columns(
         } else {
             (r0.to_vec(), h)
         };
-        Ok(plus.iter().zip(&minus).map(|(a, b)| (a - b) / span).collect())
+        Ok(plus
+            .iter()
+            .zip(&minus)
+            .map(|(a, b)| (a - b) / span)
+            .collect())
     };
     let n = x.len();
     #[cfg(feature = "parallel")]
@@ -466,7 +475,11 @@ pub fn fit(
     let mut first_error = None;
     for start in start_points(&params, opts.starts, opts.seed) {
         let budget = ev.evaluations.load(Ordering::Relaxed) + opts.max_evaluations;
-        let u0: Vec<f64> = params.iter().zip(&start).map(|(p, &x)| p.transform.u(x)).collect();
+        let u0: Vec<f64> = params
+            .iter()
+            .zip(&start)
+            .map(|(p, &x)| p.transform.u(x))
+            .collect();
         let problem = Problem {
             ev: &ev,
             u: u0.clone(),
@@ -568,7 +581,11 @@ fn analyse(
     let directions: Vec<Direction> = order
         .iter()
         .map(|&k| {
-            let rel_error = if sv[k] > floor { s / sv[k] } else { f64::INFINITY };
+            let rel_error = if sv[k] > floor {
+                s / sv[k]
+            } else {
+                f64::INFINITY
+            };
             let mut components: Vec<(String, f64)> = (0..n)
                 .map(|j| (names[j].to_string(), v_t[(k, j)]))
                 .filter(|(_, w)| w.abs() >= 0.05)
@@ -608,9 +625,15 @@ fn analyse(
                 cov[(j, j)].sqrt()
             };
             let determined = rel <= tol;
-            let at_bound = [p.lower, p.upper].iter().flatten().any(|b| {
-                (x[j] - b).abs() <= 1e-6 * p.scale.max((p.upper.unwrap_or(*b) - b).abs())
-            });
+            // Within a thousandth of the range (or of the scale, for a one-sided bound).
+            let width = match (p.lower, p.upper) {
+                (Some(lo), Some(hi)) => hi - lo,
+                _ => p.scale,
+            };
+            let at_bound = [p.lower, p.upper]
+                .iter()
+                .flatten()
+                .any(|b| (x[j] - b).abs() <= 1e-3 * width);
             FittedParameter {
                 name: p.name.clone(),
                 unit: p.unit.clone(),
@@ -626,6 +649,26 @@ fn analyse(
             }
         })
         .collect();
+    // Other starts that ended as good a fit (χ² within n·s² of the best) but elsewhere: the
+    // linearisation at one minimum cannot see them, so the parameters that differ by more than
+    // three of their error bars are not determined.
+    let mut parameters = parameters;
+    let mut elsewhere: Vec<String> = Vec::new();
+    for o in starts
+        .iter()
+        .filter(|o| o.cost <= chi2 + n as f64 * s * s && o.end.len() == n)
+    {
+        for (j, p) in parameters.iter_mut().enumerate() {
+            let far = (o.end[j] - x[j]).abs() > 3.0 * p.linear_error;
+            if far && p.determined {
+                p.determined = false;
+                p.standard_error = None;
+            }
+            if far && !elsewhere.contains(&p.name) {
+                elsewhere.push(p.name.clone());
+            }
+        }
+    }
     let correlation: Vec<Vec<f64>> = (0..n)
         .map(|a| {
             (0..n)
@@ -633,7 +676,16 @@ fn analyse(
                 .collect()
         })
         .collect();
-    let statements = identifiability_words(&parameters, &directions, params, tol);
+    let mut statements = Vec::new();
+    if !elsewhere.is_empty() {
+        statements.push(format!(
+            "starts that ended elsewhere fit as well (χ² within {n}·s² of the best): {} differ(s) \
+             between them by more than three error bars, so the data do not determine {}",
+            elsewhere.join(", "),
+            if elsewhere.len() == 1 { "it" } else { "them" }
+        ));
+    }
+    statements.extend(identifiability_words(&parameters, &directions, params, tol));
     let condition = if sv.iter().any(|&v| v <= 0.0) {
         f64::INFINITY
     } else {
@@ -745,15 +797,11 @@ fn identifiability_words(
             )),
             comps => {
                 let list: Vec<&str> = comps.iter().map(|c| c.0.as_str()).collect();
-                let combo: Vec<String> = comps
-                    .iter()
-                    .map(|(n, w)| format!("{w:+.2}·Δ{n}"))
-                    .collect();
+                let combo: Vec<String> =
+                    comps.iter().map(|(n, w)| format!("{w:+.2}·Δ{n}")).collect();
                 let moves: Vec<String> = comps
                     .iter()
-                    .map(|(n, w)| {
-                        format!("{} {n}", if *w > 0.0 { "raising" } else { "lowering" })
-                    })
+                    .map(|(n, w)| format!("{} {n}", if *w > 0.0 { "raising" } else { "lowering" }))
                     .collect();
                 out.push(format!(
                     "{} are not determined separately: along {} (each change relative to the \
@@ -792,7 +840,11 @@ fn identifiability_words(
         out.push(format!(
             "no error bar is given for {}: the data do not determine {}",
             undetermined.join(", "),
-            if undetermined.len() == 1 { "it" } else { "them" }
+            if undetermined.len() == 1 {
+                "it"
+            } else {
+                "them"
+            }
         ));
     }
     out

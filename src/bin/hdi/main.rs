@@ -10,6 +10,7 @@
 mod calibrate;
 mod common;
 mod cycle;
+mod fit;
 mod forces;
 mod scene;
 mod static_cmd;
@@ -42,6 +43,8 @@ enum Command {
     Sweep(sweep::Args),
     /// Touchdown calibration as drive firmware does it: a heater staircase up to touchdown.
     Calibrate(calibrate::Args),
+    /// Fit scene fields to measured curves (CSV), with errors and an identifiability report.
+    Fit(fit::Args),
     /// The scene, validated, as TOML (or JSON): a starting point for scenes of your own.
     Scene(scene::Args),
 }
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Cycle(a) => cycle::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Fit(a) => fit::run(a),
         Command::Scene(a) => scene::run(a),
     };
     match result {
