@@ -19,7 +19,8 @@ use crate::error::{check_finite, check_non_negative, Error, Result};
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Programme {
-    knots: Vec<(f64, f64)>,
+    // Shared so that cloning a programme (once per controller step in `drive`) allocates nothing.
+    knots: std::sync::Arc<[(f64, f64)]>,
 }
 
 impl Programme {
@@ -45,7 +46,9 @@ impl Programme {
                 ));
             }
         }
-        Ok(Programme { knots })
+        Ok(Programme {
+            knots: knots.into(),
+        })
     }
 
     /// A constant power held from `t = 0` to `t_end`.

@@ -84,7 +84,9 @@
 
 pub mod analysis;
 pub mod clearance;
+pub mod drive;
 pub mod error;
+pub mod fit;
 pub mod force;
 pub mod heater;
 pub mod model;
@@ -96,3 +98,6 @@ pub mod surface;
 pub mod units;
 
 pub use error::{Error, Result};
+/// The linear algebra crate of the public API (state vectors, Jacobian matrices), re-exported
+/// so that a system can be written without matching its version by hand.
+pub use nalgebra;

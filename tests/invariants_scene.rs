@@ -4,6 +4,7 @@
 #[path = "common/seeded.rs"]
 mod seeded;
 
+use hdi_tribology::force::TermForce;
 use hdi_tribology::force::{AirBearingModel, Footprint, GapReference};
 use hdi_tribology::scene::{ContactSpec, ElectrostaticSpec, IntermolecularSpec, Scene};
 use hdi_tribology::surface::PeakModel;
@@ -124,7 +125,10 @@ fn force_bits(s: &Scene) -> Vec<u64> {
     let mut out = Vec::new();
     for d in [lo, 0.3 * lo + 0.7 * hi, hi] {
         for t in &terms {
-            let (f, df) = t.force(d).unwrap();
+            let TermForce {
+                value: f,
+                slope: df,
+            } = t.force(d).unwrap();
             out.push(f.to_bits());
             out.push(df.to_bits());
         }

@@ -93,7 +93,8 @@ impl Tabulated {
             let (a, b) = if self.area {
                 terms[i].real_contact_area_and_slope(d)?
             } else {
-                terms[i].force(d)?
+                let f = terms[i].force(d)?;
+                (f.value, f.slope)
             };
             v += a;
             s += b;

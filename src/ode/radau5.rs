@@ -197,6 +197,12 @@ where
         }
     }
 
+    /// Follows a change of the relative tolerance between steps.
+    pub fn set_rtol(&mut self, rtol: f64) {
+        self.tol_scale = 1.0;
+        self.newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
+    }
+
     fn norm(
         &self,
         v: &OVector<f64, D>,

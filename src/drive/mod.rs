@@ -1,0 +1,38 @@
+//! A simulated drive that firmware code can drive: step it at the controller's rate, read its
+//! sensors, close the loop.
+//!
+//! [`Drive`] is the plant: the slider of a scene in a [`crate::clearance::Zone`], over a disk
+//! with run-out and waviness ([`DiskSpec`]), with a heater behind its thermal lag and a
+//! head–disk voltage ([`Command`]). [`Drive::step`] advances it by one controller period and
+//! returns the [`Sensors`] firmware reads: the embedded contact sensor, acoustic emission and
+//! the read-back amplitudes, each with its bandwidth and seeded noise, plus the [`Truth`] for
+//! test oracles.
+//!
+//! ```
+//! use hdi_tribology::drive::{scene_zone, Command, Drive, DriveOptions};
+//! use hdi_tribology::scene::Scene;
+//! let scene = Scene::paper();
+//! let zone = scene_zone(&scene, 0.025)?;
+//! let mut drive = Drive::new(&scene, &zone, 1, DriveOptions::default())?;
+//! // The firmware loop at 20 kHz: read, decide, repeat.
+//! let mut power_mw = 60.0;
+//! for _ in 0..100 {
+//!     let s = drive.step(&Command::heater_mw(power_mw), 50e-6)?;
+//!     if s.acoustic < 0.01 {
+//!         power_mw += 0.05;
+//!     }
+//! }
+//! assert!(power_mw > 60.0);
+//! # Ok::<(), hdi_tribology::Error>(())
+//! ```
+
+mod disk;
+mod plant;
+mod rng;
+mod sensors;
+
+pub use disk::{DiskSpec, Harmonic};
+pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions};
+pub use sensors::{
+    AcousticSpec, ContactSensorSpec, Readback, ReadbackSpec, SensorSpec, Sensors, Truth,
+};

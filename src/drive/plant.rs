@@ -1,0 +1,546 @@
+//! The simulated drive: the slider of a scene in a zone, stepped at the controller's rate.
+
+use super::disk::{Disk, DiskSpec};
+use super::sensors::{Physical, SensorSpec, SensorState, Sensors, Truth};
+use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
+use crate::clearance::Zone;
+use crate::error::{check_finite, check_non_negative, Error, Result};
+use crate::heater::Programme;
+use crate::model::{SliderModel, SliderSystem, StateLayout, Voltage};
+use crate::ode::{self, Method, OdeSystem, Options, SaveAt, Stats};
+use crate::scene::Scene;
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector, SVector};
+use std::f64::consts::PI;
+
+/// What the controller sets for the next period.
+///
+/// ```
+/// use hdi_tribology::drive::Command;
+/// let c = Command::heater_mw(72.5).with_dither(0.5, 10.5e3);
+/// assert_eq!(c.heater_power, 0.0725);
+/// assert_eq!(c.ac_amplitude, 0.5);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Command {
+    /// Heater power (W, ≥ 0); the protrusion follows through the heater's thermal lag.
+    pub heater_power: f64,
+    /// DC head–disk voltage (V).
+    pub dc_voltage: f64,
+    /// AC dither amplitude (V).
+    pub ac_amplitude: f64,
+    /// AC dither frequency (Hz).
+    pub ac_frequency: f64,
+}
+
+impl Command {
+    /// Heater power in milliwatts, no voltage.
+    pub fn heater_mw(p_mw: f64) -> Self {
+        Command {
+            heater_power: crate::units::mw(p_mw),
+            ..Command::default()
+        }
+    }
+
+    /// The same command with an AC dither of `amplitude` (V) at `frequency` (Hz).
+    pub fn with_dither(self, amplitude: f64, frequency: f64) -> Self {
+        Command {
+            ac_amplitude: amplitude,
+            ac_frequency: frequency,
+            ..self
+        }
+    }
+
+    fn validate(&self) -> Result<()> {
+        check_non_negative("command.heater_power", self.heater_power)?;
+        if self.heater_power > MAX_HEATER_POWER {
+            return Err(Error::invalid(
+                "command.heater_power",
+                format!(
+                    "must not exceed {} mW, got {} mW",
+                    MAX_HEATER_POWER * 1e3,
+                    self.heater_power * 1e3
+                ),
+            ));
+        }
+        check_finite("command.dc_voltage", self.dc_voltage)?;
+        check_finite("command.ac_amplitude", self.ac_amplitude)?;
+        check_non_negative("command.ac_frequency", self.ac_frequency)?;
+        Ok(())
+    }
+}
+
+/// Largest heater power a command may ask for (W): far above any thermal fly-height heater.
+const MAX_HEATER_POWER: f64 = 1.0;
+
+/// Ambient temperature drift and what it does to the clearance.
+///
+/// `ΔT_amb(t) = rate · t + amplitude · sin(2π t / period)`; the nominal clearance moves by
+/// `clearance_per_kelvin · ΔT_amb` (the slider and suspension expand; drives see a few hundredths
+/// of a nanometre per kelvin) and the contact sensor reads the ambient change too.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Ambient {
+    /// Linear drift (K/s).
+    pub rate: f64,
+    /// Amplitude of a periodic part (K).
+    pub amplitude: f64,
+    /// Its period (s, > 0).
+    pub period: f64,
+    /// Clearance change per kelvin (m/K).
+    pub clearance_per_kelvin: f64,
+}
+
+impl Default for Ambient {
+    /// No drift; 0.03 nm/K when there is one.
+    fn default() -> Self {
+        Ambient {
+            rate: 0.0,
+            amplitude: 0.0,
+            period: 1.0,
+            clearance_per_kelvin: 0.03e-9,
+        }
+    }
+}
+
+impl Ambient {
+    /// Temperature change at `t` (K).
+    pub fn temperature(&self, t: f64) -> f64 {
+        self.rate * t + self.amplitude * (2.0 * PI * t / self.period).sin()
+    }
+}
+
+/// Options of [`Drive::new`].
+///
+/// ```
+/// use hdi_tribology::drive::DriveOptions;
+/// let o = DriveOptions::default();
+/// assert_eq!(o.initial_power, 0.060);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct DriveOptions {
+    /// Heater power at the start (W); the slider starts at rest in its flying equilibrium there.
+    pub initial_power: f64,
+    /// Thermal time constant of the heater (s), used when the scene has none
+    /// (`heater.thermal_lag_s = 0`); 0 makes the protrusion follow the command at once.
+    pub heater_time_constant: f64,
+    /// The disk surface.
+    pub disk: DiskSpec,
+    /// Ambient drift.
+    pub ambient: Ambient,
+    /// The sensors.
+    pub sensors: SensorSpec,
+}
+
+impl Default for DriveOptions {
+    /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift.
+    fn default() -> Self {
+        DriveOptions {
+            initial_power: 0.060,
+            heater_time_constant: 1e-4,
+            disk: DiskSpec::default(),
+            ambient: Ambient::default(),
+            sensors: SensorSpec::default(),
+        }
+    }
+}
+
+/// The zone a scene describes by itself: its own clearance, air-bearing stiffness and disk speed,
+/// at `radius` (m).
+///
+/// ```
+/// use hdi_tribology::{drive::scene_zone, scene::Scene};
+/// let z = scene_zone(&Scene::paper(), 0.025)?;
+/// assert_eq!(z.disk_speed, 10.0);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn scene_zone(scene: &Scene, radius: f64) -> Result<Zone> {
+    crate::error::check_positive("radius", radius)?;
+    Ok(Zone {
+        name: scene.name.clone(),
+        radius,
+        disk_speed: scene.friction.disk_speed_m_per_s,
+        nominal_clearance: scene.nominal_clearance_m,
+        bearing_stiffness: scene.build_air_bearing()?.stiffness(0.0),
+    })
+}
+
+/// The slider's ODE with the disk surface moving under it.
+///
+/// The state is relative to the disk surface `w(t)` (every force of the model depends on the
+/// gap and its rate only), so the surface's motion enters as the inertial force `−m ẅ(t)`;
+/// everything else is the model's own [`SliderSystem`].
+struct DriveSystem<'a> {
+    slider: SliderSystem<'a>,
+    disk: &'a Disk,
+}
+
+impl<D: Dim> OdeSystem<D> for DriveSystem<'_>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn rhs(&self, t: f64, y: &OVector<f64, D>, dy: &mut OVector<f64, D>) {
+        self.slider.rhs(t, y, dy);
+        if !self.disk.is_flat() {
+            dy[1] -= self.disk.acceleration(t).0;
+        }
+    }
+
+    fn jacobian(&self, t: f64, y: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
+        self.slider.jacobian(t, y, j)
+    }
+
+    fn time_derivative(&self, t: f64, y: &OVector<f64, D>, d: &mut OVector<f64, D>) -> bool {
+        let ok = self.slider.time_derivative(t, y, d);
+        if ok && !self.disk.is_flat() {
+            d[1] -= self.disk.acceleration(t).1;
+        }
+        ok
+    }
+}
+
+/// The state vector, sized at compile time for the layouts a scene can have.
+#[derive(Clone, Debug)]
+enum State {
+    S4(SVector<f64, 4>),
+    S5(SVector<f64, 5>),
+    S6(SVector<f64, 6>),
+}
+
+macro_rules! with_state {
+    ($state:expr, $y:ident => $body:expr) => {
+        match $state {
+            State::S4($y) => $body,
+            State::S5($y) => $body,
+            State::S6($y) => $body,
+        }
+    };
+}
+
+/// A simulated drive: the slider of a scene flying in a zone over a wavy disk, with a heater, a
+/// head–disk voltage and the sensors firmware reads, stepped at the controller's rate.
+///
+/// Each [`Drive::step`] holds the [`Command`] over one period, advances the slider dynamics
+/// from where the last period ended (the model's [`SliderSystem`], any structure it supports,
+/// plus the disk's motion) and returns the [`Sensors`] at its end. The same seed gives the same
+/// disk and the same sensor noise, bit for bit.
+///
+/// ```
+/// use hdi_tribology::drive::{scene_zone, Command, Drive, DriveOptions};
+/// use hdi_tribology::scene::Scene;
+/// let scene = Scene::paper();
+/// let mut drive = Drive::new(&scene, &scene_zone(&scene, 0.025)?, 7, DriveOptions::default())?;
+/// let mut s = drive.step(&Command::heater_mw(60.0), 50e-6)?;
+/// for _ in 0..40 {
+///     s = drive.step(&Command::heater_mw(65.0), 50e-6)?;
+/// }
+/// // 5 mW more heater closes the gap by about η·5 mW = 0.5 nm.
+/// println!("gap {:.3} nm, sensor {:.4} Ω", s.truth.gap * 1e9, s.contact_resistance);
+/// assert!(s.truth.gap < 4.5e-9);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Drive {
+    base: SliderModel,
+    programme: Programme,
+    layout: StateLayout,
+    disk: Disk,
+    sensors: SensorState,
+    ambient: Ambient,
+    method: Method,
+    ode: Options,
+    /// Dither frequency `ode` was made for (its step cap depends on it).
+    ode_frequency: f64,
+    atol: Vec<f64>,
+    rtol: f64,
+    max_steps: usize,
+    state: State,
+    t: f64,
+    stats: Stats,
+    zone: Zone,
+    seed: u64,
+}
+
+impl Drive {
+    /// The drive of `scene` moved to `zone` (see [`Zone::scene`]), its noise and disk seeded by
+    /// `seed`. The slider starts at rest in its flying equilibrium at `opts.initial_power` with
+    /// no voltage.
+    ///
+    /// # Errors
+    /// Invalid scene, zone or options (named field); no flying equilibrium at the initial power.
+    pub fn new(scene: &Scene, zone: &Zone, seed: u64, opts: DriveOptions) -> Result<Self> {
+        check_non_negative("initial_power", opts.initial_power)?;
+        check_non_negative("heater_time_constant", opts.heater_time_constant)?;
+        check_finite("ambient.rate", opts.ambient.rate)?;
+        check_finite("ambient.amplitude", opts.ambient.amplitude)?;
+        crate::error::check_positive("ambient.period", opts.ambient.period)?;
+        check_finite(
+            "ambient.clearance_per_kelvin",
+            opts.ambient.clearance_per_kelvin,
+        )?;
+        opts.sensors.validate()?;
+        let zoned = zone.scene(scene)?;
+        let solver = CycleOptions::from_scene(&zoned)?.solver;
+        let mut base = SliderModel::from_scene(&zoned)?;
+        if base.thermal_lag == 0.0 {
+            base.thermal_lag = opts.heater_time_constant;
+        }
+        let rpm = zone.disk_speed * 60.0 / (2.0 * PI * zone.radius);
+        let disk = Disk::new(&opts.disk, rpm, seed)?;
+        // The heater command enters as the protrusion per unit power of a constant 1 W programme
+        // (`η P` = `(η P) · 1 W`), so a new command needs no new programme.
+        let programme = Programme::constant(1.0, 1.0)?;
+        let dc = base.with_voltage(Voltage {
+            dc: 0.0,
+            ac_amplitude: 0.0,
+            ..base.voltage
+        });
+        let eq = flying_equilibrium(
+            &dc,
+            opts.initial_power,
+            dc.voltage.squared(0.0),
+            &ScanGrid::default(),
+        )?;
+        let slider = SliderSystem::new(&base, programme.clone(), true);
+        let layout = slider.layout();
+        let state = match layout.len() {
+            4 => State::S4(slider.initial_state(
+                nalgebra::U4,
+                eq.y,
+                eq.protrusion,
+                eq.interface_force,
+            )),
+            5 => State::S5(slider.initial_state(
+                nalgebra::U5,
+                eq.y,
+                eq.protrusion,
+                eq.interface_force,
+            )),
+            6 => State::S6(slider.initial_state(
+                nalgebra::U6,
+                eq.y,
+                eq.protrusion,
+                eq.interface_force,
+            )),
+            n => {
+                return Err(Error::analysis(
+                    "drive",
+                    format!("no fixed-size state of {n} components"),
+                ))
+            }
+        };
+        let k = base.bearing().stiffness(0.0);
+        let a = solver.atol_displacement;
+        let mut atol = vec![a; layout.len()];
+        atol[1] = a * (k / base.mass).sqrt();
+        if let Some(i) = layout.lagged_force {
+            atol[i] = a * k;
+        }
+        // The period means of the contact force and flash temperature: 1 µN and 1 mK over 50 µs.
+        if let Some(i) = layout.contact_impulse {
+            atol[i] = 1e-6 * 5e-5;
+        }
+        if let Some(i) = layout.heat {
+            atol[i] = 1e-3 * 5e-5;
+        }
+        let friction = base.friction.coefficient * zone.disk_speed;
+        let start = Physical {
+            gap: eq.d,
+            heater_power: opts.initial_power,
+            friction_power: friction * base.contact_force(base.gaps(eq.y, eq.protrusion)),
+            ambient: 0.0,
+        };
+        let mut drive = Drive {
+            sensors: SensorState::new(opts.sensors, seed, &start),
+            base,
+            programme,
+            layout,
+            disk,
+            ambient: opts.ambient,
+            method: solver.method,
+            ode: Options::default(),
+            ode_frequency: f64::NAN,
+            atol,
+            rtol: solver.rtol,
+            max_steps: solver.max_steps,
+            state,
+            t: 0.0,
+            stats: Stats::default(),
+            zone: zone.clone(),
+            seed,
+        };
+        drive.ode_for(0.0)?;
+        Ok(drive)
+    }
+
+    /// (Re)builds the integration options when the dither frequency changes: with a dither the
+    /// step is capped at 1/40 of its period so no peak of `V²` is skipped.
+    fn ode_for(&mut self, frequency: f64) -> Result<()> {
+        if frequency == self.ode_frequency {
+            return Ok(());
+        }
+        let h_max = if frequency > 0.0 {
+            1.0 / (40.0 * frequency)
+        } else {
+            f64::INFINITY
+        };
+        let o = Options::default()
+            .rtol(self.rtol)
+            .atol_per_component(self.atol.clone())
+            .h_max(h_max)
+            .max_steps(self.max_steps)
+            .save(SaveAt::Final)
+            .dense(false);
+        o.validate(self.layout.len())
+            .map_err(|e| Error::invalid("solver", e.to_string()))?;
+        self.ode = o;
+        self.ode_frequency = frequency;
+        Ok(())
+    }
+
+    /// Holds `command` for `dt` seconds, advances the slider and returns the sensors at the end.
+    ///
+    /// # Errors
+    /// An invalid command or period (named field); an integration failure (the state is then
+    /// left at the start of the period).
+    pub fn step(&mut self, command: &Command, dt: f64) -> Result<Sensors> {
+        command.validate()?;
+        crate::error::check_positive("dt", dt)?;
+        if dt > 1.0 {
+            return Err(Error::invalid(
+                "dt",
+                format!("a controller period must not exceed 1 s, got {dt} s"),
+            ));
+        }
+        let freq = if command.ac_amplitude != 0.0 {
+            command.ac_frequency
+        } else {
+            0.0
+        };
+        self.ode_for(freq)?;
+        let (t0, t1) = (self.t, self.t + dt);
+        let ambient = self.ambient.temperature(t0);
+        // Cloning the model shares its tables (reference counts): no allocation.
+        let mut model = self.base.clone();
+        model.efficiency = self.base.efficiency * command.heater_power;
+        model.nominal_clearance += self.ambient.clearance_per_kelvin * ambient;
+        model.voltage = Voltage {
+            dc: command.dc_voltage,
+            ac_amplitude: command.ac_amplitude,
+            frequency: command.ac_frequency,
+            contact_potential: self.base.voltage.contact_potential,
+        };
+        let sys = DriveSystem {
+            slider: SliderSystem::new(&model, self.programme.clone(), true),
+            disk: &self.disk,
+        };
+        let layout = self.layout;
+        let (method, ode) = (self.method, &self.ode);
+        let mut stats = Stats::default();
+        let truth = with_state!(&mut self.state, y => {
+            advance(&sys, y, &layout, t0, t1, method, ode, &mut stats)?;
+            observe(&sys, y, &layout, t1, dt)
+        });
+        self.stats += &stats;
+        self.t = t1;
+        let friction_power =
+            model.friction.coefficient * self.zone.disk_speed * truth.mean_contact_force;
+        let phys = Physical {
+            gap: truth.gap,
+            heater_power: command.heater_power,
+            friction_power,
+            ambient,
+        };
+        let (r, ae, readback, temp) = self.sensors.sample(t1, dt, &phys);
+        Ok(Sensors {
+            t: t1,
+            contact_resistance: r,
+            acoustic: ae,
+            readback,
+            heater_power: command.heater_power,
+            truth: Truth {
+                friction_power,
+                sensor_temperature: temp,
+                disk_height: self.disk.height(t1).0,
+                ambient,
+                ..truth
+            },
+        })
+    }
+
+    /// Simulated time so far (s).
+    pub fn time(&self) -> f64 {
+        self.t
+    }
+
+    /// Solver work so far.
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    /// The zone.
+    pub fn zone(&self) -> &Zone {
+        &self.zone
+    }
+
+    /// The seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The slider model of the zone (with the heater time constant the drive uses).
+    pub fn model(&self) -> &SliderModel {
+        &self.base
+    }
+}
+
+/// Integrates one period; the one place the drive calls the ODE stepper.
+#[allow(clippy::too_many_arguments)]
+fn advance<D: Dim>(
+    sys: &DriveSystem<'_>,
+    y: &mut OVector<f64, D>,
+    layout: &StateLayout,
+    t0: f64,
+    t1: f64,
+    method: Method,
+    opts: &Options,
+    stats: &mut Stats,
+) -> Result<()>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    // The integrals restart every period: their end values are the period's sums.
+    for i in [layout.contact_impulse, layout.heat].into_iter().flatten() {
+        y[i] = 0.0;
+    }
+    let sol = ode::solve(sys, t0, y.clone(), t1, method, opts, &mut [])?;
+    *stats += &sol.stats;
+    *y = sol.y_end;
+    Ok(())
+}
+
+/// The true values at the end of a period.
+fn observe<D: Dim>(
+    sys: &DriveSystem<'_>,
+    y: &OVector<f64, D>,
+    layout: &StateLayout,
+    t: f64,
+    dt: f64,
+) -> Truth
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let m = sys.slider.model();
+    let g = sys.slider.gaps(t, y);
+    let mean = |i: Option<usize>| i.map_or(0.0, |i| y[i] / dt);
+    Truth {
+        gap: g.bulge,
+        pad_gap: g.pad,
+        displacement: y[0],
+        velocity: y[1],
+        protrusion: sys.slider.protrusion(t, y),
+        mean_contact_force: mean(layout.contact_impulse),
+        contact_force: m.contact_force(g),
+        interface_force: m.interface_force(g, m.voltage.squared(t)).value,
+        mean_flash_temperature: mean(layout.heat),
+        ..Truth::default()
+    }
+}
