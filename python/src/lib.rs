@@ -821,15 +821,15 @@ fn simulate_cycle<'py>(
     let mut setup = cycle_setup(py, target, triggered, method, rtol)?;
     setup.opts.keep_series = series;
     let r = py
-        .detach(|| {
-            let m = match v_ac {
-                Some(a) => setup.model.with_voltage(Voltage {
+        .detach(|| match v_ac {
+            Some(a) => {
+                let m = setup.model.with_voltage(Voltage {
                     ac_amplitude: a,
                     ..setup.model.voltage
-                }),
-                None => (*setup.model).clone(),
-            };
-            analysis::simulate_cycle(&m, &setup.programme, &setup.opts)
+                });
+                analysis::simulate_cycle(&m, &setup.programme, &setup.opts)
+            }
+            None => analysis::simulate_cycle(&setup.model, &setup.programme, &setup.opts),
         })
         .py()?;
     let out = PyDict::new(py);
@@ -1152,13 +1152,13 @@ fn calibrate(
     let max_mw = max_mw.unwrap_or(start_mw + 60.0);
     let mut opts = CalibrationOptions::from_mw(start_mw, step_mw, max_mw, margin_mw);
     opts.find_takeoff = find_takeoff;
-    let model = match dither_v {
-        Some(v) => model.with_voltage(Voltage {
+    let dithered = dither_v.map(|v| {
+        model.with_voltage(Voltage {
             ac_amplitude: v,
             ..model.voltage
-        }),
-        None => (*model).clone(),
-    };
+        })
+    });
+    let model: &SliderModel = dithered.as_ref().unwrap_or(&model);
     let (th, window) = (scene.detector.contact_threshold_n, scene.detector.window_s);
     let mut det: Box<dyn TouchdownDetector + Send> = match detector {
         "mean" => Box::new(MeanContactForce::new(th, window).py()?),
@@ -1174,7 +1174,7 @@ fn calibrate(
         }
     };
     let c = py
-        .detach(|| clearance::calibrate(&model, det.as_mut(), &opts))
+        .detach(|| clearance::calibrate(model, det.as_mut(), &opts))
         .py()?;
     Ok(Calibration {
         detector: c.detector.clone(),
