@@ -97,3 +97,6 @@ pub mod surface;
 pub mod units;
 
 pub use error::{Error, Result};
+/// The linear algebra crate of the public API (state vectors, Jacobian matrices), re-exported
+/// so that a system can be written without matching its version by hand.
+pub use nalgebra;

@@ -92,6 +92,8 @@ impl DenseOutput {
         self.h.push(p.h);
         self.offset.push(self.coeffs.len());
         self.coeffs.extend_from_slice(&p.coeffs);
+        // A step after a truncated one (an event that acted) extends the range again.
+        self.end_override = None;
     }
 
     /// Drops everything after time `t` (a terminal event inside the last step).

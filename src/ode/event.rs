@@ -15,8 +15,14 @@ pub enum Direction {
     Both,
 }
 
+/// Interior sign checks per step of an acting event (see [`Event::check_inside`]).
+const ACTING_INSIDE_CHECKS: usize = 4;
+
 /// Boxed event function `g(t, y)`.
 type EventFn<'a, D> = Box<dyn FnMut(f64, &OVector<f64, D>) -> f64 + 'a>;
+
+/// Boxed action `affect(t, y)` run at a located event; it may change the state in place.
+type AffectFn<'a, D> = Box<dyn FnMut(f64, &mut OVector<f64, D>) + 'a>;
 
 /// An event function `g(t, y)`; a root of `g` in the chosen direction is an event.
 ///
@@ -32,8 +38,10 @@ where
     DefaultAllocator: Allocator<D>,
 {
     f: EventFn<'a, D>,
+    affect: Option<AffectFn<'a, D>>,
     direction: Direction,
     terminal: bool,
+    inside: usize,
 }
 
 impl<'a, D: Dim> Event<'a, D>
@@ -44,8 +52,76 @@ where
     pub fn new(f: impl FnMut(f64, &OVector<f64, D>) -> f64 + 'a) -> Self {
         Event {
             f: Box::new(f),
+            affect: None,
             direction: Direction::Both,
             terminal: false,
+            inside: 0,
+        }
+    }
+
+    /// Makes the event act: at the located time `te` the integration stops inside the step,
+    /// `affect(te, y)` may change the state `y` in place (a velocity reversed, a counter reset),
+    /// and the integration goes on from `(te, y)` with the method restarted there — as after
+    /// [`Integrator::reinit`](super::Integrator::reinit). Parameters of the system can be
+    /// changed too when the system reads them from a shared cell (`Cell`, `RefCell`) that the
+    /// action writes.
+    ///
+    /// The state right after the action should not sit on the wrong side of the event's
+    /// direction, or the event fires again at once: choose [`Direction::Falling`] or
+    /// [`Direction::Rising`] for a reset. Steps are sized by the solution's accuracy, not by
+    /// the events: where the solution is smooth enough for steps longer than the time between
+    /// two events, limit them with `Options::h_max`.
+    ///
+    /// A ball bouncing with restitution 0.8 (the velocity is reversed and scaled at each
+    /// impact):
+    ///
+    /// ```
+    /// use hdi_tribology::ode::{solve, Direction, Event, FnSystem, Method, Options};
+    /// use nalgebra::Vector2;
+    /// let ball = FnSystem::new(|_t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>| {
+    ///     dy[0] = y[1];
+    ///     dy[1] = -9.81;
+    /// });
+    /// let mut events = [Event::new(|_t, y: &Vector2<f64>| y[0])
+    ///     .direction(Direction::Falling)
+    ///     .affect(|_t, y| y[1] = -0.8 * y[1])];
+    /// let opts = Options::default().rtol(1e-10).atol(1e-12);
+    /// let sol = solve(&ball, 0.0, Vector2::new(1.0, 0.0), 1.5, Method::Tsit5, &opts, &mut events)?;
+    /// // First impact at √(2/g); the second 2·0.8·√(2/g) later.
+    /// let t1 = (2.0 / 9.81f64).sqrt();
+    /// assert!((sol.events[0].t - t1).abs() < 1e-9);
+    /// assert!((sol.events[1].t - t1 * (1.0 + 1.6)).abs() < 1e-9);
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    pub fn affect(mut self, affect: impl FnMut(f64, &mut OVector<f64, D>) + 'a) -> Self {
+        self.affect = Some(Box::new(affect));
+        if self.inside == 0 {
+            self.inside = ACTING_INSIDE_CHECKS;
+        }
+        self
+    }
+
+    /// Also checks the sign of `g` at `n` evenly spaced points inside each step (on the
+    /// interpolant), so that a pair of roots within one step is not missed. 0 (only the step
+    /// ends) by default; [`affect`](Event::affect) sets 4 when none was set, because right
+    /// after an action `g` starts at zero and a long step could carry it out and back.
+    pub fn check_inside(mut self, n: usize) -> Self {
+        self.inside = n;
+        self
+    }
+
+    pub(crate) fn inside_checks(&self) -> usize {
+        self.inside
+    }
+
+    /// Whether the event acts on the state (see [`Event::affect`]).
+    pub fn acts(&self) -> bool {
+        self.affect.is_some()
+    }
+
+    pub(crate) fn apply(&mut self, t: f64, y: &mut OVector<f64, D>) {
+        if let Some(a) = self.affect.as_mut() {
+            a(t, y);
         }
     }
 
@@ -82,11 +158,11 @@ pub struct EventHit<D: Dim>
 where
     DefaultAllocator: Allocator<D>,
 {
-    /// Index of the event in the slice passed to `solve`.
+    /// Index of the event in the slice passed to `solve` (or to the integrator).
     pub index: usize,
     /// Time of the root.
     pub t: f64,
-    /// State at that time (dense output).
+    /// State at that time (dense output), before any action of the event.
     pub y: OVector<f64, D>,
     /// Whether `g` was rising (`true`) or falling through zero.
     pub rising: bool,

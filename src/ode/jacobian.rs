@@ -38,6 +38,10 @@ pub(crate) fn eval_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
 ) where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+    if sys.is_autonomous() {
+        dfdt.fill(0.0);
+        return;
+    }
     if sys.time_derivative(t, y, dfdt) {
         return;
     }

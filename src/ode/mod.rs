@@ -32,9 +32,11 @@ mod dop853;
 mod driver;
 mod error;
 mod event;
+mod integrator;
 mod jacobian;
 mod lu;
 mod options;
+mod problem;
 mod radau5;
 mod rodas5p;
 mod solution;
@@ -45,9 +47,13 @@ mod tsit5;
 pub use dense::DenseOutput;
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
+pub use integrator::{Integrator, StepStatus};
 pub use options::{Method, Options, SaveAt, Tolerance};
+pub use problem::OdeProblem;
 pub use solution::{Solution, Stats};
-pub use system::{complex_step_jacobian, finite_difference_jacobian, FnSystem, OdeSystem};
+pub use system::{
+    complex_step_jacobian, finite_difference_jacobian, FnSystem, NoJacobian, OdeSystem,
+};
 
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
@@ -93,61 +99,5 @@ pub fn solve<D: Dim, S: OdeSystem<D> + ?Sized>(
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    opts.validate(y0.len())?;
-    if y0.is_empty() {
-        return Err(OdeError::invalid(
-            "y0",
-            "the state must have at least one component",
-        ));
-    }
-    if !t0.is_finite() || !tf.is_finite() {
-        return Err(OdeError::invalid(
-            "t0, tf",
-            format!("must be finite, got t0 = {t0}, tf = {tf}"),
-        ));
-    }
-    if tf <= t0 {
-        return Err(OdeError::invalid(
-            "tf",
-            format!("must be greater than t0 (forward integration only), got t0 = {t0}, tf = {tf}"),
-        ));
-    }
-    if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
-        return Err(OdeError::invalid(
-            format!("y0[{i}]"),
-            format!("must be finite, got {}", y0[i]),
-        ));
-    }
-    let problem = driver::Problem {
-        sys,
-        t0,
-        y0,
-        tf,
-        method,
-        opts,
-        events,
-    };
-    match method {
-        Method::Tsit5 => {
-            let mut m = tsit5::Tsit5::new(&problem.y0);
-            driver::integrate(problem, &mut [&mut m])
-        }
-        Method::Dop853 => {
-            let mut m = dop853::Dop853::new(&problem.y0);
-            driver::integrate(problem, &mut [&mut m])
-        }
-        Method::Rodas5P => {
-            let mut m = rodas5p::Rodas5P::new(&problem.y0);
-            driver::integrate(problem, &mut [&mut m])
-        }
-        Method::Radau5 => {
-            let mut m = radau5::Radau5::new(&problem.y0, opts.rtol);
-            driver::integrate(problem, &mut [&mut m])
-        }
-        Method::Auto => {
-            let mut explicit = tsit5::Tsit5::new(&problem.y0);
-            let mut stiff = rodas5p::Rodas5P::new(&problem.y0);
-            driver::integrate(problem, &mut [&mut explicit, &mut stiff])
-        }
-    }
+    driver::run(sys, t0, y0, tf, method, opts, events)
 }

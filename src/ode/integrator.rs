@@ -1,0 +1,1058 @@
+//! The integration loop as an object: one accepted step per call, step size control, stops,
+//! events (recorded, terminal or acting) and method switching. [`solve`](super::solve) is a
+//! thin loop over it.
+
+use super::dense::StepPoly;
+use super::dop853::Dop853;
+use super::error::OdeError;
+use super::event::{crossing, locate, Event, EventHit};
+use super::jacobian::{eval_jacobian, spectral_radius};
+use super::options::{Method, Options};
+use super::radau5::Radau5;
+use super::rodas5p::Rodas5P;
+use super::solution::Stats;
+use super::stepper::{all_finite, Ctx, FailKind, Stepper, Trial};
+use super::system::OdeSystem;
+use super::tsit5::{Tsit5, STABILITY_BOUNDARY};
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
+
+/// Controller constants: PI control `fac = SAFETY · err^(−α) · err_prev^β` with
+/// `α = 0.7/k`, `β = 0.4/k` (Gustafsson/Söderlind), clamped to `[FAC_MIN, FAC_MAX]`.
+const SAFETY: f64 = 0.9;
+const FAC_MIN: f64 = 0.2;
+const FAC_MAX_EXPLICIT: f64 = 10.0;
+const FAC_MAX_STIFF: f64 = 6.0;
+
+/// Consecutive failed attempts of one kind before giving up with a typed error.
+const MAX_CONSECUTIVE_FAILURES: usize = 12;
+
+/// Stiffness switching (`Auto`), in the spirit of LSODA. Every `CHECK_INTERVAL` explicit
+/// steps (or when the explicit method's own indicator fires) the spectral radius ρ of the
+/// Jacobian is estimated; an explicit step with `h·ρ` above `STIFF_FRACTION` of the stability
+/// boundary is limited by stability, not accuracy. Two such checks in a row switch to the
+/// stiff method; it switches back after `STEPS_TO_RETURN` steps with `h·ρ` below
+/// `RETURN_FRACTION` of the boundary (accuracy would limit an explicit step more than
+/// stability). The gap between the fractions prevents ping-pong.
+const CHECK_INTERVAL: usize = 25;
+const STIFF_FRACTION: f64 = 0.6;
+const STIFF_CHECKS_TO_SWITCH: usize = 2;
+const RETURN_FRACTION: f64 = 0.3;
+const STEPS_TO_RETURN: usize = 5;
+
+/// What one call of [`Integrator::step`] (or [`Integrator::advance_to`]) ended with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepStatus {
+    /// An ordinary accepted step (or, for `advance_to`, the time asked for was reached).
+    Accepted,
+    /// The step ended exactly on the end time `tf`; extend it with [`Integrator::set_tf`] to
+    /// go on.
+    ReachedEnd,
+    /// An acting event (index given) cut the step at its root and changed the state; the
+    /// integration goes on from there.
+    Acted(usize),
+    /// A terminal event (index given) cut the step at its root. Stepping again goes on from
+    /// there.
+    Terminated(usize),
+}
+
+/// The methods of one integration; `Auto` holds an explicit and a stiff one.
+enum Steppers<D: Dim>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    Tsit5(Tsit5<D>),
+    Dop853(Box<Dop853<D>>),
+    Rodas5P(Box<Rodas5P<D>>),
+    Radau5(Box<Radau5<D>>),
+    Auto(Tsit5<D>, Box<Rodas5P<D>>),
+    AutoRadau(Tsit5<D>, Box<Radau5<D>>),
+}
+
+/// `Auto` takes Radau5 as its stiff method below this relative tolerance, Rodas5P from it on.
+/// Measured (docs/benchmarks.md, "Which method when"): at equal error Radau5 is as fast as
+/// Rodas5P or faster on every stiff test problem from about 1e-7 on (up to 2× on Robertson and
+/// OREGO), and it alone is right on E5; at rtol ≥ 1e-6 Rodas5P is up to 1.5× faster on Van der
+/// Pol, HIRES and the slider without AC.
+pub(crate) const AUTO_RADAU_BELOW_RTOL: f64 = 1e-6;
+
+impl<D: Dim> Steppers<D>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn new(method: Method, y0: &OVector<f64, D>, rtol: f64) -> Self {
+        match method {
+            Method::Tsit5 => Steppers::Tsit5(Tsit5::new(y0)),
+            Method::Dop853 => Steppers::Dop853(Box::new(Dop853::new(y0))),
+            Method::Rodas5P => Steppers::Rodas5P(Box::new(Rodas5P::new(y0))),
+            Method::Radau5 => Steppers::Radau5(Box::new(Radau5::new(y0, rtol))),
+            Method::Auto if rtol < AUTO_RADAU_BELOW_RTOL => {
+                Steppers::AutoRadau(Tsit5::new(y0), Box::new(Radau5::new(y0, rtol)))
+            }
+            Method::Auto => Steppers::Auto(Tsit5::new(y0), Box::new(Rodas5P::new(y0))),
+        }
+    }
+
+    fn count(&self) -> usize {
+        match self {
+            Steppers::Auto(..) | Steppers::AutoRadau(..) => 2,
+            _ => 1,
+        }
+    }
+
+    fn get<S: OdeSystem<D> + ?Sized>(&mut self, active: usize) -> &mut dyn Stepper<D, S> {
+        match self {
+            Steppers::Tsit5(m) => m,
+            Steppers::Dop853(m) => m.as_mut(),
+            Steppers::Rodas5P(m) => m.as_mut(),
+            Steppers::Radau5(m) => m.as_mut(),
+            Steppers::Auto(e, s) => {
+                if active == 0 {
+                    e
+                } else {
+                    s.as_mut()
+                }
+            }
+            Steppers::AutoRadau(e, s) => {
+                if active == 0 {
+                    e
+                } else {
+                    s.as_mut()
+                }
+            }
+        }
+    }
+
+    fn set_rtol(&mut self, rtol: f64) {
+        match self {
+            Steppers::Radau5(m) | Steppers::AutoRadau(_, m) => m.set_rtol(rtol),
+            _ => {}
+        }
+    }
+}
+
+/// An integration you can step: `y' = f(t, y)` from `(t0, y0)` towards `tf`, one accepted
+/// step at a time.
+///
+/// [`step`](Integrator::step) takes one accepted step; [`advance_to`](Integrator::advance_to)
+/// steps until it lands exactly on a time; [`interpolate`](Integrator::interpolate) evaluates
+/// the dense output inside the last step; [`reinit`](Integrator::reinit) restarts from a new
+/// state after a discontinuity; [`set_tf`](Integrator::set_tf) and
+/// [`set_tolerances`](Integrator::set_tolerances) change the run between steps. Events added
+/// with [`events`](Integrator::events) are located on each step; an
+/// [acting](Event::affect) event changes the state and the integration goes on. Looping over
+/// `step` is also the way to observe every step without saving them all.
+///
+/// [`solve`](super::solve) is this loop run to the end: stepping by hand gives the same steps,
+/// bit for bit.
+///
+/// ```
+/// use hdi_tribology::ode::{FnSystem, Integrator, Method, Options, StepStatus};
+/// use nalgebra::Vector2;
+///
+/// // The harmonic oscillator y'' = −y, stepped to t = 10, observed at every step.
+/// let osc = FnSystem::new(|_t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>| {
+///     dy[0] = y[1];
+///     dy[1] = -y[0];
+/// });
+/// let opts = Options::default().rtol(1e-10).atol(1e-12);
+/// let mut it = Integrator::new(&osc, 0.0, Vector2::new(1.0, 0.0), 10.0, Method::Dop853, &opts)?;
+/// let mut energy_drift = 0.0f64;
+/// while it.step()? != StepStatus::ReachedEnd {
+///     let y = it.state();
+///     energy_drift = energy_drift.max((y[0] * y[0] + y[1] * y[1] - 1.0).abs());
+///     // Inside the last step the dense output is available.
+///     let mid = 0.5 * (it.t_prev() + it.t());
+///     assert!((it.interpolate(mid)?[0] - mid.cos()).abs() < 1e-7);
+/// }
+/// assert_eq!(it.t(), 10.0);
+/// assert!((it.state()[0] - 10f64.cos()).abs() < 1e-8 && energy_drift < 1e-8);
+/// // Go on: a later end time, and land exactly on t = 12.5.
+/// it.set_tf(20.0)?;
+/// it.advance_to(12.5)?;
+/// assert_eq!(it.t(), 12.5);
+/// assert!((it.state()[0] - 12.5f64.cos()).abs() < 1e-8);
+/// println!("{} steps", it.stats().accepted);
+/// # Ok::<(), hdi_tribology::ode::OdeError>(())
+/// ```
+pub struct Integrator<'a, D: Dim, S: OdeSystem<D> + ?Sized>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    sys: &'a S,
+    method: Method,
+    steppers: Steppers<D>,
+    active: usize,
+    pub(crate) ctx: Ctx<D>,
+    events: Vec<Event<'a, D>>,
+    g_old: Vec<f64>,
+    /// Events located since the last public `step`/`advance_to` began.
+    pub(crate) hits: Vec<EventHit<D>>,
+    step_hits: Vec<(usize, f64, bool)>,
+    t: f64,
+    y: OVector<f64, D>,
+    y_new: OVector<f64, D>,
+    work: OVector<f64, D>,
+    /// Interpolant of the last accepted step (valid on `[poly.t0, t]` when `have_poly`).
+    pub(crate) poly: StepPoly,
+    have_poly: bool,
+    t_span0: f64,
+    tf: f64,
+    /// Kinks of the right-hand side (sorted, deduplicated); steps end on them and restart.
+    kinks: Vec<f64>,
+    kink_idx: usize,
+    /// A time the current `advance_to` must land on (no restart there).
+    target: Option<f64>,
+    h_init: Option<f64>,
+    h_max_opt: f64,
+    h_min: f64,
+    max_steps: usize,
+    event_tol: f64,
+    adaptive: bool,
+    h: f64,
+    h_needs_init: bool,
+    needs_restart: bool,
+    err_prev: f64,
+    last_rejected: bool,
+    fails: (usize, FailKind),
+    /// Non-finite trial steps seen recently (forgotten after a run of accepted steps): a step
+    /// size collapse after them is reported as what it is.
+    recent_nonfinite: usize,
+    accepted_run: usize,
+    stiff_count: usize,
+    since_check: usize,
+    return_count: usize,
+    jac_work: Option<OMatrix<f64, D, D>>,
+}
+
+impl<'a, D: Dim, S: OdeSystem<D> + ?Sized> Integrator<'a, D, S>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// Starts an integration of `sys` from `(t0, y0)` towards `tf > t0` with `method`.
+    ///
+    /// The interpolant of each step is built when `opts.dense` is on (the default) or events
+    /// are added; `opts.save` is ignored (the caller sees every step).
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] for bad arguments or options; [`OdeError::NonFinite`] when
+    /// `f(t0, y0)` is not finite.
+    pub fn new(
+        sys: &'a S,
+        t0: f64,
+        y0: OVector<f64, D>,
+        tf: f64,
+        method: Method,
+        opts: &Options,
+    ) -> Result<Self, OdeError> {
+        Self::build(sys, t0, y0, tf, method, opts, opts.dense)
+    }
+
+    /// Shared constructor; `need_poly` says whether step interpolants are built.
+    pub(crate) fn build(
+        sys: &'a S,
+        t0: f64,
+        y0: OVector<f64, D>,
+        tf: f64,
+        method: Method,
+        opts: &Options,
+        need_poly: bool,
+    ) -> Result<Self, OdeError> {
+        opts.validate(y0.len())?;
+        if y0.is_empty() {
+            return Err(OdeError::invalid(
+                "y0",
+                "the state must have at least one component",
+            ));
+        }
+        if !t0.is_finite() || !tf.is_finite() {
+            return Err(OdeError::invalid(
+                "t0, tf",
+                format!("must be finite, got t0 = {t0}, tf = {tf}"),
+            ));
+        }
+        if tf <= t0 {
+            return Err(OdeError::invalid(
+                "tf",
+                format!(
+                    "must be greater than t0 (forward integration only), got t0 = {t0}, tf = {tf}"
+                ),
+            ));
+        }
+        check_finite_state(&y0)?;
+        let n = y0.len();
+        let (rows, cols) = y0.shape_generic();
+        let atol = OVector::from_fn_generic(rows, cols, |i, _| opts.atol.get(i));
+        let steppers = Steppers::new(method, &y0, opts.rtol);
+        let switching = steppers.count() > 1;
+        let ctx = Ctx {
+            atol,
+            rtol: opts.rtol,
+            stats: Stats::default(),
+            want_stiffness: switching,
+            need_poly,
+        };
+        let mut kinks: Vec<f64> = opts.t_stops.clone();
+        kinks.sort_by(f64::total_cmp);
+        kinks.dedup();
+        let mut it = Integrator {
+            sys,
+            method,
+            steppers,
+            active: 0,
+            ctx,
+            events: Vec::new(),
+            g_old: Vec::new(),
+            hits: Vec::new(),
+            step_hits: Vec::new(),
+            t: t0,
+            y_new: y0.clone(),
+            work: y0.clone(),
+            y: y0,
+            poly: StepPoly::new(n),
+            have_poly: false,
+            t_span0: t0,
+            tf,
+            kinks,
+            kink_idx: 0,
+            target: None,
+            h_init: opts.h_init,
+            h_max_opt: opts.h_max,
+            h_min: opts.h_min,
+            max_steps: opts.max_steps,
+            event_tol: opts.event_tol,
+            adaptive: opts.adaptive,
+            h: f64::NAN,
+            h_needs_init: true,
+            needs_restart: true,
+            err_prev: 1.0,
+            last_rejected: false,
+            fails: (0, FailKind::NonFinite),
+            recent_nonfinite: 0,
+            accepted_run: 0,
+            stiff_count: 0,
+            since_check: 0,
+            return_count: 0,
+            jac_work: switching.then(|| OMatrix::zeros_generic(rows, rows)),
+        };
+        it.restart()?;
+        Ok(it)
+    }
+
+    /// Adds events, located on every step from now on (see [`Event`]); their indices in
+    /// [`EventHit`] and [`StepStatus`] count from the first event added.
+    pub fn events(mut self, events: impl IntoIterator<Item = Event<'a, D>>) -> Self {
+        for mut ev in events {
+            self.g_old.push(ev.eval(self.t, &self.y));
+            self.ctx.stats.event_evals += 1;
+            self.events.push(ev);
+        }
+        self.ctx.need_poly = true;
+        self
+    }
+
+    /// Evaluates every event at the current point (after a start, a reset or an action).
+    pub(crate) fn init_events(&mut self, events: &mut [Event<'_, D>]) {
+        self.g_old.clear();
+        for ev in events.iter_mut() {
+            self.g_old.push(ev.eval(self.t, &self.y));
+        }
+        self.ctx.stats.event_evals += events.len();
+    }
+
+    /// Restarts the method at the current point (evaluates `f`), and picks an initial step
+    /// size when none is pending.
+    fn restart(&mut self) -> Result<(), OdeError> {
+        let stepper = self.steppers.get::<S>(self.active);
+        stepper.restart(self.sys, self.t, &self.y, &mut self.ctx);
+        if !all_finite(stepper.f0()) {
+            return Err(OdeError::NonFinite {
+                t: self.t,
+                what: if self.ctx.stats.accepted == 0 {
+                    "right-hand side at the initial point".into()
+                } else {
+                    format!("right-hand side at the restart point t = {}", self.t)
+                },
+            });
+        }
+        self.needs_restart = false;
+        if self.h_needs_init {
+            let h_max = self.h_max_opt.min(self.tf - self.t_span0);
+            let order = stepper.error_order() - 1.0;
+            self.h = match self.h_init {
+                Some(h) => h,
+                None => initial_step(
+                    self.sys,
+                    self.t,
+                    &self.y,
+                    self.steppers.get::<S>(self.active).f0(),
+                    order,
+                    h_max,
+                    &mut self.work,
+                    &mut self.ctx,
+                ),
+            }
+            .min(h_max);
+            self.h_needs_init = false;
+        }
+        Ok(())
+    }
+
+    /// Current time.
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Start of the last accepted step (equal to [`t`](Integrator::t) before the first step
+    /// and after [`reinit`](Integrator::reinit)).
+    pub fn t_prev(&self) -> f64 {
+        if self.have_poly {
+            self.poly.t0
+        } else {
+            self.t
+        }
+    }
+
+    /// Current state.
+    pub fn state(&self) -> &OVector<f64, D> {
+        &self.y
+    }
+
+    /// End time.
+    pub fn tf(&self) -> f64 {
+        self.tf
+    }
+
+    /// Method asked for.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// Step size the next attempt will try.
+    pub fn next_step_size(&self) -> f64 {
+        self.h
+    }
+
+    /// Whether the stiff method of `Auto` is active (always `true` for Rodas5P and Radau5,
+    /// `false` for the explicit methods).
+    pub fn is_stiff(&self) -> bool {
+        match &self.steppers {
+            Steppers::Tsit5(_) | Steppers::Dop853(_) => false,
+            Steppers::Rodas5P(_) | Steppers::Radau5(_) => true,
+            Steppers::Auto(..) | Steppers::AutoRadau(..) => self.active == 1,
+        }
+    }
+
+    /// Work counters so far (all steps since [`new`](Integrator::new), across reinits).
+    pub fn stats(&self) -> Stats {
+        self.ctx.stats
+    }
+
+    /// Events located in the last call of [`step`](Integrator::step) or
+    /// [`advance_to`](Integrator::advance_to), in time order.
+    pub fn events_hit(&self) -> &[EventHit<D>] {
+        &self.hits
+    }
+
+    /// The state at `t` on the interpolant of the last accepted step, `t` in
+    /// `[t_prev(), t()]`.
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] when no step was taken since the start (or the last reinit),
+    /// when `t` is outside the last step, or when interpolants are off (`opts.dense = false`
+    /// and no events).
+    pub fn interpolate(&self, t: f64) -> Result<OVector<f64, D>, OdeError> {
+        if !self.ctx.need_poly {
+            return Err(OdeError::invalid(
+                "options.dense",
+                "interpolation needs dense = true (or an event)",
+            ));
+        }
+        if !self.have_poly {
+            return Err(OdeError::invalid(
+                "t",
+                "no step has been taken since the start or the last reinit",
+            ));
+        }
+        let (a, b) = (self.poly.t0, self.t);
+        if !(t >= a && t <= b) {
+            return Err(OdeError::invalid(
+                "t",
+                format!("{t} is outside the last step [{a}, {b}]"),
+            ));
+        }
+        let mut out = self.y.clone();
+        if t == b {
+            return Ok(out);
+        }
+        self.poly.eval_into(t, &mut out);
+        Ok(out)
+    }
+
+    /// Sets a new end time `tf > t()` (shorter or longer).
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] when `tf` is not finite or not after the current time.
+    pub fn set_tf(&mut self, tf: f64) -> Result<(), OdeError> {
+        if !(tf.is_finite() && tf > self.t) {
+            return Err(OdeError::invalid(
+                "tf",
+                format!(
+                    "must be finite and after the current time {}, got {tf}",
+                    self.t
+                ),
+            ));
+        }
+        self.tf = tf;
+        Ok(())
+    }
+
+    /// Changes the tolerances for the following steps.
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] naming `options.rtol` or `options.atol` when out of range.
+    pub fn set_tolerances(&mut self, rtol: f64, atol: super::Tolerance) -> Result<(), OdeError> {
+        let check = Options {
+            rtol,
+            atol,
+            ..Options::default()
+        };
+        check.validate(self.y.len())?;
+        for i in 0..self.y.len() {
+            self.ctx.atol[i] = check.atol.get(i);
+        }
+        self.ctx.rtol = rtol;
+        self.steppers.set_rtol(rtol);
+        Ok(())
+    }
+
+    /// Restarts from `(t, y)` after a discontinuity (a jump of the state or of the system's
+    /// parameters): the method drops what it carried over, a new initial step size is chosen,
+    /// and events are evaluated afresh. `t` may be earlier than the current time but must be
+    /// before `tf`.
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] for a non-finite or misplaced `t` or a non-finite or
+    /// wrongly sized `y`; [`OdeError::NonFinite`] when `f(t, y)` is not finite.
+    pub fn reinit(&mut self, t: f64, y: OVector<f64, D>) -> Result<(), OdeError> {
+        if !(t.is_finite() && t < self.tf) {
+            return Err(OdeError::invalid(
+                "t",
+                format!("must be finite and before tf = {}, got {t}", self.tf),
+            ));
+        }
+        if y.len() != self.y.len() {
+            return Err(OdeError::invalid(
+                "y",
+                format!("has {} components, the state has {}", y.len(), self.y.len()),
+            ));
+        }
+        check_finite_state(&y)?;
+        self.t = t;
+        self.y = y;
+        self.t_span0 = t;
+        self.have_poly = false;
+        self.kink_idx = 0;
+        self.h_needs_init = true;
+        self.err_prev = 1.0;
+        self.last_rejected = false;
+        self.fails = (0, FailKind::NonFinite);
+        self.restart()?;
+        let mut ev = std::mem::take(&mut self.events);
+        self.init_events(&mut ev);
+        self.events = ev;
+        Ok(())
+    }
+
+    /// Takes one accepted step (shortened to land on `tf`, a kink in `opts.t_stops`, or an
+    /// event that stops or acts).
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] when `tf` is already reached; otherwise the failures of
+    /// [`solve`](super::solve).
+    pub fn step(&mut self) -> Result<StepStatus, OdeError> {
+        self.hits.clear();
+        let mut ev = std::mem::take(&mut self.events);
+        let r = self.step_with(&mut ev);
+        self.events = ev;
+        r
+    }
+
+    /// Steps until the current time is exactly `t` (`t()` ≤ `t` ≤ `tf`); the last step is
+    /// shortened to end there, with no restart of the method. Stops early at a terminal event
+    /// (returns [`StepStatus::Terminated`]); acting events act on the way.
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] when `t` is outside `[t(), tf]`; otherwise the failures of
+    /// [`solve`](super::solve).
+    pub fn advance_to(&mut self, t: f64) -> Result<StepStatus, OdeError> {
+        if !(t >= self.t && t <= self.tf) {
+            return Err(OdeError::invalid(
+                "t",
+                format!(
+                    "must lie in [{}, {}] (current time, tf), got {t}",
+                    self.t, self.tf
+                ),
+            ));
+        }
+        self.hits.clear();
+        let mut ev = std::mem::take(&mut self.events);
+        self.target = Some(t);
+        let mut status = Ok(StepStatus::Accepted);
+        while self.t < t {
+            status = self.step_with(&mut ev);
+            match status {
+                Err(_) | Ok(StepStatus::Terminated(_)) => break,
+                _ => {}
+            }
+        }
+        self.target = None;
+        self.events = ev;
+        match status {
+            Ok(StepStatus::Acted(_)) if self.t >= self.tf => Ok(StepStatus::ReachedEnd),
+            Ok(StepStatus::Acted(_)) => Ok(StepStatus::Accepted),
+            other => other,
+        }
+    }
+
+    /// The loop body: one accepted step, with `events` located on it. Hits are appended to
+    /// `self.hits`.
+    pub(crate) fn step_with(
+        &mut self,
+        events: &mut [Event<'_, D>],
+    ) -> Result<StepStatus, OdeError> {
+        if self.t >= self.tf {
+            return Err(OdeError::invalid(
+                "tf",
+                format!(
+                    "the end time {} is reached; set a later one to go on",
+                    self.tf
+                ),
+            ));
+        }
+        if self.needs_restart {
+            self.restart()?;
+        }
+        while self.kink_idx < self.kinks.len() && self.kinks[self.kink_idx] <= self.t {
+            self.kink_idx += 1;
+        }
+        let kink = self
+            .kinks
+            .get(self.kink_idx)
+            .copied()
+            .filter(|&k| k < self.tf);
+        let mut stop = kink.unwrap_or(self.tf);
+        if let Some(tg) = self.target {
+            stop = stop.min(tg);
+        }
+        let h_max = self.h_max_opt.min(self.tf - self.t_span0);
+        let sys = self.sys;
+        let t = self.t;
+        let mut h = self.h;
+        let (err, k, stiff, hit_stop) = loop {
+            let attempts = self.ctx.stats.accepted + self.ctx.stats.rejected;
+            if attempts >= self.max_steps {
+                return Err(OdeError::TooManySteps {
+                    t,
+                    max_steps: self.max_steps,
+                });
+            }
+            // A step must change t in floating point by more than a few ulps.
+            let floor = self.h_min.max(16.0 * f64::EPSILON * t.abs()).max(1e-300);
+            let remaining = stop - t;
+            let mut hit_stop = false;
+            if h >= remaining || remaining - h < floor.max(1e-3 * h) {
+                h = remaining;
+                hit_stop = true;
+            } else if h.is_nan() || h < floor {
+                self.h = h;
+                if self.recent_nonfinite > 0 {
+                    return Err(OdeError::NonFinite {
+                        t,
+                        what: format!(
+                            "state or right-hand side: trial steps failed down to h = {h:e} (floor {floor:e})"
+                        ),
+                    });
+                }
+                return Err(OdeError::StepTooSmall { t, h, h_min: floor });
+            }
+            let stepper = self.steppers.get::<S>(self.active);
+            let k = stepper.error_order();
+            let stiff = stepper.is_stiff();
+            let trial = stepper.attempt(sys, t, &self.y, h, &mut self.y_new, &mut self.ctx);
+            let err = match trial {
+                Trial::Done { err } if err.is_finite() => err,
+                Trial::Done { .. } => {
+                    self.recent_nonfinite += 1;
+                    self.accepted_run = 0;
+                    register_failure(&mut self.fails, FailKind::NonFinite, t, h)?;
+                    self.ctx.stats.rejected += 1;
+                    h *= 0.25;
+                    self.last_rejected = true;
+                    continue;
+                }
+                Trial::Failed { factor, kind } => {
+                    if kind == FailKind::NonFinite {
+                        self.recent_nonfinite += 1;
+                    }
+                    self.accepted_run = 0;
+                    register_failure(&mut self.fails, kind, t, h)?;
+                    self.ctx.stats.rejected += 1;
+                    h *= factor;
+                    self.last_rejected = true;
+                    continue;
+                }
+            };
+            if err > 1.0 && self.adaptive {
+                self.fails.0 = 0;
+                self.ctx.stats.rejected += 1;
+                let fac = (SAFETY * err.powf(-1.0 / k)).max(FAC_MIN);
+                h *= fac;
+                self.last_rejected = true;
+                continue;
+            }
+            break (err, k, stiff, hit_stop);
+        };
+
+        // Accepted.
+        let h_acc = h;
+        self.fails.0 = 0;
+        self.accepted_run += 1;
+        if self.accepted_run >= 50 {
+            self.recent_nonfinite = 0;
+        }
+        self.ctx.stats.accepted += 1;
+        if stiff {
+            self.ctx.stats.stiff_steps += 1;
+        }
+        let stepper = self.steppers.get::<S>(self.active);
+        stepper.accept(
+            sys,
+            t,
+            &self.y,
+            h,
+            &self.y_new,
+            &mut self.poly,
+            &mut self.ctx,
+        );
+        self.have_poly = self.ctx.need_poly;
+        let t_new = if hit_stop { stop } else { t + h };
+
+        // Events: sign changes between the ends of the step, located on the interpolant.
+        self.step_hits.clear();
+        for (i, ev) in events.iter_mut().enumerate() {
+            let g_new = ev.eval(t_new, &self.y_new);
+            self.ctx.stats.event_evals += 1;
+            // The first sub-interval (between the step ends and any interior checks) on
+            // which g changes sign in the event's direction.
+            let inside = ev.inside_checks();
+            let (mut ta, mut ga) = (t, self.g_old[i]);
+            let mut bracket = None;
+            for j in 1..=inside + 1 {
+                let (tb, gb) = if j == inside + 1 {
+                    (t_new, g_new)
+                } else {
+                    let tb = t + (t_new - t) * j as f64 / (inside + 1) as f64;
+                    self.poly.eval_into(tb, &mut self.work);
+                    self.ctx.stats.event_evals += 1;
+                    (tb, ev.eval(tb, &self.work))
+                };
+                if let Some(rising) = crossing(ev.get_direction(), ga, gb) {
+                    bracket = Some((ta, ga, tb, gb, rising));
+                    break;
+                }
+                (ta, ga) = (tb, gb);
+            }
+            if let Some((ta, ga, tb, gb, rising)) = bracket {
+                let (te, evals) = locate(
+                    ev,
+                    &self.poly,
+                    ta,
+                    ga,
+                    tb,
+                    gb,
+                    self.event_tol,
+                    &mut self.work,
+                );
+                self.ctx.stats.event_evals += evals;
+                self.step_hits.push((i, te, rising));
+            }
+            self.g_old[i] = g_new;
+        }
+        self.step_hits.sort_by(|a, b| a.1.total_cmp(&b.1));
+        // The first event that stops or acts cuts the step; later roots are dropped (those of
+        // acting events are found again after the restart).
+        let mut t_cut = None;
+        let mut cut_by = None;
+        let mut terminal = false;
+        for &(i, te, rising) in &self.step_hits {
+            if let Some(tc) = t_cut {
+                if te > tc {
+                    break;
+                }
+            }
+            self.poly.eval_into(te, &mut self.work);
+            self.hits.push(EventHit {
+                index: i,
+                t: te,
+                y: self.work.clone(),
+                rising,
+            });
+            if events[i].is_terminal() || events[i].acts() {
+                if t_cut.is_none() {
+                    t_cut = Some(te);
+                    cut_by = Some(i);
+                }
+                terminal |= events[i].is_terminal();
+            }
+        }
+        let t_reach = t_cut.unwrap_or(t_new);
+        if let Some(tc) = t_cut {
+            self.poly.eval_into(tc, &mut self.y_new);
+        }
+        self.t = t_reach;
+        std::mem::swap(&mut self.y, &mut self.y_new);
+
+        // Next step size.
+        let (alpha, beta) = (0.7 / k, 0.4 / k);
+        let e = err.max(1e-10);
+        let mut fac = SAFETY * e.powf(-alpha) * self.err_prev.powf(beta);
+        let fac_max = if stiff {
+            FAC_MAX_STIFF
+        } else {
+            FAC_MAX_EXPLICIT
+        };
+        if self.last_rejected {
+            fac = fac.min(1.0);
+        }
+        let stepper = self.steppers.get::<S>(self.active);
+        if let Some(hint) = stepper.step_hint() {
+            fac = fac.min(hint);
+        }
+        if self.adaptive {
+            h = stepper
+                .propose(h, h * fac.clamp(FAC_MIN, fac_max))
+                .min(h_max);
+        } else if let Some(h0) = self.h_init {
+            h = h0.min(h_max);
+        }
+        self.h = h;
+        self.err_prev = e;
+        self.last_rejected = false;
+
+        if let Some(i) = cut_by {
+            // Actions of every event cut at the same time, in index order.
+            let tc = self.t;
+            let mut acted = false;
+            let mut acting: Vec<usize> = self
+                .step_hits
+                .iter()
+                .filter(|&&(j, te, _)| te == tc && events[j].acts())
+                .map(|&(j, _, _)| j)
+                .collect();
+            acting.sort_unstable();
+            for j in acting {
+                events[j].apply(tc, &mut self.y);
+                acted = true;
+            }
+            if acted {
+                check_finite_state(&self.y).map_err(|_| OdeError::NonFinite {
+                    t: tc,
+                    what: format!("state set by the action of event {i}"),
+                })?;
+            }
+            // The method's carried-over data belong to the uncut step end.
+            self.needs_restart = true;
+            self.init_events(events);
+            return Ok(if terminal {
+                StepStatus::Terminated(i)
+            } else {
+                StepStatus::Acted(i)
+            });
+        }
+
+        if hit_stop && kink == Some(stop) {
+            // The right-hand side may have a kink here: no derivative carries over.
+            self.kink_idx += 1;
+            self.restart()?;
+        }
+
+        if self.t >= self.tf {
+            return Ok(StepStatus::ReachedEnd);
+        }
+        // Stiffness switching.
+        if self.steppers.count() > 1 {
+            self.switch_check(stiff, h_acc);
+        }
+        Ok(StepStatus::Accepted)
+    }
+
+    fn switch_check(&mut self, stiff: bool, h_acc: f64) {
+        let sys = self.sys;
+        let switch = if !stiff {
+            self.since_check += 1;
+            // The cheap indicator of the explicit method flags growing stiff components;
+            // a periodic Jacobian check catches a step size pinned at the stability limit
+            // while those components are still damped.
+            let flagged = self
+                .steppers
+                .get::<S>(self.active)
+                .stiffness()
+                .is_some_and(|h_rho| h_rho > STABILITY_BOUNDARY);
+            if flagged || self.since_check >= CHECK_INTERVAL {
+                self.since_check = 0;
+                let f0 = self.steppers.get::<S>(self.active).f0();
+                let rho = estimate_radius(
+                    sys,
+                    self.t,
+                    &self.y,
+                    f0,
+                    &mut self.jac_work,
+                    &mut self.work,
+                    &mut self.ctx,
+                );
+                if h_acc * rho > STIFF_FRACTION * STABILITY_BOUNDARY {
+                    self.stiff_count += 1;
+                } else {
+                    self.stiff_count = 0;
+                }
+            }
+            self.stiff_count >= STIFF_CHECKS_TO_SWITCH
+        } else {
+            match self.steppers.get::<S>(self.active).stiffness() {
+                Some(rho) if h_acc * rho < RETURN_FRACTION * STABILITY_BOUNDARY => {
+                    self.return_count += 1;
+                }
+                _ => self.return_count = 0,
+            }
+            self.return_count >= STEPS_TO_RETURN
+        };
+        if switch {
+            self.active = (self.active + 1) % self.steppers.count();
+            self.ctx.stats.stiffness_switches += 1;
+            self.stiff_count = 0;
+            self.since_check = 0;
+            self.return_count = 0;
+            self.err_prev = 1.0;
+            self.needs_restart = true;
+        }
+    }
+}
+
+impl<D: Dim, S: OdeSystem<D> + ?Sized> Integrator<'_, D, S>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// Time, state and work counters at the end, consuming the integrator.
+    pub(crate) fn finish(self) -> (f64, OVector<f64, D>, Stats) {
+        (self.t, self.y, self.ctx.stats)
+    }
+}
+
+fn check_finite_state<D: Dim>(y: &OVector<f64, D>) -> Result<(), OdeError>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+        return Err(OdeError::invalid(
+            format!("y0[{i}]"),
+            format!("must be finite, got {}", y[i]),
+        ));
+    }
+    Ok(())
+}
+
+fn register_failure(
+    fails: &mut (usize, FailKind),
+    kind: FailKind,
+    t: f64,
+    h: f64,
+) -> Result<(), OdeError> {
+    if fails.1 == kind {
+        fails.0 += 1;
+    } else {
+        *fails = (1, kind);
+    }
+    if fails.0 < MAX_CONSECUTIVE_FAILURES {
+        return Ok(());
+    }
+    Err(match kind {
+        FailKind::NonFinite => OdeError::NonFinite {
+            t,
+            what: format!("state or right-hand side in every trial step down to h = {h:e}"),
+        },
+        FailKind::Newton => OdeError::NewtonDivergence {
+            t,
+            h,
+            reason: format!("{MAX_CONSECUTIVE_FAILURES} consecutive failures while halving h"),
+        },
+        FailKind::Singular => OdeError::SingularMatrix { t, h },
+    })
+}
+
+/// Initial step size after Hairer, Nørsett & Wanner (1993), II.4: a step whose explicit
+/// Euler error estimate matches the tolerance for a method of order `p`.
+#[allow(clippy::too_many_arguments)]
+fn initial_step<D: Dim, S: OdeSystem<D> + ?Sized>(
+    sys: &S,
+    t: f64,
+    y: &OVector<f64, D>,
+    f0: &OVector<f64, D>,
+    p: f64,
+    h_max: f64,
+    work: &mut OVector<f64, D>,
+    ctx: &mut Ctx<D>,
+) -> f64
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let d0 = ctx.norm_at(y, y);
+    let d1 = ctx.norm_at(f0, y);
+    let mut h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    h0 = h0.min(h_max);
+    let mut y1 = y.clone();
+    y1.axpy(h0, f0, 1.0);
+    sys.rhs(t + h0, &y1, work);
+    ctx.stats.rhs_evals += 1;
+    let mut diff = work.clone();
+    diff -= f0;
+    let d2 = ctx.norm_at(&diff, y) / h0;
+    let h1 = if d1.max(d2) <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / (p + 1.0))
+    };
+    let h = (100.0 * h0).min(h1).min(h_max);
+    if h.is_finite() && h > 0.0 {
+        h
+    } else {
+        h0
+    }
+}
+
+/// Spectral radius of the Jacobian at `(t, y)` for the stiffness check (∞ when the Jacobian is
+/// not finite, which sends the integration to the stiff method).
+fn estimate_radius<D: Dim, S: OdeSystem<D> + ?Sized>(
+    sys: &S,
+    t: f64,
+    y: &OVector<f64, D>,
+    f0: &OVector<f64, D>,
+    jac: &mut Option<OMatrix<f64, D, D>>,
+    work: &mut OVector<f64, D>,
+    ctx: &mut Ctx<D>,
+) -> f64
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let Some(jac) = jac.as_mut() else {
+        return 0.0;
+    };
+    if eval_jacobian(sys, t, y, f0, jac, work, ctx) {
+        spectral_radius(jac, y)
+    } else {
+        f64::INFINITY
+    }
+}
