@@ -26,11 +26,17 @@
 //! # Ok::<(), hdi_tribology::Error>(())
 //! ```
 
+mod controller;
 mod disk;
 mod plant;
 mod rng;
 mod sensors;
 
+pub use controller::{
+    run, AcousticLevel, Action, Channel, ClearanceHold, ContactSensorSlope, Controller, HoldPhase,
+    HoldSettings, LevelDetector, LevelStats, Staircase, StaircaseOutcome, StaircaseSettings,
+    TrueContact,
+};
 pub use disk::{DiskSpec, Harmonic};
 pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions};
 pub use sensors::{

@@ -128,10 +128,15 @@ pub struct DriveOptions {
     pub ambient: Ambient,
     /// The sensors.
     pub sensors: SensorSpec,
+    /// ODE method. The scene's tolerances are used, not its method: a controller period is
+    /// several air-bearing periods long, and a stiff method steps over it in one step near
+    /// equilibrium, where an explicit one needs many (docs/benchmarks.md, "Drive").
+    pub method: Method,
 }
 
 impl Default for DriveOptions {
-    /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift.
+    /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift;
+    /// Rodas5P.
     fn default() -> Self {
         DriveOptions {
             initial_power: 0.060,
@@ -139,6 +144,7 @@ impl Default for DriveOptions {
             disk: DiskSpec::default(),
             ambient: Ambient::default(),
             sensors: SensorSpec::default(),
+            method: Method::Rodas5P,
         }
     }
 }
@@ -247,8 +253,9 @@ pub struct Drive {
     ambient: Ambient,
     method: Method,
     ode: Options,
-    /// Dither frequency `ode` was made for (its step cap depends on it).
-    ode_frequency: f64,
+    /// Dither frequency and period `ode` was made for (its first step and step cap depend on
+    /// them).
+    ode_key: (f64, f64),
     atol: Vec<f64>,
     rtol: f64,
     max_steps: usize,
@@ -355,9 +362,9 @@ impl Drive {
             layout,
             disk,
             ambient: opts.ambient,
-            method: solver.method,
+            method: opts.method,
             ode: Options::default(),
-            ode_frequency: f64::NAN,
+            ode_key: (f64::NAN, f64::NAN),
             atol,
             rtol: solver.rtol,
             max_steps: solver.max_steps,
@@ -367,14 +374,14 @@ impl Drive {
             zone: zone.clone(),
             seed,
         };
-        drive.ode_for(0.0)?;
+        drive.ode_for(0.0, 5e-5)?;
         Ok(drive)
     }
 
     /// (Re)builds the integration options when the dither frequency changes: with a dither the
     /// step is capped at 1/40 of its period so no peak of `V²` is skipped.
-    fn ode_for(&mut self, frequency: f64) -> Result<()> {
-        if frequency == self.ode_frequency {
+    fn ode_for(&mut self, frequency: f64, dt: f64) -> Result<()> {
+        if (frequency, dt) == self.ode_key {
             return Ok(());
         }
         let h_max = if frequency > 0.0 {
@@ -382,7 +389,10 @@ impl Drive {
         } else {
             f64::INFINITY
         };
+        // Every period starts with a step of the whole period: near equilibrium the stiff method
+        // takes it in one, and in a transient the step control cuts it down.
         let o = Options::default()
+            .h_init(dt.min(h_max))
             .rtol(self.rtol)
             .atol_per_component(self.atol.clone())
             .h_max(h_max)
@@ -392,7 +402,7 @@ impl Drive {
         o.validate(self.layout.len())
             .map_err(|e| Error::invalid("solver", e.to_string()))?;
         self.ode = o;
-        self.ode_frequency = frequency;
+        self.ode_key = (frequency, dt);
         Ok(())
     }
 
@@ -415,7 +425,7 @@ impl Drive {
         } else {
             0.0
         };
-        self.ode_for(freq)?;
+        self.ode_for(freq, dt)?;
         let (t0, t1) = (self.t, self.t + dt);
         let ambient = self.ambient.temperature(t0);
         // Cloning the model shares its tables (reference counts): no allocation.

@@ -1,0 +1,133 @@
+//! Controllers driving the simulated drive: the staircase calibration against the static model,
+//! the contact-sensor and acoustic touchdown detectors, the harmonic-ratio clearance change
+//! against the true one, and the closed-loop clearance hold.
+
+use hdi_tribology::analysis::{static_hysteresis, StaticOptions};
+use hdi_tribology::drive::{
+    run, scene_zone, AcousticLevel, Command, ContactSensorSlope, Drive, DriveOptions,
+    LevelDetector, Readback, Staircase, StaircaseSettings, TrueContact,
+};
+use hdi_tribology::scene::Scene;
+
+const DT: f64 = 50e-6;
+
+fn drive(seed: u64, opts: DriveOptions) -> Drive {
+    let scene = Scene::paper();
+    Drive::new(&scene, &scene_zone(&scene, 0.025).unwrap(), seed, opts).unwrap()
+}
+
+fn calibrate<D: LevelDetector>(d: &mut Drive, settings: StaircaseSettings, det: D) -> Staircase<D> {
+    let mut st = Staircase::new(settings, det, DT).unwrap();
+    run(d, &mut st, DT, 1_000_000).unwrap();
+    assert!(st.is_done());
+    st
+}
+
+/// Static touchdown and take-off of the drive's model (the paper scene: 74.324 / 68.317 mW).
+fn static_td_to(d: &Drive) -> (f64, f64) {
+    let h = static_hysteresis(d.model(), &StaticOptions::new(5e-5)).unwrap();
+    (h.touchdown.power, h.takeoff.power)
+}
+
+#[test]
+fn staircase_through_the_drive_agrees_with_the_static_model() {
+    let mut d = drive(5, DriveOptions::default());
+    let (td, to) = static_td_to(&d);
+    assert!((td * 1e3 - 74.324).abs() < 1e-3, "static touchdown {td}");
+    let step = 0.25e-3;
+    let st = calibrate(
+        &mut d,
+        StaircaseSettings::from_mw(66.0, 0.25, 80.0, 10.0),
+        TrueContact::new(5e-5).unwrap(),
+    );
+    let out = st.outcome();
+    let cal_td = out.touchdown_power.unwrap();
+    // The first level at or above the static touchdown.
+    assert!(
+        cal_td >= td - 1e-9 && cal_td < td + step,
+        "touchdown {cal_td} vs static {td}"
+    );
+    let cal_to = out.takeoff_power.unwrap();
+    // Stepping down, the first level below the static take-off flies.
+    assert!(
+        cal_to <= to + 1e-9 && cal_to > to - step,
+        "take-off {cal_to} vs static {to}"
+    );
+    assert!((out.set_power.unwrap() - (cal_td - 0.010)).abs() < 1e-15);
+}
+
+#[test]
+fn contact_sensor_touchdown_within_1_mw_of_static() {
+    for seed in [1, 2, 3] {
+        let mut d = drive(seed, DriveOptions::default());
+        let (td, _) = static_td_to(&d);
+        let mut s = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
+        s.find_takeoff = false;
+        let st = calibrate(&mut d, s, ContactSensorSlope::new(5.0, 4).unwrap());
+        let p = st
+            .outcome()
+            .touchdown_power
+            .expect("contact sensor saw no touchdown");
+        assert!(
+            st.outcome().levels.len() > 8,
+            "the line was fitted before touchdown"
+        );
+        assert!(
+            (p - td).abs() <= 1e-3,
+            "seed {seed}: {} mW vs static {} mW",
+            p * 1e3,
+            td * 1e3
+        );
+    }
+}
+
+#[test]
+fn acoustic_touchdown_within_1_mw_of_static() {
+    for seed in [1, 2, 3] {
+        let mut d = drive(seed, DriveOptions::default());
+        let (td, _) = static_td_to(&d);
+        let mut s = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
+        s.find_takeoff = false;
+        let st = calibrate(&mut d, s, AcousticLevel::new(5.0, 3).unwrap());
+        let p = st.outcome().touchdown_power.expect("AE saw no touchdown");
+        assert!(
+            (p - td).abs() <= 1e-3,
+            "seed {seed}: {} mW vs static {} mW",
+            p * 1e3,
+            td * 1e3
+        );
+    }
+}
+
+#[test]
+fn harmonic_ratio_clearance_change_matches_the_true_one_within_the_noise() {
+    let opts = DriveOptions::default();
+    let rb = opts.sensors.readback;
+    let mut d = drive(9, opts);
+    let n = 400;
+    let window = |d: &mut Drive, mw: f64| {
+        // Settle 2 ms, then average.
+        for _ in 0..40 {
+            d.step(&Command::heater_mw(mw), DT).unwrap();
+        }
+        let (mut lr, mut gap) = (0.0, 0.0);
+        for _ in 0..n {
+            let s = d.step(&Command::heater_mw(mw), DT).unwrap();
+            lr += s.readback.log_ratio();
+            gap += s.truth.gap;
+        }
+        (lr / n as f64, gap / n as f64)
+    };
+    let (lr0, g0) = window(&mut d, 62.0);
+    let (lr1, g1) = window(&mut d, 70.0);
+    let est = Readback::clearance_change(lr0, lr1, rb.wavelength);
+    let truth = g1 - g0;
+    // Each log ratio carries √2·noise per sample; a difference of two means of n samples has
+    // standard deviation λ/(4π)·2·noise/√n.
+    let sigma = rb.wavelength / (4.0 * std::f64::consts::PI) * 2.0 * rb.noise / (n as f64).sqrt();
+    assert!(truth < -0.5e-9, "the heater closed the gap: {truth}");
+    assert!(
+        (est - truth).abs() < 4.0 * sigma,
+        "HR {est:e} vs true {truth:e} (σ {sigma:e})"
+    );
+}
