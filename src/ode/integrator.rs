@@ -506,7 +506,8 @@ where
         Ok(())
     }
 
-    /// Changes the tolerances for the following steps.
+    /// Changes the tolerances for the following steps. `Auto` keeps the stiff method chosen
+    /// from the tolerance at the start.
     ///
     /// # Errors
     /// [`OdeError::InvalidInput`] naming `options.rtol` or `options.atol` when out of range.
