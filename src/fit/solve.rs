@@ -766,7 +766,7 @@ fn analyse(
 
 fn percent(v: f64) -> String {
     if v.is_finite() {
-        format!("{:.0} %", 100.0 * v)
+        format!("{:.2} %", 100.0 * v)
     } else {
         "unbounded".into()
     }
