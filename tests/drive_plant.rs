@@ -2,7 +2,7 @@
 //! harmonic-ratio clearance change against the true one, typed errors.
 
 use hdi_tribology::analysis::{flying_equilibrium, ScanGrid};
-use hdi_tribology::drive::{scene_zone, Command, DiskSpec, Drive, DriveOptions, Readback, Sensors};
+use hdi_tribology::drive::{scene_zone, Command, DiskSpec, Drive, DriveOptions, Sensors};
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
 
