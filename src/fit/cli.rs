@@ -106,8 +106,14 @@ pub fn write_plots(result: &FitResult, dir: &Path) -> crate::Result<Vec<PathBuf>
         written.push(path);
         let rtitle = format!("residuals (fitted − measured) of {}", t.column);
         let path = dir.join(format!("{name}_residuals.svg"));
-        let mut zero = vec![(t.rows.iter().map(|r| r.x).fold(f64::INFINITY, f64::min), 0.0)];
-        zero.push((t.rows.iter().map(|r| r.x).fold(f64::NEG_INFINITY, f64::max), 0.0));
+        let mut zero = vec![(
+            t.rows.iter().map(|r| r.x).fold(f64::INFINITY, f64::min),
+            0.0,
+        )];
+        zero.push((
+            t.rows.iter().map(|r| r.x).fold(f64::NEG_INFINITY, f64::max),
+            0.0,
+        ));
         Chart {
             title: &rtitle,
             x_label: &t.x_column,

@@ -131,7 +131,11 @@ const COLUMNS: &[(&str, Role, &[Unit])] = &[
         Role::Err(Quantity::TouchdownPower),
         WATTS,
     ),
-    ("takeoff_power_err", Role::Err(Quantity::TakeoffPower), WATTS),
+    (
+        "takeoff_power_err",
+        Role::Err(Quantity::TakeoffPower),
+        WATTS,
+    ),
 ];
 
 /// One measured column of a curve, in SI, with its optional 1σ uncertainties.
@@ -211,7 +215,11 @@ fn classify(name: &str) -> Result<(Role, Unit), String> {
         Some(u) => Ok((*role, *u)),
         None => Err(format!(
             "unknown unit `{unit}` for {stem}; known units: {}",
-            units.iter().map(|u| u.suffix).collect::<Vec<_>>().join(", ")
+            units
+                .iter()
+                .map(|u| u.suffix)
+                .collect::<Vec<_>>()
+                .join(", ")
         )),
     }
 }
@@ -221,7 +229,8 @@ impl DataSet {
     pub fn from_path(path: impl AsRef<Path>) -> Result<DataSet, DataError> {
         let path = path.as_ref();
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| err(&origin, None, None, e.to_string()))?;
+        let text =
+            std::fs::read_to_string(path).map_err(|e| err(&origin, None, None, e.to_string()))?;
         Self::from_csv_str(&text, &origin)
     }
 
@@ -246,11 +255,12 @@ impl DataSet {
         let header_line = rdr.position().line().saturating_sub(1).max(header_line);
         let mut roles = Vec::new();
         for (i, name) in headers.iter().enumerate() {
-            let (role, unit) = classify(name)
-                .map_err(|r| err(origin, Some(header_line), Some((i, name)), r))?;
-            if let Some((j, _, _)) = roles.iter().find(|(_, r, _)| {
-                matches!((r, role), (Role::X(_), Role::X(_))) || *r == role
-            }) {
+            let (role, unit) =
+                classify(name).map_err(|r| err(origin, Some(header_line), Some((i, name)), r))?;
+            if let Some((j, _, _)) = roles
+                .iter()
+                .find(|(_, r, _)| matches!((r, role), (Role::X(_), Role::X(_))) || *r == role)
+            {
                 return Err(err(
                     origin,
                     Some(header_line),
@@ -288,7 +298,10 @@ impl DataSet {
                         origin,
                         Some(header_line),
                         Some((i, &headers[i])),
-                        format!("missing column: an uncertainty of {} without the column itself", q.stem()),
+                        format!(
+                            "missing column: an uncertainty of {} without the column itself",
+                            q.stem()
+                        ),
                     ));
                 }
             }
@@ -308,9 +321,9 @@ impl DataSet {
                 if text.is_empty() {
                     return Err(err(origin, Some(line), at, "missing value".into()));
                 }
-                let v: f64 = text.parse().map_err(|_| {
-                    err(origin, Some(line), at, format!("not a number: `{text}`"))
-                })?;
+                let v: f64 = text
+                    .parse()
+                    .map_err(|_| err(origin, Some(line), at, format!("not a number: `{text}`")))?;
                 if !v.is_finite() {
                     return Err(err(
                         origin,
@@ -334,7 +347,10 @@ impl DataSet {
                             origin,
                             Some(line),
                             at,
-                            format!("duplicate x value {text} {} (first at line {l0})", unit.suffix),
+                            format!(
+                                "duplicate x value {text} {} (first at line {l0})",
+                                unit.suffix
+                            ),
                         ));
                     }
                     first_at.push((si, line));
@@ -390,5 +406,7 @@ impl DataSet {
 }
 
 fn v_at(cols: &BTreeMap<usize, Vec<f64>>, i: usize) -> f64 {
-    cols.get(&i).and_then(|c| c.last().copied()).unwrap_or(f64::NAN)
+    cols.get(&i)
+        .and_then(|c| c.last().copied())
+        .unwrap_or(f64::NAN)
 }

@@ -31,8 +31,8 @@ pub use cli::{run_cli, write_plots, CliArgs};
 pub use data::{CurveKind, DataError, DataSet, Observed, Quantity, Unit};
 pub use params::FreeParameter;
 pub use solve::{
-    fit, model_curves, Direction, FitOptions, FitResult, FittedParameter, Identifiability, IntegrationCheck,
-    ResidualRow, ResidualTable, StartOutcome,
+    fit, model_curves, Direction, FitOptions, FitResult, FittedParameter, Identifiability,
+    IntegrationCheck, ResidualRow, ResidualTable, StartOutcome,
 };
 
 /// Why a fit could not be made.

@@ -70,7 +70,10 @@ impl std::str::FromStr for FreeParameter {
             None => (s.trim(), None),
         };
         if name.is_empty() {
-            return Err(Error::invalid("--free", format!("empty parameter name in `{s}`")));
+            return Err(Error::invalid(
+                "--free",
+                format!("empty parameter name in `{s}`"),
+            ));
         }
         let mut p = FreeParameter::new(name);
         if let Some(b) = bounds {
@@ -85,7 +88,10 @@ impl std::str::FromStr for FreeParameter {
                     return Ok(None);
                 }
                 t.trim().parse::<f64>().map(Some).map_err(|_| {
-                    Error::invalid(format!("--free {name}"), format!("bound `{t}` is not a number"))
+                    Error::invalid(
+                        format!("--free {name}"),
+                        format!("bound `{t}` is not a number"),
+                    )
                 })
             };
             p.lower = num(lo)?;
@@ -170,7 +176,10 @@ pub(super) struct Resolved {
 /// The roughness σ is held both by the surface heights and by a Rice-maxima peak law. Until the
 /// scene keeps it in one field, freeing one sets the other too when the two are equal in the
 /// scene.
-const SAME_SIGMA: [&[&str]; 2] = [&["surface", "height_sigma_m"], &["surface", "peaks", "sigma_m"]];
+const SAME_SIGMA: [&[&str]; 2] = [
+    &["surface", "height_sigma_m"],
+    &["surface", "peaks", "sigma_m"],
+];
 
 pub(super) fn get<'a>(v: &'a Value, path: &[String]) -> Option<&'a Value> {
     path.iter().try_fold(v, |v, k| v.get(k))
@@ -230,7 +239,9 @@ fn reader_factor(base: &Value, leaf: &[String], key: &str) -> Option<f64> {
     obj.insert(key.to_string(), Value::from(1.0));
     let scene = Scene::from_json_str(&trial.to_string()).ok()?;
     let back = serde_json::to_value(&scene).ok()?;
-    get(&back, leaf)?.as_f64().filter(|f| f.is_finite() && *f != 0.0)
+    get(&back, leaf)?
+        .as_f64()
+        .filter(|f| f.is_finite() && *f != 0.0)
 }
 
 /// Resolves `p` against the scene's serde form `base`.
@@ -284,7 +295,10 @@ pub(super) fn resolve(base: &Value, p: &FreeParameter) -> Result<Resolved> {
     let start = p.start.unwrap_or(si / factor);
     let unit = unit_suffix(key, &path);
     let bad = |what: &str, v: f64| {
-        Error::invalid(field.clone(), format!("{what} must be finite, got {v:?} {unit}"))
+        Error::invalid(
+            field.clone(),
+            format!("{what} must be finite, got {v:?} {unit}"),
+        )
     };
     for (what, v) in [("lower bound", p.lower), ("upper bound", p.upper)] {
         if let Some(v) = v.filter(|v| !v.is_finite()) {
@@ -319,11 +333,19 @@ pub(super) fn resolve(base: &Value, p: &FreeParameter) -> Result<Resolved> {
         (Some(lo), Some(hi)) => Transform::Both { lo, hi },
         (Some(lo), None) => Transform::Lower {
             lo,
-            s: if start > lo { start - lo } else { start.abs().max(1.0) },
+            s: if start > lo {
+                start - lo
+            } else {
+                start.abs().max(1.0)
+            },
         },
         (None, Some(hi)) => Transform::Upper {
             hi,
-            s: if start < hi { hi - start } else { start.abs().max(1.0) },
+            s: if start < hi {
+                hi - start
+            } else {
+                start.abs().max(1.0)
+            },
         },
         (None, None) => Transform::Free {
             x0: start,
@@ -354,7 +376,9 @@ pub(super) fn resolve(base: &Value, p: &FreeParameter) -> Result<Resolved> {
 /// The unit a name carries: what follows the SI field's stem (`height_sigma_nm` → `nm`); for an
 /// SI name, from its first SI unit token on (`stiffness_n_per_m` → `n_per_m`).
 fn unit_suffix(key: &str, path: &[String]) -> String {
-    const SI_TOKENS: &[&str] = &["m", "n", "v", "j", "w", "s", "pa", "hz", "kg", "m2", "per", "k"];
+    const SI_TOKENS: &[&str] = &[
+        "m", "n", "v", "j", "w", "s", "pa", "hz", "kg", "m2", "per", "k",
+    ];
     let si = path.last().map(String::as_str).unwrap_or("");
     if si == key {
         let tokens: Vec<&str> = key.split('_').collect();
@@ -424,14 +448,21 @@ mod tests {
         let e = resolve(&base, &FreeParameter::new("radius_of_curvature_mm"))
             .unwrap_err()
             .to_string();
-        assert!(e.contains("ambiguous") && e.contains("contact.footprint.radius_of_curvature_mm"), "{e}");
+        assert!(
+            e.contains("ambiguous") && e.contains("contact.footprint.radius_of_curvature_mm"),
+            "{e}"
+        );
         let r = resolve(
             &base,
             &FreeParameter::new("contact.footprint.radius_of_curvature_mm"),
         )
         .unwrap();
         assert_eq!(r.path, ["contact", "footprint", "radius_of_curvature_m"]);
-        let e = resolve(&base, &FreeParameter::new("height_sigma_nm").bounded(2.0, 1.0)).unwrap_err();
+        let e = resolve(
+            &base,
+            &FreeParameter::new("height_sigma_nm").bounded(2.0, 1.0),
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("below upper bound"), "{e}");
     }
 

@@ -72,7 +72,10 @@ impl FitOptions {
             ("static_table_rel_tol", self.static_table_rel_tol, 0.01),
         ] {
             if !(v > 0.0 && v <= hi) {
-                return Err(Error::invalid(f, format!("must lie in (0, {hi}], got {v:?}")));
+                return Err(Error::invalid(
+                    f,
+                    format!("must lie in (0, {hi}], got {v:?}"),
+                ));
             }
         }
         Ok(())
@@ -298,7 +301,9 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
             // A trial point the model cannot evaluate: far worse than the last good one, so the
             // optimiser shrinks its step instead of stopping.
             (None, Some(g)) => Some(LmVector::from_vec(
-                g.iter().map(|v| 10.0 * v + v.signum() * 1e3 + 1e3).collect(),
+                g.iter()
+                    .map(|v| 10.0 * v + v.signum() * 1e3 + 1e3)
+                    .collect(),
             )),
             (None, None) => None,
         }
@@ -357,7 +362,11 @@ fn jacobian_columns(
         } else {
             (r0.to_vec(), h)
         };
-        Ok(plus.iter().zip(&minus).map(|(a, b)| (a - b) / span).collect())
+        Ok(plus
+            .iter()
+            .zip(&minus)
+            .map(|(a, b)| (a - b) / span)
+            .collect())
     };
     let n = x.len();
     #[cfg(feature = "parallel")]
@@ -466,7 +475,11 @@ pub fn fit(
     let mut first_error = None;
     for start in start_points(&params, opts.starts, opts.seed) {
         let budget = ev.evaluations.load(Ordering::Relaxed) + opts.max_evaluations;
-        let u0: Vec<f64> = params.iter().zip(&start).map(|(p, &x)| p.transform.u(x)).collect();
+        let u0: Vec<f64> = params
+            .iter()
+            .zip(&start)
+            .map(|(p, &x)| p.transform.u(x))
+            .collect();
         let problem = Problem {
             ev: &ev,
             u: u0.clone(),
@@ -568,7 +581,11 @@ fn analyse(
     let directions: Vec<Direction> = order
         .iter()
         .map(|&k| {
-            let rel_error = if sv[k] > floor { s / sv[k] } else { f64::INFINITY };
+            let rel_error = if sv[k] > floor {
+                s / sv[k]
+            } else {
+                f64::INFINITY
+            };
             let mut components: Vec<(String, f64)> = (0..n)
                 .map(|j| (names[j].to_string(), v_t[(k, j)]))
                 .filter(|(_, w)| w.abs() >= 0.05)
@@ -608,9 +625,10 @@ fn analyse(
                 cov[(j, j)].sqrt()
             };
             let determined = rel <= tol;
-            let at_bound = [p.lower, p.upper].iter().flatten().any(|b| {
-                (x[j] - b).abs() <= 1e-6 * p.scale.max((p.upper.unwrap_or(*b) - b).abs())
-            });
+            let at_bound = [p.lower, p.upper]
+                .iter()
+                .flatten()
+                .any(|b| (x[j] - b).abs() <= 1e-6 * p.scale.max((p.upper.unwrap_or(*b) - b).abs()));
             FittedParameter {
                 name: p.name.clone(),
                 unit: p.unit.clone(),
@@ -745,15 +763,11 @@ fn identifiability_words(
             )),
             comps => {
                 let list: Vec<&str> = comps.iter().map(|c| c.0.as_str()).collect();
-                let combo: Vec<String> = comps
-                    .iter()
-                    .map(|(n, w)| format!("{w:+.2}·Δ{n}"))
-                    .collect();
+                let combo: Vec<String> =
+                    comps.iter().map(|(n, w)| format!("{w:+.2}·Δ{n}")).collect();
                 let moves: Vec<String> = comps
                     .iter()
-                    .map(|(n, w)| {
-                        format!("{} {n}", if *w > 0.0 { "raising" } else { "lowering" })
-                    })
+                    .map(|(n, w)| format!("{} {n}", if *w > 0.0 { "raising" } else { "lowering" }))
                     .collect();
                 out.push(format!(
                     "{} are not determined separately: along {} (each change relative to the \
@@ -792,7 +806,11 @@ fn identifiability_words(
         out.push(format!(
             "no error bar is given for {}: the data do not determine {}",
             undetermined.join(", "),
-            if undetermined.len() == 1 { "it" } else { "them" }
+            if undetermined.len() == 1 {
+                "it"
+            } else {
+                "them"
+            }
         ));
     }
     out
