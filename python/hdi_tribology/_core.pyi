@@ -341,3 +341,20 @@ def calibrate(
 ) -> Calibration:
     """Touchdown calibration by heater steps (mW) with detector ``"mean"``, ``"ae"`` or
     ``"vibration"``, optionally under an AC dither (V)."""
+
+def fit(
+    scene: Scene,
+    data: Sequence[Union[str, os.PathLike[str]]],
+    free: Sequence[str],
+    *,
+    starts: int = 1,
+    seed: int = 1,
+    max_evaluations: int = 400,
+) -> Dict[str, Any]:
+    """Fits the ``free`` parameters of ``scene`` (named as a scene file names them, in that
+    name's unit, optional bounds: ``"efficiency_nm_per_mw=0.05:0.2"``) to measured curves (CSV
+    files in engineering units). Returns ``scene`` (the fitted Scene), ``parameters`` (dicts:
+    name, unit, field, value, start, standard_error, linear_error, determined, lower, upper),
+    ``correlation``, ``residuals``, ``identifiability``, ``points``, ``chi2``,
+    ``residual_scale``, ``converged``, ``termination``, ``evaluations``, ``starts``,
+    ``integration``, ``trusted``, ``warnings``. Raises DataFileError on a bad file."""
