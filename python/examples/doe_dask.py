@@ -60,11 +60,8 @@ def run_group(sigma_nm, hamaker_j, amplitudes):
                 for v in amplitudes]
     rows = []
     for c in cycles:
-        status = "ok"
-        if c.hysteresis_w is None:
-            status = "no touchdown or take-off detected"
-        elif c.hysteresis_w < 0:
-            status = "negative hysteresis: not a valid result"
+        # the crate's flags: no_touchdown, no_takeoff, negative_hysteresis (not a valid result)
+        status = " ".join(c.flags) if c.flags else "ok"
         rows.append((sigma_nm, hamaker_j, c.v_ac_v,
                      c.touchdown.power_w if c.touchdown else None,
                      c.takeoff.power_w if c.takeoff else None,

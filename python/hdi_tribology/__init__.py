@@ -29,6 +29,7 @@ from ._core import (
     ac_sweep_refined,
     calibrate,
     clearance_change,
+    fit,
     forces,
     linear_response,
     pull_in_voltage,
@@ -38,6 +39,7 @@ from ._core import (
 )
 from ._errors import (
     AnalysisError,
+    DataFileError,
     FileError,
     HdiError,
     InvalidInputError,
@@ -50,6 +52,7 @@ __all__ = [
     "AnalysisError",
     "Calibration",
     "Cycle",
+    "DataFileError",
     "Detection",
     "Equilibrium",
     "FileError",
@@ -70,6 +73,7 @@ __all__ = [
     "ac_sweep_refined",
     "calibrate",
     "clearance_change",
+    "fit",
     "forces",
     "linear_response",
     "pull_in_voltage",

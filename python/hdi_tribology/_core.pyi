@@ -153,6 +153,9 @@ class Cycle:
     """Rejected solver steps."""
     wall_seconds: float
     """Wall time of the simulation inside Rust (s)."""
+    flags: List[str]
+    """What is wrong with the cycle, empty when nothing is: ``no_touchdown``, ``no_takeoff``,
+    ``negative_hysteresis`` (a detection artefact, not a hysteresis)."""
     @property
     def hysteresis_mw(self) -> Optional[float]:
         """Touchdown minus take-off power (mW); None unless both were detected."""
@@ -164,10 +167,19 @@ class RefinedCycle:
     """The last, most accurate run."""
     rtol: float
     """Its relative tolerance."""
+    atol_m: float
+    """Its absolute tolerance on the displacement (m)."""
     power_change_w: float
-    """Largest change of touchdown or take-off power from the run before (W)."""
+    """Largest change of touchdown or take-off power from the run before (W); inf when a
+    detection came or went between the two."""
+    temperature_change_k: float
+    """Change of the mean temperature rise from the run before (K)."""
     converged: bool
-    """Whether that change is within the tolerance asked for."""
+    """Whether both changes are within the tolerances asked for."""
+    status: str
+    """``"converged"`` or ``"not_converged"``."""
+    flags: List[str]
+    """The cycle's flags, and ``not_converged``."""
     runs: int
     """Cycles run."""
     steps: int
@@ -241,11 +253,13 @@ class Forces(TypedDict):
     other_n: F64Array
     real_contact_area_m2: F64Array
     total_n: F64Array
+    in_table_range: npt.NDArray[np.bool_]
 
 def forces(target: Target, gaps_nm: F64Array, protrusion_nm: float = 0.0) -> Forces:
     """Every interface force at bulge gaps ``gaps_nm`` (nm; pad gaps ``gaps_nm +
     protrusion_nm``) at the scene's DC voltage: float64 arrays shaped as ``gaps_nm``, in N
-    (positive away from the disk), N/V² and m²."""
+    (positive away from the disk), N/V² and m², and ``in_table_range`` (False where a gap lies
+    outside the scene's force tables: computed by direct quadrature there)."""
 
 def static_hysteresis(target: Target, contact_threshold_un: Optional[float] = None) -> StaticHysteresis:
     """Static touchdown and take-off at the scene's DC voltage (threshold in µN; default the
@@ -270,10 +284,12 @@ def simulate_cycle(
     triggered: bool = False,
     method: Optional[str] = None,
     rtol: Optional[float] = None,
+    atol_nm: Optional[float] = None,
     series: bool = True,
 ) -> Dict[str, Any]:
     """One touchdown/take-off cycle at AC amplitude ``v_ac`` (V; default the scene's), under
-    the scene's programme (or the touchdown-triggered protocol). Returns ``cycle`` (Cycle),
+    the scene's programme (or the touchdown-triggered protocol). ``rtol`` scales the absolute
+    tolerance with it unless ``atol_nm`` (nm) is given, as ``hdi cycle`` does. Returns ``cycle`` (Cycle),
     ``touchdown``/``takeoff`` (Detection or None) and, with ``series``, float64 arrays per
     accepted step: ``t_s``, ``power_w``, ``d_m``, ``air_bearing_n``, ``intermolecular_n``,
     ``electrostatic_n``, ``contact_n``, ``total_n``, ``temperature_rise_k``, ``indicator_n``
@@ -286,6 +302,7 @@ def ac_sweep(
     triggered: bool = False,
     method: Optional[str] = None,
     rtol: Optional[float] = None,
+    atol_nm: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> List[Cycle]:
     """One cycle per AC amplitude (V; default the scene's sweep list), on ``threads`` rayon
@@ -296,13 +313,17 @@ def ac_sweep_refined(
     power_tol_mw: float,
     amplitudes_v: Optional[Sequence[float]] = None,
     *,
+    temperature_tol_k: float = 0.05,
+    max_runs: int = 4,
     triggered: bool = False,
     method: Optional[str] = None,
     rtol: Optional[float] = None,
+    atol_nm: Optional[float] = None,
     threads: Optional[int] = None,
 ) -> List[RefinedCycle]:
-    """``ac_sweep`` with the tolerance tightened tenfold per run (at most 4) until touchdown
-    and take-off move by at most ``power_tol_mw`` (mW)."""
+    """``ac_sweep`` with the tolerances tightened tenfold per run (at most ``max_runs``) until
+    touchdown and take-off move by at most ``power_tol_mw`` (mW) and the mean temperature rise
+    by at most ``temperature_tol_k`` (K)."""
 
 def linear_response(target: Target, power_mw: float) -> LinearResponse:
     """The linearised slider about its flying equilibrium at ``power_mw`` (mW)."""
@@ -320,3 +341,20 @@ def calibrate(
 ) -> Calibration:
     """Touchdown calibration by heater steps (mW) with detector ``"mean"``, ``"ae"`` or
     ``"vibration"``, optionally under an AC dither (V)."""
+
+def fit(
+    scene: Scene,
+    data: Sequence[Union[str, os.PathLike[str]]],
+    free: Sequence[str],
+    *,
+    starts: int = 1,
+    seed: int = 1,
+    max_evaluations: int = 400,
+) -> Dict[str, Any]:
+    """Fits the ``free`` parameters of ``scene`` (named as a scene file names them, in that
+    name's unit, optional bounds: ``"efficiency_nm_per_mw=0.05:0.2"``) to measured curves (CSV
+    files in engineering units). Returns ``scene`` (the fitted Scene), ``parameters`` (dicts:
+    name, unit, field, value, start, standard_error, linear_error, determined, lower, upper),
+    ``correlation``, ``residuals``, ``identifiability``, ``points``, ``chi2``,
+    ``residual_scale``, ``converged``, ``termination``, ``evaluations``, ``starts``,
+    ``integration``, ``trusted``, ``warnings``. Raises DataFileError on a bad file."""

@@ -51,3 +51,10 @@ class FileError(HdiError, OSError):
     """Reading or writing a file failed: ``path`` and ``reason``."""
 
     path: str
+
+
+class DataFileError(HdiError, ValueError):
+    """A bad measurement file for ``fit``: ``file``, ``line`` and ``column`` (1-based, or
+    None), ``column_name`` and ``reason`` (with the value as written)."""
+
+    file: str

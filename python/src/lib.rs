@@ -5,8 +5,12 @@
 //! are in engineering units where the name says so (`_mw`, `_nm`, `_v`); results carry their
 //! SI unit in their name (`power_w`, `d_m`) and engineering-unit properties beside them.
 
+// A Python function's keyword arguments are its options: many arguments are the API here.
+#![allow(clippy::too_many_arguments)]
+
 use std::sync::Arc;
 
+use hdi_tribology::analysis::sweep::{self, Flag};
 use hdi_tribology::analysis::{
     self, CycleOptions, CycleResult, HeaterProgramme, Refinement, ScanGrid, StaticOptions,
 };
@@ -14,6 +18,7 @@ use hdi_tribology::clearance::{
     self, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
     VibrationRms,
 };
+use hdi_tribology::fit::{DataSet, FitError, FitOptions, FreeParameter};
 use hdi_tribology::force::Gaps;
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::units;
@@ -49,6 +54,15 @@ fn to_py_err(e: hdi_tribology::Error) -> PyErr {
         ),
         other => ("HdiError", vec![("reason", other.to_string())]),
     };
+    py_error(class, &message, attrs)
+}
+
+/// An instance of the exception class `class` of `hdi_tribology._errors`, with `attrs` set.
+fn py_error<V: for<'py> IntoPyObject<'py>>(
+    class: &str,
+    message: &str,
+    attrs: Vec<(&str, V)>,
+) -> PyErr {
     Python::attach(|py| {
         let made = (|| -> PyResult<PyErr> {
             let cls = py.import("hdi_tribology._errors")?.getattr(class)?;
@@ -56,7 +70,7 @@ fn to_py_err(e: hdi_tribology::Error) -> PyErr {
             for (k, v) in attrs {
                 kwargs.set_item(k, v)?;
             }
-            let inst = cls.call((message.clone(),), Some(&kwargs))?;
+            let inst = cls.call((message,), Some(&kwargs))?;
             Ok(PyErr::from_value(inst))
         })();
         made.unwrap_or_else(|e| e)
@@ -347,6 +361,11 @@ fn forces<'py>(
     }
     let protrusion = units::nm(protrusion_nm);
     let (scene, model) = model_of(py, target)?;
+    let (lo, hi) = model.forces().table_range();
+    let in_range: Vec<bool> = gaps
+        .iter()
+        .map(|&d| (lo..=hi).contains(&d) && (lo..=hi).contains(&(d + protrusion)))
+        .collect();
     let rows = py.detach(|| {
         let volt2 = scene.dc_volt2();
         gaps.iter()
@@ -377,6 +396,7 @@ fn forces<'py>(
         array(py, col(|b| b.real_contact_area)),
     )?;
     out.set_item("total_n", array(py, col(|b| b.total)))?;
+    out.set_item("in_table_range", PyArray1::from_vec(py, in_range))?;
     Ok(out)
 }
 
@@ -715,6 +735,9 @@ struct Cycle {
     rejected_steps: usize,
     /// Wall time of the simulation in Rust (s).
     wall_seconds: f64,
+    /// What is wrong with the cycle, empty when nothing is: `no_touchdown`, `no_takeoff`,
+    /// `negative_hysteresis` (a detection artefact, not a hysteresis).
+    flags: Vec<String>,
 }
 
 impl From<&CycleResult> for Cycle {
@@ -729,7 +752,28 @@ impl From<&CycleResult> for Cycle {
             steps: r.stats.accepted,
             rejected_steps: r.stats.rejected,
             wall_seconds: r.wall_seconds,
+            flags: flag_names(&sweep::flags(r)),
         }
+    }
+}
+
+/// The crate's flags by their snake_case names (`no_touchdown`, `negative_hysteresis`, …), as
+/// the `hdi` program prints them.
+fn flag_names(flags: &[Flag]) -> Vec<String> {
+    flags
+        .iter()
+        .map(|f| match serde_json::to_value(f) {
+            Ok(serde_json::Value::String(s)) => s,
+            _ => f.to_string(),
+        })
+        .collect()
+}
+
+fn fmt_flags(flags: &[String]) -> String {
+    if flags.is_empty() {
+        String::new()
+    } else {
+        format!(", flags={flags:?}")
     }
 }
 
@@ -746,12 +790,13 @@ impl Cycle {
     }
     fn __repr__(&self) -> String {
         format!(
-            "Cycle(v_ac_v={}, touchdown_mw={}, takeoff_mw={}, hysteresis_mw={}, steps={})",
+            "Cycle(v_ac_v={}, touchdown_mw={}, takeoff_mw={}, hysteresis_mw={}, steps={}{})",
             self.v_ac_v,
             fmt_opt_mw(self.touchdown.as_ref().map(|d| d.power_w)),
             fmt_opt_mw(self.takeoff.as_ref().map(|d| d.power_w)),
             fmt_opt_mw(self.hysteresis_w),
-            self.steps
+            self.steps,
+            fmt_flags(&self.flags)
         )
     }
 }
@@ -770,6 +815,7 @@ fn cycle_setup(
     triggered: bool,
     method: Option<&str>,
     rtol: Option<f64>,
+    atol_nm: Option<f64>,
 ) -> PyResult<CycleSetup> {
     let (scene, model) = model_of(py, target)?;
     let mut opts = CycleOptions::from_scene(&scene).py()?;
@@ -778,8 +824,13 @@ fn cycle_setup(
             .parse()
             .map_err(|e: hdi_tribology::ode::OdeError| invalid("method", e.to_string()))?;
     }
+    // as `hdi cycle`: a new rtol scales the absolute tolerance with it unless that is given
     if let Some(r) = rtol {
+        opts.solver.atol_displacement *= r / opts.solver.rtol;
         opts.solver.rtol = r;
+    }
+    if let Some(a) = atol_nm {
+        opts.solver.atol_displacement = units::nm(a);
     }
     let programme = if triggered {
         let t = &scene.heater.triggered;
@@ -808,7 +859,7 @@ fn cycle_setup(
 /// `contact_n`, `total_n` (N), `temperature_rise_k` (K), `indicator_n` (N, NaN before the
 /// detector window has filled).
 #[pyfunction]
-#[pyo3(signature = (target, v_ac = None, *, triggered = false, method = None, rtol = None, series = true))]
+#[pyo3(signature = (target, v_ac = None, *, triggered = false, method = None, rtol = None, atol_nm = None, series = true))]
 fn simulate_cycle<'py>(
     py: Python<'py>,
     target: &Bound<'py, PyAny>,
@@ -816,9 +867,10 @@ fn simulate_cycle<'py>(
     triggered: bool,
     method: Option<&str>,
     rtol: Option<f64>,
+    atol_nm: Option<f64>,
     series: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut setup = cycle_setup(py, target, triggered, method, rtol)?;
+    let mut setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     setup.opts.keep_series = series;
     let r = py
         .detach(|| match v_ac {
@@ -884,8 +936,7 @@ fn amplitudes_or_scene(scene: &Scn, amplitudes_v: Option<Vec<f64>>) -> PyResult<
 /// (`threads` threads, default all cores) with the GIL released. Returns a list of `Cycle`, in
 /// the order of the amplitudes; results do not depend on the thread count.
 #[pyfunction]
-#[pyo3(signature = (target, amplitudes_v = None, *, triggered = false, method = None, rtol = None, threads = None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (target, amplitudes_v = None, *, triggered = false, method = None, rtol = None, atol_nm = None, threads = None))]
 fn ac_sweep(
     py: Python<'_>,
     target: &Bound<'_, PyAny>,
@@ -893,9 +944,10 @@ fn ac_sweep(
     triggered: bool,
     method: Option<&str>,
     rtol: Option<f64>,
+    atol_nm: Option<f64>,
     threads: Option<usize>,
 ) -> PyResult<Vec<Cycle>> {
-    let setup = cycle_setup(py, target, triggered, method, rtol)?;
+    let setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     let amplitudes = amplitudes_or_scene(&setup.scene, amplitudes_v)?;
     let rows = py.detach(|| {
         on_threads(threads, || {
@@ -912,10 +964,19 @@ struct RefinedCycle {
     cycle: Cycle,
     /// Its relative tolerance.
     rtol: f64,
-    /// Largest change of touchdown or take-off power from the run before (W).
+    /// Its absolute tolerance on the displacement (m).
+    atol_m: f64,
+    /// Largest change of touchdown or take-off power from the run before (W); infinite when a
+    /// detection came or went between the two.
     power_change_w: f64,
-    /// Whether that change is within the tolerance asked for.
+    /// Change of the mean temperature rise from the run before (K).
+    temperature_change_k: f64,
+    /// Whether both changes are within the tolerances asked for.
     converged: bool,
+    /// `"converged"` or `"not_converged"`.
+    status: String,
+    /// The cycle's flags, and `not_converged`.
+    flags: Vec<String>,
     /// Cycles run.
     runs: usize,
     /// Accepted steps over all runs.
@@ -928,36 +989,44 @@ struct RefinedCycle {
 impl RefinedCycle {
     fn __repr__(&self) -> String {
         format!(
-            "RefinedCycle(v_ac_v={}, hysteresis_mw={}, rtol={:e}, power_change_mw={:.3e}, converged={}, runs={})",
+            "RefinedCycle(v_ac_v={}, hysteresis_mw={}, rtol={:e}, power_change_mw={:.3e}, status={:?}, runs={}{})",
             self.cycle.v_ac_v,
             fmt_opt_mw(self.cycle.hysteresis_w),
             self.rtol,
             units::to_mw(self.power_change_w),
-            if self.converged { "True" } else { "False" },
-            self.runs
+            self.status,
+            self.runs,
+            fmt_flags(&self.flags)
         )
     }
 }
 
-/// `ac_sweep` with the tolerance refined per amplitude (tenfold tighter, at most 4 runs) until
-/// touchdown and take-off move by at most `power_tol_mw` (mW). Returns a list of
-/// `RefinedCycle`; check `converged` before trusting a row.
+/// `ac_sweep` with the tolerances refined per amplitude (tenfold tighter per run, at most
+/// `max_runs` runs) until touchdown and take-off move by at most `power_tol_mw` (mW) and the
+/// mean temperature rise by at most `temperature_tol_k` (K). Returns a list of `RefinedCycle`;
+/// check `converged` (or `flags`) before trusting a row.
 #[pyfunction]
-#[pyo3(signature = (target, power_tol_mw, amplitudes_v = None, *, triggered = false, method = None, rtol = None, threads = None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (target, power_tol_mw, amplitudes_v = None, *, temperature_tol_k = 0.05, max_runs = 4, triggered = false, method = None, rtol = None, atol_nm = None, threads = None))]
 fn ac_sweep_refined(
     py: Python<'_>,
     target: &Bound<'_, PyAny>,
     power_tol_mw: f64,
     amplitudes_v: Option<Vec<f64>>,
+    temperature_tol_k: f64,
+    max_runs: usize,
     triggered: bool,
     method: Option<&str>,
     rtol: Option<f64>,
+    atol_nm: Option<f64>,
     threads: Option<usize>,
 ) -> PyResult<Vec<RefinedCycle>> {
-    let setup = cycle_setup(py, target, triggered, method, rtol)?;
+    let setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     let amplitudes = amplitudes_or_scene(&setup.scene, amplitudes_v)?;
-    let refine = Refinement::new(units::mw(power_tol_mw));
+    let refine = Refinement {
+        temperature_tol: temperature_tol_k,
+        max_runs,
+        ..Refinement::new(units::mw(power_tol_mw))
+    };
     let rows = py.detach(|| {
         on_threads(threads, || {
             analysis::ac_sweep_refined(
@@ -974,8 +1043,17 @@ fn ac_sweep_refined(
         .map(|r| RefinedCycle {
             cycle: Cycle::from(&r.cycle),
             rtol: r.rtol,
+            atol_m: r.atol,
             power_change_w: r.change,
+            temperature_change_k: r.temperature_change,
             converged: r.converged,
+            status: if r.converged {
+                "converged"
+            } else {
+                "not_converged"
+            }
+            .into(),
+            flags: flag_names(&r.flags()),
             runs: r.runs,
             steps: r.stats.accepted,
             wall_seconds: r.wall_seconds,
@@ -1133,7 +1211,6 @@ impl Calibration {
 /// `"vibration"`. `dither_v` adds an AC dither (V) while calibrating.
 #[pyfunction]
 #[pyo3(signature = (target, *, detector = "mean", start_mw = None, step_mw = 0.5, max_mw = None, margin_mw = 15.0, dither_v = None, find_takeoff = true))]
-#[allow(clippy::too_many_arguments)]
 fn calibrate(
     py: Python<'_>,
     target: &Bound<'_, PyAny>,
@@ -1189,6 +1266,100 @@ fn calibrate(
 }
 
 // ---------------------------------------------------------------------------------------------
+// Fit
+
+fn fit_error(e: FitError) -> PyErr {
+    match e {
+        FitError::Data(d) => {
+            let message = d.to_string();
+            Python::attach(|py| {
+                let attrs: Vec<(&str, Py<PyAny>)> = vec![
+                    (
+                        "file",
+                        d.file.into_pyobject(py).map(|o| o.into_any().unbind()),
+                    ),
+                    (
+                        "line",
+                        d.line.into_pyobject(py).map(|o| o.into_any().unbind()),
+                    ),
+                    (
+                        "column",
+                        d.column.into_pyobject(py).map(|o| o.into_any().unbind()),
+                    ),
+                    (
+                        "column_name",
+                        d.column_name
+                            .into_pyobject(py)
+                            .map(|o| o.into_any().unbind()),
+                    ),
+                    (
+                        "reason",
+                        d.reason.into_pyobject(py).map(|o| o.into_any().unbind()),
+                    ),
+                ]
+                .into_iter()
+                .filter_map(|(k, v)| v.ok().map(|v| (k, v)))
+                .collect();
+                py_error("DataFileError", &message, attrs)
+            })
+        }
+        FitError::Other(e) => to_py_err(e),
+        other => py_error("HdiError", &other.to_string(), Vec::<(&str, String)>::new()),
+    }
+}
+
+/// Fits the `free` parameters of `scene` to measured curves (CSV files in engineering units,
+/// see `docs/fit.md`). Each parameter is named as a scene file names it, in that name's unit,
+/// with optional bounds: `"height_sigma_nm"`, `"efficiency_nm_per_mw=0.05:0.2"`.
+///
+/// Returns a dict: `scene` (the fitted `Scene`), `parameters` (list of dicts: name, value,
+/// unit, standard_error, …), `correlation`, `residuals`, `identifiability`, `points`, `chi2`,
+/// `residual_scale`, `converged`, `termination`, `evaluations`, `starts`, `integration`,
+/// `trusted` and `warnings`, as `hdi fit` prints them. Check `trusted` and `warnings`.
+#[pyfunction]
+#[pyo3(signature = (scene, data, free, *, starts = 1, seed = 1, max_evaluations = 400))]
+fn fit<'py>(
+    py: Python<'py>,
+    scene: &Scene,
+    data: Vec<std::path::PathBuf>,
+    free: Vec<String>,
+    starts: usize,
+    seed: u64,
+    max_evaluations: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let options = FitOptions {
+        starts,
+        seed,
+        max_evaluations,
+        ..FitOptions::default()
+    };
+    let scene_in = scene.inner.clone();
+    let result = py
+        .detach(|| -> Result<_, FitError> {
+            let sets = data
+                .iter()
+                .map(DataSet::from_path)
+                .collect::<Result<Vec<_>, _>>()?;
+            let free = free
+                .iter()
+                .map(|f| f.parse::<FreeParameter>())
+                .collect::<Result<Vec<_>, _>>()?;
+            hdi_tribology::fit::fit(&scene_in, &sets, &free, &options)
+        })
+        .map_err(fit_error)?;
+    let text = serde_json::to_string(&result)
+        .map_err(|e| invalid("fit", format!("cannot convert the result: {e}")))?;
+    let out = json_module(py)?.call_method1("loads", (text,))?;
+    out.set_item(
+        "scene",
+        Scene {
+            inner: result.scene,
+        },
+    )?;
+    Ok(out)
+}
+
+// ---------------------------------------------------------------------------------------------
 
 /// The native core of the `hdi_tribology` Python package.
 #[pymodule]
@@ -1214,6 +1385,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ac_sweep_refined, m)?)?;
     m.add_function(wrap_pyfunction!(linear_response, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -21,7 +21,8 @@ SERIES_KEYS = [
 def test_forces_arrays(paper_model):
     gaps = np.linspace(0.3, 5.0, 17)
     f = hdi.forces(paper_model, gaps)
-    assert sorted(f) == sorted(FORCE_KEYS)
+    assert sorted(f) == sorted(FORCE_KEYS + ["in_table_range"])
+    assert f["in_table_range"].dtype == np.bool_ and f["in_table_range"].shape == (17,)
     for k in FORCE_KEYS:
         assert f[k].shape == (17,) and f[k].dtype == np.float64, k
     assert np.array_equal(f["d_m"], gaps * 1e-9)
@@ -58,6 +59,7 @@ def test_cycle_series_and_transitions(paper_model):
     assert c.hysteresis_w == td.power_w - to.power_w > 0
     assert c.hysteresis_mw == pytest.approx(c.hysteresis_w * 1e3, rel=1e-15)
     assert repr(c).startswith("Cycle(v_ac_v=0, touchdown_mw=74.")
+    assert c.flags == []
     # the running mean has not filled before the detector window: NaN, not a number made up
     assert math.isnan(r["indicator_n"][0])
     no_series = hdi.simulate_cycle(paper_model, series=False)
