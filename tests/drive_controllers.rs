@@ -5,18 +5,22 @@
 use hdi_tribology::analysis::{static_hysteresis, StaticOptions};
 use hdi_tribology::drive::{
     run, scene_zone, AcousticLevel, Command, ContactSensorSlope, Drive, DriveOptions,
-    LevelDetector, Readback, Staircase, StaircaseSettings, TrueContact,
+    LevelDetector, Plant, Readback, Staircase, StaircaseSettings, TrueContact,
 };
 use hdi_tribology::scene::Scene;
 
 const DT: f64 = 50e-6;
 
-fn drive(seed: u64, opts: DriveOptions) -> Drive {
+fn plant(seed: u64, opts: DriveOptions) -> Plant {
     let scene = Scene::paper();
-    Drive::new(&scene, &scene_zone(&scene, 0.025).unwrap(), seed, opts).unwrap()
+    Plant::new(&scene, &scene_zone(&scene, 0.025).unwrap(), seed, opts).unwrap()
 }
 
-fn calibrate<D: LevelDetector>(d: &mut Drive, settings: StaircaseSettings, det: D) -> Staircase<D> {
+fn calibrate<D: LevelDetector>(
+    d: &mut Drive<'_>,
+    settings: StaircaseSettings,
+    det: D,
+) -> Staircase<D> {
     let mut st = Staircase::new(settings, det, DT).unwrap();
     run(d, &mut st, DT, 1_000_000).unwrap();
     assert!(st.is_done());
@@ -24,14 +28,15 @@ fn calibrate<D: LevelDetector>(d: &mut Drive, settings: StaircaseSettings, det: 
 }
 
 /// Static touchdown and take-off of the drive's model (the paper scene: 74.324 / 68.317 mW).
-fn static_td_to(d: &Drive) -> (f64, f64) {
+fn static_td_to(d: &Drive<'_>) -> (f64, f64) {
     let h = static_hysteresis(d.model(), &StaticOptions::new(5e-5)).unwrap();
     (h.touchdown.power, h.takeoff.power)
 }
 
 #[test]
 fn staircase_through_the_drive_agrees_with_the_static_model() {
-    let mut d = drive(5, DriveOptions::default());
+    let p = plant(5, DriveOptions::default());
+    let mut d = p.drive().unwrap();
     let (td, to) = static_td_to(&d);
     assert!((td * 1e3 - 74.324).abs() < 1e-3, "static touchdown {td}");
     let step = 0.25e-3;
@@ -59,7 +64,8 @@ fn staircase_through_the_drive_agrees_with_the_static_model() {
 #[test]
 fn contact_sensor_touchdown_within_1_mw_of_static() {
     for seed in [1, 2, 3] {
-        let mut d = drive(seed, DriveOptions::default());
+        let p = plant(seed, DriveOptions::default());
+        let mut d = p.drive().unwrap();
         let (td, _) = static_td_to(&d);
         let mut s = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
         s.find_takeoff = false;
@@ -84,7 +90,8 @@ fn contact_sensor_touchdown_within_1_mw_of_static() {
 #[test]
 fn acoustic_touchdown_within_1_mw_of_static() {
     for seed in [1, 2, 3] {
-        let mut d = drive(seed, DriveOptions::default());
+        let p = plant(seed, DriveOptions::default());
+        let mut d = p.drive().unwrap();
         let (td, _) = static_td_to(&d);
         let mut s = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
         s.find_takeoff = false;
@@ -103,9 +110,10 @@ fn acoustic_touchdown_within_1_mw_of_static() {
 fn harmonic_ratio_clearance_change_matches_the_true_one_within_the_noise() {
     let opts = DriveOptions::default();
     let rb = opts.sensors.readback;
-    let mut d = drive(9, opts);
+    let p = plant(9, opts);
+    let mut d = p.drive().unwrap();
     let n = 400;
-    let window = |d: &mut Drive, mw: f64| {
+    let window = |d: &mut Drive<'_>, mw: f64| {
         // Settle 2 ms, then average.
         for _ in 0..40 {
             d.step(&Command::heater_mw(mw), DT).unwrap();
