@@ -139,3 +139,77 @@ fn harmonic_ratio_clearance_change_matches_the_true_one_within_the_noise() {
         "HR {est:e} vs true {truth:e} (σ {sigma:e})"
     );
 }
+
+#[test]
+fn clearance_hold_follows_an_ambient_drift() {
+    use hdi_tribology::drive::{
+        Action, Ambient, ClearanceHold, Controller, HoldPhase, HoldSettings,
+    };
+    // A fast drift (200 K/s at 0.03 nm/K: 6 nm/s) so that a 60 ms run moves the clearance by
+    // about 0.3 nm.
+    let opts = DriveOptions {
+        ambient: Ambient {
+            rate: 200.0,
+            ..Ambient::default()
+        },
+        ..DriveOptions::default()
+    };
+    let wavelength = opts.sensors.readback.wavelength;
+    let p = plant(4, opts);
+    let eta = p.model().efficiency;
+    let mut stair = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
+    stair.find_takeoff = false;
+    let settings = HoldSettings {
+        staircase: stair,
+        wavelength,
+        efficiency: eta,
+        average: 20,
+        gain: 0.5,
+        recalibrate_after: 0.02,
+    };
+    let mut hold =
+        ClearanceHold::new(settings, ContactSensorSlope::new(5.0, 4).unwrap(), DT).unwrap();
+    let mut d = p.drive().unwrap();
+    let mut cmd = hold.start();
+    let (mut ref_gap, mut n_ref) = (0.0, 0);
+    let mut errors = Vec::new();
+    let mut hold_start = None;
+    for _ in 0..4000 {
+        let s = d.step(&cmd, DT).unwrap();
+        let phase = hold.phase();
+        match phase {
+            HoldPhase::Referencing => {
+                ref_gap += s.truth.gap;
+                n_ref += 1;
+            }
+            HoldPhase::Holding => {
+                hold_start.get_or_insert(s.t);
+                errors.push((s.t, s.truth.gap - ref_gap / n_ref as f64));
+            }
+            HoldPhase::Calibrating => {}
+        }
+        match hold.update(&s) {
+            Action::Continue(c) => cmd = c,
+            Action::Stop => panic!("the hold stopped"),
+        }
+    }
+    assert_eq!(hold.calibrations(), 1);
+    let t0 = hold_start.expect("never held");
+    let span = d.time() - t0;
+    assert!(span > 0.05, "held for {span} s");
+    // Open loop the clearance would have grown by the drift over the span.
+    let drift = 200.0 * 0.03e-9 * span;
+    // Closed loop: after the first 5 ms the error stays within 10 % of that drift.
+    let late: Vec<f64> = errors
+        .iter()
+        .filter(|e| e.0 > t0 + 5e-3)
+        .map(|e| e.1)
+        .collect();
+    let rms = (late.iter().map(|e| e * e).sum::<f64>() / late.len() as f64).sqrt();
+    assert!(
+        rms < 0.1 * drift,
+        "rms clearance error {rms:e} m against a drift of {drift:e} m"
+    );
+    // The heater took up the drift: about drift/η more power.
+    assert!(hold.power() - hold.set_power() > 0.5 * drift / eta);
+}

@@ -31,6 +31,7 @@
 mod controller;
 mod disk;
 mod plant;
+mod replay;
 mod rng;
 mod sensors;
 
@@ -41,6 +42,9 @@ pub use controller::{
 };
 pub use disk::{DiskSpec, Harmonic};
 pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions, Plant};
+pub use replay::{
+    read_commands, replay, CommandRow, ReplaySummary, MAX_REPLAY_PERIODS, SENSOR_COLUMNS,
+};
 pub use sensors::{
     AcousticSpec, ContactSensorSpec, Readback, ReadbackSpec, SensorSpec, Sensors, Truth,
 };

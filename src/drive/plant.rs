@@ -414,6 +414,11 @@ impl Plant {
     pub fn model(&self) -> &SliderModel {
         &self.base
     }
+
+    /// The sensor models.
+    pub fn sensor_spec(&self) -> &SensorSpec {
+        &self.sensors
+    }
 }
 
 /// The integrator, on a state sized at compile time for the layouts a scene can have.
