@@ -33,6 +33,7 @@ mod disk;
 mod plant;
 mod replay;
 mod rng;
+mod roc;
 mod sensors;
 
 pub use controller::{
@@ -45,6 +46,7 @@ pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions, Plant};
 pub use replay::{
     read_commands, replay, CommandRow, ReplaySummary, MAX_REPLAY_PERIODS, SENSOR_COLUMNS,
 };
+pub use roc::{touchdown_roc, RocPoint};
 pub use sensors::{
     AcousticSpec, ContactSensorSpec, Readback, ReadbackSpec, SensorSpec, Sensors, Truth,
 };

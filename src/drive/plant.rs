@@ -247,6 +247,8 @@ pub struct Plant {
     max_steps: usize,
     zone: Zone,
     seed: u64,
+    disk_spec: DiskSpec,
+    rpm: f64,
 }
 
 impl std::fmt::Debug for Plant {
@@ -347,6 +349,36 @@ impl Plant {
             max_steps: solver.max_steps,
             zone: zone.clone(),
             seed,
+            disk_spec: opts.disk,
+            rpm,
+        })
+    }
+
+    /// The same plant with another seed: a new random disk and new sensor noise, the model's
+    /// tables shared (no rebuild), for runs over many seeds.
+    ///
+    /// # Errors
+    /// None in practice (the disk was valid for the first seed).
+    pub fn with_seed(&self, seed: u64) -> Result<Plant> {
+        Ok(Plant {
+            system: DriveSystem {
+                current: RefCell::new(self.base.clone()),
+                programme: self.system.programme.clone(),
+                disk: Disk::new(&self.disk_spec, self.rpm, seed)?,
+            },
+            base: self.base.clone(),
+            layout: self.layout,
+            start: self.start,
+            start_sensors: self.start_sensors,
+            sensors: self.sensors,
+            ambient: self.ambient,
+            method: self.method,
+            ode: self.ode.clone(),
+            max_steps: self.max_steps,
+            zone: self.zone.clone(),
+            seed,
+            disk_spec: self.disk_spec.clone(),
+            rpm: self.rpm,
         })
     }
 
