@@ -34,7 +34,9 @@ fn direct_eval(f: &InterfaceForces, d: f64) -> f64 {
     f.terms()
         .iter()
         .map(|t| {
-            let (v, s) = t.force(d).unwrap_or((f64::NAN, f64::NAN));
+            let (v, s) = t
+                .force(d)
+                .map_or((f64::NAN, f64::NAN), |f| (f.value, f.slope));
             v + s
         })
         .sum()

@@ -17,7 +17,7 @@
 use hdi_tribology::analysis::HeaterProgramme::Fixed;
 use hdi_tribology::analysis::{simulate_cycle, static_hysteresis, CycleOptions, StaticOptions};
 use hdi_tribology::force::{
-    Coupling, GapReference, Gaps, InterfaceForces, InterfaceTerm, TermKind,
+    Coupling, GapReference, Gaps, InterfaceForces, InterfaceTerm, TermForce, TermKind,
 };
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::quadrature::TableOptions;
@@ -47,13 +47,16 @@ impl InterfaceTerm for Meniscus {
     fn gap(&self) -> GapReference {
         GapReference::Bulge
     }
-    fn force(&self, d: f64) -> hdi_tribology::Result<(f64, f64)> {
+    fn force(&self, d: f64) -> hdi_tribology::Result<TermForce> {
         let scale = self.fill * 2.0 * self.surface_tension / self.height * 2.0 * PI * self.radius;
         let x = (self.height - d) / self.smoothing;
         // softplus(x) = ln(1 + eˣ), written to stay finite for large |x|; its slope is the logistic.
         let softplus = x.max(0.0) + (-x.abs()).exp().ln_1p();
         let logistic = 1.0 / (1.0 + (-x).exp());
-        Ok((-scale * self.smoothing * softplus, scale * logistic))
+        Ok(TermForce {
+            value: -scale * self.smoothing * softplus,
+            slope: scale * logistic,
+        })
     }
 }
 
@@ -82,7 +85,7 @@ fn main() -> hdi_tribology::Result<()> {
     );
     for d_nm in [3.0, 2.0, 1.5, 1.0, 0.5, 0.0] {
         let g = Gaps::same(d_nm * 1e-9);
-        let (m, _) = meniscus.force(g.bulge)?;
+        let m = meniscus.force(g.bulge)?.value;
         let (a, b) = (base.static_part(g).value, with.static_part(g).value);
         println!(
             "{d_nm:>7.2} {:>14.3} {:>14.3} {:>14.3}",

@@ -86,6 +86,7 @@ pub mod analysis;
 pub mod clearance;
 pub mod drive;
 pub mod error;
+pub mod fit;
 pub mod force;
 pub mod heater;
 pub mod model;

@@ -83,3 +83,27 @@ pub fn nm_per_mw(x: f64) -> f64 {
 pub fn per_um2(x: f64) -> f64 {
     x * 1e12
 }
+
+/// A number for messages: at most seven significant digits, in exponent form when very large or
+/// very small (never a 300-digit decimal), `inf` and `NaN` as such.
+///
+/// ```
+/// use hdi_tribology::units::{fmt_short, to_nm};
+/// assert_eq!(fmt_short(to_nm(1e-8)), "10");
+/// assert_eq!(fmt_short(1e300), "1e300");
+/// assert_eq!(fmt_short(2e9), "2e9");
+/// assert_eq!(fmt_short(-0.001), "-0.001");
+/// assert_eq!(fmt_short(-7e-10), "-7e-10");
+/// assert_eq!(fmt_short(1.0 / 3.0), "0.3333333");
+/// ```
+pub fn fmt_short(x: f64) -> String {
+    if !x.is_finite() {
+        return format!("{x:?}");
+    }
+    let r: f64 = format!("{x:.6e}").parse().unwrap_or(x);
+    if r != 0.0 && !(1e-4..1e6).contains(&r.abs()) {
+        format!("{r:e}")
+    } else {
+        format!("{r}")
+    }
+}

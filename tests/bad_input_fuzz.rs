@@ -11,6 +11,7 @@
 #[path = "common/seeded.rs"]
 mod seeded;
 
+use hdi_tribology::force::TermForce;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
 use proptest::prelude::*;
@@ -32,7 +33,7 @@ fn check_outcome(r: hdi_tribology::Result<Scene>) -> Result<(), TestCaseError> {
                 let (lo, hi) = scene.table_range();
                 for d in [lo, 0.5 * (lo + hi), hi] {
                     for t in &terms {
-                        if let Ok((f, s)) = t.force(d) {
+                        if let Ok(TermForce { value: f, slope: s }) = t.force(d) {
                             prop_assert!(
                                 f.is_finite() && s.is_finite(),
                                 "{} at {d}: {f} {s}",

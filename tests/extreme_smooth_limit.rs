@@ -2,6 +2,7 @@
 //! tends to a delta function): the averaged forces must converge to the smooth closed forms, with
 //! the error shrinking like σ², down to σ far below one ulp of the gap — never blow up.
 
+use hdi_tribology::force::TermForce;
 use hdi_tribology::force::{
     Electrostatic, Footprint, GapReference, GreenwoodWilliamson, InterfaceTerm, Intermolecular,
 };
@@ -57,8 +58,11 @@ fn non_contact_terms_converge_to_the_smooth_closed_forms() {
             let lj = Intermolecular::new(A, B, None, h, fp, GapReference::Bulge).unwrap();
             let es = Electrostatic::new(0.0, hc, h, fp, GapReference::Bulge).unwrap();
             for d in [0.5e-9, 1e-9, 2e-9, 5e-9, 2e-8] {
-                let (f, s) = lj.force(d).unwrap();
-                let (fe, se) = es.force(d).unwrap();
+                let TermForce { value: f, slope: s } = lj.force(d).unwrap();
+                let TermForce {
+                    value: fe,
+                    slope: se,
+                } = es.force(d).unwrap();
                 assert!(f.is_finite() && s.is_finite() && fe.is_finite() && se.is_finite());
                 // The expansion below needs σ small against the distance to the cutoff.
                 if sigma > 0.05 * (d - hc) {
@@ -98,7 +102,7 @@ fn contact_converges_to_the_single_height_law() {
             let gw = GreenwoodWilliamson::new(e, r, eta, peaks.clone(), fp, GapReference::Bulge)
                 .unwrap();
             for d in [-2e-9, -5e-10, -1e-10, 1e-10, 1e-9] {
-                let (f, s) = gw.force(d).unwrap();
+                let TermForce { value: f, slope: s } = gw.force(d).unwrap();
                 assert!(f.is_finite() && s.is_finite() && f >= 0.0);
                 let x = (-d).max(0.0);
                 let want = match fp {

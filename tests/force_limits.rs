@@ -3,6 +3,7 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+use hdi_tribology::force::TermForce;
 use hdi_tribology::force::{
     composite_modulus, lj_zero, Electrostatic, Footprint, GapReference, GreenwoodWilliamson,
     InterfaceTerm, Intermolecular,
@@ -56,7 +57,10 @@ fn lj_p(h: f64) -> f64 {
 fn smooth_sphere_hamaker_matches_derjaguin_closed_form() {
     let t = Intermolecular::new(A, B, None, smooth(), sphere(), GapReference::Bulge).unwrap();
     for d in [0.3e-9, 0.5e-9, 1e-9, 3e-9, 10e-9, 100e-9] {
-        let (f, df) = t.force(d).unwrap();
+        let TermForce {
+            value: f,
+            slope: df,
+        } = t.force(d).unwrap();
         let exact = -A * RC / (6.0 * d * d) + B * RC / (180.0 * d.powi(8));
         let slope = A * RC / (3.0 * d.powi(3)) - 8.0 * B * RC / (180.0 * d.powi(9));
         // closed forms evaluated two ways: rounding only
@@ -70,7 +74,10 @@ fn smooth_sphere_electrostatics_matches_closed_form_with_and_without_dielectric(
     for td in [0.0, 1e-9] {
         let t = Electrostatic::new(td, 2e-10, smooth(), sphere(), GapReference::Bulge).unwrap();
         for d in [0.5e-9, 2e-9, 20e-9] {
-            let (f, df) = t.force(d).unwrap();
+            let TermForce {
+                value: f,
+                slope: df,
+            } = t.force(d).unwrap();
             let exact = -PI * RC * EPSILON_0 / (d + td);
             let slope = PI * RC * EPSILON_0 / (d + td).powi(2);
             assert!(
@@ -88,12 +95,12 @@ fn flat_plates_give_pressure_times_area() {
     let lj = Intermolecular::new(A, B, None, smooth(), plate, GapReference::Bulge).unwrap();
     let el = Electrostatic::new(0.0, 2e-10, smooth(), plate, GapReference::Pad).unwrap();
     for d in [0.4e-9, 1e-9, 5e-9] {
-        assert!(rel(lj.force(d).unwrap().0, area * lj_p(d)) < 1e-14);
+        assert!(rel(lj.force(d).unwrap().value, area * lj_p(d)) < 1e-14);
         let e = -EPSILON_0 * area / (2.0 * d * d);
-        assert!(rel(el.force(d).unwrap().0, e) < 1e-14);
+        assert!(rel(el.force(d).unwrap().value, e) < 1e-14);
     }
     // Below the cutoff a smooth plate has no non-contact points: no force.
-    assert_eq!(lj.force(1e-10).unwrap().0, 0.0);
+    assert_eq!(lj.force(1e-10).unwrap().value, 0.0);
 }
 
 #[test]
@@ -103,7 +110,10 @@ fn lennard_jones_pressure_vanishes_at_h_e() {
     let plate = Footprint::Flat { area_m2: 1.0 };
     let lj =
         Intermolecular::new(A, B, Some(0.5 * he), smooth(), plate, GapReference::Bulge).unwrap();
-    let (f, df) = lj.force(he).unwrap();
+    let TermForce {
+        value: f,
+        slope: df,
+    } = lj.force(he).unwrap();
     // each of the two parts is ~4e8 Pa; the sum cancels to rounding
     assert!(
         f.abs() < 1e-15 * A / (6.0 * PI * he.powi(3)) * 8.0,
@@ -113,7 +123,7 @@ fn lennard_jones_pressure_vanishes_at_h_e() {
         df < 0.0,
         "repulsion decreases through h_e, so the force rises as d falls"
     );
-    assert!(lj.force(0.9 * he).unwrap().0 > 0.0 && lj.force(1.1 * he).unwrap().0 < 0.0);
+    assert!(lj.force(0.9 * he).unwrap().value > 0.0 && lj.force(1.1 * he).unwrap().value < 0.0);
 }
 
 #[test]
@@ -123,13 +133,13 @@ fn small_roughness_converges_quadratically_to_the_smooth_sphere() {
         .unwrap()
         .force(d)
         .unwrap()
-        .0;
+        .value;
     let diff = |s: f64| {
         Intermolecular::new(A, B, None, rough(s), sphere(), GapReference::Bulge)
             .unwrap()
             .force(d)
             .unwrap()
-            .0
+            .value
             - f0
     };
     // F(σ) = F0 + σ² F0''/2 + O(σ⁴): with F0'' = −A Rc/d⁴ (leading part) the correction is
@@ -166,8 +176,8 @@ fn rough_flat_terms_match_an_independent_tanh_sinh_integral() {
                 hi,
             );
         // both rules are asked for 1e-12..1e-13; 1e-9 leaves room for the two error estimates
-        assert!(rel(lj.force(d).unwrap().0, m) < 1e-9, "LJ d = {d}");
-        assert!(rel(el.force(d).unwrap().0, e) < 1e-9, "el d = {d}");
+        assert!(rel(lj.force(d).unwrap().value, m) < 1e-9, "LJ d = {d}");
+        assert!(rel(el.force(d).unwrap().value, e) < 1e-9, "el d = {d}");
     }
 }
 
@@ -207,7 +217,7 @@ fn gw_with_gaussian_peaks_matches_independent_quadrature() {
         let pc = |s: f64| k * ts(|z| (z - s).powf(1.5) * pdf(z), s, top);
         let ar = |s: f64| PI * r * eta * ts(|z| (z - s) * pdf(z), s, top);
         assert!(
-            rel(flat.force(d).unwrap().0, area * pc(d)) < 1e-9,
+            rel(flat.force(d).unwrap().value, area * pc(d)) < 1e-9,
             "flat d = {d}"
         );
         assert!(
@@ -220,7 +230,7 @@ fn gw_with_gaussian_peaks_matches_independent_quadrature() {
         let upper = (d + delta).min(top);
         let f = 2.0 * PI * RC * ts(pc, d, upper);
         let a = 2.0 * PI * RC * ts(ar, d, upper);
-        assert!(rel(cap.force(d).unwrap().0, f) < 1e-8, "cap d = {d}");
+        assert!(rel(cap.force(d).unwrap().value, f) < 1e-8, "cap d = {d}");
         assert!(
             rel(cap.real_contact_area(d).unwrap(), a) < 1e-8,
             "cap area d = {d}"
@@ -255,8 +265,11 @@ fn derivatives_match_finite_differences() {
     for t in &terms {
         for d in [-5e-10, 3e-10, 1e-9, 4e-9] {
             let h = 1e-13;
-            let (_, df) = t.force(d).unwrap();
-            let fd = (t.force(d + h).unwrap().0 - t.force(d - h).unwrap().0) / (2.0 * h);
+            let TermForce {
+                value: _,
+                slope: df,
+            } = t.force(d).unwrap();
+            let fd = (t.force(d + h).unwrap().value - t.force(d - h).unwrap().value) / (2.0 * h);
             // step 1e-13 m against features of ~1e-10 m: truncation ~1e-6, quadrature noise
             // 1e-12 relative / 1e-3 step ratio ~1e-9
             assert!(
@@ -310,9 +323,9 @@ fn thin_paraboloid_band_matches_the_literal_double_integral() {
         let f = 2.0 * PI * RC * ts(pbar, d, d + delta);
         // nested tanh-sinh at 1e-13 each; Gauss–Legendre exact to (Δ/2σ)^16
         assert!(
-            rel(t.force(d).unwrap().0, f) < 1e-9,
+            rel(t.force(d).unwrap().value, f) < 1e-9,
             "d = {d}: {} vs {f}",
-            t.force(d).unwrap().0
+            t.force(d).unwrap().value
         );
     }
 }

@@ -5,6 +5,7 @@ mod seeded;
 
 use std::sync::Arc;
 
+use hdi_tribology::force::TermForce;
 use hdi_tribology::force::{
     AirBearing, CubicBearing, Electrostatic, Footprint, GapReference, GreenwoodWilliamson,
     InterfaceTerm, Intermolecular, PowerLawBearing,
@@ -45,7 +46,7 @@ proptest! {
         s in sigma(), fp in footprint(), d in -3e-9..5e-8f64,
     ) {
         let t = Intermolecular::new(a, b, None, GaussianHeights::new(s).unwrap(), fp, GapReference::Bulge).unwrap();
-        let (f, df) = t.force(d).unwrap();
+        let TermForce { value: f, slope: df } = t.force(d).unwrap();
         prop_assert!(f.is_finite() && df.is_finite());
         prop_assert!(f <= 0.0, "F = {f}");
     }
@@ -59,8 +60,8 @@ proptest! {
     ) {
         let fp = Footprint::Paraboloid { radius_of_curvature_m: rc, max_radius_m: None };
         let t = Electrostatic::new(td, hc, GaussianHeights::new(s).unwrap(), fp, GapReference::Bulge).unwrap();
-        let (f, df) = t.force(d).unwrap();
-        let (g, _) = t.force(d + step).unwrap();
+        let TermForce { value: f, slope: df } = t.force(d).unwrap();
+        let TermForce { value: g, slope: _ } = t.force(d + step).unwrap();
         prop_assert!(f < 0.0 && df >= 0.0 && df.is_finite());
         // allow for the quadrature tolerance (1e-12 relative) when the two values nearly agree
         prop_assert!(g >= f - 1e-11 * f.abs(), "F({d}) = {f}, F({}) = {g}", d + step);
@@ -76,7 +77,7 @@ proptest! {
     ) {
         let peaks = Arc::new(Gaussian::new(mean, sd).unwrap());
         let t = GreenwoodWilliamson::new(e, r, eta, peaks, fp, GapReference::Bulge).unwrap();
-        let (f, df) = t.force(d).unwrap();
+        let TermForce { value: f, slope: df } = t.force(d).unwrap();
         let (a, da) = t.real_contact_area_and_slope(d).unwrap();
         prop_assert!(f.is_finite() && df.is_finite() && a.is_finite() && da.is_finite());
         prop_assert!(f >= 0.0 && df <= 0.0 && a >= 0.0 && da <= 0.0, "{f} {df} {a} {da}");

@@ -25,7 +25,7 @@ impl Exact<'_> {
         self.0
             .iter()
             .filter(|t| pick(t.as_ref()))
-            .map(|t| t.force(d).unwrap())
+            .map(|t| t.force(d).map(|f| (f.value, f.slope)).unwrap())
             .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
     }
     /// Σ|F_i| and Σ|F_i'| over the picked terms: the scale a merged table is accurate to.
@@ -33,7 +33,7 @@ impl Exact<'_> {
         self.0
             .iter()
             .filter(|t| pick(t.as_ref()))
-            .map(|t| t.force(d).unwrap())
+            .map(|t| t.force(d).map(|f| (f.value, f.slope)).unwrap())
             .fold((0.0, 0.0), |a, b| (a.0 + b.0.abs(), a.1 + b.1.abs()))
     }
     fn area(&self, d: f64) -> (f64, f64) {

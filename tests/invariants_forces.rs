@@ -8,6 +8,7 @@
 #[path = "common/seeded.rs"]
 mod seeded;
 
+use hdi_tribology::force::TermForce;
 use hdi_tribology::force::{
     Electrostatic, Footprint, GapReference, GreenwoodWilliamson, InterfaceForces, InterfaceTerm,
     Intermolecular,
@@ -71,7 +72,7 @@ proptest! {
         ds.sort_by(f64::total_cmp);
         let mut prev: Option<f64> = None;
         for &d in &ds {
-            let (f, slope) = gw.force(d).unwrap();
+            let TermForce { value: f, slope } = gw.force(d).unwrap();
             let a = gw.real_contact_area(d).unwrap();
             prop_assert!(f.is_finite() && slope.is_finite() && a.is_finite(), "d = {d}: {f} {slope} {a}");
             prop_assert!(f >= 0.0 && slope <= 0.0 && a >= 0.0, "d = {d}: {f} {slope} {a}");
@@ -102,8 +103,8 @@ proptest! {
         let scale = sigma.max(hc);
         for x in u {
             let d = hc + x * scale;
-            let (fm, sm) = lj.force(d).unwrap();
-            let (fe, se) = es.force(d).unwrap();
+            let TermForce { value: fm, slope: sm } = lj.force(d).unwrap();
+            let TermForce { value: fe, slope: se } = es.force(d).unwrap();
             prop_assert!(fm.is_finite() && sm.is_finite(), "LJ at {d}: {fm} {sm}");
             prop_assert!(fe.is_finite() && se.is_finite(), "ES at {d}: {fe} {se}");
             prop_assert!(fm <= 0.0, "LJ at {d} = {fm} > 0");
@@ -150,7 +151,7 @@ proptest! {
         for x in u {
             let d = range.0 + x * (range.1 - range.0);
             let g = hdi_tribology::force::Gaps::same(d);
-            let parts: Vec<f64> = direct.iter().map(|t| t.force(d).unwrap().0).collect();
+            let parts: Vec<f64> = direct.iter().map(|t| t.force(d).unwrap().value).collect();
             let exact_static = parts[0] + parts[2];
             let biggest = parts[0].abs().max(parts[2].abs());
             let tab = forces.static_part(g).value;

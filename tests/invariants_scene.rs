@@ -4,6 +4,7 @@
 #[path = "common/seeded.rs"]
 mod seeded;
 
+use hdi_tribology::force::TermForce;
 use hdi_tribology::force::{AirBearingModel, Footprint, GapReference};
 use hdi_tribology::scene::{ContactSpec, ElectrostaticSpec, IntermolecularSpec, Scene};
 use hdi_tribology::surface::PeakModel;
@@ -80,6 +81,7 @@ prop_compose! {
         s.nominal_clearance_m = h0;
         s.surface.height_sigma_m = sigma;
         s.surface.peaks = peaks;
+        s.surface.independent_peak_sigma = true; // drawn independently on purpose
         s.intermolecular = lj.map(|(a, b, footprint, gap)| IntermolecularSpec {
             hamaker_attractive_j: a,
             hamaker_repulsive_j_m6: b,
@@ -124,7 +126,10 @@ fn force_bits(s: &Scene) -> Vec<u64> {
     let mut out = Vec::new();
     for d in [lo, 0.3 * lo + 0.7 * hi, hi] {
         for t in &terms {
-            let (f, df) = t.force(d).unwrap();
+            let TermForce {
+                value: f,
+                slope: df,
+            } = t.force(d).unwrap();
             out.push(f.to_bits());
             out.push(df.to_bits());
         }

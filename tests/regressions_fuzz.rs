@@ -1,5 +1,6 @@
 //! Scene-reader fuzzing cases that once failed, kept as regression tests.
 
+use hdi_tribology::force::TermForce;
 use hdi_tribology::scene::Scene;
 
 /// Accepted scenes whose parameters overflow f64 (found by `bad_input_fuzz`: a radius of
@@ -27,7 +28,7 @@ fn overflowing_parameters_give_an_error_not_infinity() {
         let (lo, hi) = scene.table_range();
         for t in scene.interface_terms().unwrap() {
             for d in [lo, 0.5 * (lo + hi), hi] {
-                if let Ok((f, s)) = t.force(d) {
+                if let Ok(TermForce { value: f, slope: s }) = t.force(d) {
                     assert!(
                         f.is_finite() && s.is_finite(),
                         "{key} = {value}: {} at {d}: {f} {s}",

@@ -6,7 +6,11 @@
 //! Where the AC drive makes contact intermittent, the running mean of the contact force hovers
 //! near its threshold and the detected touchdown and take-off become sensitive to the solver
 //! tolerance. [`ac_sweep_refined`] tightens the tolerance at each amplitude until the detected
-//! powers stop moving, and says where they did not.
+//! powers and the mean flash temperature stop moving, and says where they did not.
+//!
+//! Every cycle can say whether it is to be trusted: [`flags`] lists what is wrong with a cycle
+//! (a touchdown or take-off not detected, a negative hysteresis), and
+//! [`RefinedCycle::flags`] adds a refinement that did not converge.
 
 use serde::Serialize;
 
@@ -73,13 +77,16 @@ fn per_amplitude<T: Send>(
 /// ```
 /// use hdi_tribology::analysis::sweep::Refinement;
 /// let r = Refinement::new(6e-5);
-/// assert_eq!((r.factor, r.max_runs), (0.1, 4));
+/// assert_eq!((r.factor, r.max_runs, r.temperature_tol), (0.1, 4, 0.05));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Refinement {
     /// Largest change of the detected touchdown and take-off powers between two successive
     /// tolerances that counts as converged (W).
     pub power_tol: f64,
+    /// Largest change of the mean flash-temperature rise between two successive tolerances that
+    /// counts as converged (K).
+    pub temperature_tol: f64,
     /// Factor applied to the relative and absolute tolerances at each round, in (0, 1).
     pub factor: f64,
     /// Most cycles run per amplitude, the first included, 2 to 12.
@@ -87,11 +94,13 @@ pub struct Refinement {
 }
 
 impl Refinement {
-    /// Converged when the powers move by at most `power_tol` (W) under a tenfold tighter
-    /// tolerance; at most four runs (the tolerance tightened down to a thousandth).
+    /// Converged when the powers move by at most `power_tol` (W), and the mean flash-temperature
+    /// rise by at most 0.05 K, under a tenfold tighter tolerance; at most four runs (the
+    /// tolerance tightened down to a thousandth).
     pub fn new(power_tol: f64) -> Self {
         Refinement {
             power_tol,
+            temperature_tol: 0.05,
             factor: 0.1,
             max_runs: 4,
         }
@@ -99,6 +108,7 @@ impl Refinement {
 
     fn validate(&self) -> Result<()> {
         check_positive("refinement.power_tol", self.power_tol)?;
+        check_positive("refinement.temperature_tol", self.temperature_tol)?;
         if !(self.factor > 0.0 && self.factor < 1.0) {
             return Err(Error::invalid(
                 "refinement.factor",
@@ -122,10 +132,14 @@ pub struct RefinedCycle {
     pub cycle: CycleResult,
     /// The relative tolerance of that cycle.
     pub rtol: f64,
+    /// The absolute displacement tolerance of that cycle (m), tightened with `rtol`.
+    pub atol: f64,
     /// Largest change of the touchdown and take-off powers between the last two runs (W); ∞
     /// when one of them was detected in one run and not in the other.
     pub change: f64,
-    /// Whether `change ≤ power_tol`.
+    /// Change of the mean flash-temperature rise between the last two runs (K).
+    pub temperature_change: f64,
+    /// Whether `change ≤ power_tol` and `temperature_change ≤ temperature_tol`.
     pub converged: bool,
     /// Cycles run.
     pub runs: usize,
@@ -146,8 +160,9 @@ fn power_change(a: &CycleResult, b: &CycleResult) -> f64 {
     one(p(a.touchdown), p(b.touchdown)).max(one(p(a.takeoff), p(b.takeoff)))
 }
 
-/// [`ac_sweep`], with the tolerance at each amplitude tightened by `refine.factor` until the
-/// detected touchdown and take-off powers move by at most `refine.power_tol`, or
+/// [`ac_sweep`], with the relative and absolute tolerances at each amplitude tightened by
+/// `refine.factor` until the detected touchdown and take-off powers move by at most
+/// `refine.power_tol` and the mean flash-temperature rise by at most `refine.temperature_tol`, or
 /// `refine.max_runs` cycles have run. The cycle kept is the last (most accurate) one; the
 /// change from the one before is its error estimate, conservative.
 ///
@@ -186,13 +201,19 @@ pub fn ac_sweep_refined(
             stats += &next.stats;
             wall += next.wall_seconds;
             let change = power_change(&last, &next);
+            let temperature_change =
+                (next.mean_temperature_rise - last.mean_temperature_rise).abs();
             last = next;
-            if change <= refine.power_tol || runs >= refine.max_runs {
+            let converged =
+                change <= refine.power_tol && temperature_change <= refine.temperature_tol;
+            if converged || runs >= refine.max_runs {
                 return Ok(RefinedCycle {
                     cycle: last,
                     rtol: o.solver.rtol,
+                    atol: o.solver.atol_displacement,
                     change,
-                    converged: change <= refine.power_tol,
+                    temperature_change,
+                    converged,
                     runs,
                     stats,
                     wall_seconds: wall,
@@ -200,4 +221,77 @@ pub fn ac_sweep_refined(
             }
         }
     })
+}
+
+/// What makes a cycle's result untrustworthy, or not a result at all.
+///
+/// ```
+/// use hdi_tribology::analysis::sweep::Flag;
+/// assert_eq!(Flag::NegativeHysteresis.to_string(), "negative hysteresis");
+/// assert_eq!(serde_json::to_string(&Flag::NotConverged).unwrap(), "\"not_converged\"");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Flag {
+    /// No touchdown was detected: there is no touchdown power and no hysteresis.
+    NoTouchdown,
+    /// No take-off was detected after touchdown: there is no hysteresis.
+    NoTakeoff,
+    /// The take-off power lies above the touchdown power: not a physical hysteresis but a
+    /// detection artefact (typically the contact indicator hovering at its threshold).
+    NegativeHysteresis,
+    /// The refined tolerances did not bring the powers and the mean temperature within their
+    /// tolerances.
+    NotConverged,
+}
+
+impl std::fmt::Display for Flag {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Flag::NoTouchdown => "no touchdown detected",
+            Flag::NoTakeoff => "no take-off detected",
+            Flag::NegativeHysteresis => "negative hysteresis",
+            Flag::NotConverged => "not converged",
+        })
+    }
+}
+
+/// What is wrong with one cycle; empty when its touchdown, take-off and hysteresis are all there
+/// and the hysteresis is not negative. (Whether the tolerance was fine enough takes a refined
+/// run: see [`RefinedCycle::flags`].)
+///
+/// ```no_run
+/// use hdi_tribology::analysis::sweep::flags;
+/// use hdi_tribology::analysis::{simulate_cycle, CycleOptions, HeaterProgramme};
+/// use hdi_tribology::{model::SliderModel, scene::Scene};
+/// let scene = Scene::paper();
+/// let model = SliderModel::from_scene(&scene)?;
+/// let programme = HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+/// let r = simulate_cycle(&model, &programme, &CycleOptions::from_scene(&scene)?)?;
+/// assert!(flags(&r).is_empty());
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn flags(cycle: &CycleResult) -> Vec<Flag> {
+    let mut f = Vec::new();
+    if cycle.touchdown.is_none() {
+        f.push(Flag::NoTouchdown);
+    } else if cycle.takeoff.is_none() {
+        f.push(Flag::NoTakeoff);
+    }
+    if cycle.hysteresis.is_some_and(|h| h < 0.0) {
+        f.push(Flag::NegativeHysteresis);
+    }
+    f
+}
+
+impl RefinedCycle {
+    /// [`flags`] of the cycle kept, and [`Flag::NotConverged`] when the refinement did not
+    /// converge.
+    pub fn flags(&self) -> Vec<Flag> {
+        let mut f = flags(&self.cycle);
+        if !self.converged {
+            f.push(Flag::NotConverged);
+        }
+        f
+    }
 }

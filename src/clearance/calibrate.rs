@@ -48,8 +48,12 @@ impl Staircase {
         }
         if (self.max_power - self.start_power) / self.step > MAX_LEVELS as f64 {
             return Err(Error::invalid(
-                "staircase.step",
-                format!("more than {MAX_LEVELS} levels between start_power and max_power"),
+                "staircase.max_power",
+                format!(
+                    "more than {MAX_LEVELS} levels of step = {:?} W between start_power = {:?} W \
+                     and max_power = {:?} W",
+                    self.step, self.start_power, self.max_power
+                ),
             ));
         }
         check_positive("staircase.rise_time", self.rise_time)?;
@@ -74,7 +78,11 @@ impl Staircase {
 }
 
 /// Upper bound on the number of levels of one search, against runaway loops.
-const MAX_LEVELS: usize = 100_000;
+///
+/// ```
+/// assert_eq!(hdi_tribology::clearance::MAX_LEVELS, 100_000);
+/// ```
+pub const MAX_LEVELS: usize = 100_000;
 
 /// Options of [`calibrate`].
 ///
@@ -289,6 +297,19 @@ pub fn calibrate(
             ),
         ));
     };
+    if state.steps.len() == 1 {
+        // Fired at the baseline level: the slider was in contact before the staircase began, so
+        // there is no touchdown power to find and no contrast to measure.
+        return Err(Error::analysis(
+            "clearance calibration",
+            format!(
+                "{} fired at the start power {:?} W already, before the first heater step: \
+                 contact before the staircase began (start lower, or with less dither)",
+                detector.name(),
+                sc.start_power
+            ),
+        ));
+    }
     let contrast = match state.steps.len() {
         0 | 1 => f64::INFINITY,
         m => {

@@ -27,7 +27,9 @@ mod detector;
 mod filters;
 mod zone;
 
-pub use calibrate::{calibrate, Calibration, CalibrationOptions, Staircase, StepRecord};
+pub use calibrate::{
+    calibrate, Calibration, CalibrationOptions, Staircase, StepRecord, MAX_LEVELS,
+};
 pub use detector::{
     ContactForceRms, MeanContactForce, Relative, Sample, TouchdownDetector, VibrationRms,
 };

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use statrs::function::erf::erfc;
 
 use super::term::finite_eval;
-use super::{Coupling, Footprint, GapReference, InterfaceTerm, PressureLaw, TermKind};
+use super::{Coupling, Footprint, GapReference, InterfaceTerm, PressureLaw, TermForce, TermKind};
 use crate::error::check_positive;
 use crate::quadrature::{integrate_with_breaks, QuadOptions};
 use crate::surface::GaussianHeights;
@@ -43,7 +43,7 @@ const QUAD_REL_TOL: f64 = 1e-12;
 /// let plate = Footprint::Flat { area_m2: 1e-8 };
 /// let t = AveragedTerm::new("plates", TermKind::Electrostatic, Coupling::PerVoltSquared,
 ///     Coulomb::new(0.0)?, 1e-10, GaussianHeights::new(0.0)?, plate, GapReference::Bulge)?;
-/// let (f, _) = t.force(5e-9)?;
+/// let f = t.force(5e-9)?.value;
 /// let exact = -hdi_tribology::units::EPSILON_0 * 1e-8 / (2.0 * 25e-18);
 /// assert!((f - exact).abs() < 1e-14 * exact.abs());
 /// # Ok(()) }
@@ -231,7 +231,7 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
     fn gap(&self) -> GapReference {
         self.gap
     }
-    fn force(&self, d: f64) -> Result<(f64, f64)> {
+    fn force(&self, d: f64) -> Result<TermForce> {
         let r = (|| -> Result<(f64, f64)> {
             if !d.is_finite() {
                 return Err(Error::invalid("d", format!("must be finite, got {d}")));
@@ -270,7 +270,7 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
                 }
             }
         })()?;
-        finite_eval(self.name(), "force", d, r)
+        finite_eval(self.name(), "force", d, r).map(TermForce::from)
     }
     fn kinks(&self) -> Vec<f64> {
         // With roughness the cutoff is smeared over σ and the force is smooth on the scale of the
@@ -314,7 +314,7 @@ macro_rules! forward_term {
             fn gap(&self) -> $crate::force::GapReference {
                 self.inner.gap()
             }
-            fn force(&self, d: f64) -> $crate::Result<(f64, f64)> {
+            fn force(&self, d: f64) -> $crate::Result<$crate::force::TermForce> {
                 self.inner.force(d)
             }
             fn real_contact_area(&self, d: f64) -> $crate::Result<f64> {

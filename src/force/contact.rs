@@ -4,7 +4,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use super::term::finite_eval;
-use super::{Coupling, Footprint, GapReference, InterfaceTerm, TermKind};
+use super::{Coupling, Footprint, GapReference, InterfaceTerm, TermForce, TermKind};
 use crate::error::check_positive;
 use crate::surface::PeakDistribution;
 use crate::{Error, Result};
@@ -43,8 +43,8 @@ pub fn composite_modulus(e1: f64, nu1: f64, e2: f64, nu2: f64) -> Result<f64> {
 /// let peaks = Arc::new(Gaussian::new(0.0, 1e-9)?);
 /// let gw = GreenwoodWilliamson::new(1e11, 1e-7, 1.5e14, peaks,
 ///     Footprint::Flat { area_m2: 1e-8 }, GapReference::Bulge)?;
-/// let (f, slope) = gw.force(1e-9)?;
-/// assert!(f > 0.0 && slope < 0.0);
+/// let f = gw.force(1e-9)?;
+/// assert!(f.value > 0.0 && f.slope < 0.0);
 /// assert!(gw.real_contact_area(1e-9)? > 0.0);
 /// # Ok(()) }
 /// ```
@@ -133,7 +133,7 @@ impl InterfaceTerm for GreenwoodWilliamson {
     fn gap(&self) -> GapReference {
         self.gap
     }
-    fn force(&self, d: f64) -> Result<(f64, f64)> {
+    fn force(&self, d: f64) -> Result<TermForce> {
         let r = (|| -> Result<(f64, f64)> {
             if !d.is_finite() {
                 return Err(Error::invalid("d", format!("must be finite, got {d}")));
@@ -157,7 +157,7 @@ impl InterfaceTerm for GreenwoodWilliamson {
                 }
             }
         })()?;
-        finite_eval(self.name(), "force", d, r)
+        finite_eval(self.name(), "force", d, r).map(TermForce::from)
     }
     fn real_contact_area(&self, d: f64) -> Result<f64> {
         Ok(self.real_contact_area_and_slope(d)?.0)

@@ -17,7 +17,7 @@ use crate::Result;
 ///     Footprint::Paraboloid { radius_of_curvature_m: rc, max_radius_m: None }, GapReference::Bulge)?;
 /// let d = 3e-9;
 /// let exact = -std::f64::consts::PI * rc * hdi_tribology::units::EPSILON_0 / d; // smooth sphere
-/// assert!((t.force(d)?.0 - exact).abs() < 1e-12 * exact.abs());
+/// assert!((t.force(d)?.value - exact).abs() < 1e-12 * exact.abs());
 /// # Ok(()) }
 /// ```
 #[derive(Clone, Debug)]

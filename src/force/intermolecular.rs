@@ -13,7 +13,7 @@ use crate::Result;
 /// # fn main() -> hdi_tribology::Result<()> {
 /// let t = Intermolecular::new(1e-19, 1e-76, None, GaussianHeights::new(7e-10)?,
 ///     Footprint::Flat { area_m2: 1e-8 }, GapReference::Bulge)?;
-/// assert!(t.force(5e-9)?.0 < 0.0); // attractive far from contact
+/// assert!(t.force(5e-9)?.value < 0.0); // attractive far from contact
 /// # Ok(()) }
 /// ```
 #[derive(Clone, Debug)]

@@ -15,7 +15,7 @@
 //! let smooth = GaussianHeights::new(0.0)?;
 //! let lj = Intermolecular::new(a, b, None, smooth, sphere, GapReference::Bulge)?;
 //! let d = 2e-9;
-//! let (f, _slope) = lj.force(d)?;
+//! let f = lj.force(d)?.value;
 //! // smooth sphere, Derjaguin: −A Rc/(6 d²) + B Rc/(180 d⁸)
 //! let exact = -a * 0.02 / (6.0 * d * d) + b * 0.02 / (180.0 * d.powi(8));
 //! assert!((f - exact).abs() <= 1e-12 * exact.abs());
@@ -42,4 +42,4 @@ pub use footprint::Footprint;
 pub use interface::{Breakdown, ForceEval, Gaps, HotForces, InterfaceForces};
 pub use intermolecular::Intermolecular;
 pub use pressure::{lj_zero, Coulomb, LennardJones39, PressureLaw};
-pub use term::{Coupling, GapReference, InterfaceTerm, TermKind};
+pub use term::{Coupling, GapReference, InterfaceTerm, TermForce, TermKind};

@@ -47,6 +47,30 @@ pub enum TermKind {
     Other,
 }
 
+/// A term's force at one separation and its slope, from [`InterfaceTerm::force`].
+///
+/// ```
+/// use hdi_tribology::force::TermForce;
+/// let f = TermForce { value: -2e-4, slope: 3e5 };
+/// assert!(f.value < 0.0 && f.slope > 0.0);
+/// assert_eq!(TermForce::from((1.0, 2.0)), TermForce { value: 1.0, slope: 2.0 });
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TermForce {
+    /// The force `F(d)` in N (per V² for a [`Coupling::PerVoltSquared`] term), positive away from
+    /// the disk.
+    pub value: f64,
+    /// Its derivative `dF/dd` in N/m (per V² likewise).
+    pub slope: f64,
+}
+
+impl From<(f64, f64)> for TermForce {
+    /// `(F, dF/dd)`.
+    fn from((value, slope): (f64, f64)) -> Self {
+        TermForce { value, slope }
+    }
+}
+
 /// A force law between head and disk as a function of the mean-plane separation `d` (m).
 ///
 /// Forces are in N, positive when they push the head away from the disk; for
@@ -54,7 +78,7 @@ pub enum TermKind {
 /// your own; [`crate::force::InterfaceForces`] tabulates it with the built-in ones.
 ///
 /// ```
-/// use hdi_tribology::force::{Coupling, GapReference, InterfaceTerm, TermKind};
+/// use hdi_tribology::force::{Coupling, GapReference, InterfaceTerm, TermForce, TermKind};
 /// /// A soft exponential repulsion F = F0 exp(−d/λ).
 /// #[derive(Debug)]
 /// struct Soft { f0: f64, lambda: f64 }
@@ -63,13 +87,13 @@ pub enum TermKind {
 ///     fn kind(&self) -> TermKind { TermKind::Other }
 ///     fn coupling(&self) -> Coupling { Coupling::Static }
 ///     fn gap(&self) -> GapReference { GapReference::Bulge }
-///     fn force(&self, d: f64) -> hdi_tribology::Result<(f64, f64)> {
+///     fn force(&self, d: f64) -> hdi_tribology::Result<TermForce> {
 ///         let f = self.f0 * (-d / self.lambda).exp();
-///         Ok((f, -f / self.lambda))
+///         Ok(TermForce { value: f, slope: -f / self.lambda })
 ///     }
 /// }
 /// let s = Soft { f0: 1e-3, lambda: 1e-9 };
-/// assert!(s.force(1e-9).unwrap().0 > 0.0);
+/// assert!(s.force(1e-9).unwrap().value > 0.0);
 /// ```
 pub trait InterfaceTerm: Debug + Send + Sync {
     /// A short human-readable name.
@@ -82,7 +106,7 @@ pub trait InterfaceTerm: Debug + Send + Sync {
     fn gap(&self) -> GapReference;
     /// Exact (direct quadrature) force in N (per V² for [`Coupling::PerVoltSquared`]) and its
     /// derivative dF/dd in N/m.
-    fn force(&self, d: f64) -> Result<(f64, f64)>;
+    fn force(&self, d: f64) -> Result<TermForce>;
     /// Real contact area (m²); 0 for non-contact terms.
     fn real_contact_area(&self, d: f64) -> Result<f64> {
         let _ = d;

@@ -230,14 +230,17 @@ impl SliderModel {
     /// The static part and the per-V² part of the interface force from direct (untabulated)
     /// evaluation of every term: slow, for refinement and checks.
     pub fn interface_parts_exact(&self, g: Gaps) -> Result<(ForceEval, ForceEval)> {
-        use crate::force::{Coupling, GapReference};
+        use crate::force::{Coupling, GapReference, TermForce};
         let (mut stat, mut per_v2) = (ForceEval::default(), ForceEval::default());
         for term in self.forces.terms() {
             let (d, on_pad) = match term.gap() {
                 GapReference::Bulge => (g.bulge, false),
                 GapReference::Pad => (g.pad, true),
             };
-            let (f, df) = term.force(d)?;
+            let TermForce {
+                value: f,
+                slope: df,
+            } = term.force(d)?;
             let out = match term.coupling() {
                 Coupling::Static => &mut stat,
                 Coupling::PerVoltSquared => &mut per_v2,

@@ -1,0 +1,79 @@
+"""hdi_tribology: tribology of the head-disk interface of hard disk drives.
+
+Python bindings of the Rust crate ``hdi-tribology``: the same code, the same numbers. Inputs
+are in engineering units where their name says so (``power_mw``, ``gaps_nm``, ``v_ac`` in V);
+results carry their unit in their name (``power_w``, ``d_m``, ``total_n``), with
+engineering-unit properties beside them (``power_mw``, ``d_nm``).
+
+>>> import hdi_tribology as hdi
+>>> model = hdi.Model(hdi.Scene.paper())
+>>> h = hdi.static_hysteresis(model)
+>>> round(h.touchdown.power_mw, 1) > round(h.takeoff.power_mw, 1)
+True
+"""
+
+from ._core import (
+    Calibration,
+    Cycle,
+    Detection,
+    Equilibrium,
+    LinearResponse,
+    Model,
+    PullIn,
+    RefinedCycle,
+    Scene,
+    StaticHysteresis,
+    Transition,
+    __version__,
+    ac_sweep,
+    ac_sweep_refined,
+    calibrate,
+    clearance_change,
+    forces,
+    linear_response,
+    pull_in_voltage,
+    s_curve,
+    simulate_cycle,
+    static_hysteresis,
+)
+from ._errors import (
+    AnalysisError,
+    FileError,
+    HdiError,
+    InvalidInputError,
+    NoConvergenceError,
+    SceneError,
+    SolverError,
+)
+
+__all__ = [
+    "AnalysisError",
+    "Calibration",
+    "Cycle",
+    "Detection",
+    "Equilibrium",
+    "FileError",
+    "HdiError",
+    "InvalidInputError",
+    "LinearResponse",
+    "Model",
+    "NoConvergenceError",
+    "PullIn",
+    "RefinedCycle",
+    "Scene",
+    "SceneError",
+    "SolverError",
+    "StaticHysteresis",
+    "Transition",
+    "__version__",
+    "ac_sweep",
+    "ac_sweep_refined",
+    "calibrate",
+    "clearance_change",
+    "forces",
+    "linear_response",
+    "pull_in_voltage",
+    "s_curve",
+    "simulate_cycle",
+    "static_hysteresis",
+]

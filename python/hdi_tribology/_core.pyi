@@ -1,0 +1,322 @@
+"""Type stubs of the native core. Units are in every name: ``_m``, ``_w``, ``_n``, ``_s``,
+``_k`` (SI) and ``_nm``, ``_mw``, ``_un`` (engineering units); voltages in V."""
+
+import os
+from typing import Any, Dict, List, Mapping, Optional, Sequence, TypedDict, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+F64Array = npt.NDArray[np.float64]
+Target = Union["Model", "Scene"]
+
+class Scene:
+    """A whole head–disk interface, validated. Fields are SI with the unit in their name;
+    ``scene["surface.height_sigma_nm"]`` reads and writes a field in an engineering unit."""
+
+    @staticmethod
+    def paper() -> Scene:
+        """The built-in scene of the letter."""
+    @staticmethod
+    def from_file(path: Union[str, os.PathLike[str]]) -> Scene:
+        """Reads a ``.toml`` or ``.json`` scene file and validates it.
+
+        Raises FileError, SceneError (parse, with the file name) or InvalidInputError."""
+    @staticmethod
+    def from_toml(text: str) -> Scene:
+        """Parses TOML text (engineering units allowed) and validates it."""
+    @staticmethod
+    def from_json(text: str) -> Scene:
+        """Parses JSON text (engineering units allowed) and validates it."""
+    @staticmethod
+    def from_dict(d: Mapping[str, Any]) -> Scene:
+        """A scene from a dict shaped as the JSON file (engineering units allowed)."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The scene as plain Python values, SI units; ``from_dict`` gives it back exactly."""
+    def to_toml(self) -> str:
+        """The scene as TOML text, SI units."""
+    def to_json(self) -> str:
+        """The scene as JSON text, SI units."""
+    @property
+    def name(self) -> str:
+        """The scene's name."""
+    def __getitem__(self, path: str) -> Any:
+        """A field by dotted path, SI (``"surface.height_sigma_m"``) or engineering unit
+        (``"surface.height_sigma_nm"``, in nm). KeyError if there is no such field."""
+    def __setitem__(self, path: str, value: Any) -> None:
+        """Sets a field (SI or engineering unit) and validates the scene again; on
+        InvalidInputError the scene is unchanged."""
+    def with_values(self, values: Mapping[str, Any]) -> Scene:
+        """A validated copy with the fields (dotted paths, SI or engineering units) replaced."""
+    def __eq__(self, other: object) -> bool: ...
+
+class Model:
+    """A scene built into the slider model (force tables, air bearing, heater, voltage).
+    Building takes a fraction of a second, without the GIL; share one model across analyses."""
+
+    def __init__(self, scene: Scene) -> None: ...
+    @property
+    def scene(self) -> Scene:
+        """A copy of the scene the model was built from."""
+
+class Equilibrium:
+    """A static equilibrium of the slider."""
+
+    d_m: float
+    """Bulge gap (m)."""
+    y_m: float
+    """Head displacement away from the disk (m)."""
+    protrusion_m: float
+    """Thermal protrusion (m)."""
+    power_w: float
+    """Heater power (W)."""
+    stiffness_n_per_m: float
+    """Total stiffness (N/m)."""
+    interface_force_n: float
+    """Interface force (N), positive away from the disk."""
+    contact_force_n: float
+    """Contact force (N)."""
+    stable: bool
+    """Whether the equilibrium is stable."""
+    @property
+    def d_nm(self) -> float:
+        """Bulge gap (nm)."""
+    @property
+    def power_mw(self) -> float:
+        """Heater power (mW)."""
+
+class Transition:
+    """A touchdown or take-off on the static equilibria."""
+
+    power_w: float
+    """Heater power (W)."""
+    cause: str
+    """``"fold"`` (the branch ends) or ``"threshold"`` (contact force crosses the detector's)."""
+    at: Equilibrium
+    """The equilibrium where it happens."""
+    @property
+    def power_mw(self) -> float:
+        """Heater power (mW)."""
+
+class StaticHysteresis:
+    """Static touchdown, take-off and their difference."""
+
+    touchdown: Transition
+    takeoff: Transition
+    hysteresis_w: float
+    """Touchdown minus take-off power (W)."""
+    @property
+    def hysteresis_mw(self) -> float:
+        """Touchdown minus take-off power (mW)."""
+
+class PullIn:
+    """The pull-in voltage."""
+
+    voltage_v: float
+    """|V − φ| at pull-in (V)."""
+    d_m: float
+    """Bulge gap where the head jumps in (m)."""
+    cause: str
+    """``"fold"`` or ``"threshold"``."""
+
+class Detection:
+    """A touchdown or take-off detected in a cycle."""
+
+    time_s: float
+    """Time of detection (s)."""
+    power_w: float
+    """Programme heater power then (W)."""
+    @property
+    def power_mw(self) -> float:
+        """Programme heater power then (mW)."""
+
+class Cycle:
+    """One touchdown/take-off cycle (without its time series)."""
+
+    v_ac_v: float
+    """AC amplitude (V)."""
+    touchdown: Optional[Detection]
+    """Touchdown, None if not detected."""
+    takeoff: Optional[Detection]
+    """Take-off, None if not detected."""
+    hysteresis_w: Optional[float]
+    """Touchdown minus take-off power (W); None unless both were detected."""
+    mean_temperature_rise_k: float
+    """Mean flash temperature rise in contact (K)."""
+    duration_s: float
+    """Simulated time (s)."""
+    steps: int
+    """Accepted solver steps."""
+    rejected_steps: int
+    """Rejected solver steps."""
+    wall_seconds: float
+    """Wall time of the simulation inside Rust (s)."""
+    @property
+    def hysteresis_mw(self) -> Optional[float]:
+        """Touchdown minus take-off power (mW); None unless both were detected."""
+
+class RefinedCycle:
+    """A cycle rerun at tighter tolerances until its powers settle. Check ``converged``."""
+
+    cycle: Cycle
+    """The last, most accurate run."""
+    rtol: float
+    """Its relative tolerance."""
+    power_change_w: float
+    """Largest change of touchdown or take-off power from the run before (W)."""
+    converged: bool
+    """Whether that change is within the tolerance asked for."""
+    runs: int
+    """Cycles run."""
+    steps: int
+    """Accepted steps over all runs."""
+    wall_seconds: float
+    """Wall time over all runs (s)."""
+
+class LinearResponse:
+    """The linearised slider about its flying equilibrium."""
+
+    @property
+    def equilibrium(self) -> Equilibrium: ...
+    @property
+    def eigenvalues(self) -> List[complex]:
+        """Eigenvalues (1/s)."""
+    @property
+    def frequencies_hz(self) -> List[float]:
+        """|Im λ| / 2π (Hz)."""
+    @property
+    def damping_ratios(self) -> List[float]:
+        """−Re λ / |λ|."""
+    @property
+    def stable(self) -> bool:
+        """Whether every eigenvalue has a negative real part."""
+    @property
+    def gain_at_2f_m_per_n(self) -> float:
+        """|H(i·2π·2f)| (m/N)."""
+    @property
+    def force_at_2f_n(self) -> float:
+        """Force amplitude at 2f, |G_e| V_ac²/2 (N)."""
+    @property
+    def dither_amplitude_m(self) -> float:
+        """Predicted dither amplitude at 2f (m)."""
+    @property
+    def dither_amplitude_nm(self) -> float:
+        """Predicted dither amplitude at 2f (nm)."""
+    def transfer(self, omega_rad_s: F64Array) -> npt.NDArray[np.complex128]:
+        """H(iω) (m/N), displacement per interface force, at each ω (rad/s)."""
+
+class Calibration:
+    """A touchdown calibration as drive firmware does it."""
+
+    detector: str
+    touchdown_power_w: float
+    """First heater level where contact was seen (W)."""
+    takeoff_power_w: Optional[float]
+    """First level on the way down without contact (W), None if not searched or not found."""
+    set_power_w: float
+    """Operating power: touchdown minus the margin (W)."""
+    clearance_m: float
+    """Static flying clearance at the set power, DC voltage only (m)."""
+    contrast: float
+    """Detector level at touchdown over the level before."""
+    levels: int
+    """Heater levels run."""
+    simulated_time_s: float
+    """Simulated time (s)."""
+    @property
+    def hysteresis_w(self) -> Optional[float]:
+        """Touchdown minus take-off level (W)."""
+    @property
+    def clearance_nm(self) -> float:
+        """Clearance at the set power (nm)."""
+
+class Forces(TypedDict):
+    d_m: F64Array
+    intermolecular_n: F64Array
+    contact_n: F64Array
+    electrostatic_per_volt2_n_per_v2: F64Array
+    electrostatic_n: F64Array
+    other_n: F64Array
+    real_contact_area_m2: F64Array
+    total_n: F64Array
+
+def forces(target: Target, gaps_nm: F64Array, protrusion_nm: float = 0.0) -> Forces:
+    """Every interface force at bulge gaps ``gaps_nm`` (nm; pad gaps ``gaps_nm +
+    protrusion_nm``) at the scene's DC voltage: float64 arrays shaped as ``gaps_nm``, in N
+    (positive away from the disk), N/V² and m²."""
+
+def static_hysteresis(target: Target, contact_threshold_un: Optional[float] = None) -> StaticHysteresis:
+    """Static touchdown and take-off at the scene's DC voltage (threshold in µN; default the
+    scene detector's)."""
+
+def pull_in_voltage(target: Target, power_mw: float = 0.0, contact_threshold_un: Optional[float] = None) -> PullIn:
+    """The voltage |V − φ| (V) that pulls the head in at heater power ``power_mw`` (mW)."""
+
+def clearance_change(target: Target, dc_voltages_v: Sequence[float], contact_threshold_un: Optional[float] = None) -> Dict[str, F64Array]:
+    """Clearance change with DC voltage: arrays ``dc_voltage_v`` (V), ``touchdown_power_w``
+    (W), ``clearance_change_m`` (m)."""
+
+def s_curve(target: Target) -> Dict[str, Any]:
+    """Static equilibria along the gap: arrays ``d_m``, ``power_w``, ``y_m``,
+    ``stiffness_n_per_m``, ``contact_force_n``, ``stable`` (bool), and ``folds``, a list of
+    ``{"power_w", "d_m", "jump_in"}``."""
+
+def simulate_cycle(
+    target: Target,
+    v_ac: Optional[float] = None,
+    *,
+    triggered: bool = False,
+    method: Optional[str] = None,
+    rtol: Optional[float] = None,
+    series: bool = True,
+) -> Dict[str, Any]:
+    """One touchdown/take-off cycle at AC amplitude ``v_ac`` (V; default the scene's), under
+    the scene's programme (or the touchdown-triggered protocol). Returns ``cycle`` (Cycle),
+    ``touchdown``/``takeoff`` (Detection or None) and, with ``series``, float64 arrays per
+    accepted step: ``t_s``, ``power_w``, ``d_m``, ``air_bearing_n``, ``intermolecular_n``,
+    ``electrostatic_n``, ``contact_n``, ``total_n``, ``temperature_rise_k``, ``indicator_n``
+    (NaN until the detector window has filled)."""
+
+def ac_sweep(
+    target: Target,
+    amplitudes_v: Optional[Sequence[float]] = None,
+    *,
+    triggered: bool = False,
+    method: Optional[str] = None,
+    rtol: Optional[float] = None,
+    threads: Optional[int] = None,
+) -> List[Cycle]:
+    """One cycle per AC amplitude (V; default the scene's sweep list), on ``threads`` rayon
+    threads (default all cores), GIL released; in the order of the amplitudes."""
+
+def ac_sweep_refined(
+    target: Target,
+    power_tol_mw: float,
+    amplitudes_v: Optional[Sequence[float]] = None,
+    *,
+    triggered: bool = False,
+    method: Optional[str] = None,
+    rtol: Optional[float] = None,
+    threads: Optional[int] = None,
+) -> List[RefinedCycle]:
+    """``ac_sweep`` with the tolerance tightened tenfold per run (at most 4) until touchdown
+    and take-off move by at most ``power_tol_mw`` (mW)."""
+
+def linear_response(target: Target, power_mw: float) -> LinearResponse:
+    """The linearised slider about its flying equilibrium at ``power_mw`` (mW)."""
+
+def calibrate(
+    target: Target,
+    *,
+    detector: str = "mean",
+    start_mw: Optional[float] = None,
+    step_mw: float = 0.5,
+    max_mw: Optional[float] = None,
+    margin_mw: float = 15.0,
+    dither_v: Optional[float] = None,
+    find_takeoff: bool = True,
+) -> Calibration:
+    """Touchdown calibration by heater steps (mW) with detector ``"mean"``, ``"ae"`` or
+    ``"vibration"``, optionally under an AC dither (V)."""

@@ -1,0 +1,1219 @@
+//! Python bindings of `hdi-tribology`: a thin layer over the crate's public API.
+//!
+//! Every function here converts its arguments, calls one function of the crate with the GIL
+//! released, and converts the result. Nothing of the physics or the analyses lives here. Inputs
+//! are in engineering units where the name says so (`_mw`, `_nm`, `_v`); results carry their
+//! SI unit in their name (`power_w`, `d_m`) and engineering-unit properties beside them.
+
+use std::sync::Arc;
+
+use hdi_tribology::analysis::{
+    self, CycleOptions, CycleResult, HeaterProgramme, Refinement, ScanGrid, StaticOptions,
+};
+use hdi_tribology::clearance::{
+    self, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
+    VibrationRms,
+};
+use hdi_tribology::force::Gaps;
+use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::units;
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyKeyError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+type Scn = hdi_tribology::scene::Scene;
+
+// ---------------------------------------------------------------------------------------------
+// Errors: each crate error becomes the Python exception of `hdi_tribology._errors` of its kind,
+// with the crate's fields as attributes.
+
+fn to_py_err(e: hdi_tribology::Error) -> PyErr {
+    use hdi_tribology::Error as E;
+    let message = e.to_string();
+    let (class, attrs): (&str, Vec<(&str, String)>) = match e {
+        E::InvalidInput { field, reason } => (
+            "InvalidInputError",
+            vec![("field", field), ("reason", reason)],
+        ),
+        E::Scene { origin, reason } => ("SceneError", vec![("origin", origin), ("reason", reason)]),
+        E::NoConvergence { what, reason } => (
+            "NoConvergenceError",
+            vec![("what", what), ("reason", reason)],
+        ),
+        E::Analysis { what, reason } => ("AnalysisError", vec![("what", what), ("reason", reason)]),
+        E::Ode(o) => ("SolverError", vec![("reason", o.to_string())]),
+        E::Io { path, source } => (
+            "FileError",
+            vec![("path", path), ("reason", source.to_string())],
+        ),
+        other => ("HdiError", vec![("reason", other.to_string())]),
+    };
+    Python::attach(|py| {
+        let made = (|| -> PyResult<PyErr> {
+            let cls = py.import("hdi_tribology._errors")?.getattr(class)?;
+            let kwargs = PyDict::new(py);
+            for (k, v) in attrs {
+                kwargs.set_item(k, v)?;
+            }
+            let inst = cls.call((message.clone(),), Some(&kwargs))?;
+            Ok(PyErr::from_value(inst))
+        })();
+        made.unwrap_or_else(|e| e)
+    })
+}
+
+/// An error on an argument of a Python function, named as the caller wrote it.
+fn invalid(field: &str, reason: impl Into<String>) -> PyErr {
+    to_py_err(hdi_tribology::Error::invalid(field, reason))
+}
+
+trait OrPy<T> {
+    fn py(self) -> PyResult<T>;
+}
+
+impl<T> OrPy<T> for hdi_tribology::Result<T> {
+    fn py(self) -> PyResult<T> {
+        self.map_err(to_py_err)
+    }
+}
+
+fn json_module(py: Python<'_>) -> PyResult<Bound<'_, PyModule>> {
+    py.import("json")
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene
+
+/// A whole head–disk interface, validated (see `docs/scene_format.md`).
+///
+/// Fields are SI with the unit in their name; `scene["surface.height_sigma_nm"]` reads (and
+/// assignment writes) any dimensional field in an engineering unit instead.
+#[pyclass(module = "hdi_tribology", name = "Scene", eq)]
+#[derive(Clone, PartialEq)]
+struct Scene {
+    inner: Scn,
+}
+
+fn scene_to_dict<'py>(py: Python<'py>, s: &Scn) -> PyResult<Bound<'py, PyAny>> {
+    let text = s.to_json_string().py()?;
+    json_module(py)?.call_method1("loads", (text,))
+}
+
+fn scene_from_dict(py: Python<'_>, d: &Bound<'_, PyAny>) -> PyResult<Scn> {
+    let text: String = json_module(py)?.call_method1("dumps", (d,))?.extract()?;
+    py.detach(|| Scn::from_json_str(&text)).py()
+}
+
+/// The dict holding the last key of a dotted path, and that key.
+fn walk<'py>(root: &Bound<'py, PyAny>, path: &str) -> PyResult<(Bound<'py, PyDict>, String)> {
+    let mut parts: Vec<&str> = path.split('.').collect();
+    let last = parts.pop().unwrap_or_default().to_string();
+    let mut node = root.clone();
+    for p in parts {
+        node = node
+            .cast::<PyDict>()
+            .ok()
+            .and_then(|d| d.get_item(p).ok().flatten())
+            .filter(|n| !n.is_none())
+            .ok_or_else(|| {
+                PyKeyError::new_err(format!("scene has no section `{p}` in `{path}`"))
+            })?;
+    }
+    let dict = node
+        .cast_into::<PyDict>()
+        .map_err(|_| PyKeyError::new_err(format!("`{path}` is not a field of the scene")))?;
+    Ok((dict, last))
+}
+
+fn scale<'py>(v: &Bound<'py, PyAny>, factor: f64) -> PyResult<Bound<'py, PyAny>> {
+    let py = v.py();
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(pyo3::types::PyFloat::new(py, x / factor).into_any());
+    }
+    let xs: Vec<f64> = v.extract()?;
+    Ok(PyList::new(py, xs.into_iter().map(|x| x / factor))?.into_any())
+}
+
+#[pymethods]
+impl Scene {
+    /// The built-in scene of the letter (SI units inside).
+    #[staticmethod]
+    fn paper() -> Self {
+        Scene {
+            inner: Scn::paper(),
+        }
+    }
+
+    /// Reads a `.toml` or `.json` scene file and validates it.
+    #[staticmethod]
+    fn from_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Self> {
+        let inner = py.detach(|| Scn::from_path(&path)).py()?;
+        Ok(Scene { inner })
+    }
+
+    /// Parses a TOML scene and validates it.
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<Self> {
+        Ok(Scene {
+            inner: Scn::from_toml_str(text).py()?,
+        })
+    }
+
+    /// Parses a JSON scene and validates it.
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        Ok(Scene {
+            inner: Scn::from_json_str(text).py()?,
+        })
+    }
+
+    /// A scene from a dict shaped as the JSON file (fields may use engineering units).
+    #[staticmethod]
+    fn from_dict(py: Python<'_>, d: &Bound<'_, PyAny>) -> PyResult<Self> {
+        Ok(Scene {
+            inner: scene_from_dict(py, d)?,
+        })
+    }
+
+    /// The scene as a dict of plain Python values, SI units.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        scene_to_dict(py, &self.inner)
+    }
+
+    /// The scene as TOML text.
+    fn to_toml(&self) -> PyResult<String> {
+        self.inner.to_toml_string().py()
+    }
+
+    /// The scene as JSON text.
+    fn to_json(&self) -> PyResult<String> {
+        self.inner.to_json_string().py()
+    }
+
+    /// The scene's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+
+    /// A field by its dotted path, in SI (`"surface.height_sigma_m"`) or in an engineering unit
+    /// (`"surface.height_sigma_nm"`).
+    fn __getitem__<'py>(&self, py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyAny>> {
+        let root = scene_to_dict(py, &self.inner)?;
+        let (dict, key) = walk(&root, path)?;
+        if let Some(v) = dict.get_item(&key)? {
+            return Ok(v);
+        }
+        if let Some((si_key, factor, _unit)) = hdi_tribology::scene::engineering_unit(&key) {
+            if let Some(v) = dict.get_item(&si_key)? {
+                if v.is_none() {
+                    return Ok(v);
+                }
+                return scale(&v, factor);
+            }
+        }
+        Err(PyKeyError::new_err(format!(
+            "`{path}` is not a field of the scene"
+        )))
+    }
+
+    /// Sets a field by its dotted path (SI or engineering unit); the scene is validated again and
+    /// left unchanged when the new value is refused.
+    fn __setitem__(
+        &mut self,
+        py: Python<'_>,
+        path: &str,
+        value: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let updated = PyDict::new(py);
+        updated.set_item(path, value)?;
+        *self = self.with_values(py, &updated)?;
+        Ok(())
+    }
+
+    /// A copy with the given fields (dotted paths, SI or engineering units) replaced, validated.
+    fn with_values(&self, py: Python<'_>, values: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let root = scene_to_dict(py, &self.inner)?;
+        for (k, v) in values.iter() {
+            let path: String = k.extract()?;
+            let (dict, key) = walk(&root, &path)?;
+            if let Some((si_key, _, _)) = hdi_tribology::scene::engineering_unit(&key) {
+                if !dict.contains(&key)? {
+                    // the reader converts the engineering unit; the SI spelling must go
+                    let _ = dict.del_item(&si_key);
+                }
+            }
+            dict.set_item(&key, v)?;
+        }
+        Self::from_dict(py, &root)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Scene(name={:?})", self.inner.name)
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let text = slf.borrow().inner.to_json_string().py()?;
+        Ok((slf.get_type().getattr("from_json")?, (text,)))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Model
+
+/// A scene built into the slider model: force tables, air bearing, heater and voltage. Building
+/// takes a fraction of a second; analyses of the same scene should share one model.
+#[pyclass(module = "hdi_tribology", name = "Model", frozen)]
+struct Model {
+    scene: Arc<Scn>,
+    model: Arc<SliderModel>,
+}
+
+#[pymethods]
+impl Model {
+    #[new]
+    fn new(py: Python<'_>, scene: &Scene) -> PyResult<Self> {
+        let scene = Arc::new(scene.inner.clone());
+        let s = scene.clone();
+        let model = py.detach(move || SliderModel::from_scene(&s)).py()?;
+        Ok(Model {
+            scene,
+            model: Arc::new(model),
+        })
+    }
+
+    /// The scene the model was built from (a copy).
+    #[getter]
+    fn scene(&self) -> Scene {
+        Scene {
+            inner: (*self.scene).clone(),
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Model(scene={:?})", self.scene.name)
+    }
+}
+
+/// A `Model`, built from a `Scene` where one is given.
+fn model_of(py: Python<'_>, target: &Bound<'_, PyAny>) -> PyResult<(Arc<Scn>, Arc<SliderModel>)> {
+    if let Ok(m) = target.cast::<Model>() {
+        let m = m.get();
+        return Ok((m.scene.clone(), m.model.clone()));
+    }
+    if let Ok(s) = target.cast::<Scene>() {
+        let m = Model::new(py, &s.borrow())?;
+        return Ok((m.scene, m.model));
+    }
+    Err(pyo3::exceptions::PyTypeError::new_err(
+        "expected a hdi_tribology.Model or hdi_tribology.Scene",
+    ))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Forces
+
+fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
+    PyArray1::from_vec(py, v).into_any()
+}
+
+/// Every interface force at bulge gaps `gaps_nm` (nm), pad gaps `gaps_nm + protrusion_nm`, at
+/// the scene's DC voltage. Returns a dict of float64 arrays shaped as `gaps_nm`: `d_m` (m),
+/// `intermolecular_n`, `contact_n`, `electrostatic_n`, `other_n`, `total_n` (N, positive away
+/// from the disk), `electrostatic_per_volt2_n_per_v2` (N/V²), `real_contact_area_m2` (m²).
+#[pyfunction]
+#[pyo3(signature = (target, gaps_nm, protrusion_nm = 0.0))]
+fn forces<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
+    gaps_nm: PyReadonlyArray1<'py, f64>,
+    protrusion_nm: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let gaps: Vec<f64> = gaps_nm.as_array().iter().map(|&g| units::nm(g)).collect();
+    for (i, &g) in gaps.iter().enumerate() {
+        if !g.is_finite() {
+            return Err(invalid(
+                &format!("gaps_nm[{i}]"),
+                format!("must be finite, got {g:?}"),
+            ));
+        }
+    }
+    if !protrusion_nm.is_finite() {
+        return Err(invalid(
+            "protrusion_nm",
+            format!("must be finite, got {protrusion_nm:?}"),
+        ));
+    }
+    let protrusion = units::nm(protrusion_nm);
+    let (scene, model) = model_of(py, target)?;
+    let rows = py.detach(|| {
+        let volt2 = scene.dc_volt2();
+        gaps.iter()
+            .map(|&d| {
+                model.breakdown(
+                    Gaps {
+                        bulge: d,
+                        pad: d + protrusion,
+                    },
+                    volt2,
+                )
+            })
+            .collect::<Vec<_>>()
+    });
+    let out = PyDict::new(py);
+    let col = |f: fn(&hdi_tribology::force::Breakdown) -> f64| rows.iter().map(f).collect();
+    out.set_item("d_m", array(py, gaps))?;
+    out.set_item("intermolecular_n", array(py, col(|b| b.intermolecular)))?;
+    out.set_item("contact_n", array(py, col(|b| b.contact)))?;
+    out.set_item(
+        "electrostatic_per_volt2_n_per_v2",
+        array(py, col(|b| b.electrostatic_per_volt2)),
+    )?;
+    out.set_item("electrostatic_n", array(py, col(|b| b.electrostatic)))?;
+    out.set_item("other_n", array(py, col(|b| b.other)))?;
+    out.set_item(
+        "real_contact_area_m2",
+        array(py, col(|b| b.real_contact_area)),
+    )?;
+    out.set_item("total_n", array(py, col(|b| b.total)))?;
+    Ok(out)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Static analyses
+
+/// A static equilibrium of the slider.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+#[derive(Clone)]
+struct Equilibrium {
+    /// Bulge gap (m).
+    d_m: f64,
+    /// Head displacement away from the disk (m).
+    y_m: f64,
+    /// Thermal protrusion (m).
+    protrusion_m: f64,
+    /// Heater power (W).
+    power_w: f64,
+    /// Total stiffness (N/m).
+    stiffness_n_per_m: f64,
+    /// Interface force (N).
+    interface_force_n: f64,
+    /// Contact force (N).
+    contact_force_n: f64,
+    /// Whether the equilibrium is stable.
+    stable: bool,
+}
+
+impl From<&analysis::Equilibrium> for Equilibrium {
+    fn from(e: &analysis::Equilibrium) -> Self {
+        Equilibrium {
+            d_m: e.d,
+            y_m: e.y,
+            protrusion_m: e.protrusion,
+            power_w: e.power,
+            stiffness_n_per_m: e.stiffness,
+            interface_force_n: e.interface_force,
+            contact_force_n: e.contact_force,
+            stable: e.is_stable(),
+        }
+    }
+}
+
+#[pymethods]
+impl Equilibrium {
+    /// Bulge gap (nm).
+    #[getter]
+    fn d_nm(&self) -> f64 {
+        units::to_nm(self.d_m)
+    }
+    /// Heater power (mW).
+    #[getter]
+    fn power_mw(&self) -> f64 {
+        units::to_mw(self.power_w)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Equilibrium(d_nm={:.4}, power_mw={:.4}, stiffness_n_per_m={:.4e}, stable={})",
+            self.d_nm(),
+            self.power_mw(),
+            self.stiffness_n_per_m,
+            if self.stable { "True" } else { "False" }
+        )
+    }
+}
+
+/// A touchdown or take-off on the static equilibria.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+#[derive(Clone)]
+struct Transition {
+    /// Heater power (W).
+    power_w: f64,
+    /// `"fold"` (the branch ends) or `"threshold"` (the contact force crosses the detector's).
+    cause: String,
+    /// The equilibrium where it happens.
+    at: Equilibrium,
+}
+
+fn cause_name(c: analysis::Cause) -> String {
+    match c {
+        analysis::Cause::Fold => "fold".into(),
+        analysis::Cause::Threshold => "threshold".into(),
+    }
+}
+
+impl From<&analysis::Transition> for Transition {
+    fn from(t: &analysis::Transition) -> Self {
+        Transition {
+            power_w: t.power,
+            cause: cause_name(t.cause),
+            at: Equilibrium::from(&t.at),
+        }
+    }
+}
+
+#[pymethods]
+impl Transition {
+    /// Heater power (mW).
+    #[getter]
+    fn power_mw(&self) -> f64 {
+        units::to_mw(self.power_w)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Transition(power_mw={:.4}, cause={:?}, d_nm={:.4})",
+            self.power_mw(),
+            self.cause,
+            self.at.d_nm()
+        )
+    }
+}
+
+/// Static touchdown, take-off and their hysteresis.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+struct StaticHysteresis {
+    /// Touchdown.
+    touchdown: Transition,
+    /// Take-off.
+    takeoff: Transition,
+    /// Touchdown minus take-off power (W).
+    hysteresis_w: f64,
+}
+
+#[pymethods]
+impl StaticHysteresis {
+    /// Touchdown minus take-off power (mW).
+    #[getter]
+    fn hysteresis_mw(&self) -> f64 {
+        units::to_mw(self.hysteresis_w)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "StaticHysteresis(touchdown_mw={:.4}, takeoff_mw={:.4}, hysteresis_mw={:.4})",
+            self.touchdown.power_mw(),
+            self.takeoff.power_mw(),
+            self.hysteresis_mw()
+        )
+    }
+}
+
+fn static_options(scene: &Scn, threshold_un: Option<f64>) -> PyResult<StaticOptions> {
+    let threshold = match threshold_un {
+        Some(t) if !(t.is_finite() && t > 0.0) => {
+            return Err(invalid(
+                "contact_threshold_un",
+                format!("must be finite and > 0 µN, got {t:?}"),
+            ))
+        }
+        Some(t) => t * 1e-6,
+        None => scene.detector.contact_threshold_n,
+    };
+    Ok(StaticOptions::new(threshold))
+}
+
+/// Static touchdown and take-off powers at the scene's DC voltage, with the contact threshold
+/// of the scene's detector (or `contact_threshold_un`, µN).
+#[pyfunction]
+#[pyo3(signature = (target, contact_threshold_un = None))]
+fn static_hysteresis(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    contact_threshold_un: Option<f64>,
+) -> PyResult<StaticHysteresis> {
+    let (scene, model) = model_of(py, target)?;
+    let opts = static_options(&scene, contact_threshold_un)?;
+    let h = py
+        .detach(|| analysis::static_hysteresis(&model, &opts))
+        .py()?;
+    Ok(StaticHysteresis {
+        touchdown: (&h.touchdown).into(),
+        takeoff: (&h.takeoff).into(),
+        hysteresis_w: h.hysteresis,
+    })
+}
+
+/// The pull-in voltage.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+struct PullIn {
+    /// Pull-in voltage |V − φ| (V).
+    voltage_v: f64,
+    /// Bulge gap where the head jumps in (m).
+    d_m: f64,
+    /// `"fold"` or `"threshold"`.
+    cause: String,
+}
+
+#[pymethods]
+impl PullIn {
+    fn __repr__(&self) -> String {
+        format!(
+            "PullIn(voltage_v={:.4}, d_nm={:.4}, cause={:?})",
+            self.voltage_v,
+            units::to_nm(self.d_m),
+            self.cause
+        )
+    }
+}
+
+/// The voltage that pulls the head into contact at heater power `power_mw` (mW).
+#[pyfunction]
+#[pyo3(signature = (target, power_mw = 0.0, contact_threshold_un = None))]
+fn pull_in_voltage(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    power_mw: f64,
+    contact_threshold_un: Option<f64>,
+) -> PyResult<PullIn> {
+    let (scene, model) = model_of(py, target)?;
+    let opts = static_options(&scene, contact_threshold_un)?;
+    let p = py
+        .detach(|| analysis::pull_in_voltage(&model, units::mw(power_mw), &opts))
+        .py()?;
+    Ok(PullIn {
+        voltage_v: p.voltage,
+        d_m: p.d,
+        cause: cause_name(p.cause),
+    })
+}
+
+/// Clearance change with DC voltage (the letter's Fig. 2b). Returns a dict of float64 arrays:
+/// `dc_voltage_v` (V), `touchdown_power_w` (W), `clearance_change_m` (m).
+#[pyfunction]
+#[pyo3(signature = (target, dc_voltages_v, contact_threshold_un = None))]
+fn clearance_change<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
+    dc_voltages_v: Vec<f64>,
+    contact_threshold_un: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (scene, model) = model_of(py, target)?;
+    let opts = static_options(&scene, contact_threshold_un)?;
+    let rows = py
+        .detach(|| analysis::clearance_change(&model, &dc_voltages_v, &opts))
+        .py()?;
+    let out = PyDict::new(py);
+    out.set_item(
+        "dc_voltage_v",
+        array(py, rows.iter().map(|r| r.dc_voltage).collect()),
+    )?;
+    out.set_item(
+        "touchdown_power_w",
+        array(py, rows.iter().map(|r| r.touchdown_power).collect()),
+    )?;
+    out.set_item(
+        "clearance_change_m",
+        array(py, rows.iter().map(|r| r.clearance_change).collect()),
+    )?;
+    Ok(out)
+}
+
+/// The S-curve of static equilibria along the bulge gap, at the scene's DC voltage. Returns a
+/// dict: float64 arrays `d_m`, `power_w`, `y_m`, `stiffness_n_per_m`, `contact_force_n`, a
+/// bool array `stable`, and `folds`, a list of dicts `{power_w, d_m, jump_in}`.
+#[pyfunction]
+fn s_curve<'py>(py: Python<'py>, target: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+    let (_, model) = model_of(py, target)?;
+    let c = py
+        .detach(|| analysis::s_curve(&model, None, &ScanGrid::default()))
+        .py()?;
+    let out = PyDict::new(py);
+    let col = |f: fn(&analysis::Equilibrium) -> f64| c.points.iter().map(f).collect();
+    out.set_item("d_m", array(py, col(|e| e.d)))?;
+    out.set_item("power_w", array(py, col(|e| e.power)))?;
+    out.set_item("y_m", array(py, col(|e| e.y)))?;
+    out.set_item("stiffness_n_per_m", array(py, col(|e| e.stiffness)))?;
+    out.set_item("contact_force_n", array(py, col(|e| e.contact_force)))?;
+    let stable: Vec<bool> = c.points.iter().map(|e| e.is_stable()).collect();
+    out.set_item("stable", PyArray1::from_vec(py, stable))?;
+    let folds = PyList::empty(py);
+    for f in &c.folds {
+        let d = PyDict::new(py);
+        d.set_item("power_w", f.power)?;
+        d.set_item("d_m", f.d)?;
+        d.set_item("jump_in", f.jump_in)?;
+        folds.append(d)?;
+    }
+    out.set_item("folds", folds)?;
+    Ok(out)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cycles and sweeps
+
+/// A detected touchdown or take-off in a cycle.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+#[derive(Clone)]
+struct Detection {
+    /// Time of detection (s).
+    time_s: f64,
+    /// Programme heater power then (W).
+    power_w: f64,
+}
+
+#[pymethods]
+impl Detection {
+    /// Programme heater power then (mW).
+    #[getter]
+    fn power_mw(&self) -> f64 {
+        units::to_mw(self.power_w)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Detection(time_s={:.6e}, power_mw={:.4})",
+            self.time_s,
+            self.power_mw()
+        )
+    }
+}
+
+fn detection(d: Option<analysis::cycle::Detection>) -> Option<Detection> {
+    d.map(|d| Detection {
+        time_s: d.time,
+        power_w: d.power,
+    })
+}
+
+/// One touchdown/take-off cycle, without its time series.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+#[derive(Clone)]
+struct Cycle {
+    /// AC amplitude (V).
+    v_ac_v: f64,
+    /// Touchdown, `None` if none was detected.
+    touchdown: Option<Detection>,
+    /// Take-off, `None` if none was detected.
+    takeoff: Option<Detection>,
+    /// Touchdown minus take-off power (W), `None` unless both were detected.
+    hysteresis_w: Option<f64>,
+    /// Mean flash temperature rise while in contact (K).
+    mean_temperature_rise_k: f64,
+    /// Simulated time (s).
+    duration_s: f64,
+    /// Accepted solver steps.
+    steps: usize,
+    /// Rejected solver steps.
+    rejected_steps: usize,
+    /// Wall time of the simulation in Rust (s).
+    wall_seconds: f64,
+}
+
+impl From<&CycleResult> for Cycle {
+    fn from(r: &CycleResult) -> Self {
+        Cycle {
+            v_ac_v: r.v_ac,
+            touchdown: detection(r.touchdown),
+            takeoff: detection(r.takeoff),
+            hysteresis_w: r.hysteresis,
+            mean_temperature_rise_k: r.mean_temperature_rise,
+            duration_s: r.duration,
+            steps: r.stats.accepted,
+            rejected_steps: r.stats.rejected,
+            wall_seconds: r.wall_seconds,
+        }
+    }
+}
+
+fn fmt_opt_mw(x: Option<f64>) -> String {
+    x.map_or("None".into(), |p| format!("{:.4}", units::to_mw(p)))
+}
+
+#[pymethods]
+impl Cycle {
+    /// Touchdown minus take-off power (mW), `None` unless both were detected.
+    #[getter]
+    fn hysteresis_mw(&self) -> Option<f64> {
+        self.hysteresis_w.map(units::to_mw)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Cycle(v_ac_v={}, touchdown_mw={}, takeoff_mw={}, hysteresis_mw={}, steps={})",
+            self.v_ac_v,
+            fmt_opt_mw(self.touchdown.as_ref().map(|d| d.power_w)),
+            fmt_opt_mw(self.takeoff.as_ref().map(|d| d.power_w)),
+            fmt_opt_mw(self.hysteresis_w),
+            self.steps
+        )
+    }
+}
+
+/// How a cycle is run: programme, options and the AC amplitude override.
+struct CycleSetup {
+    scene: Arc<Scn>,
+    model: Arc<SliderModel>,
+    programme: HeaterProgramme,
+    opts: CycleOptions,
+}
+
+fn cycle_setup(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    triggered: bool,
+    method: Option<&str>,
+    rtol: Option<f64>,
+) -> PyResult<CycleSetup> {
+    let (scene, model) = model_of(py, target)?;
+    let mut opts = CycleOptions::from_scene(&scene).py()?;
+    if let Some(m) = method {
+        opts.solver.method = m
+            .parse()
+            .map_err(|e: hdi_tribology::ode::OdeError| invalid("method", e.to_string()))?;
+    }
+    if let Some(r) = rtol {
+        opts.solver.rtol = r;
+    }
+    let programme = if triggered {
+        let t = &scene.heater.triggered;
+        HeaterProgramme::Triggered {
+            start_power: t.start_power_w,
+            ramp_rate: t.ramp_rate_w_per_s,
+            overshoot: t.overshoot_w,
+        }
+    } else {
+        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme).py()?)
+    };
+    Ok(CycleSetup {
+        scene,
+        model,
+        programme,
+        opts,
+    })
+}
+
+/// One touchdown/take-off cycle under the scene's heater programme (or the touchdown-triggered
+/// protocol), at AC amplitude `v_ac` (V; default: the scene's).
+///
+/// Returns a dict: the summary `cycle` (a `Cycle`), `touchdown` and `takeoff` (`Detection` or
+/// `None`), and with `series=True` float64 arrays, one value per accepted step: `t_s` (s),
+/// `power_w` (W), `d_m` (m), `air_bearing_n`, `intermolecular_n`, `electrostatic_n`,
+/// `contact_n`, `total_n` (N), `temperature_rise_k` (K), `indicator_n` (N, NaN before the
+/// detector window has filled).
+#[pyfunction]
+#[pyo3(signature = (target, v_ac = None, *, triggered = false, method = None, rtol = None, series = true))]
+fn simulate_cycle<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
+    v_ac: Option<f64>,
+    triggered: bool,
+    method: Option<&str>,
+    rtol: Option<f64>,
+    series: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut setup = cycle_setup(py, target, triggered, method, rtol)?;
+    setup.opts.keep_series = series;
+    let r = py
+        .detach(|| {
+            let m = match v_ac {
+                Some(a) => setup.model.with_voltage(Voltage {
+                    ac_amplitude: a,
+                    ..setup.model.voltage
+                }),
+                None => (*setup.model).clone(),
+            };
+            analysis::simulate_cycle(&m, &setup.programme, &setup.opts)
+        })
+        .py()?;
+    let out = PyDict::new(py);
+    let summary = Cycle::from(&r);
+    out.set_item("touchdown", summary.touchdown.clone())?;
+    out.set_item("takeoff", summary.takeoff.clone())?;
+    out.set_item("cycle", summary)?;
+    if let Some(s) = r.series {
+        out.set_item("t_s", array(py, s.t))?;
+        out.set_item("power_w", array(py, s.power))?;
+        out.set_item("d_m", array(py, s.d))?;
+        out.set_item("air_bearing_n", array(py, s.air_bearing))?;
+        out.set_item("intermolecular_n", array(py, s.intermolecular))?;
+        out.set_item("electrostatic_n", array(py, s.electrostatic))?;
+        out.set_item("contact_n", array(py, s.contact))?;
+        out.set_item("total_n", array(py, s.total))?;
+        out.set_item("temperature_rise_k", array(py, s.temperature_rise))?;
+        out.set_item("indicator_n", array(py, s.indicator))?;
+    }
+    Ok(out)
+}
+
+/// Runs `work` on a rayon pool of `threads` threads (the global pool when `None`).
+fn on_threads<T: Send>(
+    threads: Option<usize>,
+    work: impl FnOnce() -> hdi_tribology::Result<T> + Send,
+) -> PyResult<T> {
+    match threads {
+        None => work().py(),
+        Some(0) => Err(invalid("threads", "must be at least 1, got 0")),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| invalid("threads", e.to_string()))?
+            .install(work)
+            .py(),
+    }
+}
+
+fn amplitudes_or_scene(scene: &Scn, amplitudes_v: Option<Vec<f64>>) -> PyResult<Vec<f64>> {
+    let a = amplitudes_v.unwrap_or_else(|| scene.sweep.ac_amplitudes_v.clone());
+    if a.is_empty() {
+        return Err(invalid(
+            "amplitudes_v",
+            "no amplitudes: give a list or a [sweep] list in the scene",
+        ));
+    }
+    Ok(a)
+}
+
+/// One cycle per AC amplitude (V; default: the scene's sweep list), in parallel on rayon
+/// (`threads` threads, default all cores) with the GIL released. Returns a list of `Cycle`, in
+/// the order of the amplitudes; results do not depend on the thread count.
+#[pyfunction]
+#[pyo3(signature = (target, amplitudes_v = None, *, triggered = false, method = None, rtol = None, threads = None))]
+#[allow(clippy::too_many_arguments)]
+fn ac_sweep(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    amplitudes_v: Option<Vec<f64>>,
+    triggered: bool,
+    method: Option<&str>,
+    rtol: Option<f64>,
+    threads: Option<usize>,
+) -> PyResult<Vec<Cycle>> {
+    let setup = cycle_setup(py, target, triggered, method, rtol)?;
+    let amplitudes = amplitudes_or_scene(&setup.scene, amplitudes_v)?;
+    let rows = py.detach(|| {
+        on_threads(threads, || {
+            analysis::ac_sweep(&setup.model, &setup.programme, &setup.opts, &amplitudes)
+        })
+    })?;
+    Ok(rows.iter().map(Cycle::from).collect())
+}
+
+/// A cycle run at tighter and tighter tolerances until its powers settle.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+struct RefinedCycle {
+    /// The last (most accurate) cycle.
+    cycle: Cycle,
+    /// Its relative tolerance.
+    rtol: f64,
+    /// Largest change of touchdown or take-off power from the run before (W).
+    power_change_w: f64,
+    /// Whether that change is within the tolerance asked for.
+    converged: bool,
+    /// Cycles run.
+    runs: usize,
+    /// Accepted steps over all runs.
+    steps: usize,
+    /// Wall time over all runs (s).
+    wall_seconds: f64,
+}
+
+#[pymethods]
+impl RefinedCycle {
+    fn __repr__(&self) -> String {
+        format!(
+            "RefinedCycle(v_ac_v={}, hysteresis_mw={}, rtol={:e}, power_change_mw={:.3e}, converged={}, runs={})",
+            self.cycle.v_ac_v,
+            fmt_opt_mw(self.cycle.hysteresis_w),
+            self.rtol,
+            units::to_mw(self.power_change_w),
+            if self.converged { "True" } else { "False" },
+            self.runs
+        )
+    }
+}
+
+/// `ac_sweep` with the tolerance refined per amplitude (tenfold tighter, at most 4 runs) until
+/// touchdown and take-off move by at most `power_tol_mw` (mW). Returns a list of
+/// `RefinedCycle`; check `converged` before trusting a row.
+#[pyfunction]
+#[pyo3(signature = (target, power_tol_mw, amplitudes_v = None, *, triggered = false, method = None, rtol = None, threads = None))]
+#[allow(clippy::too_many_arguments)]
+fn ac_sweep_refined(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    power_tol_mw: f64,
+    amplitudes_v: Option<Vec<f64>>,
+    triggered: bool,
+    method: Option<&str>,
+    rtol: Option<f64>,
+    threads: Option<usize>,
+) -> PyResult<Vec<RefinedCycle>> {
+    let setup = cycle_setup(py, target, triggered, method, rtol)?;
+    let amplitudes = amplitudes_or_scene(&setup.scene, amplitudes_v)?;
+    let refine = Refinement::new(units::mw(power_tol_mw));
+    let rows = py.detach(|| {
+        on_threads(threads, || {
+            analysis::ac_sweep_refined(
+                &setup.model,
+                &setup.programme,
+                &setup.opts,
+                &amplitudes,
+                &refine,
+            )
+        })
+    })?;
+    Ok(rows
+        .iter()
+        .map(|r| RefinedCycle {
+            cycle: Cycle::from(&r.cycle),
+            rtol: r.rtol,
+            power_change_w: r.change,
+            converged: r.converged,
+            runs: r.runs,
+            steps: r.stats.accepted,
+            wall_seconds: r.wall_seconds,
+        })
+        .collect())
+}
+
+// ---------------------------------------------------------------------------------------------
+// Linear response
+
+/// The linear response about the flying equilibrium at one heater power.
+#[pyclass(module = "hdi_tribology", frozen)]
+struct LinearResponse {
+    inner: analysis::LinearResponse,
+}
+
+#[pymethods]
+impl LinearResponse {
+    /// The equilibrium (under the mean V²).
+    #[getter]
+    fn equilibrium(&self) -> Equilibrium {
+        (&self.inner.equilibrium).into()
+    }
+    /// Eigenvalues as complex numbers (1/s).
+    #[getter]
+    fn eigenvalues(&self) -> Vec<numpy::Complex64> {
+        self.inner
+            .modes
+            .iter()
+            .map(|m| numpy::Complex64::new(m.re, m.im))
+            .collect()
+    }
+    /// Mode frequencies |Im λ|/2π (Hz).
+    #[getter]
+    fn frequencies_hz(&self) -> Vec<f64> {
+        self.inner.modes.iter().map(|m| m.frequency).collect()
+    }
+    /// Damping ratios −Re λ/|λ|.
+    #[getter]
+    fn damping_ratios(&self) -> Vec<f64> {
+        self.inner.modes.iter().map(|m| m.damping_ratio).collect()
+    }
+    /// Whether every eigenvalue has a negative real part.
+    #[getter]
+    fn stable(&self) -> bool {
+        self.inner.stable
+    }
+    /// |H(i·2π·2f)| (m/N).
+    #[getter]
+    fn gain_at_2f_m_per_n(&self) -> f64 {
+        self.inner.gain_at_2f
+    }
+    /// Force amplitude at 2f (N).
+    #[getter]
+    fn force_at_2f_n(&self) -> f64 {
+        self.inner.force_at_2f
+    }
+    /// Predicted dither amplitude at 2f (m).
+    #[getter]
+    fn dither_amplitude_m(&self) -> f64 {
+        self.inner.dither_amplitude
+    }
+    /// Predicted dither amplitude at 2f (nm).
+    #[getter]
+    fn dither_amplitude_nm(&self) -> f64 {
+        units::to_nm(self.inner.dither_amplitude)
+    }
+    /// H(iω) (m/N) at each angular frequency `omega_rad_s` (rad/s), a complex128 array.
+    fn transfer<'py>(
+        &self,
+        py: Python<'py>,
+        omega_rad_s: PyReadonlyArray1<'py, f64>,
+    ) -> Bound<'py, PyArray1<numpy::Complex64>> {
+        let w: Vec<f64> = omega_rad_s.as_array().to_vec();
+        let h: Vec<_> = py.detach(|| w.iter().map(|&w| self.inner.transfer(w)).collect());
+        PyArray1::from_vec(py, h)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "LinearResponse(power_mw={:.4}, d_nm={:.4}, stable={}, dither_amplitude_nm={:.4e})",
+            units::to_mw(self.inner.equilibrium.power),
+            units::to_nm(self.inner.equilibrium.d),
+            if self.inner.stable { "True" } else { "False" },
+            self.dither_amplitude_nm()
+        )
+    }
+}
+
+/// The linearised slider about its flying equilibrium at heater power `power_mw` (mW).
+#[pyfunction]
+fn linear_response(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    power_mw: f64,
+) -> PyResult<LinearResponse> {
+    let (_, model) = model_of(py, target)?;
+    let inner = py
+        .detach(|| analysis::linear_response(&model, units::mw(power_mw)))
+        .py()?;
+    Ok(LinearResponse { inner })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Calibration
+
+/// The outcome of a touchdown calibration as drive firmware does it.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+struct Calibration {
+    /// Detector used.
+    detector: String,
+    /// First heater level where contact was seen (W).
+    touchdown_power_w: f64,
+    /// First level on the way down without contact (W), `None` if not searched or not found.
+    takeoff_power_w: Option<f64>,
+    /// Operating power: touchdown power minus the margin (W).
+    set_power_w: f64,
+    /// Static flying clearance at the set power, DC voltage only (m).
+    clearance_m: f64,
+    /// Detector level at touchdown over the level before.
+    contrast: f64,
+    /// Heater levels run.
+    levels: usize,
+    /// Simulated time (s).
+    simulated_time_s: f64,
+}
+
+#[pymethods]
+impl Calibration {
+    /// Touchdown minus take-off level (W), `None` without a take-off.
+    #[getter]
+    fn hysteresis_w(&self) -> Option<f64> {
+        self.takeoff_power_w.map(|t| self.touchdown_power_w - t)
+    }
+    /// Static flying clearance at the set power (nm).
+    #[getter]
+    fn clearance_nm(&self) -> f64 {
+        units::to_nm(self.clearance_m)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Calibration(detector={:?}, touchdown_mw={:.4}, takeoff_mw={}, set_power_mw={:.4}, clearance_nm={:.4})",
+            self.detector,
+            units::to_mw(self.touchdown_power_w),
+            fmt_opt_mw(self.takeoff_power_w),
+            units::to_mw(self.set_power_w),
+            self.clearance_nm()
+        )
+    }
+}
+
+/// Touchdown calibration: heater steps of `step_mw` from `start_mw` (default: the power whose
+/// protrusion leaves 5 nm of the nominal clearance) up to `max_mw` (default `start_mw + 60`)
+/// until the detector fires, then down to take-off; the heater is set `margin_mw` below
+/// touchdown. Detectors: `"mean"` (the scene's), `"ae"` (acoustic-emission proxy),
+/// `"vibration"`. `dither_v` adds an AC dither (V) while calibrating.
+#[pyfunction]
+#[pyo3(signature = (target, *, detector = "mean", start_mw = None, step_mw = 0.5, max_mw = None, margin_mw = 15.0, dither_v = None, find_takeoff = true))]
+#[allow(clippy::too_many_arguments)]
+fn calibrate(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    detector: &str,
+    start_mw: Option<f64>,
+    step_mw: f64,
+    max_mw: Option<f64>,
+    margin_mw: f64,
+    dither_v: Option<f64>,
+    find_takeoff: bool,
+) -> PyResult<Calibration> {
+    let (scene, model) = model_of(py, target)?;
+    let start_mw = start_mw.unwrap_or_else(|| {
+        1e3 * ((scene.nominal_clearance_m - 5e-9) / scene.heater.efficiency_m_per_w).max(0.0)
+    });
+    let max_mw = max_mw.unwrap_or(start_mw + 60.0);
+    let mut opts = CalibrationOptions::from_mw(start_mw, step_mw, max_mw, margin_mw);
+    opts.find_takeoff = find_takeoff;
+    let model = match dither_v {
+        Some(v) => model.with_voltage(Voltage {
+            ac_amplitude: v,
+            ..model.voltage
+        }),
+        None => (*model).clone(),
+    };
+    let (th, window) = (scene.detector.contact_threshold_n, scene.detector.window_s);
+    let mut det: Box<dyn TouchdownDetector + Send> = match detector {
+        "mean" => Box::new(MeanContactForce::new(th, window).py()?),
+        "ae" => Box::new(ContactForceRms::new(1e-5, 5e3, 5e-5).py()?),
+        "vibration" => Box::new(
+            Relative::new(VibrationRms::new(2e-11, 5e3, 5e-5).py()?, 3.0, 1e-4, 2e-4).py()?,
+        ),
+        other => {
+            return Err(invalid(
+                "detector",
+                format!("`{other}` is not one of mean, ae, vibration"),
+            ))
+        }
+    };
+    let c = py
+        .detach(|| clearance::calibrate(&model, det.as_mut(), &opts))
+        .py()?;
+    Ok(Calibration {
+        detector: c.detector.clone(),
+        touchdown_power_w: c.touchdown_power,
+        takeoff_power_w: c.takeoff_power,
+        set_power_w: c.set_power,
+        clearance_m: c.clearance,
+        contrast: c.contrast,
+        levels: c.steps.len(),
+        simulated_time_s: c.simulated_time,
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
+
+/// The native core of the `hdi_tribology` Python package.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Scene>()?;
+    m.add_class::<Model>()?;
+    m.add_class::<Equilibrium>()?;
+    m.add_class::<Transition>()?;
+    m.add_class::<StaticHysteresis>()?;
+    m.add_class::<PullIn>()?;
+    m.add_class::<Detection>()?;
+    m.add_class::<Cycle>()?;
+    m.add_class::<RefinedCycle>()?;
+    m.add_class::<LinearResponse>()?;
+    m.add_class::<Calibration>()?;
+    m.add_function(wrap_pyfunction!(forces, m)?)?;
+    m.add_function(wrap_pyfunction!(static_hysteresis, m)?)?;
+    m.add_function(wrap_pyfunction!(pull_in_voltage, m)?)?;
+    m.add_function(wrap_pyfunction!(clearance_change, m)?)?;
+    m.add_function(wrap_pyfunction!(s_curve, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_cycle, m)?)?;
+    m.add_function(wrap_pyfunction!(ac_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(ac_sweep_refined, m)?)?;
+    m.add_function(wrap_pyfunction!(linear_response, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

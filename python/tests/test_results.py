@@ -1,0 +1,122 @@
+"""Results: arrays of the right shape and dtype, typed objects with readable reprs, and
+errors that name the argument."""
+
+import math
+
+import numpy as np
+import pytest
+
+import hdi_tribology as hdi
+
+FORCE_KEYS = [
+    "d_m", "intermolecular_n", "contact_n", "electrostatic_per_volt2_n_per_v2",
+    "electrostatic_n", "other_n", "real_contact_area_m2", "total_n",
+]
+SERIES_KEYS = [
+    "t_s", "power_w", "d_m", "air_bearing_n", "intermolecular_n", "electrostatic_n",
+    "contact_n", "total_n", "temperature_rise_k", "indicator_n",
+]
+
+
+def test_forces_arrays(paper_model):
+    gaps = np.linspace(0.3, 5.0, 17)
+    f = hdi.forces(paper_model, gaps)
+    assert sorted(f) == sorted(FORCE_KEYS)
+    for k in FORCE_KEYS:
+        assert f[k].shape == (17,) and f[k].dtype == np.float64, k
+    assert np.array_equal(f["d_m"], gaps * 1e-9)
+    # the parts add up to the total, and contact pushes away, more at smaller gaps
+    parts = f["intermolecular_n"] + f["contact_n"] + f["electrostatic_n"] + f["other_n"]
+    assert np.allclose(parts, f["total_n"], rtol=1e-12, atol=1e-18)
+    assert np.all(np.diff(f["contact_n"]) <= 0)
+    assert np.all(f["intermolecular_n"] < 0)
+
+
+def test_forces_reject_bad_gaps(paper_model):
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.forces(paper_model, np.array([1.0, np.nan]))
+    assert e.value.field == "gaps_nm[1]"
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.forces(paper_model, np.array([1.0]), protrusion_nm=math.inf)
+    assert e.value.field == "protrusion_nm"
+    with pytest.raises(TypeError):
+        hdi.forces(paper_model, np.ones((2, 2)))
+    with pytest.raises(TypeError, match="Model or hdi_tribology.Scene"):
+        hdi.forces("paper", np.ones(2))
+
+
+def test_cycle_series_and_transitions(paper_model):
+    r = hdi.simulate_cycle(paper_model)
+    c = r["cycle"]
+    n = c.steps + 1  # the initial state and every accepted step
+    for k in SERIES_KEYS:
+        assert r[k].shape == (n,) and r[k].dtype == np.float64, k
+    assert np.all(np.diff(r["t_s"]) > 0)
+    td, to = r["touchdown"], r["takeoff"]
+    assert isinstance(td, hdi.Detection) and isinstance(to, hdi.Detection)
+    assert td.time_s < to.time_s
+    assert c.hysteresis_w == td.power_w - to.power_w > 0
+    assert c.hysteresis_mw == pytest.approx(c.hysteresis_w * 1e3, rel=1e-15)
+    assert repr(c).startswith("Cycle(v_ac_v=0, touchdown_mw=74.")
+    # the running mean has not filled before the detector window: NaN, not a number made up
+    assert math.isnan(r["indicator_n"][0])
+    no_series = hdi.simulate_cycle(paper_model, series=False)
+    assert "t_s" not in no_series and no_series["cycle"].steps == c.steps
+
+
+def test_static_objects(paper_model):
+    h = hdi.static_hysteresis(paper_model)
+    assert h.touchdown.power_w > h.takeoff.power_w
+    assert h.hysteresis_w == h.touchdown.power_w - h.takeoff.power_w
+    assert h.touchdown.cause in ("fold", "threshold")
+    assert repr(h).startswith("StaticHysteresis(touchdown_mw=74.")
+    assert h.touchdown.at.d_nm == pytest.approx(h.touchdown.at.d_m * 1e9, rel=1e-15)
+    p = hdi.pull_in_voltage(paper_model)
+    assert p.voltage_v > 0 and p.cause in ("fold", "threshold")
+    c = hdi.s_curve(paper_model)
+    n = c["d_m"].shape[0]
+    assert n > 10 and c["stable"].dtype == np.bool_ and c["stable"].shape == (n,)
+    assert any(f["jump_in"] for f in c["folds"])
+    cc = hdi.clearance_change(paper_model, [-1.0, 0.0, 1.0])
+    assert cc["clearance_change_m"].shape == (3,)
+
+
+def test_linear_response(paper_model):
+    lr = hdi.linear_response(paper_model, 50.0)
+    assert lr.stable and all(z.real < 0 for z in lr.eigenvalues)
+    assert lr.equilibrium.power_mw == pytest.approx(50.0, rel=1e-12)
+    w = np.array([0.0, 1e3, 1e6])
+    h = lr.transfer(w)
+    assert h.dtype == np.complex128 and h.shape == (3,)
+    # at zero frequency the transfer is the static compliance, 1 / stiffness
+    assert h[0].real == pytest.approx(1.0 / lr.equilibrium.stiffness_n_per_m, rel=1e-6)
+
+
+def test_cycle_argument_errors(paper_model):
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.simulate_cycle(paper_model, method="euler")
+    assert e.value.field == "method"
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.simulate_cycle(paper_model, rtol=-1.0, series=False)
+    assert "rtol" in e.value.field
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.ac_sweep(paper_model, [0.0, math.nan])
+    assert e.value.field == "amplitudes[1]"
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.ac_sweep(paper_model, [0.0], threads=0)
+    assert e.value.field == "threads"
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.calibrate(paper_model, detector="sonar")
+    assert e.value.field == "detector" and "sonar" in e.value.reason
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.static_hysteresis(paper_model, contact_threshold_un=-1.0)
+    assert e.value.field == "contact_threshold_un"
+
+
+def test_sweep_does_not_depend_on_threads(paper_model):
+    amps = [0.0, 0.3, 0.6]
+    one = hdi.ac_sweep(paper_model, amps, threads=1)
+    two = hdi.ac_sweep(paper_model, amps, threads=2)
+    key = lambda c: (c.v_ac_v, c.hysteresis_w, c.mean_temperature_rise_k, c.steps)
+    assert [key(c) for c in one] == [key(c) for c in two]
+    assert [c.v_ac_v for c in one] == amps

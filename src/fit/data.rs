@@ -1,0 +1,412 @@
+//! Measured curves read from CSV files, in engineering units, with one clear error per bad file.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::Path;
+
+use serde::Serialize;
+
+/// A bad data file: which file, where in it, and why.
+///
+/// ```
+/// use hdi_tribology::fit::DataSet;
+/// let e = DataSet::from_csv_str("dc_voltage_v,touchdown_power_mw\n0.5,nan\n", "td.csv").unwrap_err();
+/// assert_eq!((e.line, e.column), (Some(2), Some(2)));
+/// assert_eq!(e.to_string(), "td.csv, line 2, column 2 (`touchdown_power_mw`): must be a finite number, got `nan`");
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct DataError {
+    /// The file (or the origin given for a string).
+    pub file: String,
+    /// Line in the file, 1-based (the header is line 1 unless comments precede it).
+    pub line: Option<u64>,
+    /// Column, 1-based.
+    pub column: Option<usize>,
+    /// The column's name as the file spells it.
+    pub column_name: Option<String>,
+    /// What is wrong, with the value as written.
+    pub reason: String,
+}
+
+impl fmt::Display for DataError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some(l) = self.line {
+            write!(f, ", line {l}")?;
+        }
+        if let Some(c) = self.column {
+            write!(f, ", column {c}")?;
+        }
+        if let Some(n) = &self.column_name {
+            write!(f, " (`{n}`)")?;
+        }
+        write!(f, ": {}", self.reason)
+    }
+}
+
+impl std::error::Error for DataError {}
+
+/// What a curve measures, decided by its x column.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveKind {
+    /// Static touchdown (and take-off) power against DC voltage (the letter's Fig. 2b):
+    /// x column `dc_voltage_*`.
+    StaticVsDc,
+    /// Dynamic touchdown and take-off power against AC amplitude (Fig. 2d), one cycle of the
+    /// scene's fixed heater programme per amplitude: x column `ac_amplitude_*`.
+    CycleVsAc,
+}
+
+/// A measured quantity of a curve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    /// Touchdown power.
+    TouchdownPower,
+    /// Take-off power.
+    TakeoffPower,
+}
+
+impl Quantity {
+    /// The column stem, e.g. `touchdown_power`.
+    pub fn stem(self) -> &'static str {
+        match self {
+            Quantity::TouchdownPower => "touchdown_power",
+            Quantity::TakeoffPower => "takeoff_power",
+        }
+    }
+}
+
+/// A unit of a column: its suffix and the factor to SI.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Unit {
+    /// The suffix as written (`mw`, `v`, …).
+    pub suffix: &'static str,
+    /// Factor from this unit to SI.
+    pub to_si: f64,
+}
+
+const VOLTS: &[Unit] = &[
+    Unit {
+        suffix: "v",
+        to_si: 1.0,
+    },
+    Unit {
+        suffix: "mv",
+        to_si: 1e-3,
+    },
+];
+const WATTS: &[Unit] = &[
+    Unit {
+        suffix: "mw",
+        to_si: 1e-3,
+    },
+    Unit {
+        suffix: "w",
+        to_si: 1.0,
+    },
+    Unit {
+        suffix: "uw",
+        to_si: 1e-6,
+    },
+];
+
+/// The role of a column.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Role {
+    X(CurveKind),
+    Y(Quantity),
+    Err(Quantity),
+}
+
+/// Column stems, their role and their units.
+const COLUMNS: &[(&str, Role, &[Unit])] = &[
+    ("dc_voltage", Role::X(CurveKind::StaticVsDc), VOLTS),
+    ("ac_amplitude", Role::X(CurveKind::CycleVsAc), VOLTS),
+    ("touchdown_power", Role::Y(Quantity::TouchdownPower), WATTS),
+    ("takeoff_power", Role::Y(Quantity::TakeoffPower), WATTS),
+    (
+        "touchdown_power_err",
+        Role::Err(Quantity::TouchdownPower),
+        WATTS,
+    ),
+    (
+        "takeoff_power_err",
+        Role::Err(Quantity::TakeoffPower),
+        WATTS,
+    ),
+];
+
+/// One measured column of a curve, in SI, with its optional 1σ uncertainties.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Observed {
+    /// What it measures.
+    pub quantity: Quantity,
+    /// Values (SI).
+    pub values: Vec<f64>,
+    /// Standard uncertainty of each value (SI), when the file gives one.
+    pub errors: Option<Vec<f64>>,
+    /// The unit the file used (results are given back in it).
+    pub unit: Unit,
+}
+
+/// One measured curve: an x column and one or more measured columns.
+///
+/// Columns are named `<quantity>_<unit>`: x is `dc_voltage_v` (or `_mv`) or `ac_amplitude_v`
+/// (or `_mv`); measured columns are `touchdown_power_mw` and `takeoff_power_mw` (or `_w`,
+/// `_uw`), each with an optional uncertainty column `touchdown_power_err_mw` etc. Lines starting
+/// with `#` are comments.
+///
+/// ```
+/// use hdi_tribology::fit::{CurveKind, DataSet};
+/// let d = DataSet::from_csv_str(
+///     "# Fig. 2(b)\ndc_voltage_v,touchdown_power_mw\n-0.5,72.5\n0,74.3\n0.5,72.5\n",
+///     "td.csv",
+/// ).unwrap();
+/// assert_eq!(d.kind, CurveKind::StaticVsDc);
+/// assert_eq!(d.x, vec![-0.5, 0.0, 0.5]);
+/// assert!((d.observed[0].values[1] - 0.0743).abs() < 1e-15);
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DataSet {
+    /// Where it came from (file name).
+    pub origin: String,
+    /// The kind of curve.
+    pub kind: CurveKind,
+    /// The x column as the file names it.
+    pub x_name: String,
+    /// x values (SI: volts).
+    pub x: Vec<f64>,
+    /// The unit of the x column in the file.
+    pub x_unit: Unit,
+    /// The measured columns.
+    pub observed: Vec<Observed>,
+    /// Line of each row in the file.
+    pub lines: Vec<u64>,
+}
+
+fn err(file: &str, line: Option<u64>, col: Option<(usize, &str)>, reason: String) -> DataError {
+    DataError {
+        file: file.to_string(),
+        line,
+        column: col.map(|c| c.0 + 1),
+        column_name: col.map(|c| c.1.to_string()),
+        reason,
+    }
+}
+
+/// The role and unit of a header name, or why it is not known.
+fn classify(name: &str) -> Result<(Role, Unit), String> {
+    let known = || {
+        COLUMNS
+            .iter()
+            .map(|(stem, _, units)| format!("{stem}_{}", units[0].suffix))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let Some((stem, unit)) = name.rsplit_once('_') else {
+        return Err(format!("unknown column; known columns: {}", known()));
+    };
+    let Some((_, role, units)) = COLUMNS.iter().find(|(s, _, _)| *s == stem) else {
+        return Err(format!("unknown column; known columns: {}", known()));
+    };
+    match units.iter().find(|u| u.suffix == unit) {
+        Some(u) => Ok((*role, *u)),
+        None => Err(format!(
+            "unknown unit `{unit}` for {stem}; known units: {}",
+            units
+                .iter()
+                .map(|u| u.suffix)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}
+
+impl DataSet {
+    /// Reads a curve from a CSV file.
+    pub fn from_path(path: impl AsRef<Path>) -> Result<DataSet, DataError> {
+        let path = path.as_ref();
+        let origin = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| err(&origin, None, None, e.to_string()))?;
+        Self::from_csv_str(&text, &origin)
+    }
+
+    /// Reads a curve from CSV text; `origin` names it in errors.
+    pub fn from_csv_str(text: &str, origin: &str) -> Result<DataSet, DataError> {
+        let mut rdr = csv::ReaderBuilder::new()
+            .comment(Some(b'#'))
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let csv_err = |e: csv::Error| {
+            let line = e.position().map(|p| p.line());
+            let reason = match e.kind() {
+                csv::ErrorKind::UnequalLengths {
+                    expected_len, len, ..
+                } => format!("{len} fields, the header has {expected_len}"),
+                _ => e.to_string(),
+            };
+            err(origin, line, None, reason)
+        };
+        let header_line = rdr.position().line().max(1);
+        let headers = rdr.headers().map_err(csv_err)?.clone();
+        let header_line = rdr.position().line().saturating_sub(1).max(header_line);
+        let mut roles = Vec::new();
+        for (i, name) in headers.iter().enumerate() {
+            let (role, unit) =
+                classify(name).map_err(|r| err(origin, Some(header_line), Some((i, name)), r))?;
+            if let Some((j, _, _)) = roles
+                .iter()
+                .find(|(_, r, _)| matches!((r, role), (Role::X(_), Role::X(_))) || *r == role)
+            {
+                return Err(err(
+                    origin,
+                    Some(header_line),
+                    Some((i, name)),
+                    format!("the same quantity as column {} (`{}`)", j + 1, &headers[*j]),
+                ));
+            }
+            roles.push((i, role, unit));
+        }
+        let at_header = |reason: String| err(origin, Some(header_line), None, reason);
+        let Some(&(xi, Role::X(kind), x_unit)) =
+            roles.iter().find(|(_, r, _)| matches!(r, Role::X(_)))
+        else {
+            return Err(at_header(
+                "missing column: no x column (`dc_voltage_v` or `ac_amplitude_v`)".into(),
+            ));
+        };
+        let ys: Vec<(usize, Quantity, Unit)> = roles
+            .iter()
+            .filter_map(|&(i, r, u)| match r {
+                Role::Y(q) => Some((i, q, u)),
+                _ => None,
+            })
+            .collect();
+        if ys.is_empty() {
+            return Err(at_header(
+                "missing column: no measured column (`touchdown_power_mw` or `takeoff_power_mw`)"
+                    .into(),
+            ));
+        }
+        for &(i, r, _) in &roles {
+            if let Role::Err(q) = r {
+                if !ys.iter().any(|y| y.1 == q) {
+                    return Err(err(
+                        origin,
+                        Some(header_line),
+                        Some((i, &headers[i])),
+                        format!(
+                            "missing column: an uncertainty of {} without the column itself",
+                            q.stem()
+                        ),
+                    ));
+                }
+            }
+        }
+
+        let mut x = Vec::new();
+        let mut lines = Vec::new();
+        let mut cols: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
+        let mut first_at: Vec<(f64, u64)> = Vec::new();
+        for rec in rdr.records() {
+            let rec = rec.map_err(csv_err)?;
+            let line = rec.position().map_or(0, |p| p.line());
+            for &(i, role, unit) in &roles {
+                let name = &headers[i];
+                let text = rec.get(i).unwrap_or("");
+                let at = Some((i, name));
+                if text.is_empty() {
+                    return Err(err(origin, Some(line), at, "missing value".into()));
+                }
+                let v: f64 = text
+                    .parse()
+                    .map_err(|_| err(origin, Some(line), at, format!("not a number: `{text}`")))?;
+                if !v.is_finite() {
+                    return Err(err(
+                        origin,
+                        Some(line),
+                        at,
+                        format!("must be a finite number, got `{text}`"),
+                    ));
+                }
+                if matches!(role, Role::Err(_)) && v <= 0.0 {
+                    return Err(err(
+                        origin,
+                        Some(line),
+                        at,
+                        format!("an uncertainty must be > 0, got {text} {}", unit.suffix),
+                    ));
+                }
+                if matches!(role, Role::X(_)) {
+                    let si = v * unit.to_si;
+                    if let Some((_, l0)) = first_at.iter().find(|(x0, _)| *x0 == si) {
+                        return Err(err(
+                            origin,
+                            Some(line),
+                            at,
+                            format!(
+                                "duplicate x value {text} {} (first at line {l0})",
+                                unit.suffix
+                            ),
+                        ));
+                    }
+                    first_at.push((si, line));
+                }
+                cols.entry(i).or_default().push(v * unit.to_si);
+            }
+            x.push(v_at(&cols, xi));
+            lines.push(line);
+        }
+        if x.is_empty() {
+            return Err(err(origin, None, None, "no data rows".into()));
+        }
+        let observed = ys
+            .iter()
+            .map(|&(i, q, unit)| {
+                let errors = roles
+                    .iter()
+                    .find(|(_, r, _)| *r == Role::Err(q))
+                    .map(|(j, _, _)| cols[j].clone());
+                Observed {
+                    quantity: q,
+                    values: cols[&i].clone(),
+                    errors,
+                    unit,
+                }
+            })
+            .collect();
+        Ok(DataSet {
+            origin: origin.to_string(),
+            kind,
+            x_name: headers[xi].to_string(),
+            x,
+            x_unit,
+            observed,
+            lines,
+        })
+    }
+
+    /// Number of measured values (residuals) in the curve.
+    pub fn len(&self) -> usize {
+        self.observed.iter().map(|o| o.values.len()).sum()
+    }
+
+    /// Whether the curve holds no measured value.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Whether its model needs time integration.
+    pub fn is_dynamic(&self) -> bool {
+        self.kind == CurveKind::CycleVsAc
+    }
+}
+
+fn v_at(cols: &BTreeMap<usize, Vec<f64>>, i: usize) -> f64 {
+    cols.get(&i)
+        .and_then(|c| c.last().copied())
+        .unwrap_or(f64::NAN)
+}
