@@ -10,6 +10,7 @@
 mod calibrate;
 mod common;
 mod cycle;
+mod drive;
 mod forces;
 mod scene;
 mod static_cmd;
@@ -44,6 +45,9 @@ enum Command {
     Calibrate(calibrate::Args),
     /// The scene, validated, as TOML (or JSON): a starting point for scenes of your own.
     Scene(scene::Args),
+    /// A command file (time, heater power, voltage) replayed through the simulated drive; the
+    /// sensor CSV written.
+    Drive(drive::Args),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +60,7 @@ fn main() -> ExitCode {
         Command::Sweep(a) => sweep::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Scene(a) => scene::run(a),
+        Command::Drive(a) => drive::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
