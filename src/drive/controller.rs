@@ -47,7 +47,7 @@ pub trait Controller {
 /// Those of [`Drive::step`]; an [`Error::Analysis`] when the controller has not stopped after
 /// `max_periods`.
 pub fn run(
-    drive: &mut Drive,
+    drive: &mut Drive<'_>,
     controller: &mut dyn Controller,
     dt: f64,
     max_periods: usize,
@@ -460,10 +460,11 @@ pub struct StaircaseOutcome {
 /// `clearance::calibrate`, driven through [`Drive`], judged by any [`LevelDetector`].
 ///
 /// ```no_run
-/// use hdi_tribology::drive::{run, scene_zone, ContactSensorSlope, Drive, DriveOptions, Staircase, StaircaseSettings};
+/// use hdi_tribology::drive::{run, scene_zone, ContactSensorSlope, DriveOptions, Plant, Staircase, StaircaseSettings};
 /// use hdi_tribology::scene::Scene;
 /// let scene = Scene::paper();
-/// let mut drive = Drive::new(&scene, &scene_zone(&scene, 0.025)?, 1, DriveOptions::default())?;
+/// let plant = Plant::new(&scene, &scene_zone(&scene, 0.025)?, 1, DriveOptions::default())?;
+/// let mut drive = plant.drive()?;
 /// let dt = 50e-6;
 /// let mut cal = Staircase::new(StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0), ContactSensorSlope::new(5.0, 4)?, dt)?;
 /// run(&mut drive, &mut cal, dt, 1_000_000)?;

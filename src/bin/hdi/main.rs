@@ -10,6 +10,7 @@
 mod calibrate;
 mod common;
 mod cycle;
+mod drive;
 mod fit;
 mod forces;
 mod scene;
@@ -47,6 +48,9 @@ enum Command {
     Fit(fit::Args),
     /// The scene, validated, as TOML (or JSON): a starting point for scenes of your own.
     Scene(scene::Args),
+    /// A command file (time, heater power, voltage) replayed through the simulated drive; the
+    /// sensor CSV written.
+    Drive(drive::Args),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +64,7 @@ fn main() -> ExitCode {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Fit(a) => fit::run(a),
         Command::Scene(a) => scene::run(a),
+        Command::Drive(a) => drive::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
