@@ -172,30 +172,53 @@ impl Renames {
 /// SI unit names a message may write after a value, dropped when the value is rewritten.
 const SI_UNITS: &[&str] = &["m", "m²", "m⁻²", "s", "W", "Hz", "Pa", "N", "m/W", "W/s"];
 
-/// `reason` with the value after `got ` (in SI) rewritten in the engineering unit (`factor` to
-/// SI): `got -5e-10` becomes `got -0.5 nm`.
+/// `reason` with its values rewritten from SI in the engineering unit (`factor` to SI): the
+/// value after `got ` and every number followed by an SI unit name, so that a bound and the
+/// value seen read in the unit the file used (`must not exceed 1e-7 m, got -5e-10` becomes
+/// `must not exceed 100 nm, got -0.5 nm`).
 fn in_unit(reason: &str, factor: f64, unit: &str) -> String {
-    let Some(at) = reason.find("got ") else {
-        return reason.to_string();
-    };
-    let (head, tail) = reason.split_at(at + 4);
-    let end = tail
-        .find(|c: char| c.is_whitespace() || c == ',' || c == ')')
-        .unwrap_or(tail.len());
-    let Ok(x) = tail[..end].parse::<f64>() else {
-        return reason.to_string();
-    };
-    let mut rest = &tail[end..];
-    if let Some(r) = rest.strip_prefix(' ') {
-        let word = r
-            .split(|c: char| c.is_whitespace() || c == ',')
-            .next()
-            .unwrap_or("");
-        if SI_UNITS.contains(&word) {
-            rest = &r[word.len()..];
+    let words: Vec<&str> = reason.split(' ').collect();
+    let mut out: Vec<String> = Vec::with_capacity(words.len());
+    let mut i = 0;
+    while i < words.len() {
+        let word = words[i];
+        // A number may carry a sign prefix (±) and trailing punctuation (`,` or `)`).
+        let body_start = word.find(|c: char| c != '±').unwrap_or(word.len());
+        let body_end = word
+            .find(|c: char| c == ',' || c == ')')
+            .unwrap_or(word.len())
+            .max(body_start);
+        let (sign, body, tail) = (
+            &word[..body_start],
+            &word[body_start..body_end],
+            &word[body_end..],
+        );
+        let next_is_si = tail.is_empty()
+            && words
+                .get(i + 1)
+                .map(|w| w.trim_end_matches([',', ')']))
+                .is_some_and(|w| SI_UNITS.contains(&w));
+        let after_got = i > 0 && words[i - 1] == "got";
+        match body.parse::<f64>() {
+            Ok(x) if next_is_si || after_got => {
+                let value = format!("{sign}{}", crate::units::fmt_short(x / factor));
+                if next_is_si {
+                    let next = words[i + 1];
+                    let rest = &next[next.trim_end_matches([',', ')']).len()..];
+                    out.push(format!("{value} {unit}{rest}"));
+                    i += 2;
+                } else {
+                    out.push(format!("{value} {unit}{tail}"));
+                    i += 1;
+                }
+            }
+            _ => {
+                out.push(word.to_string());
+                i += 1;
+            }
         }
     }
-    format!("{head}{} {unit}{rest}", crate::units::fmt_short(x / factor))
+    out.join(" ")
 }
 
 fn path(prefix: &str, key: &str) -> String {
@@ -391,13 +414,21 @@ mod tests {
         );
         assert_eq!(
             in_unit("must not exceed 1e-7 m, got 1e291 m", 1e-9, "nm"),
-            "must not exceed 1e-7 m, got 1e300 nm"
+            "must not exceed 100 nm, got 1e300 nm"
         );
         assert_eq!(
             in_unit("got 0.5 W, too much", 1e-3, "mW"),
             "got 500 mW, too much"
         );
         assert_eq!(in_unit("no value", 1e-3, "mW"), "no value");
+        assert_eq!(
+            in_unit("must be at most 1e7 Hz, got 1e15 Hz", 1e3, "kHz"),
+            "must be at most 10000 kHz, got 1e12 kHz"
+        );
+        assert_eq!(
+            in_unit("must lie in [1e-11, 0.01], got 2 s", 1e-3, "ms"),
+            "must lie in [1e-11, 0.01], got 2000 ms"
+        );
     }
 
     #[test]
