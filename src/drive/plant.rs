@@ -109,7 +109,7 @@ impl Ambient {
     }
 }
 
-/// Options of [`Drive::new`].
+/// Options of [`Plant::new`].
 ///
 /// ```
 /// use hdi_tribology::drive::DriveOptions;
