@@ -14,7 +14,9 @@ use crate::error::{check_positive, Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem, StateLayout};
 use crate::ode::{self, Method, Options, SaveAt, Solution, Stats};
-use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector, U4, U5, U6};
+use nalgebra::{
+    allocator::Allocator, DefaultAllocator, DimName, OVector, U10, U4, U5, U6, U7, U8, U9,
+};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -244,11 +246,22 @@ pub fn simulate_cycle(
 ) -> Result<CycleResult> {
     opts.validate()?;
     super::equilibrium::check_heater(model)?;
-    let layout = StateLayout::new(model.thermal_lag > 0.0, model.interface_lag > 0.0, true);
+    // Dispatch on the state size to stack vectors: a step allocates nothing, and a scene pays
+    // only for the coordinates and lags it uses.
+    let layout = StateLayout::new(
+        model.structure.dofs(),
+        model.thermal_lag > 0.0,
+        model.interface_lag > 0.0,
+        true,
+    );
     match layout.len() {
         4 => run::<U4>(model, programme, opts),
         5 => run::<U5>(model, programme, opts),
         6 => run::<U6>(model, programme, opts),
+        7 => run::<U7>(model, programme, opts),
+        8 => run::<U8>(model, programme, opts),
+        9 => run::<U9>(model, programme, opts),
+        10 => run::<U10>(model, programme, opts),
         n => Err(Error::analysis(
             "cycle",
             format!("unexpected state size {n}"),
@@ -406,9 +419,9 @@ where
     let heat = layout
         .heat
         .ok_or_else(|| Error::analysis("cycle", "no heat state"))?;
-    let y0: OVector<f64, D> = sys.initial_state(D::name(), eq.y, eq.protrusion, eq.interface_force);
+    let y0: OVector<f64, D> = sys.initial_state(D::name(), &eq.rest());
 
-    let ode_opts = ode_options(model, opts, &layout, &initial_programme)?;
+    let ode_opts = ode_options(&sys, opts, &initial_programme)?;
     let mut traj = Trajectory::<D> {
         segments: Vec::new(),
     };
@@ -482,7 +495,7 @@ where
                 (t_end, start_power),
             ])?;
             sys = SliderSystem::new(model, final_programme.clone(), true);
-            let o = ode_options(model, opts, &layout, &final_programme)?;
+            let o = ode_options(&sys, opts, &final_programme)?;
             let t_now = traj.segments.last().map_or(t0, |s| s.t_final());
             let sol = solve(&sys, t_now, y, t_end, &o)?;
             traj.segments.push(sol);
@@ -532,46 +545,24 @@ where
     })
 }
 
-fn ode_options(
-    model: &SliderModel,
-    opts: &CycleOptions,
-    layout: &StateLayout,
-    programme: &Programme,
-) -> Result<Options> {
+fn ode_options(sys: &SliderSystem, opts: &CycleOptions, programme: &Programme) -> Result<Options> {
     let s = opts.solver;
-    let k = model.bearing().stiffness(0.0);
-    let omega = (k / model.mass).sqrt();
-    let mut atol = vec![0.0; layout.len()];
-    atol[0] = s.atol_displacement;
-    atol[1] = s.atol_displacement * omega;
-    if let Some(i) = layout.delta {
-        atol[i] = s.atol_displacement;
-    }
-    if let Some(i) = layout.lagged_force {
-        atol[i] = s.atol_displacement * k;
-    }
     // The integrals only need the accuracy the detector and the mean temperature use.
-    if let Some(i) = layout.contact_impulse {
-        atol[i] = s.rtol * opts.detector.contact_threshold * opts.detector.window;
-    }
-    if let Some(i) = layout.heat {
-        atol[i] = s.rtol * opts.detector.window;
-    }
-    let v = model.voltage;
-    let h_max = s.max_step.unwrap_or(if v.is_time_dependent() {
-        1.0 / (40.0 * v.frequency.abs())
-    } else {
-        f64::INFINITY
-    });
+    let atol = sys.tolerances(
+        s.atol_displacement,
+        s.rtol * opts.detector.contact_threshold * opts.detector.window,
+        s.rtol * opts.detector.window,
+    );
+    let n = atol.len();
     let o = Options::default()
         .rtol(s.rtol)
         .atol_per_component(atol)
-        .h_max(h_max)
+        .h_max(sys.model().max_step(s.max_step))
         .max_steps(s.max_steps)
         .t_stops(programme.knots().iter().map(|k| k.0).collect())
         .save(SaveAt::Steps)
         .dense(true);
-    o.validate(layout.len())
+    o.validate(n)
         .map_err(|e| Error::invalid("solver", e.to_string()))?;
     Ok(o)
 }
@@ -587,7 +578,8 @@ where
     let mut reason = format!(
         "at t = {t:.6e} s the pad gap h0 + y fell to zero (bulge gap d = {:.4e} m, velocity {:.3e} \
          m/s): the slider body would enter the disk, outside the lumped model",
-        g.bulge, s[1]
+        g.bulge,
+        s[sys.layout().velocity(0)]
     );
     if model.interface_lag > 0.0 {
         let k_contact = -model.forces().contact(g).d_bulge;
@@ -615,25 +607,11 @@ fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError)
                  is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact and \
                  lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
                 opts.solver.method,
-                fastest_rate(model)
+                model.fastest_rate()
             ),
         ),
         other => Error::Ode(other),
     }
-}
-
-/// A bound on the fastest rate of the slider (1/s): the bearing mode, the damping rate and the
-/// inverse lags (the contact stiffness only raises the first, see `docs/validity.md`).
-fn fastest_rate(model: &SliderModel) -> f64 {
-    let k = model.bearing().stiffness(0.0);
-    let c = model.bearing().damping(0.0);
-    let mut r = (k / model.mass).sqrt().max(c / model.mass);
-    for tau in [model.interface_lag, model.thermal_lag] {
-        if tau > 0.0 {
-            r = r.max(1.0 / tau);
-        }
-    }
-    r
 }
 
 fn series_of<D: DimName>(sys: &SliderSystem, traj: &Trajectory<D>, det: &Detecting<D>) -> TimeSeries
@@ -652,7 +630,7 @@ where
             let g = sys.gaps(*t, s);
             let volt2 = model.voltage.squared(*t);
             let b = model.breakdown(g, volt2);
-            let f_ab = model.bearing().force(s[0], s[1]);
+            let f_ab = sys.bearing_force(s);
             out.t.push(*t);
             out.power.push(sys.programme().power(*t));
             out.d.push(g.bulge);
