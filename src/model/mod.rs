@@ -419,7 +419,8 @@ impl SliderModel {
         )
     }
 
-    /// A heater programme from the scene's knots.
+    /// A heater programme from the scene's knots (the analyses' translation of a scene is
+    /// `analysis::Protocol::from_scene`, or `analysis::HeaterProgramme::fixed_from_scene`).
     pub fn programme_from_knots(knots: &[[f64; 2]]) -> Result<Programme> {
         Programme::new(knots.iter().map(|k| (k[0], k[1])).collect())
     }
