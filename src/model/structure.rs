@@ -5,16 +5,6 @@
 //! the bulge, whose displacement is `bᵀq`. Everything is stored in fixed-size matrices of
 //! [`MAX_DOF`] rows; only the first [`Structure::dofs`] are used, and the state of an ODE holds
 //! only those.
-//!
-//! ```
-//! use hdi_tribology::model::Structure;
-//! let s = Structure::bulge(1e-6, 1e-13, 4e5, 0.05)?;
-//! assert_eq!(s.dofs(), 2);
-//! // On a fixed body the bulge rings at √(k_b/m_b)/2π:
-//! let f = (4e5f64 / 1e-13).sqrt() / (2.0 * std::f64::consts::PI);
-//! assert!((f - 3.183e8).abs() < 1e5);
-//! # Ok::<(), hdi_tribology::Error>(())
-//! ```
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 
@@ -37,7 +27,19 @@ pub(crate) type DofMatrix = SMatrix<f64, MAX_DOF, MAX_DOF>;
 /// The bordered system of [`Structure::displaced_bulge`]: coordinates plus the load.
 type Bordered = SMatrix<f64, { MAX_DOF + 1 }, { MAX_DOF + 1 }>;
 
-/// A linear structure on the air bearing (see the module documentation).
+/// A linear structure on the air bearing: `M q̈ + C q̇ + K q = e₀ F_ab(q₀, q̇₀) + b F_if`, with
+/// coordinate 0 the body heave (where the air-bearing law acts) and the bulge at `bᵀq`.
+///
+/// ```
+/// use hdi_tribology::model::Structure;
+/// let s = Structure::bulge(1e-6, 1e-13, 4e5, 0.05)?;
+/// assert_eq!(s.dofs(), 2);
+/// // A bulge far lighter than the body rings at √(k_b/m_b)/2π:
+/// let f = s.natural_frequencies(3e5);
+/// let exact = (4e5f64 / 1e-13).sqrt() / (2.0 * std::f64::consts::PI);
+/// assert!((f[1] - exact).abs() < 1e-6 * exact);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Structure {
     n: usize,

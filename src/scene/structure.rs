@@ -4,21 +4,6 @@
 //! Degree of freedom 0 is always the heave of the slider body at the air bearing (`slider.mass_kg`
 //! and the `[air_bearing]` law act there); the interface forces act on the bulge, whose
 //! displacement towards and away from the disk is `bᵀq` with the influence vector `b`.
-//!
-//! ```
-//! use hdi_tribology::scene::{Scene, StructureSpec};
-//! let text = Scene::paper().to_toml_string()? + r#"
-//! [structure]
-//! preset = "bulge"
-//! mass_kg = 1e-13
-//! stiffness_n_per_m = 4e5
-//! damping_ratio = 0.05
-//! "#;
-//! let scene = Scene::from_toml_str(&text)?;
-//! assert!(matches!(scene.structure, StructureSpec::Bulge { .. }));
-//! assert_eq!(Scene::paper().structure, StructureSpec::Rigid);
-//! # Ok::<(), hdi_tribology::Error>(())
-//! ```
 
 use serde::{Deserialize, Serialize};
 
@@ -29,6 +14,21 @@ use crate::{Error, Result};
 pub const MAX_DOF: usize = 3;
 
 /// The slider's structure. `rigid` (the default) is one mass on the air bearing.
+///
+/// ```
+/// use hdi_tribology::scene::{Scene, StructureSpec};
+/// let text = Scene::paper().to_toml_string()? + r#"
+/// [structure]
+/// preset = "bulge"
+/// mass_kg = 1e-13
+/// stiffness_n_per_m = 4e5
+/// damping_ratio = 0.05
+/// "#;
+/// let scene = Scene::from_toml_str(&text)?;
+/// assert!(matches!(scene.structure, StructureSpec::Bulge { .. }));
+/// assert_eq!(Scene::paper().structure, StructureSpec::Rigid);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "preset", rename_all = "snake_case", deny_unknown_fields)]
 pub enum StructureSpec {
