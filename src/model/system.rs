@@ -168,11 +168,7 @@ impl<'a> SliderSystem<'a> {
     where
         DefaultAllocator: Allocator<D>,
     {
-        let mut q = super::structure::zero_dofs();
-        for i in 0..self.layout.dofs {
-            q[i] = s[i];
-        }
-        q
+        self.block(s, 0)
     }
 
     /// The velocities `q̇` of state `s`.
@@ -181,11 +177,20 @@ impl<'a> SliderSystem<'a> {
     where
         DefaultAllocator: Allocator<D>,
     {
-        let mut v = super::structure::zero_dofs();
+        self.block(s, self.layout.velocity(0))
+    }
+
+    /// `dofs` entries of `s` from `start`, as coordinates.
+    #[inline]
+    fn block<D: Dim>(&self, s: &OVector<f64, D>, start: usize) -> Dofs
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let mut q = super::structure::zero_dofs();
         for i in 0..self.layout.dofs {
-            v[i] = s[self.layout.velocity(i)];
+            q[i] = s[start + i];
         }
-        v
+        q
     }
 
     /// Protrusion at time `t` and state `s`.
