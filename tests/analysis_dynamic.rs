@@ -4,7 +4,7 @@ use hdi_tribology::analysis::response::simulated_dither;
 use hdi_tribology::analysis::*;
 use hdi_tribology::force::Gaps;
 use hdi_tribology::heater::Programme;
-use hdi_tribology::model::{SliderModel, SliderSystem, Voltage};
+use hdi_tribology::model::{Dofs, SliderModel, SliderSystem, Voltage};
 use hdi_tribology::ode::{self, Method, Options, SaveAt};
 use hdi_tribology::quadrature::{integrate, QuadOptions};
 use hdi_tribology::scene::Scene;
@@ -14,8 +14,7 @@ fn paper() -> (Scene, SliderModel, CycleOptions, HeaterProgramme) {
     let scene = Scene::paper();
     let model = SliderModel::from_scene(&scene).unwrap();
     let opts = CycleOptions::from_scene(&scene).unwrap();
-    let fixed =
-        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme).unwrap());
+    let fixed = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     (scene, model, opts, fixed)
 }
 
@@ -77,11 +76,7 @@ fn hysteresis_collapses_above_an_ac_threshold() {
 fn triggered_temperature_rise_grows_with_hysteresis() {
     let (scene, model, opts, _) = paper();
     let t = &scene.heater.triggered;
-    let trig = HeaterProgramme::Triggered {
-        start_power: t.start_power_w,
-        ramp_rate: t.ramp_rate_w_per_s,
-        overshoot: t.overshoot_w,
-    };
+    let trig = HeaterProgramme::triggered_from_scene(&scene);
     let rs = ac_sweep(&model, &trig, &opts, &[0.0, 0.4, 0.8]).unwrap();
     let (a, b, c) = (&rs[0], &rs[1], &rs[2]);
     assert!(a.hysteresis.unwrap() > b.hysteresis.unwrap());
@@ -108,7 +103,9 @@ fn undamped_unforced_slider_conserves_energy() {
     // Start 2 nm above the flying position, at rest: a large, anharmonic oscillation that comes
     // within a few nanometres of the disk.
     let eq = flying_equilibrium(&model, power, 1.0, &ScanGrid::default()).unwrap();
-    let y0 = sys.initial_state(U2, eq.y + 2e-9, delta, 0.0);
+    let mut rest = eq.rest();
+    rest.q[0] += 2e-9;
+    let y0 = sys.initial_state(U2, &rest);
     let t_end = 2e-4;
     let times: Vec<f64> = (0..=50).map(|i| t_end * i as f64 / 50.0).collect();
     let o = Options::default()
@@ -116,10 +113,10 @@ fn undamped_unforced_slider_conserves_energy() {
         .atol_per_component(vec![1e-22, 1e-22 * 5.5e5])
         .save(SaveAt::Times(times));
     let sol = ode::solve(&sys, 0.0, y0, t_end, Method::Dop853, &o, &mut []).unwrap();
-    let d_ref = model.gaps(eq.y, delta).bulge;
+    let d_ref = model.gaps(&eq.q, delta).bulge;
     // Potential of the interface force, U = −∫_{d_ref}^{d} F ds, by adaptive quadrature.
     let energy = |y: f64, v: f64| {
-        let d = model.gaps(y, delta).bulge;
+        let d = model.gaps(&Dofs::new(y, 0.0, 0.0), delta).bulge;
         let q = integrate(
             |s| {
                 let g = Gaps {
@@ -137,7 +134,7 @@ fn undamped_unforced_slider_conserves_energy() {
             },
         )
         .unwrap();
-        0.5 * model.mass * v * v + 0.5 * 3e5 * y * y - q.value
+        0.5 * model.structure.body_mass() * v * v + 0.5 * 3e5 * y * y - q.value
     };
     let e0 = energy(sol.y[0][0], sol.y[0][1]);
     let scale = 0.5 * 3e5 * (2e-9f64).powi(2);

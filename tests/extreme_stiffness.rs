@@ -45,7 +45,7 @@ fn contact_equilibrium(model: &SliderModel, power: f64) -> Option<Equilibrium> {
 fn eigen_magnitudes(model: &SliderModel, power: f64, e: &Equilibrium) -> Vec<f64> {
     let sys = SliderSystem::new(model, Programme::constant(power, 1.0).unwrap(), false);
     let n = sys.layout().len();
-    let s: DVector<f64> = sys.initial_state(Dyn(n), e.y, e.protrusion, e.interface_force);
+    let s: DVector<f64> = sys.initial_state(Dyn(n), &e.rest());
     let mut j = DMatrix::zeros(n, n);
     assert!(OdeSystem::<Dyn>::jacobian(&sys, 0.0, &s, &mut j));
     j.complex_eigenvalues().iter().map(|z| z.norm()).collect()
@@ -72,7 +72,7 @@ fn contact_ramp_steps(method: Method) -> (Vec<f64>, f64, ode::Stats) {
     let programme = Programme::new(vec![(0.0, p0), (1e-3, p0 + 0.005)]).unwrap();
     let sys = SliderSystem::new(&model, programme, false);
     assert_eq!(sys.layout().len(), 3);
-    let y0: DVector<f64> = sys.initial_state(Dyn(3), e.y, e.protrusion, e.interface_force);
+    let y0: DVector<f64> = sys.initial_state(Dyn(3), &e.rest());
     let (k, m) = (3e5f64, 1e-6f64);
     let opts = Options::default()
         .rtol(1e-6)
@@ -218,7 +218,7 @@ fn stiffness_ratios_of_the_extreme_scenes() {
                 flying_equilibrium(&model, p0, volt2, &ScanGrid::default()),
             ) {
                 let prod = v[0] * v[1];
-                let want = e.stiffness / model.mass;
+                let want = e.stiffness / model.structure.body_mass();
                 assert!(
                     (prod - want).abs() <= 1e-9 * want,
                     "{}: {prod:e} vs {want:e}",

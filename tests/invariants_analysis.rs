@@ -172,7 +172,7 @@ proptest! {
         let Ok((td, _)) = hysteresis_of(&s) else { return Ok(()) };
         let volt2 = model.voltage.effective_dc().powi(2);
         let e = flying_equilibrium(&model, frac * td, volt2, &ScanGrid::default()).unwrap();
-        let g = model.gaps(e.y, e.protrusion);
+        let g = model.gaps(&e.q, e.protrusion);
         let f = model.interface_force_exact(g, volt2).unwrap();
         let fab = model.bearing().force(e.y, 0.0);
         let scale = fab.abs() + f.value.abs();

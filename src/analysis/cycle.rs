@@ -14,7 +14,9 @@ use crate::error::{check_positive, Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem, StateLayout};
 use crate::ode::{self, Method, Options, SaveAt, Solution, Stats};
-use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector, U4, U5, U6};
+use nalgebra::{
+    allocator::Allocator, DefaultAllocator, DimName, OVector, U10, U4, U5, U6, U7, U8, U9,
+};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -76,29 +78,6 @@ pub struct CycleOptions {
 }
 
 impl CycleOptions {
-    /// The detector and solver settings of a scene, without time series.
-    pub fn from_scene(scene: &crate::scene::Scene) -> Result<Self> {
-        let method: Method = scene
-            .solver
-            .method
-            .parse()
-            .map_err(|e: ode::OdeError| Error::invalid("solver.method", e.to_string()))?;
-        Ok(CycleOptions {
-            detector: Detector {
-                contact_threshold: scene.detector.contact_threshold_n,
-                window: scene.detector.window_s,
-            },
-            solver: SolverSettings {
-                method,
-                rtol: scene.solver.rtol,
-                atol_displacement: scene.solver.atol_m,
-                max_step: scene.solver.max_step_s,
-                max_steps: scene.solver.max_steps,
-            },
-            keep_series: false,
-        })
-    }
-
     fn validate(&self) -> Result<()> {
         check_positive(
             "detector.contact_threshold",
@@ -124,6 +103,18 @@ pub struct Detection {
     pub time: f64,
     /// Programme power at that time (W).
     pub power: f64,
+}
+
+impl Detection {
+    /// The programme power in milliwatts.
+    ///
+    /// ```
+    /// let d = hdi_tribology::analysis::Detection { time: 1e-3, power: 0.0743 };
+    /// assert!((d.power_mw() - 74.3).abs() < 1e-12);
+    /// ```
+    pub fn power_mw(&self) -> f64 {
+        crate::units::to_mw(self.power)
+    }
 }
 
 /// Time series of one cycle, at every accepted step.
@@ -223,6 +214,21 @@ impl CycleResult {
     pub fn hysteresis_mw(&self) -> Option<f64> {
         self.hysteresis.map(crate::units::to_mw)
     }
+
+    /// The hysteresis for printing: `6.417` (mW, three decimals) when both transitions were
+    /// detected, else which one was not.
+    ///
+    /// ```
+    /// # use hdi_tribology::analysis::CycleResult;
+    /// # fn f(r: &CycleResult) { println!("ΔP = {} mW", r.hysteresis_text()); }
+    /// ```
+    pub fn hysteresis_text(&self) -> String {
+        match (self.touchdown, self.takeoff, self.hysteresis_mw()) {
+            (_, _, Some(h)) => format!("{h:.3}"),
+            (None, _, _) => "n/a (no touchdown detected)".into(),
+            (Some(_), _, None) => "n/a (no take-off detected)".into(),
+        }
+    }
 }
 
 /// Simulates one touchdown/take-off cycle.
@@ -232,7 +238,7 @@ impl CycleResult {
 /// use hdi_tribology::{model::SliderModel, scene::Scene};
 /// let scene = Scene::paper();
 /// let model = SliderModel::from_scene(&scene)?;
-/// let programme = HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+/// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
 /// let r = simulate_cycle(&model, &programme, &CycleOptions::from_scene(&scene)?)?;
 /// println!("ΔP = {:?} W, mean ΔT = {} K", r.hysteresis, r.mean_temperature_rise);
 /// # Ok::<(), hdi_tribology::Error>(())
@@ -244,11 +250,22 @@ pub fn simulate_cycle(
 ) -> Result<CycleResult> {
     opts.validate()?;
     super::equilibrium::check_heater(model)?;
-    let layout = StateLayout::new(model.thermal_lag > 0.0, model.interface_lag > 0.0, true);
+    // Dispatch on the state size to stack vectors: a step allocates nothing, and a scene pays
+    // only for the coordinates and lags it uses.
+    let layout = StateLayout::new(
+        model.structure.dofs(),
+        model.thermal_lag > 0.0,
+        model.interface_lag > 0.0,
+        true,
+    );
     match layout.len() {
         4 => run::<U4>(model, programme, opts),
         5 => run::<U5>(model, programme, opts),
         6 => run::<U6>(model, programme, opts),
+        7 => run::<U7>(model, programme, opts),
+        8 => run::<U8>(model, programme, opts),
+        9 => run::<U9>(model, programme, opts),
+        10 => run::<U10>(model, programme, opts),
         n => Err(Error::analysis(
             "cycle",
             format!("unexpected state size {n}"),
@@ -406,9 +423,9 @@ where
     let heat = layout
         .heat
         .ok_or_else(|| Error::analysis("cycle", "no heat state"))?;
-    let y0: OVector<f64, D> = sys.initial_state(D::name(), eq.y, eq.protrusion, eq.interface_force);
+    let y0: OVector<f64, D> = sys.initial_state(D::name(), &eq.rest());
 
-    let ode_opts = ode_options(model, opts, &layout, &initial_programme)?;
+    let ode_opts = ode_options(&sys, opts, &initial_programme)?;
     let mut traj = Trajectory::<D> {
         segments: Vec::new(),
     };
@@ -482,7 +499,7 @@ where
                 (t_end, start_power),
             ])?;
             sys = SliderSystem::new(model, final_programme.clone(), true);
-            let o = ode_options(model, opts, &layout, &final_programme)?;
+            let o = ode_options(&sys, opts, &final_programme)?;
             let t_now = traj.segments.last().map_or(t0, |s| s.t_final());
             let sol = solve(&sys, t_now, y, t_end, &o)?;
             traj.segments.push(sol);
@@ -532,46 +549,24 @@ where
     })
 }
 
-fn ode_options(
-    model: &SliderModel,
-    opts: &CycleOptions,
-    layout: &StateLayout,
-    programme: &Programme,
-) -> Result<Options> {
+fn ode_options(sys: &SliderSystem, opts: &CycleOptions, programme: &Programme) -> Result<Options> {
     let s = opts.solver;
-    let k = model.bearing().stiffness(0.0);
-    let omega = (k / model.mass).sqrt();
-    let mut atol = vec![0.0; layout.len()];
-    atol[0] = s.atol_displacement;
-    atol[1] = s.atol_displacement * omega;
-    if let Some(i) = layout.delta {
-        atol[i] = s.atol_displacement;
-    }
-    if let Some(i) = layout.lagged_force {
-        atol[i] = s.atol_displacement * k;
-    }
     // The integrals only need the accuracy the detector and the mean temperature use.
-    if let Some(i) = layout.contact_impulse {
-        atol[i] = s.rtol * opts.detector.contact_threshold * opts.detector.window;
-    }
-    if let Some(i) = layout.heat {
-        atol[i] = s.rtol * opts.detector.window;
-    }
-    let v = model.voltage;
-    let h_max = s.max_step.unwrap_or(if v.is_time_dependent() {
-        1.0 / (40.0 * v.frequency.abs())
-    } else {
-        f64::INFINITY
-    });
+    let atol = sys.tolerances(
+        s.atol_displacement,
+        s.rtol * opts.detector.contact_threshold * opts.detector.window,
+        s.rtol * opts.detector.window,
+    );
+    let n = atol.len();
     let o = Options::default()
         .rtol(s.rtol)
         .atol_per_component(atol)
-        .h_max(h_max)
+        .h_max(sys.model().max_step(s.max_step))
         .max_steps(s.max_steps)
         .t_stops(programme.knots().iter().map(|k| k.0).collect())
         .save(SaveAt::Steps)
         .dense(true);
-    o.validate(layout.len())
+    o.validate(n)
         .map_err(|e| Error::invalid("solver", e.to_string()))?;
     Ok(o)
 }
@@ -587,7 +582,8 @@ where
     let mut reason = format!(
         "at t = {t:.6e} s the pad gap h0 + y fell to zero (bulge gap d = {:.4e} m, velocity {:.3e} \
          m/s): the slider body would enter the disk, outside the lumped model",
-        g.bulge, s[1]
+        g.bulge,
+        s[sys.layout().velocity(0)]
     );
     if model.interface_lag > 0.0 {
         let k_contact = -model.forces().contact(g).d_bulge;
@@ -615,25 +611,11 @@ fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError)
                  is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact and \
                  lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
                 opts.solver.method,
-                fastest_rate(model)
+                model.fastest_rate()
             ),
         ),
         other => Error::Ode(other),
     }
-}
-
-/// A bound on the fastest rate of the slider (1/s): the bearing mode, the damping rate and the
-/// inverse lags (the contact stiffness only raises the first, see `docs/validity.md`).
-fn fastest_rate(model: &SliderModel) -> f64 {
-    let k = model.bearing().stiffness(0.0);
-    let c = model.bearing().damping(0.0);
-    let mut r = (k / model.mass).sqrt().max(c / model.mass);
-    for tau in [model.interface_lag, model.thermal_lag] {
-        if tau > 0.0 {
-            r = r.max(1.0 / tau);
-        }
-    }
-    r
 }
 
 fn series_of<D: DimName>(sys: &SliderSystem, traj: &Trajectory<D>, det: &Detecting<D>) -> TimeSeries
@@ -652,7 +634,7 @@ where
             let g = sys.gaps(*t, s);
             let volt2 = model.voltage.squared(*t);
             let b = model.breakdown(g, volt2);
-            let f_ab = model.bearing().force(s[0], s[1]);
+            let f_ab = sys.bearing_force(s);
             out.t.push(*t);
             out.power.push(sys.programme().power(*t));
             out.d.push(g.bulge);

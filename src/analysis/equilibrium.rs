@@ -1,14 +1,16 @@
 //! Static equilibria along the heater power: the S-curve, its folds and their stability.
 //!
-//! At fixed heater power and DC voltage the slider rests where `F_ab(y, 0) + F_if(d) = 0`. The
-//! equilibria are parametrised by the bulge gap `d`: for each `d` the air-bearing balance gives
-//! `y`, hence the protrusion `δ = h0 + y − d` and the power `P = δ/η`. An equilibrium is stable
-//! where the total stiffness `k_ab − ∂F_if/∂y` is positive; folds are where it vanishes.
+//! At fixed heater power and DC voltage the slider rests where `K q = e₀ F_ab(q₀) + b F_if(d)`
+//! (for the rigid slider `F_ab(y, 0) + F_if(d) = 0`). The equilibria are parametrised by the bulge
+//! gap `d`: for each `d` the static balance ([`SliderModel::balance`]) gives the coordinates `q`,
+//! hence the protrusion `δ = h0 + bᵀq − d` and the power `P = δ/η`. An equilibrium is stable
+//! where the total stiffness condensed onto the bulge ([`SliderModel::total_stiffness`];
+//! `k_ab − ∂F_if/∂y` for the rigid slider) is positive; folds are where it vanishes.
 
 use super::roots::brent;
 use crate::error::{Error, Result};
-use crate::force::{ForceEval, Gaps};
-use crate::model::SliderModel;
+use crate::force::ForceEval;
+use crate::model::{Dofs, Rest, SliderModel};
 use serde::Serialize;
 
 /// One equilibrium of the slider.
@@ -16,8 +18,10 @@ use serde::Serialize;
 pub struct Equilibrium {
     /// Bulge gap `d` (m).
     pub d: f64,
-    /// Air-bearing displacement `y` (m).
+    /// Air-bearing displacement `y` of the slider body (m): `q₀`.
     pub y: f64,
+    /// All coordinates `q` of the structure (m, rad).
+    pub q: Dofs,
     /// Protrusion `δ` (m).
     pub protrusion: f64,
     /// Heater power `P = δ/η` (W).
@@ -34,6 +38,15 @@ impl Equilibrium {
     /// Whether the equilibrium is stable.
     pub fn is_stable(&self) -> bool {
         self.stiffness > 0.0
+    }
+
+    /// The state of rest at this equilibrium, to start a simulation from.
+    pub fn rest(&self) -> Rest {
+        Rest {
+            q: self.q,
+            protrusion: self.protrusion,
+            interface_force: self.interface_force,
+        }
     }
 }
 
@@ -157,49 +170,27 @@ impl<'a> EquilibriumSolver<'a> {
 
     /// The equilibrium whose bulge gap is `d`, through the tables.
     pub fn at_gap(&self, d: f64) -> Result<Equilibrium> {
-        let (y, f) = self.model.bearing_balance(d, self.volt2)?;
-        Ok(self.assemble(d, y, &f))
+        let (q, f) = self.model.balance(d, self.volt2, false)?;
+        Ok(self.assemble(d, q, &f))
     }
 
     /// The equilibrium whose bulge gap is `d`, from direct evaluation of every term.
     pub fn at_gap_exact(&self, d: f64) -> Result<Equilibrium> {
-        let m = self.model;
-        let h0 = m.nominal_clearance;
-        // Newton on the balance with exact forces, started from the tabulated solution.
-        let (mut y, _) = m.bearing_balance(d, self.volt2)?;
-        let mut f = ForceEval::default();
-        for _ in 0..50 {
-            f = m.interface_force_exact(
-                Gaps {
-                    bulge: d,
-                    pad: h0 + y,
-                },
-                self.volt2,
-            )?;
-            let r = m.bearing().force(y, 0.0) + f.value;
-            let dr = -m.bearing().stiffness(y) + f.d_pad;
-            let step = -r / dr;
-            y += step;
-            if step.abs() <= 1e-16 * h0 + 1e-13 * y.abs() {
-                break;
-            }
-        }
-        Ok(self.assemble(d, y, &f))
+        let (q, f) = self.model.balance(d, self.volt2, true)?;
+        Ok(self.assemble(d, q, &f))
     }
 
-    fn assemble(&self, d: f64, y: f64, f: &ForceEval) -> Equilibrium {
+    fn assemble(&self, d: f64, q: Dofs, f: &ForceEval) -> Equilibrium {
         let m = self.model;
-        let protrusion = m.nominal_clearance + y - d;
-        let g = Gaps {
-            bulge: d,
-            pad: m.nominal_clearance + y,
-        };
+        let protrusion = m.nominal_clearance + m.structure.bulge_displacement(&q) - d;
+        let g = m.gaps(&q, protrusion);
         Equilibrium {
             d,
-            y,
+            y: q[0],
+            q,
             protrusion,
             power: m.power_for(protrusion),
-            stiffness: m.total_stiffness(y, f),
+            stiffness: m.total_stiffness(&q, f),
             interface_force: f.value,
             contact_force: m.contact_force(g),
         }
@@ -263,7 +254,7 @@ pub struct SCurve {
 /// ```
 pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) -> Result<SCurve> {
     check_heater(model)?;
-    let volt2 = model.voltage.effective_dc().powi(2);
+    let volt2 = model.voltage.dc_squared();
     let (lo, hi) = range.unwrap_or_else(|| model.forces().table_range());
     if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
         return Err(Error::invalid(

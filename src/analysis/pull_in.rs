@@ -1,8 +1,9 @@
 //! Pull-in voltage and clearance change with DC voltage (MODEL.md section 6).
 //!
-//! At fixed protrusion `δ = ηP` the equilibria are parametrised by the bulge gap `d`:
-//! `y = d − h0 + δ` and the voltage that holds the head there is
-//! `V²(d) = −(F_ab(y, 0) + F_static(d))/G_e(d)`. Pull-in is the first maximum of `V²` (where the
+//! At fixed protrusion `δ = ηP` the equilibria are parametrised by the bulge gap `d`: the bulge
+//! sits at `z = d − h0 + δ`, the structure on the air bearing needs the load `F_s(z)` on the bulge
+//! to hold it there ([`SliderModel::bulge_load`]; `−F_ab(z, 0)` for the rigid slider), and the
+//! voltage that holds the head there is `V²(d) = (F_s(z) − F_static(d))/G_e(d)`. Pull-in is the first maximum of `V²` (where the
 //! total stiffness vanishes) or the first gap whose contact force reaches `F_th`, scanning `d`
 //! down from the zero-voltage equilibrium.
 
@@ -10,7 +11,6 @@ use super::equilibrium::EquilibriumSolver;
 use super::roots::brent;
 use super::touchdown::{touchdown_at, touchdown_signed, Cause, StaticOptions};
 use crate::error::{check_finite, Error, Result};
-use crate::force::Gaps;
 use crate::model::{SliderModel, Voltage};
 use serde::Serialize;
 
@@ -34,18 +34,15 @@ impl VoltageBalance<'_> {
     /// `(V², total stiffness, contact force)` at gap `d`, tabulated or exact.
     fn at(&self, d: f64, exact: bool) -> Result<(f64, f64, f64)> {
         let m = self.model;
-        let y = d - m.nominal_clearance + self.delta;
-        let g = Gaps {
-            bulge: d,
-            pad: d + self.delta,
-        };
+        let (q, load, k_structure) = m.bulge_load(d - m.nominal_clearance + self.delta)?;
+        let g = m.gaps(&q, self.delta);
         let (s, e) = if exact {
             m.interface_parts_exact(g)?
         } else {
             (m.forces().static_part(g), m.forces().per_volt2_part(g))
         };
-        let volt2 = -(m.bearing().force(y, 0.0) + s.value) / e.value;
-        let k = m.bearing().stiffness(y) - (s.d_bulge + s.d_pad) - volt2 * (e.d_bulge + e.d_pad);
+        let volt2 = (load - s.value) / e.value;
+        let k = k_structure - (s.d_bulge + s.d_pad) - volt2 * (e.d_bulge + e.d_pad);
         Ok((volt2, k, m.contact_force(g)))
     }
 }

@@ -1,14 +1,17 @@
-//! Linear response about a stable equilibrium: frequency response, modes and the dither that an
-//! AC voltage drives at twice its frequency (MODEL.md section 6).
+//! Linear response about a stable equilibrium: modes (frequency, damping ratio, shape), frequency
+//! response, and the dither that an AC voltage drives at twice its frequency (MODEL.md section 6).
 //!
-//! The state-space matrix is the slider's own Jacobian (with lags, if the scene has them) at the
-//! equilibrium under the mean `V²`; `H(iω) = e_yᵀ (iω − A)⁻¹ b` with `b` the input of a unit force.
+//! The state-space matrix `A` is the slider's own Jacobian (every coordinate of its structure,
+//! with lags if the scene has them) at the equilibrium under the mean `V²`;
+//! `H(iω) = cᵀ (iω − A)⁻¹ u` with `u` the input of a unit interface force and `cᵀx = bᵀq` the
+//! bulge displacement.
 
 use super::equilibrium::{flying_equilibrium, Equilibrium, ScanGrid};
 use crate::error::{Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem, Voltage};
 use crate::ode::OdeSystem;
+use crate::scene::MAX_DOF;
 use nalgebra::{DMatrix, DVector, Dyn};
 use num_complex::Complex64;
 use serde::Serialize;
@@ -25,6 +28,10 @@ pub struct Mode {
     pub frequency: f64,
     /// Damping ratio `−Re λ / |λ|`.
     pub damping_ratio: f64,
+    /// Mode shape over the structure's coordinates: the eigenvector's displacement part, scaled
+    /// so that its largest entry is 1 and rotated to be real there (signed real parts; entries
+    /// beyond the structure's coordinates are 0). All zero for a mode of the lags alone.
+    pub shape: [f64; MAX_DOF],
 }
 
 /// The linear response about the flying equilibrium at one heater power.
@@ -32,7 +39,7 @@ pub struct Mode {
 pub struct LinearResponse {
     /// The equilibrium (under the mean `V²`).
     pub equilibrium: Equilibrium,
-    /// Eigenvalues of the linearised system.
+    /// Eigenvalues of the linearised system, with shapes, by ascending frequency.
     pub modes: Vec<Mode>,
     /// Whether every eigenvalue has a negative real part.
     pub stable: bool,
@@ -40,34 +47,119 @@ pub struct LinearResponse {
     pub gain_at_2f: f64,
     /// Amplitude of the force at `2f`: `|G_e| V_ac²/2` (N).
     pub force_at_2f: f64,
-    /// Predicted dither amplitude of `y` at `2f` (m).
+    /// Predicted dither amplitude of the bulge at `2f` (m).
     pub dither_amplitude: f64,
     #[serde(skip)]
     a: DMatrix<f64>,
     #[serde(skip)]
-    input: usize,
+    input: DVector<f64>,
     #[serde(skip)]
-    a_input_gain: f64,
+    output: DVector<f64>,
+}
+
+/// `(iω − A)⁻¹ u`, or NaN where singular.
+fn resolvent(
+    a: &DMatrix<f64>,
+    omega: Complex64,
+    u: &DVector<Complex64>,
+) -> Option<DVector<Complex64>> {
+    let n = a.nrows();
+    let m = DMatrix::<Complex64>::from_fn(n, n, |i, j| {
+        let diag = if i == j {
+            omega
+        } else {
+            Complex64::new(0.0, 0.0)
+        };
+        diag - Complex64::new(a[(i, j)], 0.0)
+    });
+    m.lu().solve(u)
 }
 
 impl LinearResponse {
-    /// `H(iω)` (m/N): displacement per unit interface force at angular frequency `omega`.
+    /// `H(iω)` (m/N): bulge displacement per unit interface force at angular frequency `omega`.
     pub fn transfer(&self, omega: f64) -> Complex64 {
-        let n = self.a.nrows();
-        let m = DMatrix::<Complex64>::from_fn(n, n, |i, j| {
-            let diag = if i == j {
-                Complex64::new(0.0, omega)
-            } else {
-                Complex64::new(0.0, 0.0)
-            };
-            diag - Complex64::new(self.a[(i, j)], 0.0)
-        });
-        let mut b = DVector::<Complex64>::zeros(n);
-        b[self.input] = Complex64::new(self.a_input_gain, 0.0);
-        m.lu()
-            .solve(&b)
-            .map_or(Complex64::new(f64::NAN, f64::NAN), |x| x[0])
+        let u = self.input.map(|x| Complex64::new(x, 0.0));
+        resolvent(&self.a, Complex64::new(0.0, omega), &u)
+            .map_or(Complex64::new(f64::NAN, f64::NAN), |x| {
+                x.iter().zip(self.output.iter()).map(|(x, c)| x * c).sum()
+            })
     }
+}
+
+/// Diagonal similarity `B = D⁻¹ A D` with powers of two that makes row and column norms alike
+/// (Parlett–Reinsch balancing): a stiff bulge puts entries of 10¹⁸ beside entries of 1, and
+/// without it the eigenvalues of the slow modes drown in rounding. Returns `B` and `D`.
+fn balanced(a: &DMatrix<f64>) -> (DMatrix<f64>, DVector<f64>) {
+    let n = a.nrows();
+    let mut b = a.clone();
+    let mut d = DVector::<f64>::from_element(n, 1.0);
+    for _ in 0..200 {
+        let mut done = true;
+        for i in 0..n {
+            let c: f64 = (0..n).filter(|&j| j != i).map(|j| b[(j, i)].abs()).sum();
+            let r: f64 = (0..n).filter(|&j| j != i).map(|j| b[(i, j)].abs()).sum();
+            if c == 0.0 || r == 0.0 || !c.is_finite() || !r.is_finite() {
+                continue;
+            }
+            let (mut cc, mut rr, mut f) = (c, r, 1.0);
+            while cc < rr / 2.0 {
+                cc *= 2.0;
+                rr /= 2.0;
+                f *= 2.0;
+            }
+            while cc >= rr * 2.0 {
+                cc /= 2.0;
+                rr *= 2.0;
+                f /= 2.0;
+            }
+            if (cc + rr) / f < 0.95 * (c + r) {
+                done = false;
+                d[i] *= f;
+                for j in 0..n {
+                    b[(i, j)] /= f;
+                    b[(j, i)] *= f;
+                }
+            }
+        }
+        if done {
+            break;
+        }
+    }
+    (b, d)
+}
+
+/// The shape of the mode of eigenvalue `l` of `A = D B D⁻¹` (`B` balanced, `D = diag(scale)`):
+/// two steps of inverse iteration on `B` from a uniform vector, back-scaled by `D`, displacement
+/// part normalised.
+fn mode_shape(b: &DMatrix<f64>, scale: &DVector<f64>, l: Complex64, dofs: usize) -> [f64; MAX_DOF] {
+    let n = b.nrows();
+    let eps = 1e-10 * l.norm().max(1.0);
+    let shift = l + Complex64::new(eps, eps);
+    let mut shape = [0.0; MAX_DOF];
+    // (B − s)⁻¹ v = −(s − B)⁻¹ v.
+    let step = |v: &DVector<Complex64>| resolvent(b, shift, &v.map(|x| -x));
+    let u = DVector::<Complex64>::from_element(n, Complex64::new(1.0, 0.0));
+    let Some(xb) = step(&u).and_then(|x| step(&x)) else {
+        return shape;
+    };
+    let x = DVector::<Complex64>::from_fn(n, |i, _| xb[i] * scale[i]);
+    let Some(big) = x
+        .iter()
+        .take(dofs)
+        .copied()
+        .max_by(|p, q| p.norm().total_cmp(&q.norm()))
+    else {
+        return shape;
+    };
+    // A mode of the lag states alone moves no coordinate (velocities are |λ| × positions).
+    let total = x.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    if big.norm() * l.norm().max(1.0) <= 1e-9 * total {
+        return shape;
+    }
+    for (i, v) in x.iter().take(dofs).enumerate() {
+        shape[i] = (v / big).re;
+    }
+    shape
 }
 
 /// Linear response about the flying equilibrium at heater power `power` (W).
@@ -83,8 +175,7 @@ impl LinearResponse {
 /// ```
 pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse> {
     let v = model.voltage;
-    let v0 = v.effective_dc();
-    let mean_volt2 = v0 * v0 + 0.5 * v.ac_amplitude * v.ac_amplitude;
+    let mean_volt2 = v.mean_squared();
     let eq = flying_equilibrium(model, power, mean_volt2, &ScanGrid::default())?;
     // Freeze the voltage at its mean square: a DC voltage with the same V².
     let frozen = model.with_voltage(Voltage {
@@ -95,14 +186,27 @@ pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse
     let sys = SliderSystem::new(&frozen, Programme::constant(power, 1.0)?, false);
     let layout = sys.layout();
     let n = layout.len();
-    let state = sys.initial_state(Dyn(n), eq.y, eq.protrusion, eq.interface_force);
+    let state = sys.initial_state(Dyn(n), &eq.rest());
     let mut a = DMatrix::<f64>::zeros(n, n);
     OdeSystem::<Dyn>::jacobian(&sys, 0.0, &state, &mut a);
-    let (input, gain) = match layout.lagged_force {
-        Some(i) => (i, 1.0 / model.interface_lag),
-        None => (1, 1.0 / model.mass),
-    };
-    let modes: Vec<Mode> = a
+    // A unit interface force enters through the lag, or through M⁻¹b on the accelerations.
+    let st = &model.structure;
+    let mut input = DVector::<f64>::zeros(n);
+    match layout.lagged_force {
+        Some(i) => input[i] = 1.0 / model.interface_lag,
+        None => {
+            let per_force = st.mass_solve(&st.bulge_vector());
+            for r in 0..layout.dofs {
+                input[layout.velocity(r)] = per_force[r];
+            }
+        }
+    }
+    let mut output = DVector::<f64>::zeros(n);
+    for (r, b) in st.bulge_influence().iter().enumerate() {
+        output[r] = *b;
+    }
+    let (bal, scale) = balanced(&a);
+    let mut modes: Vec<Mode> = bal
         .complex_eigenvalues()
         .iter()
         .map(|l| {
@@ -112,14 +216,20 @@ pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse
                 im: l.im,
                 frequency: l.im.abs() / (2.0 * PI),
                 damping_ratio: if norm > 0.0 { -l.re / norm } else { 0.0 },
+                shape: mode_shape(&bal, &scale, *l, layout.dofs),
             }
         })
         .collect();
+    modes.sort_by(|p, q| {
+        p.frequency
+            .total_cmp(&q.frequency)
+            .then(q.re.total_cmp(&p.re))
+    });
     if modes.iter().any(|m| !m.re.is_finite()) {
         return Err(Error::analysis("linear response", "non-finite eigenvalue"));
     }
     let stable = modes.iter().all(|m| m.re < 0.0);
-    let g = model.gaps(eq.y, eq.protrusion);
+    let g = model.gaps(&eq.q, eq.protrusion);
     let ge = if model.forces().has_voltage_terms() {
         model.forces().per_volt2_part(g).value
     } else {
@@ -135,14 +245,14 @@ pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse
         dither_amplitude: 0.0,
         a,
         input,
-        a_input_gain: gain,
+        output,
     };
     r.gain_at_2f = r.transfer(2.0 * PI * 2.0 * v.frequency).norm();
     r.dither_amplitude = r.gain_at_2f * force_at_2f;
     Ok(r)
 }
 
-/// Dither amplitude of `y` at `2f` from a simulation at constant heater power `power` (W): half
+/// Dither amplitude of the bulge at `2f` from a simulation at constant heater power `power` (W): half
 /// the peak-to-peak displacement over the last `periods` periods of `V²`, after `settle` periods
 /// for the start-up transient to decay.
 ///
@@ -164,7 +274,6 @@ pub fn simulated_dither(
     periods: usize,
 ) -> Result<f64> {
     use crate::ode::{solve, Options, SaveAt};
-    use nalgebra::U2;
     let v = model.voltage;
     if !v.is_time_dependent() {
         return Err(Error::analysis(
@@ -179,31 +288,24 @@ pub fn simulated_dither(
     let t_end = (settle + periods) as f64 * period;
     let eq = flying_equilibrium(model, power, v.squared(0.0), &ScanGrid::default())?;
     let sys = SliderSystem::new(model, Programme::constant(power, t_end)?, false);
-    if sys.layout().len() != 2 {
-        return Err(Error::analysis(
-            "simulated dither",
-            "only scenes without thermal or interface lag",
-        ));
-    }
-    let y0 = sys.initial_state(U2, eq.y, eq.protrusion, eq.interface_force);
+    let y0 = sys.initial_state(Dyn(sys.layout().len()), &eq.rest());
     let t_start = settle as f64 * period;
     let samples = 400 * periods;
     let times: Vec<f64> = (0..=samples)
         .map(|i| t_start + (t_end - t_start) * i as f64 / samples as f64)
         .collect();
     let s = opts.solver;
-    let omega = (model.bearing().stiffness(0.0) / model.mass).sqrt();
     let o = Options::default()
         .rtol(s.rtol)
-        .atol_per_component(vec![s.atol_displacement, s.atol_displacement * omega])
-        .h_max(period / 20.0)
+        .atol_per_component(sys.tolerances(s.atol_displacement, 0.0, 0.0))
+        .h_max(model.max_step(None))
         .max_steps(s.max_steps)
         .save(SaveAt::Times(times));
     let sol = solve(&sys, 0.0, y0, t_end, s.method, &o, &mut [])?;
     let (lo, hi) = sol
         .y
         .iter()
-        .map(|x| x[0])
+        .map(|x| model.structure.bulge_displacement(&sys.coordinates(x)))
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
             (a.min(y), b.max(y))
         });

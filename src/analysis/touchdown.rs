@@ -36,8 +36,8 @@ impl Transition {
     ///
     /// ```
     /// # use hdi_tribology::analysis::{equilibrium::Equilibrium, touchdown::{Cause, Transition}};
-    /// # let at = Equilibrium { d: 0.0, y: 0.0, protrusion: 0.0, power: 0.0, stiffness: 0.0,
-    /// #     interface_force: 0.0, contact_force: 0.0 };
+    /// # let at = Equilibrium { d: 0.0, y: 0.0, q: Default::default(), protrusion: 0.0, power: 0.0,
+    /// #     stiffness: 0.0, interface_force: 0.0, contact_force: 0.0 };
     /// let t = Transition { power: 0.0743, at, cause: Cause::Fold };
     /// assert!((t.power_mw() - 74.3).abs() < 1e-12);
     /// ```
@@ -110,7 +110,7 @@ impl StaticHysteresis {
 pub fn touchdown_power(model: &SliderModel, opts: &StaticOptions) -> Result<Transition> {
     opts.validate()?;
     super::equilibrium::check_heater(model)?;
-    let volt2 = model.voltage.effective_dc().powi(2);
+    let volt2 = model.voltage.dc_squared();
     touchdown_at(model, volt2, opts)
 }
 
@@ -242,7 +242,7 @@ pub fn takeoff_power(
     opts.validate()?;
     super::equilibrium::check_heater(model)?;
     crate::error::check_finite("start_power", start_power)?;
-    let volt2 = model.voltage.effective_dc().powi(2);
+    let volt2 = model.voltage.dc_squared();
     takeoff_at(model, volt2, start_power, opts)
 }
 

@@ -270,7 +270,7 @@ pub fn calibrate(
         model,
         opts,
         t: 0.0,
-        y: probe.initial_state(Dyn(n), eq.y, eq.protrusion, eq.interface_force),
+        y: probe.initial_state(Dyn(n), &eq.rest()),
         power: sc.start_power,
         stats: Stats::default(),
         steps: Vec::new(),
@@ -348,7 +348,7 @@ pub fn calibrate(
             ),
         ));
     }
-    let dc2 = model.voltage.effective_dc().powi(2);
+    let dc2 = model.voltage.dc_squared();
     let clearance = flying_equilibrium(model, set_power, dc2, &grid)?.d;
     Ok(Calibration {
         detector: detector.name().to_string(),
@@ -424,7 +424,7 @@ impl Run<'_> {
                 t,
                 power: programme.power(t),
                 displacement: s[0],
-                velocity: s[1],
+                velocity: s[sys.layout().velocity(0)],
                 gap: g.bulge,
                 contact_force: m.contact_force(g),
                 interface_force: f.value,
@@ -445,23 +445,9 @@ impl Run<'_> {
 
     fn ode_options(&self, programme: &Programme, times: Vec<f64>) -> Options {
         let m = self.model;
-        let omega = (m.bearing().stiffness(0.0).abs() / m.mass).sqrt();
-        let a = self.opts.atol_displacement;
-        let n = self.y.len();
-        let mut atol = vec![a; n];
-        atol[1] = a * omega;
-        if let Some(i) = SliderSystem::new(m, programme.clone(), false)
-            .layout()
-            .lagged_force
-        {
-            atol[i] = a * m.bearing().stiffness(0.0).abs();
-        }
-        // With a dither, cap the step at 1/40 of the voltage period so no peak of V² is skipped.
-        let h_max = if m.voltage.is_time_dependent() {
-            1.0 / (40.0 * m.voltage.frequency.abs())
-        } else {
-            f64::INFINITY
-        };
+        let sys = SliderSystem::new(m, programme.clone(), false);
+        let atol = sys.tolerances(self.opts.atol_displacement, 0.0, 0.0);
+        let h_max = m.max_step(None);
         Options::default()
             .rtol(self.opts.rtol)
             .atol_per_component(atol)

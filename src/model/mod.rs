@@ -4,9 +4,11 @@
 //! [`SliderSystem`] lays that physics out as an ODE for [`crate::ode`]. This is the only module
 //! that knows both the physics and the stepper.
 
+mod structure;
 mod system;
 
-pub use system::{SliderSystem, StateLayout};
+pub use structure::{Dofs, Structure};
+pub use system::{Rest, SliderSystem, StateLayout};
 
 use crate::error::{Error, Result};
 use crate::force::{AirBearing, Breakdown, ForceEval, Gaps, HotForces, InterfaceForces};
@@ -53,6 +55,24 @@ impl Voltage {
         2.0 * self.at(t) * self.ac_amplitude * w * (w * t).cos()
     }
 
+    /// `(V_dc − φ)²` (V²): the squared voltage of a static (DC) analysis.
+    ///
+    /// ```
+    /// # use hdi_tribology::model::Voltage;
+    /// let v = Voltage { dc: 1.0, ac_amplitude: 0.5, frequency: 1.0e4, contact_potential: 0.2 };
+    /// assert!((v.dc_squared() - 0.64).abs() < 1e-15);
+    /// assert!((v.mean_squared() - (0.64 + 0.125)).abs() < 1e-15);
+    /// ```
+    pub fn dc_squared(&self) -> f64 {
+        self.effective_dc().powi(2)
+    }
+
+    /// The time mean of `V(t)²`: `(V_dc − φ)² + V_ac²/2` (V²).
+    pub fn mean_squared(&self) -> f64 {
+        let v0 = self.effective_dc();
+        v0 * v0 + 0.5 * self.ac_amplitude * self.ac_amplitude
+    }
+
     /// Whether the voltage changes in time.
     pub fn is_time_dependent(&self) -> bool {
         self.ac_amplitude != 0.0 && self.frequency != 0.0
@@ -96,13 +116,14 @@ impl Friction {
     }
 }
 
-/// One degree-of-freedom slider with a heater-driven bulge (MODEL.md section 2).
+/// The slider with a heater-driven bulge (MODEL.md section 2) on its [`Structure`]: one rigid
+/// mass by default, or a body with a bulge or pitch of its own.
 ///
 /// ```no_run
-/// use hdi_tribology::{model::SliderModel, scene::Scene};
+/// use hdi_tribology::{model::{Dofs, SliderModel}, scene::Scene};
 /// let model = SliderModel::from_scene(&Scene::paper())?;
 /// // Interface force at the flying position with the heater at 60 mW, no voltage:
-/// let g = model.gaps(0.0, model.protrusion(0.06));
+/// let g = model.gaps(&Dofs::zeros(), model.protrusion(0.06));
 /// println!("{} N", model.interface_force(g, 0.0).value);
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
@@ -110,8 +131,8 @@ impl Friction {
 pub struct SliderModel {
     forces: Arc<InterfaceForces>,
     bearing: Arc<dyn AirBearing>,
-    /// Lumped mass `m` (kg).
-    pub mass: f64,
+    /// Masses, springs and dampers, and where the bulge sits.
+    pub structure: Structure,
     /// Nominal clearance `h0` (m).
     pub nominal_clearance: f64,
     /// Heater efficiency `η` (m/W).
@@ -160,7 +181,7 @@ impl SliderModel {
         Ok(SliderModel {
             forces: Arc::new(forces),
             bearing,
-            mass: scene.slider.mass_kg,
+            structure: Structure::from_spec(&scene.structure, scene.slider.mass_kg)?,
             nominal_clearance: scene.nominal_clearance_m,
             efficiency: scene.heater.efficiency_m_per_w,
             thermal_lag: scene.heater.thermal_lag_s,
@@ -187,6 +208,23 @@ impl SliderModel {
         }
     }
 
+    /// The same model on another structure (tables are shared, not rebuilt): a map over the
+    /// bulge's frequency or damping is a loop over this.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{model::{SliderModel, Structure}, scene::Scene};
+    /// let rigid = SliderModel::from_scene(&Scene::paper())?;
+    /// let bulge = rigid.with_structure(Structure::bulge(1e-6, 1e-13, 4e5, 0.05)?);
+    /// assert_eq!(bulge.structure.dofs(), 2);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn with_structure(&self, structure: Structure) -> Self {
+        SliderModel {
+            structure,
+            ..self.clone()
+        }
+    }
+
     /// The tabulated interface forces.
     pub fn forces(&self) -> &InterfaceForces {
         &self.forces
@@ -207,11 +245,13 @@ impl SliderModel {
         delta / self.efficiency
     }
 
-    /// Gaps at displacement `y` and protrusion `delta`: bulge `h0 + y − δ`, pad `h0 + y`.
-    pub fn gaps(&self, y: f64, delta: f64) -> Gaps {
+    /// The one home of the gap geometry: at coordinates `q` and protrusion `delta` the bulge gap
+    /// is `h0 + bᵀq − δ` and the pad gap `h0 + q₀` (for the rigid slider: `h0 + y − δ`, `h0 + y`).
+    #[inline]
+    pub fn gaps(&self, q: &Dofs, delta: f64) -> Gaps {
         Gaps {
-            bulge: self.nominal_clearance + y - delta,
-            pad: self.nominal_clearance + y,
+            bulge: self.nominal_clearance + self.structure.bulge_displacement(q) - delta,
+            pad: self.nominal_clearance + q[0],
         }
     }
 
@@ -281,71 +321,109 @@ impl SliderModel {
         self.friction.flash_temperature(fc, area)
     }
 
-    /// Air-bearing displacement `y` that balances the interface force at bulge gap `d` (the pad
-    /// gap follows `y`), for `V² = volt2`. Returns `y` and the interface force there.
+    /// The static balance with the bulge gap held at `d` (the protrusion then follows from
+    /// `d = h0 + bᵀq − δ`), for `V² = volt2`: the coordinates `q` where the structure, the air
+    /// bearing and the interface force balance, `K q = e₀ F_ab(q₀) + b F_if(d, h0 + q₀)`, and the
+    /// interface force there. `exact` polishes the tabulated solution with direct (untabulated)
+    /// forces.
     ///
-    /// Solved by a safeguarded Newton iteration on `F_ab(y, 0) + F_if(d, h0 + y) = 0`; with no pad
-    /// terms and a linear bearing it converges in one step.
-    pub fn bearing_balance(&self, d: f64, volt2: f64) -> Result<(f64, ForceEval)> {
+    /// Solved by a safeguarded Newton iteration; with no pad terms and a linear bearing it
+    /// converges in one step.
+    pub fn balance(&self, d: f64, volt2: f64, exact: bool) -> Result<(Dofs, ForceEval)> {
         let h0 = self.nominal_clearance;
-        let eval = |y: f64| {
-            let g = Gaps {
-                bulge: d,
-                pad: h0 + y,
-            };
-            let f = self.interface_force(g, volt2);
-            let r = self.bearing.force(y, 0.0) + f.value;
-            let dr = -self.bearing.stiffness(y) + f.d_pad;
-            (r, dr, f)
+        let st = &self.structure;
+        let at = |q0: f64| Gaps {
+            bulge: d,
+            pad: h0 + q0,
+        };
+        let residual = |q: &Dofs, f: &ForceEval| {
+            let r = st.generalised_force(q, &Dofs::zeros(), self.bearing.force(q[0], 0.0), f.value);
+            let j = st.tangent(self.bearing.stiffness(q[0]), 0.0, f.d_pad);
+            (r, j)
         };
         // Start from the linearised bearing.
-        let k0 = self.bearing.stiffness(0.0);
-        let f0 = self.interface_force(Gaps { bulge: d, pad: h0 }, volt2);
-        let mut y = f0.value / k0;
+        let f0 = self.interface_force(at(0.0), volt2);
+        let j0 = st.tangent(self.bearing.stiffness(0.0), 0.0, 0.0);
+        let mut q = st
+            .solve(&j0, &(st.bulge_vector() * f0.value))
+            .unwrap_or_default();
         // Keep the pad gap positive: the power-law bearing is singular at g = 0.
         let y_floor = -h0 * (1.0 - 1e-9);
-        if y <= y_floor {
-            y = 0.5 * y_floor;
+        if q[0] <= y_floor {
+            q[0] = 0.5 * y_floor;
         }
+        let mut found = None;
         for _ in 0..200 {
-            let (r, dr, f) = eval(y);
-            if !r.is_finite() || !dr.is_finite() {
+            let f = self.interface_force(at(q[0]), volt2);
+            let (r, j) = residual(&q, &f);
+            if !r.iter().all(|x| x.is_finite()) || !j.iter().all(|x| x.is_finite()) {
                 // Say which term failed rather than that no balance exists.
-                let g = Gaps {
-                    bulge: d,
-                    pad: h0 + y,
-                };
-                self.interface_force_exact(g, volt2)?;
+                self.interface_force_exact(at(q[0]), volt2)?;
                 return Err(Error::no_convergence(
                     "air-bearing balance",
-                    format!("the forces are not finite at d = {d:e} m, y = {y:e} m"),
+                    format!("the forces are not finite at d = {d:e} m, q = {:e} m", q[0]),
                 ));
             }
-            if dr >= 0.0 {
+            if !st.is_positive(&j) {
                 break;
             }
-            let step = -r / dr;
-            let mut y_new = y + step;
-            if y_new <= y_floor {
-                y_new = 0.5 * (y + y_floor);
+            let Some(step) = st.solve(&j, &r) else { break };
+            let mut q_new = q + step;
+            if q_new[0] <= y_floor {
+                q_new[0] = 0.5 * (q[0] + y_floor);
             }
-            if (y_new - y).abs() <= 1e-15 * h0 + 1e-12 * y.abs() {
-                return Ok((y_new, f));
+            if st.step_converged(&(q_new - q), &q, 1e-15 * h0, 1e-12) {
+                found = Some((q_new, f));
+                break;
             }
-            y = y_new;
+            q = q_new;
         }
-        Err(Error::no_convergence(
-            "air-bearing balance",
-            format!("no displacement balances the interface force at d = {d:e} m, V² = {volt2}"),
-        ))
+        let Some((mut q, mut f)) = found else {
+            return Err(Error::no_convergence(
+                "air-bearing balance",
+                format!(
+                    "no displacement balances the interface force at d = {d:e} m, V² = {volt2}"
+                ),
+            ));
+        };
+        if exact {
+            // Newton on the balance with direct forces, from the tabulated solution.
+            for _ in 0..50 {
+                f = self.interface_force_exact(at(q[0]), volt2)?;
+                let (r, j) = residual(&q, &f);
+                let Some(step) = st.solve(&j, &r) else { break };
+                q += step;
+                if st.step_converged(&step, &q, 1e-16 * h0, 1e-13) {
+                    break;
+                }
+            }
+        }
+        Ok((q, f))
     }
 
-    /// Total vertical stiffness `k_ab(y) − ∂F_if/∂y` at fixed protrusion; positive means stable.
-    pub fn total_stiffness(&self, y: f64, f: &ForceEval) -> f64 {
-        self.bearing.stiffness(y) - f.d_bulge - f.d_pad
+    /// The one home of the total stiffness: the stiffness that the bulge meets at coordinates
+    /// `q` under an interface force `f`, by static condensation of the structure, air bearing
+    /// and interface (`k_ab(y) − ∂F_if/∂y` for the rigid slider); positive means stable.
+    pub fn total_stiffness(&self, q: &Dofs, f: &ForceEval) -> f64 {
+        let j = self
+            .structure
+            .tangent(self.bearing.stiffness(q[0]), f.d_bulge, f.d_pad);
+        self.structure.condensed(&j)
     }
 
-    /// A heater programme from the scene's knots.
+    /// The coordinates that hold the bulge displacement `bᵀq` at `z` (m) with the air bearing
+    /// alone, the load on the bulge that does it (N), and the structure's stiffness condensed
+    /// onto the bulge there (N/m). For the rigid slider: `y = z`, `−F_ab(z)`, `k_ab(z)`.
+    pub fn bulge_load(&self, z: f64) -> Result<(Dofs, f64, f64)> {
+        self.structure.displaced_bulge(
+            z,
+            |y| (self.bearing.force(y, 0.0), self.bearing.stiffness(y)),
+            self.nominal_clearance,
+        )
+    }
+
+    /// A heater programme from the scene's knots (the analyses' translation of a scene is
+    /// `analysis::Protocol::from_scene`, or `analysis::HeaterProgramme::fixed_from_scene`).
     pub fn programme_from_knots(knots: &[[f64; 2]]) -> Result<Programme> {
         Programme::new(knots.iter().map(|k| (k[0], k[1])).collect())
     }

@@ -1,23 +1,28 @@
 //! The slider as an ODE: state layout, right-hand side and analytic Jacobian.
 
-use super::SliderModel;
+use super::{Dofs, SliderModel};
 use crate::force::Gaps;
 use crate::heater::Programme;
 use crate::ode::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 
-/// Where each quantity sits in the state vector. Only what the scene needs is there: the
-/// protrusion only with a thermal lag, the lagged force only with an interface lag, and the two
-/// running integrals only when a cycle needs them.
+/// Where each quantity sits in the state vector. Only what the scene needs is there: one position
+/// and one velocity per degree of freedom of the structure, the protrusion only with a thermal
+/// lag, the lagged force only with an interface lag, and the two running integrals only when a
+/// cycle needs them.
 ///
 /// ```
 /// use hdi_tribology::model::StateLayout;
-/// let l = StateLayout::new(false, true, true);
+/// let l = StateLayout::new(1, false, true, true);
 /// assert_eq!(l.len(), 5);
 /// assert_eq!((l.delta, l.lagged_force, l.contact_impulse, l.heat), (None, Some(2), Some(3), Some(4)));
+/// let two = StateLayout::new(2, false, false, true);
+/// assert_eq!((two.velocity(0), two.velocity(1), two.contact_impulse), (2, 3, Some(4)));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StateLayout {
+    /// Number of mechanical degrees of freedom `n`: positions at `0..n`, velocities at `n..2n`.
+    pub dofs: usize,
     /// Protrusion `δ` (m), with a thermal lag.
     pub delta: Option<usize>,
     /// Lagged interface force `F_eff` (N), with an interface lag.
@@ -30,9 +35,9 @@ pub struct StateLayout {
 }
 
 impl StateLayout {
-    /// Displacement `y` and velocity `v` first (indices 0 and 1), then the optional states.
-    pub fn new(thermal_lag: bool, interface_lag: bool, integrals: bool) -> Self {
-        let mut len = 2;
+    /// Positions and velocities of `dofs` coordinates first, then the optional states.
+    pub fn new(dofs: usize, thermal_lag: bool, interface_lag: bool, integrals: bool) -> Self {
+        let mut len = 2 * dofs;
         let mut next = |on: bool| {
             on.then(|| {
                 len += 1;
@@ -44,6 +49,7 @@ impl StateLayout {
         let contact_impulse = next(integrals);
         let heat = next(integrals);
         StateLayout {
+            dofs,
             delta,
             lagged_force,
             contact_impulse,
@@ -52,15 +58,32 @@ impl StateLayout {
         }
     }
 
+    /// Index of the velocity of coordinate `i`.
+    pub fn velocity(&self, i: usize) -> usize {
+        self.dofs + i
+    }
+
     /// Number of states.
     pub fn len(&self) -> usize {
         self.len
     }
 
-    /// Always false: `y` and `v` are always there.
+    /// Always false: positions and velocities are always there.
     pub fn is_empty(&self) -> bool {
         false
     }
+}
+
+/// A state of rest: coordinates, protrusion and the interface force there (the static equilibria
+/// of `analysis` give one).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rest {
+    /// Coordinates `q`.
+    pub q: Dofs,
+    /// Protrusion `δ` (m).
+    pub protrusion: f64,
+    /// Interface force (N).
+    pub interface_force: f64,
 }
 
 /// [`SliderModel`] under a heater programme, as an [`OdeSystem`].
@@ -69,7 +92,7 @@ impl StateLayout {
 /// use hdi_tribology::{heater::Programme, model::{SliderModel, SliderSystem}, scene::Scene};
 /// let model = SliderModel::from_scene(&Scene::paper())?;
 /// let sys = SliderSystem::new(&model, Programme::constant(0.06, 1e-3)?, false);
-/// assert_eq!(sys.layout().len(), 2);
+/// assert_eq!(sys.layout().len(), 2 * model.structure.dofs());
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 #[derive(Clone, Debug)]
@@ -93,6 +116,7 @@ impl<'a> SliderSystem<'a> {
     /// The slider under `programme`; `integrals` adds the contact impulse and heat states.
     pub fn new(model: &'a SliderModel, programme: Programme, integrals: bool) -> Self {
         let layout = StateLayout::new(
+            model.structure.dofs(),
             model.thermal_lag > 0.0,
             model.interface_lag > 0.0,
             integrals,
@@ -119,21 +143,54 @@ impl<'a> SliderSystem<'a> {
         self.model
     }
 
-    /// Writes the initial state for rest at displacement `y` with protrusion `delta` and interface
-    /// force `f_if` into a vector of the layout's length (other entries zero).
-    pub fn initial_state<D: Dim>(&self, dim: D, y: f64, delta: f64, f_if: f64) -> OVector<f64, D>
+    /// The one home of "start at rest": the state at `rest` with zero velocities, in a vector of
+    /// the layout's length (the integrals start at zero).
+    pub fn initial_state<D: Dim>(&self, dim: D, rest: &Rest) -> OVector<f64, D>
     where
         DefaultAllocator: Allocator<D>,
     {
         let mut s = OVector::<f64, D>::zeros_generic(dim, nalgebra::Const::<1>);
-        s[0] = y;
+        for i in 0..self.layout.dofs {
+            s[i] = rest.q[i];
+        }
         if let Some(i) = self.layout.delta {
-            s[i] = delta;
+            s[i] = rest.protrusion;
         }
         if let Some(i) = self.layout.lagged_force {
-            s[i] = f_if;
+            s[i] = rest.interface_force;
         }
         s
+    }
+
+    /// The coordinates `q` of state `s`.
+    #[inline]
+    pub fn coordinates<D: Dim>(&self, s: &OVector<f64, D>) -> Dofs
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        self.block(s, 0)
+    }
+
+    /// The velocities `q̇` of state `s`.
+    #[inline]
+    pub fn velocities<D: Dim>(&self, s: &OVector<f64, D>) -> Dofs
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        self.block(s, self.layout.velocity(0))
+    }
+
+    /// `dofs` entries of `s` from `start`, as coordinates.
+    #[inline]
+    fn block<D: Dim>(&self, s: &OVector<f64, D>, start: usize) -> Dofs
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let mut q = super::structure::zero_dofs();
+        for i in 0..self.layout.dofs {
+            q[i] = s[start + i];
+        }
+        q
     }
 
     /// Protrusion at time `t` and state `s`.
@@ -152,7 +209,15 @@ impl<'a> SliderSystem<'a> {
     where
         DefaultAllocator: Allocator<D>,
     {
-        self.model.gaps(s[0], self.protrusion(t, s))
+        self.model.gaps(&self.coordinates(s), self.protrusion(t, s))
+    }
+
+    /// The air-bearing force at state `s` (N).
+    pub fn bearing_force<D: Dim>(&self, s: &OVector<f64, D>) -> f64
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        self.model.bearing().force(s[0], s[self.layout.velocity(0)])
     }
 
     fn local<D: Dim>(&self, t: f64, s: &OVector<f64, D>) -> Local
@@ -160,7 +225,7 @@ impl<'a> SliderSystem<'a> {
         DefaultAllocator: Allocator<D>,
     {
         let delta = self.protrusion(t, s);
-        let g = self.model.gaps(s[0], delta);
+        let g = self.model.gaps(&self.coordinates(s), delta);
         let volt2 = self.model.voltage.squared(t);
         let (f, hot) = self.model.hot_forces(g, volt2);
         Local { g, delta, f, hot }
@@ -189,23 +254,30 @@ where
 {
     fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
         let m = self.model;
+        let st = &m.structure;
+        let lay = self.layout;
         let l = self.local(t, s);
-        let drive = match self.layout.lagged_force {
+        let drive = match lay.lagged_force {
             Some(i) => s[i],
             None => l.f.value,
         };
-        ds[0] = s[1];
-        ds[1] = (m.bearing().force(s[0], s[1]) + drive) / m.mass;
-        if let Some(i) = self.layout.delta {
+        let (q, v) = (self.coordinates(s), self.velocities(s));
+        let f_ab = m.bearing().force(q[0], v[0]);
+        let a = st.mass_solve(&st.generalised_force(&q, &v, f_ab, drive));
+        for i in 0..lay.dofs {
+            ds[i] = v[i];
+            ds[lay.velocity(i)] = a[i];
+        }
+        if let Some(i) = lay.delta {
             ds[i] = (m.protrusion(self.programme.power(t)) - l.delta) / m.thermal_lag;
         }
-        if let Some(i) = self.layout.lagged_force {
+        if let Some(i) = lay.lagged_force {
             ds[i] = (l.f.value - s[i]) / m.interface_lag;
         }
-        if let Some(i) = self.layout.contact_impulse {
+        if let Some(i) = lay.contact_impulse {
             ds[i] = l.hot.contact.value;
         }
-        if let Some(i) = self.layout.heat {
+        if let Some(i) = lay.heat {
             let area = m.forces().real_contact_area(l.g);
             ds[i] = m.friction.flash_temperature(l.hot.contact.value, area);
         }
@@ -213,44 +285,86 @@ where
 
     fn jacobian(&self, t: f64, s: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
         let m = self.model;
+        let st = &m.structure;
+        let lay = self.layout;
+        let n = lay.dofs;
         let l = self.local(t, s);
         j.fill(0.0);
-        // ∂F_if/∂y moves both gaps; ∂F_if/∂δ only the bulge gap.
-        let f_y = l.f.d_bulge + l.f.d_pad;
+        let b = st.bulge_vector();
+        // ∂F/∂q_c = f_b b_c + f_p [c = 0]: the bulge gap moves with bᵀq, the pad gap with q₀.
+        let along = |e: &crate::force::ForceEval, c: usize| {
+            let pad = if c == 0 { e.d_pad } else { 0.0 };
+            e.d_bulge * b[c] + pad
+        };
+        let y0 = s[0];
+        let k = st.tangent(m.bearing().stiffness(y0), 0.0, 0.0);
+        let c = st.damping_with(m.bearing().damping(y0));
+        for col in 0..n {
+            j[(col, lay.velocity(col))] = 1.0;
+            // Columns of −M⁻¹(K + e₀e₀ᵀk_ab) and −M⁻¹(C + e₀e₀ᵀc_ab).
+            let (mut fk, mut fc) = (Dofs::zeros(), Dofs::zeros());
+            for r in 0..n {
+                fk[r] = -k[(r, col)];
+                fc[r] = -c[(r, col)];
+            }
+            let (ak, ac) = (st.mass_solve(&fk), st.mass_solve(&fc));
+            for r in 0..n {
+                j[(lay.velocity(r), col)] = ak[r];
+                j[(lay.velocity(r), lay.velocity(col))] = ac[r];
+            }
+        }
+        // The interface force enters through b, lagged or not.
+        let per_force = st.mass_solve(&b);
         let f_delta = -l.f.d_bulge;
-        j[(0, 1)] = 1.0;
-        j[(1, 0)] = -m.bearing().stiffness(s[0]) / m.mass;
-        j[(1, 1)] = -m.bearing().damping(s[0]) / m.mass;
-        match self.layout.lagged_force {
+        match lay.lagged_force {
             Some(i) => {
-                j[(1, i)] = 1.0 / m.mass;
-                j[(i, 0)] = f_y / m.interface_lag;
+                for r in 0..n {
+                    j[(lay.velocity(r), i)] = per_force[r];
+                }
+                for col in 0..n {
+                    j[(i, col)] = along(&l.f, col) / m.interface_lag;
+                }
                 j[(i, i)] = -1.0 / m.interface_lag;
-                if let Some(k) = self.layout.delta {
+                if let Some(k) = lay.delta {
                     j[(i, k)] = f_delta / m.interface_lag;
                 }
             }
             None => {
-                j[(1, 0)] += f_y / m.mass;
-                if let Some(k) = self.layout.delta {
-                    j[(1, k)] = f_delta / m.mass;
+                for col in 0..n {
+                    let mut g = Dofs::zeros();
+                    for r in 0..n {
+                        g[r] = b[r] * along(&l.f, col);
+                    }
+                    let a = st.mass_solve(&g);
+                    for r in 0..n {
+                        j[(lay.velocity(r), col)] += a[r];
+                    }
+                }
+                if let Some(k) = lay.delta {
+                    let a = st.mass_solve(&(b * f_delta));
+                    for r in 0..n {
+                        j[(lay.velocity(r), k)] = a[r];
+                    }
                 }
             }
         }
-        if let Some(k) = self.layout.delta {
+        if let Some(k) = lay.delta {
             j[(k, k)] = -1.0 / m.thermal_lag;
         }
-        if let Some(i) = self.layout.contact_impulse {
-            let c = l.hot.contact;
-            j[(i, 0)] = c.d_bulge + c.d_pad;
-            if let Some(k) = self.layout.delta {
-                j[(i, k)] = -c.d_bulge;
+        if let Some(i) = lay.contact_impulse {
+            for col in 0..n {
+                j[(i, col)] = along(&l.hot.contact, col);
+            }
+            if let Some(k) = lay.delta {
+                j[(i, k)] = -l.hot.contact.d_bulge;
             }
         }
-        if let Some(i) = self.layout.heat {
+        if let Some(i) = lay.heat {
             let (_, dd) = self.heat_rate(l.g);
-            j[(i, 0)] = dd;
-            if let Some(k) = self.layout.delta {
+            for col in 0..n {
+                j[(i, col)] = dd * b[col];
+            }
+            if let Some(k) = lay.delta {
                 j[(i, k)] = -dd;
             }
         }
@@ -270,7 +384,13 @@ where
         let f_t = -l.f.d_bulge * delta_rate + m.voltage.squared_rate(t) * l.hot.per_volt2.value;
         match self.layout.lagged_force {
             Some(i) => dfdt[i] = f_t / m.interface_lag,
-            None => dfdt[1] = f_t / m.mass,
+            None => {
+                let st = &m.structure;
+                let a = st.mass_solve(&(st.bulge_vector() * f_t));
+                for r in 0..self.layout.dofs {
+                    dfdt[self.layout.velocity(r)] = a[r];
+                }
+            }
         }
         if let Some(k) = self.layout.delta {
             dfdt[k] = m.protrusion(p_rate) / m.thermal_lag;
@@ -283,5 +403,96 @@ where
             dfdt[i] = -dd * delta_rate;
         }
         true
+    }
+}
+
+/// The one home of the ODE scales: how fast the slider can move, and what absolute accuracy each
+/// state needs for a given accuracy of the displacement.
+impl SliderModel {
+    /// Angular frequency scale of each coordinate (rad/s): `√(J_ii/M_ii)` with the structure's
+    /// stiffness plus the bearing's at rest (`√(k_ab/m)` for the rigid slider).
+    pub fn angular_frequencies(&self) -> Dofs {
+        let st = &self.structure;
+        let j = st.tangent(self.bearing().stiffness(0.0), 0.0, 0.0);
+        let m = st.mass_matrix();
+        let mut w = Dofs::zeros();
+        for i in 0..st.dofs() {
+            w[i] = (j[(i, i)] / m[(i, i)]).sqrt();
+        }
+        w
+    }
+
+    /// A bound on the fastest rate of the slider (1/s): the structure's and bearing's modes,
+    /// their damping rates and the inverse lags (the contact stiffness only raises the first, see
+    /// `docs/validity.md`).
+    pub fn fastest_rate(&self) -> f64 {
+        let st = &self.structure;
+        let c = st.damping_with(self.bearing().damping(0.0));
+        let m = st.mass_matrix();
+        let w = self.angular_frequencies();
+        let mut r = 0.0f64;
+        for i in 0..st.dofs() {
+            r = r.max(w[i]).max(c[(i, i)] / m[(i, i)]);
+        }
+        for tau in [self.interface_lag, self.thermal_lag] {
+            if tau > 0.0 {
+                r = r.max(1.0 / tau);
+            }
+        }
+        r
+    }
+
+    /// The largest step (s): `given`, else a fortieth of the voltage period with AC (no peak of
+    /// `V²` is stepped over), else unlimited.
+    pub fn max_step(&self, given: Option<f64>) -> f64 {
+        let v = self.voltage;
+        given.unwrap_or(if v.is_time_dependent() {
+            1.0 / (40.0 * v.frequency.abs())
+        } else {
+            f64::INFINITY
+        })
+    }
+}
+
+impl SliderSystem<'_> {
+    /// Absolute tolerances of every state for the displacement tolerance `displacement` (m):
+    /// positions to `displacement` (rotations to it over their lever), velocities times their
+    /// angular frequency, the protrusion to `displacement`, the lagged force times the stiffness
+    /// at the bulge, and the integrals to `impulse` (N s) and `heat` (K s).
+    ///
+    /// ```
+    /// use hdi_tribology::{heater::Programme, model::{SliderModel, SliderSystem}, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let sys = SliderSystem::new(&model, Programme::constant(0.06, 1e-3)?, true);
+    /// let atol = sys.tolerances(1e-14, 1e-12, 1e-10);
+    /// assert_eq!(atol.len(), 4);
+    /// assert!((atol[1] / 1e-14 - (3e5f64 / 1e-6).sqrt()).abs() < 1e-6);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn tolerances(&self, displacement: f64, impulse: f64, heat: f64) -> Vec<f64> {
+        let m = self.model;
+        let st = &m.structure;
+        let lay = self.layout;
+        let w = m.angular_frequencies();
+        let mut atol = vec![0.0; lay.len()];
+        for i in 0..lay.dofs {
+            let a = displacement / st.length_scale(i);
+            atol[i] = a;
+            atol[lay.velocity(i)] = a * w[i];
+        }
+        if let Some(i) = lay.delta {
+            atol[i] = displacement;
+        }
+        if let Some(i) = lay.lagged_force {
+            let j = st.tangent(m.bearing().stiffness(0.0), 0.0, 0.0);
+            atol[i] = displacement * st.condensed(&j).abs();
+        }
+        if let Some(i) = lay.contact_impulse {
+            atol[i] = impulse;
+        }
+        if let Some(i) = lay.heat {
+            atol[i] = heat;
+        }
+        atol
     }
 }

@@ -63,6 +63,7 @@ mod eng_units;
 mod io;
 mod paper;
 mod spec;
+mod structure;
 mod toml_text;
 mod validate;
 
@@ -72,3 +73,4 @@ pub use spec::{
     ContactSpec, DetectorSpec, ElectrostaticSpec, FrictionSpec, HeaterSpec, IntermolecularSpec,
     Scene, SliderSpec, SolverSpec, SurfaceSpec, SweepSpec, TableSpec, TriggeredSpec, VoltageSpec,
 };
+pub use structure::{StructureSpec, MAX_DOF};

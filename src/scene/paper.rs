@@ -1,6 +1,7 @@
 //! The built-in paper scene (the crate's single home of the physics defaults).
 
 use super::spec::*;
+use super::structure::StructureSpec;
 use crate::force::{AirBearingModel, Footprint, GapReference};
 use crate::surface::PeakModel;
 
@@ -62,6 +63,7 @@ impl Scene {
                 mass_kg: mass,
                 interface_lag_s: 0.0,
             },
+            structure: StructureSpec::Rigid,
             heater: HeaterSpec {
                 efficiency_m_per_w: 1.0e-7,
                 thermal_lag_s: 0.0,

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::structure::StructureSpec;
 use crate::force::{AirBearingModel, Footprint, GapReference};
 use crate::surface::PeakModel;
 
@@ -28,6 +29,9 @@ pub struct Scene {
     pub air_bearing: AirBearingModel,
     /// Slider (lumped mass).
     pub slider: SliderSpec,
+    /// Structure: rigid (default), bulge, pitch or general (see [`StructureSpec`]).
+    #[serde(default, skip_serializing_if = "StructureSpec::is_rigid")]
+    pub structure: StructureSpec,
     /// Heater and its programmes.
     pub heater: HeaterSpec,
     /// Applied voltage.

@@ -100,6 +100,7 @@ impl Scene {
         self.air_bearing.build()?;
         check_positive("slider.mass_kg", self.slider.mass_kg)?;
         check_non_negative("slider.interface_lag_s", self.slider.interface_lag_s)?;
+        self.validate_structure()?;
         self.validate_heater()?;
         let v = &self.voltage;
         check_magnitude("voltage.dc_v", v.dc_v, MAX_VOLTAGE_V, "V")?;
@@ -304,6 +305,41 @@ impl Scene {
                         ),
                     ));
                 }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// The structure's own fields, and that pad-gap terms (which act on the body) are only used
+    /// with the rigid structure, where body and bulge are one.
+    fn validate_structure(&self) -> Result<()> {
+        self.structure.validate()?;
+        if self.structure.is_rigid() {
+            return Ok(());
+        }
+        let pad = [
+            (
+                "intermolecular.gap",
+                self.intermolecular.as_ref().map(|t| t.gap),
+            ),
+            (
+                "electrostatic.gap",
+                self.electrostatic.as_ref().map(|t| t.gap),
+            ),
+            ("contact.gap", self.contact.as_ref().map(|t| t.gap)),
+        ];
+        for (field, gap) in pad {
+            if gap == Some(crate::force::GapReference::Pad) {
+                return Err(Error::invalid(
+                    field,
+                    format!(
+                        "\"pad\" needs the rigid structure: with structure.preset = \"{}\" the \
+                         interface forces act on the bulge only",
+                        self.structure.preset()
+                    ),
+                ));
             }
         }
         Ok(())

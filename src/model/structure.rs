@@ -1,0 +1,560 @@
+//! The slider's structure: lumped masses, springs and dampers, and where the bulge sits on them.
+//!
+//! The equation of motion is `M q̈ + C q̇ + K q = e₀ F_ab(q₀, q̇₀) + b F_if`: degree of freedom 0
+//! is the heave of the slider body, where the air-bearing law acts; the interface force acts on
+//! the bulge, whose displacement is `bᵀq`. Everything is stored in fixed-size matrices of
+//! [`MAX_DOF`] rows; only the first [`Structure::dofs`] are used, and the state of an ODE holds
+//! only those.
+
+use nalgebra::{DMatrix, SMatrix, SVector};
+
+use crate::error::{check_finite, check_non_negative, check_positive};
+use crate::scene::{StructureSpec, MAX_DOF};
+use crate::{Error, Result};
+
+/// Generalised coordinates `q` (m for translations, rad for rotations); entries beyond
+/// [`Structure::dofs`] are zero.
+pub type Dofs = SVector<f64, MAX_DOF>;
+
+/// All coordinates zero (callable where generic allocator bounds hide `Dofs::zeros`).
+pub(crate) fn zero_dofs() -> Dofs {
+    Dofs::zeros()
+}
+
+/// A matrix over the generalised coordinates.
+pub(crate) type DofMatrix = SMatrix<f64, MAX_DOF, MAX_DOF>;
+
+/// The bordered system of [`Structure::displaced_bulge`]: coordinates plus the load.
+type Bordered = SMatrix<f64, { MAX_DOF + 1 }, { MAX_DOF + 1 }>;
+
+/// A linear structure on the air bearing: `M q̈ + C q̇ + K q = e₀ F_ab(q₀, q̇₀) + b F_if`, with
+/// coordinate 0 the body heave (where the air-bearing law acts) and the bulge at `bᵀq`.
+///
+/// ```
+/// use hdi_tribology::model::Structure;
+/// let s = Structure::bulge(1e-6, 1e-13, 4e5, 0.05)?;
+/// assert_eq!(s.dofs(), 2);
+/// // A bulge far lighter than the body rings at √(k_b/m_b)/2π:
+/// let f = s.natural_frequencies(3e5);
+/// let exact = (4e5f64 / 1e-13).sqrt() / (2.0 * std::f64::consts::PI);
+/// assert!((f[1] - exact).abs() < 1e-6 * exact);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Structure {
+    n: usize,
+    mass: DofMatrix,
+    mass_inverse: DofMatrix,
+    diagonal_mass: bool,
+    damping: DofMatrix,
+    stiffness: DofMatrix,
+    bulge: Dofs,
+    /// Length per unit of each coordinate (1 for translations, the lever for rotations): makes
+    /// the convergence tests of the static solvers dimensionally consistent.
+    length_scale: Dofs,
+}
+
+impl Structure {
+    /// One rigid mass (kg): today's slider.
+    ///
+    /// ```
+    /// let s = hdi_tribology::model::Structure::rigid(1e-6)?;
+    /// assert_eq!((s.dofs(), s.bulge_influence()), (1, &[1.0][..]));
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn rigid(mass: f64) -> Result<Self> {
+        check_positive("slider.mass_kg", mass)?;
+        Self::build(1, &[[mass]], &[[0.0]], &[[0.0]], &[1.0], "structure")
+    }
+
+    /// Body of mass `body_mass` (kg) on the air bearing, and the bulge of mass `bulge_mass` (kg)
+    /// on a spring `stiffness` (N/m) and damper of damping ratio `damping_ratio` to the body.
+    /// Coordinates: body heave, bulge displacement (both absolute).
+    pub fn bulge(
+        body_mass: f64,
+        bulge_mass: f64,
+        stiffness: f64,
+        damping_ratio: f64,
+    ) -> Result<Self> {
+        check_positive("slider.mass_kg", body_mass)?;
+        check_positive("structure.mass_kg", bulge_mass)?;
+        check_positive("structure.stiffness_n_per_m", stiffness)?;
+        check_non_negative("structure.damping_ratio", damping_ratio)?;
+        let (k, c) = (
+            stiffness,
+            2.0 * damping_ratio * (stiffness * bulge_mass).sqrt(),
+        );
+        Self::build(
+            2,
+            &[[body_mass, 0.0], [0.0, bulge_mass]],
+            &[[c, -c], [-c, c]],
+            &[[k, -k], [-k, k]],
+            &[0.0, 1.0],
+            "structure",
+        )
+    }
+
+    /// Body heave (mass `body_mass`, kg) and pitch (inertia `inertia`, kg m²) with the air
+    /// bearing's pitch stiffness `k_pitch` (N m/rad), heave–pitch coupling `k_coupling` (N/rad),
+    /// pitch damping `c_pitch` (N m s/rad) and coupling damping `c_coupling` (N s/rad); the bulge
+    /// sits at `trailing_edge` (m) from the pivot: `z = y + L θ`.
+    pub fn pitch(
+        body_mass: f64,
+        inertia: f64,
+        [k_pitch, k_coupling]: [f64; 2],
+        [c_pitch, c_coupling]: [f64; 2],
+        trailing_edge: f64,
+    ) -> Result<Self> {
+        check_positive("slider.mass_kg", body_mass)?;
+        check_positive("structure.inertia_kg_m2", inertia)?;
+        check_finite("structure.trailing_edge_m", trailing_edge)?;
+        let mut s = Self::build(
+            2,
+            &[[body_mass, 0.0], [0.0, inertia]],
+            &[[0.0, c_coupling], [c_coupling, c_pitch]],
+            &[[0.0, k_coupling], [k_coupling, k_pitch]],
+            &[1.0, trailing_edge],
+            "structure",
+        )?;
+        if trailing_edge != 0.0 {
+            s.length_scale[1] = trailing_edge.abs();
+        }
+        Ok(s)
+    }
+
+    /// Any structure of 1 to [`MAX_DOF`] coordinates: `M`, `C`, `K` (rows) and the bulge
+    /// influence vector `b`. `M` must be symmetric positive definite, `C` and `K`
+    /// symmetric (the air bearing's heave law is added on coordinate 0).
+    ///
+    /// ```
+    /// use hdi_tribology::model::Structure;
+    /// let m = vec![vec![1e-6, 0.0], vec![0.0, 1e-13]];
+    /// let k = vec![vec![4e5, -4e5], vec![-4e5, 4e5]];
+    /// let c = vec![vec![0.0; 2]; 2];
+    /// assert!(Structure::general(&m, &c, &k, &[0.0, 1.0]).is_ok());
+    /// let bad = vec![vec![1e-6, 0.0], vec![0.0, -1e-13]];
+    /// let e = Structure::general(&bad, &c, &k, &[0.0, 1.0]).unwrap_err().to_string();
+    /// assert!(e.contains("structure.mass"), "{e}");
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn general(
+        mass: &[Vec<f64>],
+        damping: &[Vec<f64>],
+        stiffness: &[Vec<f64>],
+        bulge_influence: &[f64],
+    ) -> Result<Self> {
+        StructureSpec::General {
+            mass: mass.to_vec(),
+            damping: damping.to_vec(),
+            stiffness: stiffness.to_vec(),
+            bulge_influence: bulge_influence.to_vec(),
+        }
+        .validate()?;
+        let n = bulge_influence.len();
+        let rows = |m: &[Vec<f64>]| {
+            let mut a = [[0.0; MAX_DOF]; MAX_DOF];
+            for (i, row) in m.iter().enumerate() {
+                a[i][..n].copy_from_slice(row);
+            }
+            a
+        };
+        let mut b = [0.0; MAX_DOF];
+        b[..n].copy_from_slice(bulge_influence);
+        Self::build(
+            n,
+            &rows(mass),
+            &rows(damping),
+            &rows(stiffness),
+            &b,
+            "structure",
+        )
+    }
+
+    /// The structure a scene describes, with the body mass of `slider.mass_kg`.
+    pub fn from_spec(spec: &StructureSpec, body_mass: f64) -> Result<Self> {
+        spec.validate()?;
+        match spec {
+            StructureSpec::Rigid => Self::rigid(body_mass),
+            &StructureSpec::Bulge {
+                mass_kg,
+                stiffness_n_per_m,
+                damping_ratio,
+            } => Self::bulge(body_mass, mass_kg, stiffness_n_per_m, damping_ratio),
+            &StructureSpec::Pitch {
+                inertia_kg_m2,
+                stiffness_n_m_per_rad,
+                coupling_stiffness_n_per_rad,
+                damping_n_m_s_per_rad,
+                coupling_damping_n_s_per_rad,
+                trailing_edge_m,
+            } => Self::pitch(
+                body_mass,
+                inertia_kg_m2,
+                [stiffness_n_m_per_rad, coupling_stiffness_n_per_rad],
+                [damping_n_m_s_per_rad, coupling_damping_n_s_per_rad],
+                trailing_edge_m,
+            ),
+            StructureSpec::General {
+                mass,
+                damping,
+                stiffness,
+                bulge_influence,
+            } => Self::general(mass, damping, stiffness, bulge_influence),
+        }
+    }
+
+    fn build<const R: usize>(
+        n: usize,
+        mass: &[[f64; R]],
+        damping: &[[f64; R]],
+        stiffness: &[[f64; R]],
+        bulge: &[f64],
+        prefix: &str,
+    ) -> Result<Self> {
+        let fill = |rows: &[[f64; R]]| {
+            let mut m = DofMatrix::zeros();
+            for i in 0..n {
+                for j in 0..n {
+                    m[(i, j)] = rows[i][j];
+                }
+            }
+            m
+        };
+        let (m, c, k) = (fill(mass), fill(damping), fill(stiffness));
+        let mut b = Dofs::zeros();
+        for i in 0..n {
+            b[i] = bulge[i];
+        }
+        for (name, a, definite) in [
+            ("mass", &m, true),
+            ("damping", &c, false),
+            ("stiffness", &k, false),
+        ] {
+            check_matrix(&format!("{prefix}.{name}"), a, n, definite)?;
+        }
+        let mut padded = m;
+        for i in n..MAX_DOF {
+            padded[(i, i)] = 1.0;
+        }
+        let mut mass_inverse = padded
+            .try_inverse()
+            .ok_or_else(|| Error::invalid(format!("{prefix}.mass"), "is singular"))?;
+        for i in n..MAX_DOF {
+            mass_inverse[(i, i)] = 0.0;
+        }
+        let diagonal_mass = (0..n).all(|i| (0..n).all(|j| i == j || m[(i, j)] == 0.0));
+        let mut length_scale = Dofs::zeros();
+        for i in 0..n {
+            length_scale[i] = if i == 0 { 1.0 } else { b[i].abs().max(1.0) };
+        }
+        Ok(Structure {
+            n,
+            mass: m,
+            mass_inverse,
+            diagonal_mass,
+            damping: c,
+            stiffness: k,
+            bulge: b,
+            length_scale,
+        })
+    }
+
+    /// Number of mechanical degrees of freedom.
+    pub fn dofs(&self) -> usize {
+        self.n
+    }
+
+    /// The bulge influence vector `b`.
+    pub fn bulge_influence(&self) -> &[f64] {
+        &self.bulge.as_slice()[..self.n]
+    }
+
+    /// The mass matrix `M` (n × n).
+    pub fn mass_matrix(&self) -> DMatrix<f64> {
+        self.mass.view((0, 0), (self.n, self.n)).into_owned()
+    }
+
+    /// The structural damping matrix `C` (n × n), without the air bearing's heave damping.
+    pub fn damping_matrix(&self) -> DMatrix<f64> {
+        self.damping.view((0, 0), (self.n, self.n)).into_owned()
+    }
+
+    /// The structural stiffness matrix `K` (n × n), without the air bearing's heave stiffness.
+    pub fn stiffness_matrix(&self) -> DMatrix<f64> {
+        self.stiffness.view((0, 0), (self.n, self.n)).into_owned()
+    }
+
+    /// The body mass `M₀₀` (kg).
+    pub fn body_mass(&self) -> f64 {
+        self.mass[(0, 0)]
+    }
+
+    /// The bulge displacement `bᵀq` (m).
+    #[inline]
+    pub fn bulge_displacement(&self, q: &Dofs) -> f64 {
+        self.bulge.dot(q)
+    }
+
+    /// The bulge influence vector `b` as coordinates.
+    pub(crate) fn bulge_vector(&self) -> Dofs {
+        self.bulge
+    }
+
+    /// Whether a tangent `J` is positive (one coordinate) or has a positive determinant.
+    pub(crate) fn is_positive(&self, j: &DofMatrix) -> bool {
+        if self.n == 1 {
+            return j[(0, 0)] > 0.0;
+        }
+        if self.n == 2 {
+            return j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)] > 0.0;
+        }
+        let mut padded = *j;
+        for i in self.n..MAX_DOF {
+            padded[(i, i)] = 1.0;
+        }
+        padded.determinant() > 0.0
+    }
+
+    /// The length per unit of coordinate `i` (1 for translations, the lever for rotations).
+    pub(crate) fn length_scale(&self, i: usize) -> f64 {
+        self.length_scale[i]
+    }
+
+    /// `M⁻¹ f` (a diagonal mass divides, so the one-mass slider is exactly `f/m`).
+    #[inline]
+    pub(crate) fn mass_solve(&self, f: &Dofs) -> Dofs {
+        if self.diagonal_mass {
+            let mut a = Dofs::zeros();
+            for i in 0..self.n {
+                a[i] = f[i] / self.mass[(i, i)];
+            }
+            a
+        } else {
+            self.mass_inverse * f
+        }
+    }
+
+    /// The generalised force `e₀ f_heave + b f_bulge − K q − C v`.
+    #[inline]
+    pub(crate) fn generalised_force(&self, q: &Dofs, v: &Dofs, f_heave: f64, f_bulge: f64) -> Dofs {
+        let mut f = Dofs::zeros();
+        for i in 0..self.n {
+            let mut x = self.bulge[i] * f_bulge;
+            if i == 0 {
+                x += f_heave;
+            }
+            for j in 0..self.n {
+                x -= self.stiffness[(i, j)] * q[j];
+                x -= self.damping[(i, j)] * v[j];
+            }
+            f[i] = x;
+        }
+        f
+    }
+
+    /// Tangent stiffness `K + e₀e₀ᵀ k_heave − b (f_b bᵀ + f_p e₀ᵀ)`, for a heave stiffness
+    /// `k_heave` and an interface force whose derivatives along the bulge and pad gaps are `f_b`
+    /// and `f_p`.
+    pub(crate) fn tangent(&self, k_heave: f64, f_b: f64, f_p: f64) -> DofMatrix {
+        let mut j = self.stiffness;
+        j[(0, 0)] += k_heave;
+        for r in 0..self.n {
+            for c in 0..self.n {
+                let pad = if c == 0 { f_p } else { 0.0 };
+                j[(r, c)] -= self.bulge[r] * (f_b * self.bulge[c] + pad);
+            }
+        }
+        j
+    }
+
+    /// The damping `C + e₀e₀ᵀ c_heave`.
+    pub(crate) fn damping_with(&self, c_heave: f64) -> DofMatrix {
+        let mut c = self.damping;
+        c[(0, 0)] += c_heave;
+        c
+    }
+
+    /// Solves `J x = r` on the used block; `None` when `J` is singular.
+    pub(crate) fn solve(&self, j: &DofMatrix, r: &Dofs) -> Option<Dofs> {
+        if self.n == 1 {
+            let x = r[0] / j[(0, 0)];
+            return x.is_finite().then(|| Dofs::new(x, 0.0, 0.0));
+        }
+        if self.n == 2 {
+            // Cramer's rule: the presets' case, several times cheaper than a padded LU.
+            let det = j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)];
+            let x0 = (r[0] * j[(1, 1)] - j[(0, 1)] * r[1]) / det;
+            let x1 = (j[(0, 0)] * r[1] - r[0] * j[(1, 0)]) / det;
+            return (x0.is_finite() && x1.is_finite()).then(|| {
+                let mut x = Dofs::zeros();
+                x[0] = x0;
+                x[1] = x1;
+                x
+            });
+        }
+        let mut padded = *j;
+        for i in self.n..MAX_DOF {
+            padded[(i, i)] = 1.0;
+        }
+        let x = padded.lu().solve(r)?;
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    }
+
+    /// Static condensation onto the bulge: the stiffness `1/(bᵀ J⁻¹ b)` that a force on the
+    /// bulge meets through the whole structure with tangent `J` (N/m). Zero where `J` is
+    /// singular; for one coordinate `J₀₀/b₀²`.
+    pub(crate) fn condensed(&self, j: &DofMatrix) -> f64 {
+        if self.n == 1 {
+            let b = self.bulge[0];
+            return if b == 1.0 {
+                j[(0, 0)]
+            } else {
+                j[(0, 0)] / (b * b)
+            };
+        }
+        match self.solve(j, &self.bulge) {
+            Some(x) => 1.0 / self.bulge.dot(&x),
+            None => 0.0,
+        }
+    }
+
+    /// Largest change of `q` relative to the coordinates' length scales, for convergence tests.
+    pub(crate) fn step_converged(&self, step: &Dofs, q: &Dofs, abs: f64, rel: f64) -> bool {
+        (0..self.n).all(|i| {
+            let s = self.length_scale[i];
+            (step[i] * s).abs() <= abs + rel * (q[i] * s).abs()
+        })
+    }
+
+    /// The coordinates that put the bulge at `z` (m) in static equilibrium with the heave law
+    /// `heave(q₀) = (F_ab, k_ab)`, and the load on the bulge that holds it there: solves
+    /// `K q − e₀ F_ab(q₀) = b F`, `bᵀq = z` by Newton's method. Returns `(q, F, ∂F/∂z)`; the
+    /// last is the structure's stiffness condensed onto the bulge.
+    pub(crate) fn displaced_bulge(
+        &self,
+        z: f64,
+        heave: impl Fn(f64) -> (f64, f64),
+        scale: f64,
+    ) -> Result<(Dofs, f64, f64)> {
+        if self.n == 1 {
+            let b = self.bulge[0];
+            let q0 = if b == 1.0 { z } else { z / b };
+            let (f_ab, k_ab) = heave(q0);
+            let load = (self.stiffness[(0, 0)] * q0 - f_ab) / b;
+            let k = self.condensed(&self.tangent(k_ab, 0.0, 0.0));
+            return Ok((Dofs::new(q0, 0.0, 0.0), load, k));
+        }
+        let n = self.n;
+        let mut q = Dofs::zeros();
+        let mut load = 0.0;
+        for _ in 0..100 {
+            let (f_ab, k_ab) = heave(q[0]);
+            let j = self.tangent(k_ab, 0.0, 0.0);
+            let mut a = Bordered::identity();
+            let mut r = SVector::<f64, { MAX_DOF + 1 }>::zeros();
+            for i in 0..n {
+                for c in 0..n {
+                    a[(i, c)] = j[(i, c)];
+                }
+                a[(i, n)] = -self.bulge[i];
+                a[(n, i)] = self.bulge[i];
+                let mut x = -self.bulge[i] * load;
+                if i == 0 {
+                    x -= f_ab;
+                }
+                for c in 0..n {
+                    x += self.stiffness[(i, c)] * q[c];
+                }
+                r[i] = -x;
+            }
+            a[(n, n)] = 0.0;
+            r[n] = z - self.bulge_displacement(&q);
+            let Some(dx) = a.lu().solve(&r) else { break };
+            let mut step = Dofs::zeros();
+            for i in 0..n {
+                step[i] = dx[i];
+                q[i] += dx[i];
+            }
+            load += dx[n];
+            if !load.is_finite() || q.iter().any(|x| !x.is_finite()) {
+                break;
+            }
+            if self.step_converged(&step, &q, 1e-16 * scale, 1e-13) {
+                let (_, k_ab) = heave(q[0]);
+                return Ok((q, load, self.condensed(&self.tangent(k_ab, 0.0, 0.0))));
+            }
+        }
+        Err(Error::no_convergence(
+            "structure balance",
+            format!("no static displacement puts the bulge at {z:e} m"),
+        ))
+    }
+
+    /// Undamped natural frequencies (Hz) of the structure with a heave stiffness `k_heave`
+    /// (N/m) on coordinate 0, ascending: `√eig(M⁻¹K)/2π`.
+    ///
+    /// ```
+    /// use hdi_tribology::model::Structure;
+    /// let f = Structure::rigid(1e-6)?.natural_frequencies(3e5);
+    /// assert!((f[0] - (3e5f64 / 1e-6).sqrt() / (2.0 * std::f64::consts::PI)).abs() < 1e-6);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn natural_frequencies(&self, k_heave: f64) -> Vec<f64> {
+        let k = self.tangent(k_heave, 0.0, 0.0);
+        let n = self.n;
+        // Symmetric form L⁻¹ K L⁻ᵀ with M = L Lᵀ.
+        let m = self.mass_matrix();
+        let Some(chol) = m.cholesky() else {
+            return vec![f64::NAN; n];
+        };
+        let kd = k.view((0, 0), (n, n)).into_owned();
+        let l = chol.l();
+        let Some(linv) = l.clone().try_inverse() else {
+            return vec![f64::NAN; n];
+        };
+        let s = &linv * kd * linv.transpose();
+        let s = (&s + s.transpose()) * 0.5;
+        let mut w: Vec<f64> = s
+            .symmetric_eigenvalues()
+            .iter()
+            .map(|&l| l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+            .collect();
+        w.sort_by(f64::total_cmp);
+        w
+    }
+}
+
+/// Finite and symmetric on the used block, and positive definite if `definite` (the mass). The
+/// stiffness and damping are not required to be semi-definite on their own: the air bearing's
+/// heave law completes them (a pitch coupling makes the structural part alone indefinite).
+fn check_matrix(field: &str, a: &DofMatrix, n: usize, definite: bool) -> Result<()> {
+    for i in 0..n {
+        for j in 0..n {
+            check_finite(&format!("{field}[{i}][{j}]"), a[(i, j)])?;
+            let (x, y) = (a[(i, j)], a[(j, i)]);
+            if (x - y).abs() > 1e-12 * x.abs().max(y.abs()) {
+                return Err(Error::invalid(
+                    format!("{field}[{i}][{j}]"),
+                    format!("the matrix must be symmetric, got {x:e} and [{j}][{i}] = {y:e}"),
+                ));
+            }
+        }
+    }
+    if !definite {
+        return Ok(());
+    }
+    let block = a.view((0, 0), (n, n)).into_owned();
+    let eig = block.symmetric_eigenvalues();
+    let largest = eig.iter().fold(0.0f64, |m, &x| m.max(x.abs()));
+    let smallest = eig.iter().copied().fold(f64::INFINITY, f64::min);
+    if !(smallest > 1e-14 * largest && largest > 0.0) {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must be positive definite, its smallest eigenvalue is {smallest:e} (largest \
+                 {largest:e})"
+            ),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,176 @@
+//! The `[structure]` section: how the slider deforms and moves, as lumped masses, springs and
+//! dampers, and where the bulge sits on them.
+//!
+//! Degree of freedom 0 is always the heave of the slider body at the air bearing (`slider.mass_kg`
+//! and the `[air_bearing]` law act there); the interface forces act on the bulge, whose
+//! displacement towards and away from the disk is `bᵀq` with the influence vector `b`.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{check_finite, check_non_negative, check_positive};
+use crate::{Error, Result};
+
+/// Largest number of mechanical degrees of freedom of a structure.
+pub const MAX_DOF: usize = 3;
+
+/// The slider's structure. `rigid` (the default) is one mass on the air bearing.
+///
+/// ```
+/// use hdi_tribology::scene::{Scene, StructureSpec};
+/// let text = Scene::paper().to_toml_string()? + r#"
+/// [structure]
+/// preset = "bulge"
+/// mass_kg = 1e-13
+/// stiffness_n_per_m = 4e5
+/// damping_ratio = 0.05
+/// "#;
+/// let scene = Scene::from_toml_str(&text)?;
+/// assert!(matches!(scene.structure, StructureSpec::Bulge { .. }));
+/// assert_eq!(Scene::paper().structure, StructureSpec::Rigid);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "preset", rename_all = "snake_case", deny_unknown_fields)]
+pub enum StructureSpec {
+    /// One rigid mass `slider.mass_kg` on the air bearing; the bulge moves with it.
+    #[default]
+    Rigid,
+    /// Body heave plus the heater-driven bulge as its own mass on a spring and damper to the
+    /// body; the interface forces act on the bulge. Coordinates: body heave `y`, bulge `z`.
+    Bulge {
+        /// Effective mass of the bulge `m_b` (kg).
+        mass_kg: f64,
+        /// Stiffness `k_b` between bulge and body (N/m).
+        stiffness_n_per_m: f64,
+        /// Damping ratio `ζ_b = c_b / (2 √(k_b m_b))` of the bulge on a fixed body.
+        damping_ratio: f64,
+    },
+    /// Body heave `y` plus pitch `θ` (positive lifts the trailing edge), with the air bearing's
+    /// pitch stiffness and damping and their coupling to heave; the bulge sits rigidly at the
+    /// trailing edge, `z = y + L θ`.
+    Pitch {
+        /// Pitch inertia about the pivot `I` (kg m²).
+        inertia_kg_m2: f64,
+        /// Pitch stiffness `k_θθ` (N m/rad).
+        stiffness_n_m_per_rad: f64,
+        /// Heave–pitch coupling stiffness `k_yθ = k_θy` (N/rad).
+        coupling_stiffness_n_per_rad: f64,
+        /// Pitch damping `c_θθ` (N m s/rad).
+        damping_n_m_s_per_rad: f64,
+        /// Heave–pitch coupling damping `c_yθ = c_θy` (N s/rad).
+        coupling_damping_n_s_per_rad: f64,
+        /// Distance `L` from the pivot to the bulge at the trailing edge (m).
+        trailing_edge_m: f64,
+    },
+    /// Any linear structure of 1 to [`MAX_DOF`] degrees of freedom:
+    /// `M q̈ + C q̇ + K q = e₀ F_ab + b F_if`. Degree of freedom 0 is the body heave, where the
+    /// air-bearing law acts and `slider.mass_kg` is ignored (the mass matrix holds it). The
+    /// matrices are symmetric, `M` positive definite, `C` and `K` symmetric; `K`
+    /// holds the structure's own springs only (the air bearing's heave law is added on DOF 0).
+    General {
+        /// Mass matrix `M` (rows; kg, kg m, kg m² by coordinate).
+        mass: Vec<Vec<f64>>,
+        /// Damping matrix `C` (rows).
+        damping: Vec<Vec<f64>>,
+        /// Stiffness matrix `K` (rows).
+        stiffness: Vec<Vec<f64>>,
+        /// Bulge influence vector `b`: the bulge displacement is `bᵀq`.
+        bulge_influence: Vec<f64>,
+    },
+}
+
+impl StructureSpec {
+    /// Whether this is the default rigid slider.
+    pub fn is_rigid(&self) -> bool {
+        *self == StructureSpec::Rigid
+    }
+
+    /// The preset's name as written in a scene file.
+    pub fn preset(&self) -> &'static str {
+        match self {
+            StructureSpec::Rigid => "rigid",
+            StructureSpec::Bulge { .. } => "bulge",
+            StructureSpec::Pitch { .. } => "pitch",
+            StructureSpec::General { .. } => "general",
+        }
+    }
+
+    /// Field-by-field checks; errors name `structure.<field>`. The matrix properties of the
+    /// general form (symmetry, definiteness) are checked when the model is built.
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            StructureSpec::Rigid => {}
+            StructureSpec::Bulge {
+                mass_kg,
+                stiffness_n_per_m,
+                damping_ratio,
+            } => {
+                check_positive("structure.mass_kg", *mass_kg)?;
+                check_positive("structure.stiffness_n_per_m", *stiffness_n_per_m)?;
+                check_non_negative("structure.damping_ratio", *damping_ratio)?;
+            }
+            StructureSpec::Pitch {
+                inertia_kg_m2,
+                stiffness_n_m_per_rad,
+                coupling_stiffness_n_per_rad,
+                damping_n_m_s_per_rad,
+                coupling_damping_n_s_per_rad,
+                trailing_edge_m,
+            } => {
+                check_positive("structure.inertia_kg_m2", *inertia_kg_m2)?;
+                check_positive("structure.stiffness_n_m_per_rad", *stiffness_n_m_per_rad)?;
+                check_finite(
+                    "structure.coupling_stiffness_n_per_rad",
+                    *coupling_stiffness_n_per_rad,
+                )?;
+                check_non_negative("structure.damping_n_m_s_per_rad", *damping_n_m_s_per_rad)?;
+                check_finite(
+                    "structure.coupling_damping_n_s_per_rad",
+                    *coupling_damping_n_s_per_rad,
+                )?;
+                check_finite("structure.trailing_edge_m", *trailing_edge_m)?;
+            }
+            StructureSpec::General {
+                mass,
+                damping,
+                stiffness,
+                bulge_influence,
+            } => {
+                let n = bulge_influence.len();
+                if n == 0 || n > MAX_DOF {
+                    return Err(Error::invalid(
+                        "structure.bulge_influence",
+                        format!("needs 1 to {MAX_DOF} entries, got {n}"),
+                    ));
+                }
+                for (i, &b) in bulge_influence.iter().enumerate() {
+                    check_finite(&format!("structure.bulge_influence[{i}]"), b)?;
+                }
+                if bulge_influence.iter().all(|&b| b == 0.0) {
+                    return Err(Error::invalid(
+                        "structure.bulge_influence",
+                        "must not be all zero: the interface forces would act on nothing",
+                    ));
+                }
+                for (name, m) in [
+                    ("mass", mass),
+                    ("damping", damping),
+                    ("stiffness", stiffness),
+                ] {
+                    if m.len() != n || m.iter().any(|row| row.len() != n) {
+                        return Err(Error::invalid(
+                            format!("structure.{name}"),
+                            format!("must be {n} × {n} (the length of structure.bulge_influence)"),
+                        ));
+                    }
+                    for (i, row) in m.iter().enumerate() {
+                        for (j, &x) in row.iter().enumerate() {
+                            check_finite(&format!("structure.{name}[{i}][{j}]"), x)?;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
