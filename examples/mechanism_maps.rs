@@ -311,7 +311,9 @@ const NEGATIVE: RGBColor = RGBColor(90, 90, 90);
 type Quantity = (&'static str, fn(&Point) -> Option<f64>);
 
 const QUANTITIES: [Quantity; 3] = [
-    ("ΔP (mW)", |p| p.dp().filter(|&d| d >= 0.0).map(|d| d * 1e3)),
+    ("ΔP (mW)", |p| {
+        p.dp().filter(|&d| d >= 0.0).map(|d| d * 1e3)
+    }),
     ("P_TD (mW)", |p| p.td.map(|x| x * 1e3)),
     ("P_TO (mW)", |p| p.to.map(|x| x * 1e3)),
 ];
@@ -377,9 +379,12 @@ fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> 
             )
         }))?;
         let r = (300.0 / n as f64 / 4.0).clamp(1.0, 6.0) as i32;
-        chart.draw_series(points.iter().filter(|p| p.bounce).map(|p| {
-            Circle::new((p.v_ac, p.param.log10()), r, WHITE.filled())
-        }))?;
+        chart.draw_series(
+            points
+                .iter()
+                .filter(|p| p.bounce)
+                .map(|p| Circle::new((p.v_ac, p.param.log10()), r, WHITE.filled())),
+        )?;
         for (w, c) in [(4, WHITE), (2, BLACK)] {
             chart.draw_series(std::iter::once(Rectangle::new(
                 [
@@ -414,7 +419,10 @@ fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> 
         }))?;
     }
     let legend = [
-        (UNCONVERGED, "not converged (TD or TO moves > 0.05 mW at 10× rtol)"),
+        (
+            UNCONVERGED,
+            "not converged (TD or TO moves > 0.05 mW at 10× rtol)",
+        ),
         (UNDETECTED, "no touchdown or no take-off"),
         (BLACK, "runaway: slider hits the disk, or > 3e5 steps"),
         (NEGATIVE, "ΔP < 0 (ΔP panel)"),
@@ -423,13 +431,20 @@ fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> 
     let mut x = 20;
     for (c, text) in legend {
         bottom.draw(&Rectangle::new([(x, 15), (x + 18, 33)], c.filled()))?;
-        bottom.draw(&Rectangle::new([(x, 15), (x + 18, 33)], BLACK.stroke_width(1)))?;
+        bottom.draw(&Rectangle::new(
+            [(x, 15), (x + 18, 33)],
+            BLACK.stroke_width(1),
+        ))?;
         bottom.draw(&Text::new(text, (x + 24, 17), style.clone()))?;
         x += 24 + 7 * text.chars().count() as i32 + 20;
     }
     bottom.draw(&Circle::new((x + 9, 24), 5, WHITE.filled()))?;
     bottom.draw(&Circle::new((x + 9, 24), 5, BLACK.stroke_width(1)))?;
-    bottom.draw(&Text::new("bounces in the hold", (x + 20, 17), style.clone()))?;
+    bottom.draw(&Text::new(
+        "bounces in the hold",
+        (x + 20, 17),
+        style.clone(),
+    ))?;
     bottom.draw(&Text::new(
         "outlined: physically plausible band",
         (20, 38),
@@ -518,10 +533,7 @@ fn check(setup: &Setup, spec: &MapSpec, points: &[Point]) -> Res<()> {
         let r = simulate_cycle(&m, &setup.programme, &o);
         let show = |x: Option<f64>| x.map_or("—".to_string(), |x| format!("{:.3}", x * 1e3));
         let (td, to) = match &r {
-            Ok(r) => (
-                r.touchdown.map(|d| d.power),
-                r.takeoff.map(|d| d.power),
-            ),
+            Ok(r) => (r.touchdown.map(|d| d.power), r.takeoff.map(|d| d.power)),
             Err(_) => (None, None),
         };
         println!(
@@ -557,7 +569,8 @@ fn main() -> Res<()> {
     let out = value("--out").unwrap_or_else(|| "out/maps".into());
     let out = Path::new(&out);
     std::fs::create_dir_all(out)?;
-    let scene = Scene::from_path(value("--scene").unwrap_or_else(|| "scenes/paper_bulge.toml".into()))?;
+    let scene =
+        Scene::from_path(value("--scene").unwrap_or_else(|| "scenes/paper_bulge.toml".into()))?;
     let names = value("--maps").unwrap_or_else(|| "freq,zeta,lag_rigid,lag_bulge".into());
     let setup = Setup::from_scene(&scene)?;
     println!(
@@ -571,13 +584,20 @@ fn main() -> Res<()> {
         setup.bulge.frequency() * 1e-6,
         setup.bulge.zeta
     );
-    for spec in MAPS.iter().filter(|s| names.split(',').any(|x| x == s.name)) {
+    for spec in MAPS
+        .iter()
+        .filter(|s| names.split(',').any(|x| x == s.name))
+    {
         let clock = Instant::now();
         let points = run_map(&setup, spec, n)?;
         let wall = clock.elapsed().as_secs_f64();
         draw_map(&out.join(format!("{}.svg", spec.name)), spec, &points, n)?;
         write_points(&out.join(format!("{}.csv", spec.name)), &points)?;
-        println!("{:<10} {} cycles pairs in {wall:.1} s", spec.name, points.len());
+        println!(
+            "{:<10} {} cycles pairs in {wall:.1} s",
+            spec.name,
+            points.len()
+        );
         summarise(spec, &points);
         if args.iter().any(|a| a == "--check") {
             check(&setup, spec, &points)?;
@@ -595,7 +615,10 @@ mod tests {
     #[test]
     fn tiny_rigid_lag_map_matches_statics() -> Res<()> {
         use hdi_tribology::analysis::{touchdown_power, StaticOptions};
-        let scene = Scene::from_path(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper_bulge.toml"))?;
+        let scene = Scene::from_path(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenes/paper_bulge.toml"
+        ))?;
         let setup = Setup::from_scene(&scene)?;
         let spec = MAPS[2];
         let points = run_map(&setup, &spec, 3)?;
