@@ -14,7 +14,6 @@
 //!
 //! Run with `cargo run --release --example custom_term`.
 
-use hdi_tribology::analysis::HeaterProgramme::Fixed;
 use hdi_tribology::analysis::{simulate_cycle, static_hysteresis, CycleOptions, StaticOptions};
 use hdi_tribology::force::{
     Coupling, GapReference, Gaps, InterfaceForces, InterfaceTerm, TermKind,
@@ -94,7 +93,7 @@ fn main() -> hdi_tribology::Result<()> {
         assert!((b - (a + m)).abs() <= 1e-7 * (a.abs() + m.abs()));
     }
 
-    let programme = Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+    let programme = hdi_tribology::analysis::HeaterProgramme::fixed_from_scene(&scene)?;
     let cycle_opts = CycleOptions::from_scene(&scene)?;
     let static_opts = StaticOptions::new(scene.detector.contact_threshold_n);
     println!(

@@ -28,14 +28,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         });
     }
     let programme = if flag("--triggered").is_some() {
-        let t = &scene.heater.triggered;
-        HeaterProgramme::Triggered {
-            start_power: t.start_power_w,
-            ramp_rate: t.ramp_rate_w_per_s,
-            overshoot: t.overshoot_w,
-        }
+        HeaterProgramme::triggered_from_scene(&scene)
     } else {
-        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?)
+        HeaterProgramme::fixed_from_scene(&scene)?
     };
     let mut opts = CycleOptions::from_scene(&scene)?;
     opts.keep_series = true;

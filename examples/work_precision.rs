@@ -138,8 +138,7 @@ impl Slider {
     fn new() -> Res<Self> {
         let scene = Scene::paper();
         let model = SliderModel::from_scene(&scene)?;
-        let programme =
-            HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+        let programme = HeaterProgramme::fixed_from_scene(&scene)?;
         Ok(Slider {
             scene,
             model,

@@ -14,8 +14,7 @@ fn paper() -> (Scene, SliderModel, CycleOptions, HeaterProgramme) {
     let scene = Scene::paper();
     let model = SliderModel::from_scene(&scene).unwrap();
     let opts = CycleOptions::from_scene(&scene).unwrap();
-    let fixed =
-        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme).unwrap());
+    let fixed = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     (scene, model, opts, fixed)
 }
 
@@ -77,11 +76,7 @@ fn hysteresis_collapses_above_an_ac_threshold() {
 fn triggered_temperature_rise_grows_with_hysteresis() {
     let (scene, model, opts, _) = paper();
     let t = &scene.heater.triggered;
-    let trig = HeaterProgramme::Triggered {
-        start_power: t.start_power_w,
-        ramp_rate: t.ramp_rate_w_per_s,
-        overshoot: t.overshoot_w,
-    };
+    let trig = HeaterProgramme::triggered_from_scene(&scene);
     let rs = ac_sweep(&model, &trig, &opts, &[0.0, 0.4, 0.8]).unwrap();
     let (a, b, c) = (&rs[0], &rs[1], &rs[2]);
     assert!(a.hysteresis.unwrap() > b.hysteresis.unwrap());

@@ -101,8 +101,7 @@ fn static_of(scene: &Scene) -> Result<StaticHysteresis> {
 
 fn cycle_of(scene: &Scene) -> Result<CycleResult> {
     let model = SliderModel::from_scene(scene)?;
-    let programme =
-        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+    let programme = HeaterProgramme::fixed_from_scene(scene)?;
     simulate_cycle(&model, &programme, &CycleOptions::from_scene(scene)?)
 }
 

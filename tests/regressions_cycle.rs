@@ -14,8 +14,7 @@ fn self_excited_contact_stops_with_a_reason_instead_of_nan() {
     let mut scene = Scene::paper();
     scene.slider.interface_lag_s = 1e-7;
     let model = SliderModel::from_scene(&scene).unwrap();
-    let programme =
-        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme).unwrap());
+    let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     match simulate_cycle(
         &model,
         &programme,
@@ -37,8 +36,7 @@ fn a_short_interface_lag_runs_through() {
     let mut scene = Scene::paper();
     scene.slider.interface_lag_s = 1e-11;
     let model = SliderModel::from_scene(&scene).unwrap();
-    let programme =
-        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme).unwrap());
+    let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     let r = simulate_cycle(
         &model,
         &programme,

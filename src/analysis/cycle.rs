@@ -78,29 +78,6 @@ pub struct CycleOptions {
 }
 
 impl CycleOptions {
-    /// The detector and solver settings of a scene, without time series.
-    pub fn from_scene(scene: &crate::scene::Scene) -> Result<Self> {
-        let method: Method = scene
-            .solver
-            .method
-            .parse()
-            .map_err(|e: ode::OdeError| Error::invalid("solver.method", e.to_string()))?;
-        Ok(CycleOptions {
-            detector: Detector {
-                contact_threshold: scene.detector.contact_threshold_n,
-                window: scene.detector.window_s,
-            },
-            solver: SolverSettings {
-                method,
-                rtol: scene.solver.rtol,
-                atol_displacement: scene.solver.atol_m,
-                max_step: scene.solver.max_step_s,
-                max_steps: scene.solver.max_steps,
-            },
-            keep_series: false,
-        })
-    }
-
     fn validate(&self) -> Result<()> {
         check_positive(
             "detector.contact_threshold",
@@ -126,6 +103,18 @@ pub struct Detection {
     pub time: f64,
     /// Programme power at that time (W).
     pub power: f64,
+}
+
+impl Detection {
+    /// The programme power in milliwatts.
+    ///
+    /// ```
+    /// let d = hdi_tribology::analysis::Detection { time: 1e-3, power: 0.0743 };
+    /// assert!((d.power_mw() - 74.3).abs() < 1e-12);
+    /// ```
+    pub fn power_mw(&self) -> f64 {
+        crate::units::to_mw(self.power)
+    }
 }
 
 /// Time series of one cycle, at every accepted step.
@@ -225,6 +214,21 @@ impl CycleResult {
     pub fn hysteresis_mw(&self) -> Option<f64> {
         self.hysteresis.map(crate::units::to_mw)
     }
+
+    /// The hysteresis for printing: `6.417` (mW, three decimals) when both transitions were
+    /// detected, else which one was not.
+    ///
+    /// ```
+    /// # use hdi_tribology::analysis::CycleResult;
+    /// # fn f(r: &CycleResult) { println!("ΔP = {} mW", r.hysteresis_text()); }
+    /// ```
+    pub fn hysteresis_text(&self) -> String {
+        match (self.touchdown, self.takeoff, self.hysteresis_mw()) {
+            (_, _, Some(h)) => format!("{h:.3}"),
+            (None, _, _) => "n/a (no touchdown detected)".into(),
+            (Some(_), _, None) => "n/a (no take-off detected)".into(),
+        }
+    }
 }
 
 /// Simulates one touchdown/take-off cycle.
@@ -234,7 +238,7 @@ impl CycleResult {
 /// use hdi_tribology::{model::SliderModel, scene::Scene};
 /// let scene = Scene::paper();
 /// let model = SliderModel::from_scene(&scene)?;
-/// let programme = HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+/// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
 /// let r = simulate_cycle(&model, &programme, &CycleOptions::from_scene(&scene)?)?;
 /// println!("ΔP = {:?} W, mean ΔT = {} K", r.hysteresis, r.mean_temperature_rise);
 /// # Ok::<(), hdi_tribology::Error>(())

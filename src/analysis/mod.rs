@@ -6,16 +6,23 @@
 
 pub mod cycle;
 pub mod equilibrium;
+pub mod protocol;
 pub mod pull_in;
 pub mod response;
 pub mod roots;
 pub mod sweep;
 pub mod touchdown;
 
-pub use cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme, TimeSeries};
-pub use equilibrium::{flying_equilibrium, s_curve, Equilibrium, Fold, SCurve, ScanGrid};
+pub use cycle::{
+    simulate_cycle, CycleOptions, CycleResult, Detection, Detector, HeaterProgramme,
+    SolverSettings, TimeSeries,
+};
+pub use equilibrium::{
+    flying_equilibrium, s_curve, Equilibrium, EquilibriumSolver, Fold, SCurve, ScanGrid,
+};
+pub use protocol::Protocol;
 pub use pull_in::{clearance_change, pull_in_voltage, ClearanceChange, PullIn};
-pub use response::{linear_response, LinearResponse};
+pub use response::{linear_response, LinearResponse, Mode};
 pub use sweep::{ac_sweep, ac_sweep_refined, RefinedCycle, Refinement};
 pub use touchdown::{
     static_hysteresis, takeoff_power, touchdown_power, Cause, StaticHysteresis, StaticOptions,

@@ -25,7 +25,7 @@ use crate::Error;
 /// use hdi_tribology::{model::SliderModel, scene::Scene};
 /// let scene = Scene::paper();
 /// let model = SliderModel::from_scene(&scene)?;
-/// let programme = HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+/// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
 /// let opts = CycleOptions::from_scene(&scene)?;
 /// for r in ac_sweep(&model, &programme, &opts, &[0.0, 0.5, 1.0])? {
 ///     println!("{} V: {:?}", r.v_ac, r.hysteresis);
@@ -157,7 +157,7 @@ fn power_change(a: &CycleResult, b: &CycleResult) -> f64 {
 /// use hdi_tribology::{model::SliderModel, scene::Scene};
 /// let scene = Scene::paper();
 /// let model = SliderModel::from_scene(&scene)?;
-/// let programme = HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
+/// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
 /// let opts = CycleOptions::from_scene(&scene)?;
 /// for r in ac_sweep_refined(&model, &programme, &opts, &[0.0, 0.7], &Refinement::new(6e-5))? {
 ///     let mark = if r.converged { "" } else { " (not converged)" };

@@ -208,6 +208,23 @@ impl SliderModel {
         }
     }
 
+    /// The same model on another structure (tables are shared, not rebuilt): a map over the
+    /// bulge's frequency or damping is a loop over this.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{model::{SliderModel, Structure}, scene::Scene};
+    /// let rigid = SliderModel::from_scene(&Scene::paper())?;
+    /// let bulge = rigid.with_structure(Structure::bulge(1e-6, 1e-13, 4e5, 0.05)?);
+    /// assert_eq!(bulge.structure.dofs(), 2);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn with_structure(&self, structure: Structure) -> Self {
+        SliderModel {
+            structure,
+            ..self.clone()
+        }
+    }
+
     /// The tabulated interface forces.
     pub fn forces(&self) -> &InterfaceForces {
         &self.forces
@@ -402,7 +419,8 @@ impl SliderModel {
         )
     }
 
-    /// A heater programme from the scene's knots.
+    /// A heater programme from the scene's knots (the analyses' translation of a scene is
+    /// `analysis::Protocol::from_scene`, or `analysis::HeaterProgramme::fixed_from_scene`).
     pub fn programme_from_knots(knots: &[[f64; 2]]) -> Result<Programme> {
         Programme::new(knots.iter().map(|k| (k[0], k[1])).collect())
     }

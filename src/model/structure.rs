@@ -303,6 +303,9 @@ impl Structure {
         if self.n == 1 {
             return j[(0, 0)] > 0.0;
         }
+        if self.n == 2 {
+            return j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)] > 0.0;
+        }
         let mut padded = *j;
         for i in self.n..MAX_DOF {
             padded[(i, i)] = 1.0;
@@ -374,6 +377,18 @@ impl Structure {
         if self.n == 1 {
             let x = r[0] / j[(0, 0)];
             return x.is_finite().then(|| Dofs::new(x, 0.0, 0.0));
+        }
+        if self.n == 2 {
+            // Cramer's rule: the presets' case, several times cheaper than a padded LU.
+            let det = j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)];
+            let x0 = (r[0] * j[(1, 1)] - j[(0, 1)] * r[1]) / det;
+            let x1 = (j[(0, 0)] * r[1] - r[0] * j[(1, 0)]) / det;
+            return (x0.is_finite() && x1.is_finite()).then(|| {
+                let mut x = Dofs::zeros();
+                x[0] = x0;
+                x[1] = x1;
+                x
+            });
         }
         let mut padded = *j;
         for i in self.n..MAX_DOF {
