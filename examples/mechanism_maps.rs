@@ -13,9 +13,10 @@
 //! zero during the hold at the highest power (the contact bounces). The outlined band is the
 //! physically plausible range estimated in docs/analyses.md.
 //!
-//! `cargo run --release --example mechanism_maps -- --grid 100 --out docs/img/maps` draws the
+//! `cargo run --release --example mechanism_maps -- --grid 12 --out docs/img/maps` draws the
 //! maps of docs/analyses.md; `--maps freq,zeta` picks maps, `--check` reruns a few points with
-//! Radau5 at a hundredfold tighter tolerance. Without `--grid` a 6 × 6 grid runs in seconds.
+//! Radau5 at a hundredfold tighter tolerance. Without `--grid` a 6 × 6 grid runs (a few minutes
+//! for all four maps on two cores; the test runs a 3 × 3 map in seconds).
 
 use hdi_tribology::analysis::cycle::{CycleOptions, HeaterProgramme};
 use hdi_tribology::analysis::{ac_sweep_refined, simulate_cycle, Refinement};
