@@ -1,0 +1,644 @@
+//! Does the AC voltage advance take-off? Maps of the dynamic hysteresis `ΔP`, the touchdown power
+//! `P_TD` and the take-off power `P_TO` over the AC amplitude and one structural parameter, for
+//! the few-peak deformable-slider scene `scenes/paper_bulge.toml`:
+//! - `freq`: V_ac × the bulge's natural frequency on a fixed body (`bulge`);
+//! - `zeta`: V_ac × the bulge's damping ratio (`bulge`);
+//! - `lag_rigid`, `lag_bulge`: V_ac × the interface lag τ, on `rigid` and on `bulge`.
+//!
+//! Every point runs the scene's fixed programme twice, at the scene's tolerance and at one ten
+//! times tighter (`ac_sweep_refined` with two runs): a point counts as converged when touchdown
+//! and take-off move by at most 0.05 mW between the two. The heatmaps colour only converged
+//! points with both detections (and, for `ΔP`, a non-negative value); the others are drawn in
+//! grey or black and named in the legend. A white dot marks a point whose contact force drops to
+//! zero during the hold at the highest power (the contact bounces). The outlined band is the
+//! physically plausible range estimated in docs/analyses.md.
+//!
+//! `cargo run --release --example mechanism_maps -- --grid 12 --out docs/img/maps` draws the
+//! maps of docs/analyses.md; `--maps freq,zeta` picks maps, `--check` reruns a few points with
+//! Radau5 at a hundredfold tighter tolerance. Without `--grid` a 6 × 6 grid runs (a few minutes
+//! for all four maps on two cores; the test runs a 3 × 3 map in seconds).
+
+use hdi_tribology::analysis::cycle::{CycleOptions, HeaterProgramme};
+use hdi_tribology::analysis::{ac_sweep_refined, simulate_cycle, Refinement};
+use hdi_tribology::model::{SliderModel, Structure};
+use hdi_tribology::ode::Method;
+use hdi_tribology::report::write_csv;
+use hdi_tribology::scene::{Scene, StructureSpec};
+use plotters::prelude::*;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::path::Path;
+use std::time::Instant;
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// Largest change of `P_TD` and `P_TO` between the run at the scene's rtol and ten times tighter
+/// for a point to count as converged (W).
+const POWER_TOL: f64 = 5e-5;
+
+/// Step limit of one cycle of a map.
+const MAX_STEPS: usize = 300_000;
+
+/// The scene's bulge: mass (kg), stiffness (N/m), damping ratio.
+#[derive(Clone, Copy, Debug)]
+struct Bulge {
+    mass: f64,
+    stiffness: f64,
+    zeta: f64,
+}
+
+impl Bulge {
+    fn frequency(&self) -> f64 {
+        (self.stiffness / self.mass).sqrt() / (2.0 * PI)
+    }
+}
+
+/// What a map varies along its vertical axis (log scale).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Axis {
+    /// Bulge natural frequency on a fixed body (Hz), at the scene's bulge mass and damping ratio.
+    Frequency,
+    /// Bulge damping ratio, at the scene's bulge mass and stiffness.
+    Damping,
+    /// Interface lag τ (s), on the given structure.
+    Lag { bulge: bool },
+}
+
+#[derive(Clone, Copy, Debug)]
+struct MapSpec {
+    name: &'static str,
+    title: &'static str,
+    axis: Axis,
+    /// log10 of the axis range.
+    range: (f64, f64),
+    /// log10 of the physically plausible band.
+    plausible: (f64, f64),
+    label: &'static str,
+}
+
+const MAPS: [MapSpec; 4] = [
+    MapSpec {
+        name: "freq",
+        title: "bulge: V_ac × bulge natural frequency",
+        axis: Axis::Frequency,
+        range: (6.5, 9.5),
+        // 10 MHz – 1.3 GHz: k = 2E*a = 4e5 … 2e6 N/m, m = ρL³ with L = 2 … 30 µm.
+        plausible: (7.0, 9.11),
+        label: "f_b (Hz)",
+    },
+    MapSpec {
+        name: "zeta",
+        title: "bulge: V_ac × bulge damping ratio",
+        axis: Axis::Damping,
+        range: (-4.0, 0.0),
+        // radiation into the body, ζ ≈ 0.43/√B for B = m/(ρa³) = 1 … 1000, plus material loss.
+        plausible: (-1.9, -0.37),
+        label: "ζ_b",
+    },
+    MapSpec {
+        name: "lag_rigid",
+        title: "rigid: V_ac × interface lag",
+        axis: Axis::Lag { bulge: false },
+        range: (-10.0, -5.0),
+        // a wave crossing 10 µm … 1.2 mm at 8.7 km/s: 1 ns … 140 ns.
+        plausible: (-9.0, -6.854),
+        label: "τ (s)",
+    },
+    MapSpec {
+        name: "lag_bulge",
+        title: "bulge: V_ac × interface lag",
+        axis: Axis::Lag { bulge: true },
+        range: (-10.0, -5.0),
+        plausible: (-9.0, -6.854),
+        label: "τ (s)",
+    },
+];
+
+/// How a map point ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Status {
+    /// Both detections, converged.
+    Fine,
+    /// Both detections, but touchdown or take-off moved by more than `POWER_TOL` at 10× rtol.
+    Unconverged,
+    /// No touchdown, or no take-off, under the programme.
+    Undetected,
+    /// The cycle failed: the slider ran into the disk or the solver gave up.
+    Runaway,
+}
+
+impl Status {
+    fn code(self) -> f64 {
+        match self {
+            Status::Fine => 0.0,
+            Status::Unconverged => 1.0,
+            Status::Undetected => 2.0,
+            Status::Runaway => 3.0,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Point {
+    v_ac: f64,
+    param: f64,
+    td: Option<f64>,
+    to: Option<f64>,
+    status: Status,
+    bounce: bool,
+}
+
+impl Point {
+    fn dp(&self) -> Option<f64> {
+        Some(self.td? - self.to?)
+    }
+}
+
+struct Setup {
+    base: SliderModel,
+    programme: HeaterProgramme,
+    opts: CycleOptions,
+    bulge: Bulge,
+    body_mass: f64,
+    /// Start and end of the hold at the highest power (s).
+    hold: (f64, f64),
+}
+
+impl Setup {
+    fn from_scene(scene: &Scene) -> Res<Self> {
+        let StructureSpec::Bulge {
+            mass_kg,
+            stiffness_n_per_m,
+            damping_ratio,
+        } = scene.structure
+        else {
+            return Err("the maps need a scene with a bulge structure".into());
+        };
+        let knots = &scene.heater.programme;
+        let top = knots.iter().map(|k| k[1]).fold(f64::MIN, f64::max);
+        let at_top: Vec<f64> = knots.iter().filter(|k| k[1] == top).map(|k| k[0]).collect();
+        let mut opts = CycleOptions::from_scene(scene)?;
+        opts.keep_series = true;
+        // A cycle of this scene takes 1e3 … 5e4 steps; one that needs more is bouncing without
+        // bound and is marked as a runaway instead of running for minutes.
+        opts.solver.max_steps = opts.solver.max_steps.min(MAX_STEPS);
+        Ok(Setup {
+            base: SliderModel::from_scene(scene)?,
+            programme: HeaterProgramme::Fixed(SliderModel::programme_from_knots(knots)?),
+            opts,
+            bulge: Bulge {
+                mass: mass_kg,
+                stiffness: stiffness_n_per_m,
+                zeta: damping_ratio,
+            },
+            body_mass: scene.slider.mass_kg,
+            hold: (at_top[0], at_top[at_top.len() - 1]),
+        })
+    }
+
+    /// The model of one map point.
+    fn model(&self, axis: Axis, param: f64, v_ac: f64) -> Res<SliderModel> {
+        let b = self.bulge;
+        let mut m = self.base.clone();
+        m.structure = match axis {
+            Axis::Frequency => Structure::bulge(
+                self.body_mass,
+                b.mass,
+                b.mass * (2.0 * PI * param).powi(2),
+                b.zeta,
+            )?,
+            Axis::Damping => Structure::bulge(self.body_mass, b.mass, b.stiffness, param)?,
+            Axis::Lag { bulge: true } => {
+                m.interface_lag = param;
+                Structure::bulge(self.body_mass, b.mass, b.stiffness, b.zeta)?
+            }
+            Axis::Lag { bulge: false } => {
+                m.interface_lag = param;
+                Structure::rigid(self.body_mass)?
+            }
+        };
+        m.voltage.ac_amplitude = v_ac;
+        Ok(m)
+    }
+
+    fn run(&self, axis: Axis, param: f64, v_ac: f64) -> Res<Point> {
+        let m = self.model(axis, param, v_ac)?;
+        let refine = Refinement {
+            power_tol: POWER_TOL,
+            factor: 0.1,
+            max_runs: 2,
+        };
+        let mut p = Point {
+            v_ac,
+            param,
+            td: None,
+            to: None,
+            status: Status::Runaway,
+            bounce: false,
+        };
+        let r = match ac_sweep_refined(&m, &self.programme, &self.opts, &[v_ac], &refine) {
+            Ok(mut r) => r.remove(0),
+            // The slider entering the disk, or the stepper giving up, is a property of this
+            // point: mark it, do not stop the map.
+            Err(_) => return Ok(p),
+        };
+        p.td = r.cycle.touchdown.map(|d| d.power);
+        p.to = r.cycle.takeoff.map(|d| d.power);
+        p.status = match (p.td, p.to, r.converged) {
+            (Some(_), Some(_), true) => Status::Fine,
+            (Some(_), Some(_), false) => Status::Unconverged,
+            _ => Status::Undetected,
+        };
+        if let Some(s) = &r.cycle.series {
+            p.bounce = p.td.is_some()
+                && s.t
+                    .iter()
+                    .zip(&s.contact)
+                    .any(|(&t, &f)| t >= self.hold.0 && t <= self.hold.1 && f <= 0.0);
+        }
+        Ok(p)
+    }
+}
+
+fn log_grid((lo, hi): (f64, f64), n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|j| lo + (hi - lo) * j as f64 / (n.max(2) - 1) as f64)
+        .collect()
+}
+
+fn run_map(setup: &Setup, spec: &MapSpec, n: usize) -> Res<Vec<Point>> {
+    let volts = log_grid((0.0, 1.0), n);
+    let params = log_grid(spec.range, n);
+    let cells: Vec<(f64, f64)> = params
+        .iter()
+        .flat_map(|&y| volts.iter().map(move |&v| (v, 10f64.powf(y))))
+        .collect();
+    cells
+        .par_iter()
+        .map(|&(v, p)| setup.run(spec.axis, p, v).map_err(|e| e.to_string()))
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(Into::into)
+}
+
+/// Viridis, from its published anchor colours (colour-blind safe, sequential).
+fn viridis(x: f64) -> RGBColor {
+    const A: [(u8, u8, u8); 9] = [
+        (68, 1, 84),
+        (71, 44, 122),
+        (59, 81, 139),
+        (44, 113, 142),
+        (33, 144, 141),
+        (39, 173, 129),
+        (92, 200, 99),
+        (170, 220, 50),
+        (253, 231, 37),
+    ];
+    let x = x.clamp(0.0, 1.0) * (A.len() - 1) as f64;
+    let i = (x.floor() as usize).min(A.len() - 2);
+    let f = x - i as f64;
+    let mix = |a: u8, b: u8| (a as f64 + (b as f64 - a as f64) * f).round() as u8;
+    RGBColor(
+        mix(A[i].0, A[i + 1].0),
+        mix(A[i].1, A[i + 1].1),
+        mix(A[i].2, A[i + 1].2),
+    )
+}
+
+const UNCONVERGED: RGBColor = RGBColor(150, 150, 150);
+const UNDETECTED: RGBColor = RGBColor(225, 225, 225);
+const NEGATIVE: RGBColor = RGBColor(90, 90, 90);
+
+/// One quantity of a map: its name and value (mW) at a point, `None` where it is not shown.
+type Quantity = (&'static str, fn(&Point) -> Option<f64>);
+
+const QUANTITIES: [Quantity; 3] = [
+    ("ΔP (mW)", |p| {
+        p.dp().filter(|&d| d >= 0.0).map(|d| d * 1e3)
+    }),
+    ("P_TD (mW)", |p| p.td.map(|x| x * 1e3)),
+    ("P_TO (mW)", |p| p.to.map(|x| x * 1e3)),
+];
+
+fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> {
+    let root = SVGBackend::new(path, (1500, 520)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (top, bottom) = root.split_vertically(470);
+    let top = top.titled(spec.title, ("sans-serif", 22))?;
+    let panels = top.split_evenly((1, 3));
+    let dv = 1.0 / (n.max(2) - 1) as f64;
+    let dy = (spec.range.1 - spec.range.0) / (n.max(2) - 1) as f64;
+    for (panel, (name, value)) in panels.iter().zip(QUANTITIES) {
+        let (plot, bar) = panel.split_horizontally(400);
+        let shown: Vec<f64> = points
+            .iter()
+            .filter(|p| p.status == Status::Fine)
+            .filter_map(value)
+            .collect();
+        let lo = shown.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = shown.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let (lo, hi) = if lo.is_finite() && hi > lo {
+            (lo, hi)
+        } else if lo.is_finite() {
+            (lo - 0.5, lo + 0.5)
+        } else {
+            (0.0, 1.0)
+        };
+        let mut chart = ChartBuilder::on(&plot)
+            .caption(name, ("sans-serif", 18))
+            .margin(8)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d(
+                -dv / 2.0..1.0 + dv / 2.0,
+                spec.range.0 - dy / 2.0..spec.range.1 + dy / 2.0,
+            )?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("V_ac (V)")
+            .y_desc(spec.label)
+            .label_style(("sans-serif", 14))
+            .axis_desc_style(("sans-serif", 15))
+            .y_label_formatter(&|y| format!("1e{y:.0}"))
+            .y_labels((spec.range.1 - spec.range.0).ceil() as usize + 1)
+            .draw()?;
+        chart.draw_series(points.iter().map(|p| {
+            let y = p.param.log10();
+            let colour = match (p.status, value(p)) {
+                (Status::Fine, Some(v)) => viridis((v - lo) / (hi - lo)),
+                (Status::Fine, None) => NEGATIVE,
+                (Status::Unconverged, _) => UNCONVERGED,
+                (Status::Undetected, _) => UNDETECTED,
+                (Status::Runaway, _) => BLACK,
+            };
+            Rectangle::new(
+                [
+                    (p.v_ac - dv / 2.0, y - dy / 2.0),
+                    (p.v_ac + dv / 2.0, y + dy / 2.0),
+                ],
+                colour.filled(),
+            )
+        }))?;
+        let r = (300.0 / n as f64 / 4.0).clamp(1.0, 6.0) as i32;
+        chart.draw_series(
+            points
+                .iter()
+                .filter(|p| p.bounce)
+                .map(|p| Circle::new((p.v_ac, p.param.log10()), r, WHITE.filled())),
+        )?;
+        for (w, c) in [(4, WHITE), (2, BLACK)] {
+            chart.draw_series(std::iter::once(Rectangle::new(
+                [
+                    (-dv / 2.0, spec.plausible.0),
+                    (1.0 + dv / 2.0, spec.plausible.1),
+                ],
+                c.stroke_width(w),
+            )))?;
+        }
+        // Colour bar.
+        let mut cb = ChartBuilder::on(&bar)
+            .margin_top(38)
+            .margin_bottom(48)
+            .margin_right(5)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0.0..1.0, lo..hi)?;
+        cb.configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_labels(6)
+            .label_style(("sans-serif", 13))
+            .y_label_formatter(&|v| format!("{v:.2}"))
+            .draw()?;
+        let steps = 100;
+        cb.draw_series((0..steps).map(|i| {
+            let a = lo + (hi - lo) * i as f64 / steps as f64;
+            let b = lo + (hi - lo) * (i + 1) as f64 / steps as f64;
+            Rectangle::new(
+                [(0.0, a), (1.0, b)],
+                viridis(i as f64 / (steps - 1) as f64).filled(),
+            )
+        }))?;
+    }
+    let legend = [
+        (
+            UNCONVERGED,
+            "not converged (TD or TO moves > 0.05 mW at 10× rtol)",
+        ),
+        (UNDETECTED, "no touchdown or no take-off"),
+        (BLACK, "runaway: slider hits the disk, or > 3e5 steps"),
+        (NEGATIVE, "ΔP < 0 (ΔP panel)"),
+    ];
+    let style = ("sans-serif", 15).into_font();
+    let mut x = 20;
+    for (c, text) in legend {
+        bottom.draw(&Rectangle::new([(x, 15), (x + 18, 33)], c.filled()))?;
+        bottom.draw(&Rectangle::new(
+            [(x, 15), (x + 18, 33)],
+            BLACK.stroke_width(1),
+        ))?;
+        bottom.draw(&Text::new(text, (x + 24, 17), style.clone()))?;
+        x += 24 + 7 * text.chars().count() as i32 + 20;
+    }
+    bottom.draw(&Circle::new((x + 9, 24), 5, WHITE.filled()))?;
+    bottom.draw(&Circle::new((x + 9, 24), 5, BLACK.stroke_width(1)))?;
+    bottom.draw(&Text::new(
+        "bounces in the hold",
+        (x + 20, 17),
+        style.clone(),
+    ))?;
+    bottom.draw(&Text::new(
+        "outlined: physically plausible band",
+        (20, 38),
+        style,
+    ))?;
+    root.present()?;
+    Ok(())
+}
+
+fn write_points(path: &Path, points: &[Point]) -> Res<()> {
+    let col = |f: &dyn Fn(&Point) -> f64| points.iter().map(f).collect::<Vec<f64>>();
+    let nan = f64::NAN;
+    write_csv(
+        path,
+        &[
+            "v_ac_v",
+            "parameter",
+            "touchdown_w",
+            "takeoff_w",
+            "hysteresis_w",
+            "status",
+            "bounce",
+        ],
+        &[
+            &col(&|p| p.v_ac),
+            &col(&|p| p.param),
+            &col(&|p| p.td.unwrap_or(nan)),
+            &col(&|p| p.to.unwrap_or(nan)),
+            &col(&|p| p.dp().unwrap_or(nan)),
+            &col(&|p| p.status.code()),
+            &col(&|p| p.bounce as u8 as f64),
+        ],
+    )?;
+    Ok(())
+}
+
+/// Per map: inside the plausible band, the largest shift of `P_TO` and `P_TD` from their value
+/// at `V_ac = 0` on the same row, over converged points (mW).
+fn summarise(spec: &MapSpec, points: &[Point]) {
+    let inside = |p: &Point| {
+        let y = p.param.log10();
+        y >= spec.plausible.0 - 1e-9 && y <= spec.plausible.1 + 1e-9
+    };
+    let fine: Vec<&Point> = points
+        .iter()
+        .filter(|p| p.status == Status::Fine && inside(p))
+        .collect();
+    let row0 = |p: &Point| {
+        fine.iter()
+            .find(|q| q.param == p.param && q.v_ac == 0.0)
+            .copied()
+    };
+    let (mut to_up, mut td_down) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for p in &fine {
+        if let Some(z) = row0(p) {
+            to_up = to_up.max((p.to.unwrap_or(f64::NAN) - z.to.unwrap_or(f64::NAN)) * 1e3);
+            td_down = td_down.max((z.td.unwrap_or(f64::NAN) - p.td.unwrap_or(f64::NAN)) * 1e3);
+        }
+    }
+    let count = |s: Status| points.iter().filter(|p| inside(p) && p.status == s).count();
+    println!(
+        "{:<10} plausible band: {} fine, {} unconverged, {} undetected, {} runaway, {} bounce; \
+         largest P_TO rise {:+.3} mW, largest P_TD fall {:+.3} mW (vs V_ac = 0)",
+        spec.name,
+        fine.len(),
+        count(Status::Unconverged),
+        count(Status::Undetected),
+        count(Status::Runaway),
+        points.iter().filter(|p| inside(p) && p.bounce).count(),
+        to_up,
+        td_down
+    );
+}
+
+/// A few points again with Radau5 at a hundredfold tighter tolerance than the map's first run.
+fn check(setup: &Setup, spec: &MapSpec, points: &[Point]) -> Res<()> {
+    let mid = 10f64.powf(0.5 * (spec.plausible.0 + spec.plausible.1));
+    for v in [0.0, 0.4, 0.8] {
+        let p = setup.run(spec.axis, mid, v)?;
+        let m = setup.model(spec.axis, mid, v)?;
+        let mut o = setup.opts;
+        o.keep_series = false;
+        o.solver.method = Method::Radau5;
+        o.solver.rtol *= 0.01;
+        o.solver.atol_displacement *= 0.01;
+        let r = simulate_cycle(&m, &setup.programme, &o);
+        let show = |x: Option<f64>| x.map_or("—".to_string(), |x| format!("{:.3}", x * 1e3));
+        let (td, to) = match &r {
+            Ok(r) => (r.touchdown.map(|d| d.power), r.takeoff.map(|d| d.power)),
+            Err(_) => (None, None),
+        };
+        println!(
+            "  check {:<10} {:.3e} at {v:.1} V: map (Auto, rtol 1e-7) TD {} TO {} mW [{:?}]; \
+             Radau5 rtol {:.0e}: TD {} TO {} mW{}",
+            spec.name,
+            mid,
+            show(p.td),
+            show(p.to),
+            p.status,
+            o.solver.rtol,
+            show(td),
+            show(to),
+            if r.is_err() { " (failed)" } else { "" }
+        );
+    }
+    let _ = points;
+    Ok(())
+}
+
+fn main() -> Res<()> {
+    let args: Vec<String> = std::env::args().collect();
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
+    let n: usize = value("--grid").map_or(Ok(6), |s| s.parse())?;
+    if !(2..=400).contains(&n) {
+        return Err("--grid must be between 2 and 400".into());
+    }
+    let out = value("--out").unwrap_or_else(|| "out/maps".into());
+    let out = Path::new(&out);
+    std::fs::create_dir_all(out)?;
+    let scene =
+        Scene::from_path(value("--scene").unwrap_or_else(|| "scenes/paper_bulge.toml".into()))?;
+    let names = value("--maps").unwrap_or_else(|| "freq,zeta,lag_rigid,lag_bulge".into());
+    let setup = Setup::from_scene(&scene)?;
+    println!(
+        "# {} ({} × {} grid, {} threads); scene bulge {:.3e} kg, {:.3e} N/m ({:.1} MHz), ζ = {}",
+        scene.name,
+        n,
+        n,
+        rayon::current_num_threads(),
+        setup.bulge.mass,
+        setup.bulge.stiffness,
+        setup.bulge.frequency() * 1e-6,
+        setup.bulge.zeta
+    );
+    for spec in MAPS
+        .iter()
+        .filter(|s| names.split(',').any(|x| x == s.name))
+    {
+        let clock = Instant::now();
+        let points = run_map(&setup, spec, n)?;
+        let wall = clock.elapsed().as_secs_f64();
+        draw_map(&out.join(format!("{}.svg", spec.name)), spec, &points, n)?;
+        write_points(&out.join(format!("{}.csv", spec.name)), &points)?;
+        println!(
+            "{:<10} {} cycles pairs in {wall:.1} s",
+            spec.name,
+            points.len()
+        );
+        summarise(spec, &points);
+        if args.iter().any(|a| a == "--check") {
+            check(&setup, spec, &points)?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a 3 × 3 lag map of the rigid structure, the shortest lag at zero AC touches down within
+    /// the detector's delay (2 × ramp × window) above the static touchdown power.
+    #[test]
+    fn tiny_rigid_lag_map_matches_statics() -> Res<()> {
+        use hdi_tribology::analysis::{touchdown_power, StaticOptions};
+        let scene = Scene::from_path(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenes/paper_bulge.toml"
+        ))?;
+        let setup = Setup::from_scene(&scene)?;
+        let spec = MAPS[2];
+        let points = run_map(&setup, &spec, 3)?;
+        assert_eq!(points.len(), 9);
+        let p = points[0];
+        assert_eq!((p.v_ac, p.param), (0.0, 1e-10));
+        let m = setup.model(spec.axis, p.param, 0.0)?;
+        let stat = touchdown_power(&m, &StaticOptions::new(scene.detector.contact_threshold_n))?;
+        let td = p.td.ok_or("no touchdown")?;
+        let bias = 2.0 * 5e-3 / 1e-3 * scene.detector.window_s;
+        assert!(
+            td >= stat.power - 1e-6 && td <= stat.power + bias,
+            "{td} vs {}",
+            stat.power
+        );
+        let dir = std::env::temp_dir().join("hdi_mechanism_maps_test");
+        std::fs::create_dir_all(&dir)?;
+        draw_map(&dir.join("m.svg"), &spec, &points, 3)?;
+        assert!(std::fs::metadata(dir.join("m.svg"))?.len() > 1000);
+        Ok(())
+    }
+}
