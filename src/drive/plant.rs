@@ -6,10 +6,12 @@ use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
 use crate::clearance::Zone;
 use crate::error::{check_finite, check_non_negative, Error, Result};
 use crate::heater::Programme;
-use crate::model::{SliderModel, SliderSystem, StateLayout, Voltage};
+use crate::model::{Rest, SliderModel, SliderSystem, StateLayout, Voltage};
 use crate::ode::{Integrator, Method, OdeSystem, Options, Stats};
 use crate::scene::Scene;
-use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector, U4, U5, U6};
+use nalgebra::{
+    allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector, U10, U4, U5, U6, U7, U8, U9,
+};
 use std::cell::RefCell;
 use std::f64::consts::PI;
 
@@ -198,6 +200,8 @@ where
     fn rhs(&self, t: f64, y: &OVector<f64, D>, dy: &mut OVector<f64, D>) {
         self.with_slider(|s| s.rhs(t, y, dy));
         if !self.disk.is_flat() {
+            // The disk's motion enters the (rigid) slider's relative coordinate as −ẅ; the
+            // plant refuses a moving disk under other structures.
             dy[1] -= self.disk.acceleration(t).0;
         }
     }
@@ -238,7 +242,7 @@ pub struct Plant {
     system: DriveSystem,
     base: SliderModel,
     layout: StateLayout,
-    start: [f64; 3],
+    start: Rest,
     start_sensors: Physical,
     sensors: SensorSpec,
     ambient: Ambient,
@@ -301,21 +305,17 @@ impl Plant {
             dc.voltage.squared(0.0),
             &ScanGrid::default(),
         )?;
-        let layout = SliderSystem::new(&base, programme.clone(), true).layout();
-        let k = base.bearing().stiffness(0.0);
-        let a = solver.atol_displacement;
-        let mut atol = vec![a; layout.len()];
-        atol[1] = a * (k / base.mass).sqrt();
-        if let Some(i) = layout.lagged_force {
-            atol[i] = a * k;
+        let probe = SliderSystem::new(&base, programme.clone(), true);
+        let layout = probe.layout();
+        if layout.dofs > 1 && !disk.is_flat() {
+            return Err(Error::invalid(
+                "drive.disk",
+                "run-out and waviness are modelled for the rigid structure only; \
+                 use a flat disk with the scene's [structure]",
+            ));
         }
         // The period means of the contact force and flash temperature: 1 µN and 1 mK over 50 µs.
-        if let Some(i) = layout.contact_impulse {
-            atol[i] = 1e-6 * 5e-5;
-        }
-        if let Some(i) = layout.heat {
-            atol[i] = 1e-3 * 5e-5;
-        }
+        let atol = probe.tolerances(solver.atol_displacement, 1e-6 * 5e-5, 1e-3 * 5e-5);
         let ode = Options::default()
             .rtol(solver.rtol)
             .atol_per_component(atol)
@@ -329,7 +329,7 @@ impl Plant {
         let start_sensors = Physical {
             gap: eq.d,
             heater_power: opts.initial_power,
-            friction_power: friction * base.contact_force(base.gaps(eq.y, eq.protrusion)),
+            friction_power: friction * base.contact_force(base.gaps(&eq.q, eq.protrusion)),
             ambient: 0.0,
         };
         Ok(Plant {
@@ -340,7 +340,7 @@ impl Plant {
             },
             base,
             layout,
-            start: [eq.y, eq.protrusion, eq.interface_force],
+            start: eq.rest(),
             start_sensors,
             sensors: opts.sensors,
             ambient: opts.ambient,
@@ -389,34 +389,29 @@ impl Plant {
     /// A state size the drive has no fixed-size vector for; integrator set-up failures.
     pub fn drive(&self) -> Result<Drive<'_>> {
         let sys = &self.system;
-        let [y, delta, f] = self.start;
         let (m, o) = (self.method, &self.ode);
         let probe = SliderSystem::new(&self.base, sys.programme.clone(), true);
+        let rest = &self.start;
+        macro_rules! start {
+            ($variant:ident, $dim:expr) => {
+                Integ::$variant(Integrator::new(
+                    sys,
+                    0.0,
+                    probe.initial_state($dim, rest),
+                    1.0,
+                    m,
+                    o,
+                )?)
+            };
+        }
         let integ = match self.layout.len() {
-            4 => Integ::S4(Integrator::new(
-                sys,
-                0.0,
-                probe.initial_state(U4, y, delta, f),
-                1.0,
-                m,
-                o,
-            )?),
-            5 => Integ::S5(Integrator::new(
-                sys,
-                0.0,
-                probe.initial_state(U5, y, delta, f),
-                1.0,
-                m,
-                o,
-            )?),
-            6 => Integ::S6(Integrator::new(
-                sys,
-                0.0,
-                probe.initial_state(U6, y, delta, f),
-                1.0,
-                m,
-                o,
-            )?),
+            4 => start!(S4, U4),
+            5 => start!(S5, U5),
+            6 => start!(S6, U6),
+            7 => start!(S7, U7),
+            8 => start!(S8, U8),
+            9 => start!(S9, U9),
+            10 => start!(S10, U10),
             n => {
                 return Err(Error::analysis(
                     "drive",
@@ -458,6 +453,10 @@ enum Integ<'p> {
     S4(Integrator<'p, U4, DriveSystem>),
     S5(Integrator<'p, U5, DriveSystem>),
     S6(Integrator<'p, U6, DriveSystem>),
+    S7(Integrator<'p, U7, DriveSystem>),
+    S8(Integrator<'p, U8, DriveSystem>),
+    S9(Integrator<'p, U9, DriveSystem>),
+    S10(Integrator<'p, U10, DriveSystem>),
 }
 
 macro_rules! with_integ {
@@ -466,6 +465,10 @@ macro_rules! with_integ {
             Integ::S4($it) => $body,
             Integ::S5($it) => $body,
             Integ::S6($it) => $body,
+            Integ::S7($it) => $body,
+            Integ::S8($it) => $body,
+            Integ::S9($it) => $body,
+            Integ::S10($it) => $body,
         }
     };
 }
@@ -631,7 +634,7 @@ where
         gap: g.bulge,
         pad_gap: g.pad,
         displacement: y[0],
-        velocity: y[1],
+        velocity: y[layout.velocity(0)],
         protrusion: sys.protrusion(t, y),
         mean_contact_force: mean(layout.contact_impulse),
         contact_force: m.contact_force(g),
