@@ -449,6 +449,8 @@ impl Plant {
 }
 
 /// The integrator, on a state sized at compile time for the layouts a scene can have.
+// One per drive, built once and never moved per step: the size difference costs nothing.
+#[allow(clippy::large_enum_variant)]
 enum Integ<'p> {
     S4(Integrator<'p, U4, DriveSystem>),
     S5(Integrator<'p, U5, DriveSystem>),

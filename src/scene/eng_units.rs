@@ -184,10 +184,7 @@ fn in_unit(reason: &str, factor: f64, unit: &str) -> String {
         let word = words[i];
         // A number may carry a sign prefix (±) and trailing punctuation (`,` or `)`).
         let body_start = word.find(|c: char| c != '±').unwrap_or(word.len());
-        let body_end = word
-            .find(|c: char| c == ',' || c == ')')
-            .unwrap_or(word.len())
-            .max(body_start);
+        let body_end = word.find([',', ')']).unwrap_or(word.len()).max(body_start);
         let (sign, body, tail) = (
             &word[..body_start],
             &word[body_start..body_end],
