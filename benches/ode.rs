@@ -1,10 +1,12 @@
 //! Speed of the ODE stepper on a slider-like proxy (a 2-state oscillator with a mode at
 //! 87 kHz, a 21 kHz drive and a stiff one-sided contact, integrated for 7.6 ms) and on the
-//! stiff Van der Pol oscillator, for every method. Run: `cargo bench --bench ode`; a table of
-//! the work done (steps, evaluations, factorisations) comes first.
+//! stiff Van der Pol oscillator, for every method, and the same Van der Pol runs stepped by hand
+//! with the `Integrator` (`van_der_pol_mu1000_stepped/*`: the overhead of stepping against
+//! `solve`). Run: `cargo bench --bench ode`; a table of the work done (steps, evaluations,
+//! factorisations) comes first.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use hdi_tribology::ode::{solve, Method, OdeSystem, Options, SaveAt};
+use hdi_tribology::ode::{solve, Integrator, Method, OdeSystem, Options, SaveAt, StepStatus};
 use nalgebra::{Matrix2, Vector2, U2};
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -165,6 +167,14 @@ fn bench(c: &mut Criterion) {
                     &mut [],
                 )
                 .unwrap()
+            })
+        });
+        c.bench_function(&format!("van_der_pol_mu1000_stepped/{m}"), |b| {
+            b.iter(|| {
+                let y0 = black_box(Vector2::new(2.0, 0.0));
+                let mut it = Integrator::new(&vdp, 0.0, y0, 2000.0, m, &opts).unwrap();
+                while it.step().unwrap() != StepStatus::ReachedEnd {}
+                *it.state()
             })
         });
     }

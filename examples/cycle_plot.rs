@@ -1,19 +1,33 @@
 //! One touchdown/take-off cycle of any scene, plotted.
 //!
-//! `cargo run --release --example cycle_plot -- my_scene.toml [--v-ac 0.6] [--triggered]`
-//! writes `out/cycle_plot/` with the time series as CSV and three SVG charts: forces against
+//! `cargo run --release --example cycle_plot -- my_scene.toml [--v-ac 0.6] [--triggered]
+//! [--out DIR]` writes `DIR` (default `$HDI_OUT_DIR/cycle_plot`, else `out/cycle_plot`) with the time series as CSV and three SVG charts: forces against
 //! time, spacing against time, and the contact indicator against heater power. Without a scene
 //! file it uses the built-in paper scene. Start a scene of your own from
 //! `cargo run --features cli --bin hdi -- scene --paper > my_scene.toml`.
 
 use hdi_tribology::analysis::{simulate_cycle, CycleOptions, HeaterProgramme};
 use hdi_tribology::model::{SliderModel, Voltage};
-use hdi_tribology::report::{Chart, Series};
+use hdi_tribology::report::{palette, Chart, Series};
 use hdi_tribology::scene::Scene;
 use std::path::Path;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+#[path = "common/figures.rs"]
+#[allow(dead_code)]
+mod figures;
+#[path = "common/output.rs"]
+mod output;
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+fn main() -> Res<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    let out = output::out_dir("cycle_plot", &args)?;
+    run(&args, &out)
+}
+
+/// Runs the cycle the arguments ask for and writes its files into `out`.
+fn run(args: &[String], out: &Path) -> Res<()> {
     let flag = |name: &str| args.iter().position(|a| a == name);
     let value = |name: &str| flag(name).and_then(|i| args.get(i + 1));
     let scene = match args.first().filter(|a| !a.starts_with("--")) {
@@ -42,49 +56,57 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let r = simulate_cycle(&model, &programme, &opts)?;
     let s = r.series.as_ref().ok_or("no time series")?;
 
-    let out = Path::new("out/cycle_plot");
-    std::fs::create_dir_all(out)?;
     s.write_csv(&out.join("series.csv"))?;
-    let ms = |f: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
-        (0..s.t.len()).map(|i| (s.t[i] * 1e3, f(i))).collect()
-    };
-    let line = |label, points| Series {
-        label,
-        points,
-        markers: false,
-    };
+    let all = (f64::NEG_INFINITY, f64::INFINITY);
+    let what = format!(
+        "{}, V_ac = {} V, {} programme",
+        scene.name,
+        model.voltage.ac_amplitude,
+        if flag("--triggered").is_some() {
+            "touchdown-triggered"
+        } else {
+            "fixed"
+        }
+    );
+    let title = |t: &str| format!("{t}: {what}");
+    figures::forces_chart(&title("forces"), s, all, None).to_svg(
+        &out.join("forces.svg"),
+        1000,
+        550,
+    )?;
     Chart {
-        title: &scene.name,
-        x_label: "t (ms)",
-        y_label: "force (mN)",
-        series: vec![
-            line("air bearing", ms(&|i| s.air_bearing[i] * 1e3)),
-            line("intermolecular", ms(&|i| s.intermolecular[i] * 1e3)),
-            line("electrostatic", ms(&|i| s.electrostatic[i] * 1e3)),
-            line("contact", ms(&|i| s.contact[i] * 1e3)),
-            line("total", ms(&|i| s.total[i] * 1e3)),
-        ],
-        log: (false, false),
-    }
-    .to_svg(&out.join("forces.svg"), 1000, 550)?;
-    Chart {
-        title: &scene.name,
+        title: &title("spacing"),
         x_label: "t (ms)",
         y_label: "bulge gap d (nm)",
-        series: vec![line("d", ms(&|i| s.d[i] * 1e9))],
-        log: (false, false),
+        series: vec![
+            Series::line("", figures::window(s, all, |s, i| s.d[i] * 1e9)).colour(figures::SPACING),
+        ],
+        ..Chart::default()
     }
     .to_svg(&out.join("spacing.svg"), 1000, 400)?;
     let indicator = (0..s.t.len())
         .filter(|&i| s.indicator[i].is_finite())
         .map(|i| (s.power[i] * 1e3, s.indicator[i] * 1e6))
         .collect();
+    let threshold = scene.detector.contact_threshold_n * 1e6;
+    let (p0, p1) = s
+        .power
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &p| {
+            (a.min(p * 1e3), b.max(p * 1e3))
+        });
     Chart {
-        title: &scene.name,
+        title: &title("contact indicator"),
         x_label: "heater power (mW)",
         y_label: "running mean of F_c (µN)",
-        series: vec![line("contact indicator", indicator)],
-        log: (false, false),
+        series: vec![
+            Series::line("contact indicator", indicator).colour(palette::BLUE),
+            Series::line("threshold F_th", vec![(p0, threshold), (p1, threshold)])
+                .colour(palette::BLACK)
+                .width(1)
+                .dashed(),
+        ],
+        ..Chart::default()
     }
     .to_svg(&out.join("indicator.svg"), 900, 500)?;
 
@@ -114,9 +136,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 #[cfg(test)]
 mod tests {
-    /// `cargo test` runs the example, so CI runs every example.
+    /// `cargo test` runs the example (into a temporary directory), so CI runs every example.
     #[test]
     fn example_runs() {
-        super::main().expect("the example runs to completion");
+        let dir = tempfile::tempdir().unwrap();
+        super::run(&[], dir.path()).expect("the example runs to completion");
+        for f in ["series.csv", "forces.svg", "spacing.svg", "indicator.svg"] {
+            assert!(dir.path().join(f).is_file(), "{f} written");
+        }
     }
 }

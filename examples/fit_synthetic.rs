@@ -1,1 +1,240 @@
-fn main() {}
+//! Synthetic spin-stand measurements from the paper scene, with seeded noise, fitted back.
+//!
+//! Two fits: a static one (touchdown and take-off power at ten DC voltages, 20 points, four free
+//! parameters) and one that adds a six-amplitude AC hysteresis curve (one dynamic cycle per
+//! amplitude). Each prints the true values against the fitted ones with their standard errors,
+//! the identifiability report, and the wall time against the time of one model evaluation
+//! measured in the same run.
+//!
+//!     cargo run --release --example fit_synthetic [-- static|dynamic|dynamic-tight]
+
+use std::time::Instant;
+
+use hdi_tribology::fit::{fit, model_curves, DataSet, FitOptions, FitResult, FreeParameter};
+use hdi_tribology::scene::Scene;
+use hdi_tribology::surface::Xoshiro256;
+
+/// Seeded Gaussian noise of standard deviation `sd` (Box–Muller).
+fn gauss(rng: &mut Xoshiro256, sd: f64) -> f64 {
+    let (u, v) = (rng.next_open01(), rng.next_open01());
+    sd * (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+}
+
+/// The model's curves on `grid` with noise of `sd_mw` added, as a data file would give them.
+fn measure(truth: &Scene, grid: &str, origin: &str, sd_mw: f64, seed: u64) -> DataSet {
+    let template = DataSet::from_csv_str(grid, origin).expect("grid");
+    let mut d = model_curves(truth, &[template])
+        .expect("model curves")
+        .remove(0);
+    let mut rng = Xoshiro256::new(seed);
+    for o in &mut d.observed {
+        for v in &mut o.values {
+            *v += gauss(&mut rng, sd_mw * 1e-3);
+        }
+    }
+    d
+}
+
+fn grid(x_col: &str, xs: &[f64]) -> String {
+    let mut s = format!("{x_col},touchdown_power_mw,takeoff_power_mw\n");
+    for x in xs {
+        s.push_str(&format!("{x},0,0\n"));
+    }
+    s
+}
+
+fn report(title: &str, r: &FitResult, truth: &[f64], secs: f64, one_eval: f64) {
+    println!("\n== {title}");
+    println!(
+        "{:<24} {:>12} {:>12} {:>12} {:>8}",
+        "parameter", "true", "fitted", "1σ error", "|Δ|/σ"
+    );
+    for (p, t) in r.parameters.iter().zip(truth) {
+        match p.standard_error {
+            Some(se) => println!(
+                "{:<24} {:>12.4e} {:>12.4e} {:>12.3e} {:>8.2}",
+                p.name,
+                t,
+                p.value,
+                se,
+                (p.value - t).abs() / se
+            ),
+            None => println!(
+                "{:<24} {:>12.4e} {:>12.4e} {:>12} {:>8}",
+                p.name, t, p.value, "not determined", "-"
+            ),
+        }
+    }
+    for s in &r.identifiability.statements {
+        println!("  · {s}");
+    }
+    for w in &r.warnings {
+        println!("  ! {w}");
+    }
+    if let Some(i) = &r.integration {
+        println!(
+            "  integration check: rtol {:e}, largest weighted change under 10× tighter tolerances {:.2e} ({:.3} of the scatter)",
+            i.rtol, i.max_weighted_change, i.ratio_to_scatter
+        );
+    }
+    println!(
+        "  {} points, χ² {:.3}, s {:.3}, converged {}, trusted {}, {} model evaluations",
+        r.points, r.chi2, r.residual_scale, r.converged, r.trusted, r.evaluations
+    );
+    println!(
+        "  wall time {secs:.3} s; one model evaluation {one_eval:.4} s; ratio {:.1}",
+        secs / one_eval
+    );
+}
+
+/// Times one model evaluation of `baseline` and the fit from `start`, then reports both.
+fn timed_fit(
+    title: &str,
+    baseline: &Scene,
+    start: &Scene,
+    data: &[DataSet],
+    free: &[FreeParameter],
+    truth: &[f64],
+) -> Result<(), hdi_tribology::fit::FitError> {
+    let t = Instant::now();
+    model_curves(baseline, data)?;
+    let one = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let r = fit(start, data, free, &FitOptions::default())?;
+    report(title, &r, truth, t.elapsed().as_secs_f64(), one);
+    Ok(())
+}
+
+fn main() -> Result<(), hdi_tribology::fit::FitError> {
+    let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());
+    // The truth: the paper scene with a contact potential of 0.2 V.
+    let mut truth = Scene::paper();
+    if let Some(e) = truth.electrostatic.as_mut() {
+        e.contact_potential_v = 0.2;
+    }
+    // The starting scene: every free parameter off by 10–30 %.
+    let mut start = truth.clone();
+    start.surface.height_sigma_m = 0.6e-9;
+    if let hdi_tribology::surface::PeakModel::RiceMaxima { sigma_m, .. } = &mut start.surface.peaks
+    {
+        *sigma_m = 0.6e-9;
+    }
+    if let Some(m) = start.intermolecular.as_mut() {
+        m.hamaker_attractive_j = 1.3e-19;
+    }
+    if let Some(e) = start.electrostatic.as_mut() {
+        e.contact_potential_v = 0.0;
+    }
+    start.heater.efficiency_m_per_w = 1.1e-7;
+    let free = vec![
+        FreeParameter::new("height_sigma_nm").bounded(0.3, 1.5),
+        FreeParameter::new("hamaker_attractive_j").bounded(2e-20, 5e-19),
+        FreeParameter::new("contact_potential_v").bounded(-1.0, 1.0),
+        FreeParameter::new("efficiency_nm_per_mw").bounded(0.05, 0.2),
+    ];
+    let true_values = [0.7, 1e-19, 0.2, 0.1];
+    let dc: Vec<f64> = (0..10).map(|i| -0.4 + 1.2 * i as f64 / 9.0).collect();
+    let static_data = measure(
+        &truth,
+        &grid("dc_voltage_v", &dc),
+        "static_vs_vdc.csv",
+        0.05,
+        7,
+    );
+    let opts = FitOptions::default();
+
+    if !which.starts_with("dynamic") {
+        timed_fit(
+            "static: touchdown and take-off at 10 DC voltages (20 points), 4 parameters",
+            &start,
+            &start,
+            std::slice::from_ref(&static_data),
+            &free,
+            &true_values,
+        )?;
+        // The same data, touchdown only, for σ and A alone: the combination the issue asks about.
+        let td_only = {
+            let mut d = static_data.clone();
+            d.observed
+                .retain(|o| o.quantity == hdi_tribology::fit::Quantity::TouchdownPower);
+            d
+        };
+        let pair = &free[..2];
+        let mut near = truth.clone();
+        near.surface = start.surface.clone();
+        near.intermolecular = start.intermolecular.clone();
+        let multi = FitOptions { starts: 6, ..opts };
+        let r = fit(&near, &[td_only], pair, &multi)?;
+        report(
+            "touchdown alone, σ and A free, 6 starts",
+            &r,
+            &true_values[..2],
+            f64::NAN,
+            f64::NAN,
+        );
+    }
+    if !which.starts_with("dynamic") {
+        // Four parameters that leave the force tables as they are: one table for the whole fit.
+        let free4 = vec![
+            FreeParameter::new("contact_potential_v").bounded(-1.0, 1.0),
+            FreeParameter::new("efficiency_nm_per_mw").bounded(0.05, 0.2),
+            FreeParameter::new("nominal_clearance_nm").bounded(7.0, 13.0),
+            FreeParameter::new("stiffness_n_per_m").bounded(1e5, 1e6),
+        ];
+        let mut s4 = truth.clone();
+        if let Some(e) = s4.electrostatic.as_mut() {
+            e.contact_potential_v = 0.0;
+        }
+        s4.heater.efficiency_m_per_w = 1.1e-7;
+        s4.nominal_clearance_m = 1.05e-8;
+        s4.air_bearing = hdi_tribology::force::AirBearingModel::Linear {
+            stiffness_n_per_m: 3.3e5,
+            damping_n_s_per_m: 0.0548,
+        };
+        timed_fit(
+            "static, 20 points, φ, η, h0 and k free (the force tables are built once)",
+            &s4,
+            &s4,
+            std::slice::from_ref(&static_data),
+            &free4,
+            &[0.2, 0.1, 10.0, 3e5],
+        )?;
+    }
+    if which != "static" {
+        // The paper scene as it is (φ = 0), with σ, A and η free.
+        let mut truth = truth.clone();
+        if let Some(e) = truth.electrostatic.as_mut() {
+            e.contact_potential_v = 0.0;
+        }
+        let mut start = start.clone();
+        if let Some(e) = start.electrostatic.as_mut() {
+            e.contact_potential_v = 0.0;
+        }
+        // `dynamic-tight`: cycles at rtol 1e-8 (the scene's is 1e-6).
+        if which == "dynamic-tight" {
+            for s in [&mut truth, &mut start] {
+                s.solver.rtol = 1e-8;
+                s.solver.atol_m = 1e-16;
+            }
+        }
+        let free = [free[0].clone(), free[1].clone(), free[3].clone()];
+        let true_values = [0.7, 1e-19, 0.1];
+        let ac = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0];
+        let ac_grid = grid("ac_amplitude_v", &ac);
+        let ac_data = measure(&truth, &ac_grid, "cycle_vs_vac.csv", 0.05, 11);
+        let dc_grid = grid("dc_voltage_v", &dc);
+        let static_data = measure(&truth, &dc_grid, "static_vs_vdc.csv", 0.05, 7);
+        let data = [static_data, ac_data];
+        timed_fit(
+            "static curve plus a 6-amplitude AC hysteresis curve (32 points), σ, A, η",
+            // At the start the cycle detects no take-off at zero amplitude (clipped, fitted
+            // against the programme's end): the baseline evaluation is timed at the truth.
+            &truth,
+            &start,
+            &data,
+            &free,
+            &true_values,
+        )?;
+    }
+    Ok(())
+}

@@ -4,12 +4,18 @@
 //!
 //! Concentrations spike by five orders of magnitude once per period; an event marks each spike
 //! (y₁ rising through 1000) so the period can be read off. The automatic method switches between
-//! the explicit Tsit5 and the stiff Rodas5P; a tight Rodas5P run is the reference.
+//! the explicit Tsit5 and a stiff method; a tight Rodas5P run is the reference.
+//!
+//! The second part steps the integrator by hand: the same reaction with an acting event that
+//! "titrates" the bromide-like species y₂ (halves it) whenever y₁ spikes, observing every step
+//! without saving them, and an exact stop at a chosen time.
 //!
 //! Run with `cargo run --release --example own_ode`.
 
-use hdi_tribology::ode::{solve, Direction, Event, FnSystem, Method, OdeError, Options, SaveAt};
-use nalgebra::Vector3;
+use hdi_tribology::nalgebra::Vector3;
+use hdi_tribology::ode::{
+    solve, Direction, Event, FnSystem, Integrator, Method, OdeError, Options, SaveAt, StepStatus,
+};
 use std::time::Instant;
 
 fn main() -> Result<(), OdeError> {
@@ -84,6 +90,51 @@ fn main() -> Result<(), OdeError> {
         "reference y(720) = {:.8e}, {:.8e}, {:.8e}",
         reference.y_end[0], reference.y_end[1], reference.y_end[2]
     );
+    stepped_by_hand(&orego, y0, t_end)
+}
+
+/// The integrator stepped by hand with an acting event and a streaming observer.
+fn stepped_by_hand<S>(orego: &S, y0: Vector3<f64>, t_end: f64) -> Result<(), OdeError>
+where
+    S: hdi_tribology::ode::OdeSystem<hdi_tribology::nalgebra::U3>,
+{
+    let opts = Options::default().rtol(1e-8).atol(1e-10);
+    // At each spike y₂ is halved: the action changes the state and the integration goes on.
+    let titrate = Event::new(|_t, y: &Vector3<f64>| y[0] - 1000.0)
+        .direction(Direction::Rising)
+        .affect(|_t, y| y[1] *= 0.5);
+    let mut it = Integrator::new(orego, 0.0, y0, t_end, Method::Auto, &opts)?.events([titrate]);
+    // Observer: the peak of y₁ and the number of steps, without storing the trajectory.
+    let (mut peak, mut t_peak, mut steps) = (0.0f64, 0.0, 0usize);
+    let mut actions: Vec<f64> = Vec::new();
+    // Stop exactly at t = 300 on the way (dense output inside the last step lands there).
+    it.advance_to(300.0)?;
+    let y300 = *it.state();
+    // Events located on the way to t = 300 (here: the first spike, which acted).
+    actions.extend(it.events_hit().iter().map(|e| e.t));
+    loop {
+        let status = it.step()?;
+        steps += 1;
+        if it.state()[0] > peak {
+            (peak, t_peak) = (it.state()[0], it.t());
+        }
+        if let StepStatus::Acted(_) = status {
+            actions.push(it.t());
+        }
+        if status == StepStatus::ReachedEnd {
+            break;
+        }
+    }
+    println!(
+        "stepped by hand (auto, rtol 1e-8): y(300) = {:.6e}, {:.6e}, {:.6e}",
+        y300[0], y300[1], y300[2]
+    );
+    let times: Vec<String> = actions.iter().map(|t| format!("{t:.4}")).collect();
+    println!(
+        "  after t = 300: {steps} steps, peak y₁ = {peak:.4e} at t = {t_peak:.3}; y₂ halved at t = {}",
+        times.join(", ")
+    );
+    println!("  work: {:?}", it.stats());
     Ok(())
 }
 

@@ -1,38 +1,87 @@
 //! The main job: the paper's figures for the built-in paper scene.
 //!
-//! Writes SVG plots and CSV tables into `out/paper/` and prints a summary table:
-//! - Fig. 1: contact indicator against heater power over a touchdown-triggered cycle;
+//! Writes SVG plots and CSV tables into the output directory and prints a summary table:
+//! - Fig. 1: the contact indicator (normalized by the threshold F_th) against the heater power
+//!   measured from touchdown, over touchdown-triggered cycles (`--fig1-absolute`: against the
+//!   absolute power, in µN);
 //! - Fig. 2(b): clearance change against DC voltage, with a parabolic fit;
-//! - Fig. 3(a–c): forces and spacing against time at 0 V and 0.6 V AC;
-//! - Fig. 3(d): hysteresis against AC amplitude;
+//! - Fig. 3(a), (c): forces against time at 0 V and 0.6 V AC, on one y range;
+//! - Fig. 3(b): a zoom of the total, electrostatic and air-bearing forces at 0.6 V with the
+//!   spacing on a second axis, in the letter's colours;
+//! - Fig. 3(d): hysteresis against AC amplitude under both programmes;
 //! - Fig. 4: mean temperature rise against hysteresis, under both programmes.
 //!
-//! Run with `cargo run --release --example paper`; `-- --method NAME` picks another ODE method
-//! (tsit5, dop853, rodas5p, radau5, auto) than the scene's.
+//! In Fig. 3(d) and Fig. 4 a point whose powers were still moving at the tightest tolerance is
+//! drawn hollow, and a negative hysteresis (not physical) as a cross.
+//!
+//! Run with `cargo run --release --example paper -- [--out DIR] [--method NAME]
+//! [--fig1-absolute] [--wall-seconds]`. The output directory is `DIR`, else
+//! `$HDI_OUT_DIR/paper`, else `out/paper`. `--method` picks another ODE method (tsit5, dop853,
+//! rodas5p, radau5, auto) than the scene's; `--wall-seconds` adds the run-dependent wall time
+//! to the sweep tables.
 
-use hdi_tribology::analysis::cycle::{CycleResult, TimeSeries};
 use hdi_tribology::analysis::response::simulated_dither;
 use hdi_tribology::analysis::*;
 use hdi_tribology::model::{SliderModel, Voltage};
-use hdi_tribology::report::{write_csv, Chart, Series};
+use hdi_tribology::ode::Method;
+use hdi_tribology::report::{palette, write_csv, Chart, Colour, CsvTable, Marker, Series};
 use hdi_tribology::scene::Scene;
 use std::path::Path;
 use std::time::Instant;
 
+#[path = "common/figures.rs"]
+mod figures;
+#[path = "common/output.rs"]
+mod output;
+
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
+/// What the command line asks for besides the output directory.
+#[derive(Clone, Debug, Default)]
+struct Options {
+    /// An ODE method other than the scene's.
+    method: Option<Method>,
+    /// Fig. 1 against the absolute heater power, the indicator in µN.
+    fig1_absolute: bool,
+    /// Add the wall time (different on every run) to the sweep tables.
+    wall_seconds: bool,
+}
+
+impl Options {
+    fn parse(args: &[String]) -> Res<Self> {
+        let method = match args.iter().position(|a| a == "--method") {
+            Some(i) => Some(args.get(i + 1).ok_or("--method needs a name")?.parse()?),
+            None => None,
+        };
+        Ok(Options {
+            method,
+            fig1_absolute: args.iter().any(|a| a == "--fig1-absolute"),
+            wall_seconds: args.iter().any(|a| a == "--wall-seconds"),
+        })
+    }
+}
+
 fn main() -> Res<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let options = Options::parse(&args)?;
+    let out = output::out_dir("paper", &args)?;
+    run(&options, &out)
+}
+
+/// The fixed programme's colour and marker in every figure.
+const FIXED: (Colour, Marker) = (palette::BLUE, Marker::Circle);
+/// The touchdown-triggered programme's colour and marker in every figure.
+const TRIGGERED: (Colour, Marker) = (palette::VERMILION, Marker::Triangle);
+
+/// Computes everything and writes the files into `out`.
+fn run(options: &Options, out: &Path) -> Res<()> {
     let clock = Instant::now();
-    let out = Path::new("out/paper");
-    std::fs::create_dir_all(out)?;
     let scene = Scene::paper();
     let model = SliderModel::from_scene(&scene)?;
     let static_opts = StaticOptions::new(scene.detector.contact_threshold_n);
     let mut opts = CycleOptions::from_scene(&scene)?;
-    let args: Vec<String> = std::env::args().collect();
-    if let Some(i) = args.iter().position(|a| a == "--method") {
-        let name = args.get(i + 1).ok_or("--method needs a name")?;
-        opts.solver.method = name.parse()?;
+    if let Some(m) = options.method {
+        opts.solver.method = m;
     }
     let fixed = HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
     let t = &scene.heater.triggered;
@@ -77,18 +126,15 @@ fn main() -> Res<()> {
             }
         );
     }
+    let col = |f: fn(&Equilibrium) -> f64| curve.points.iter().map(f).collect::<Vec<f64>>();
     write_csv(
         &out.join("s_curve.csv"),
         &["d_m", "power_w", "stiffness_n_per_m", "contact_force_n"],
         &[
-            &curve.points.iter().map(|p| p.d).collect::<Vec<_>>(),
-            &curve.points.iter().map(|p| p.power).collect::<Vec<_>>(),
-            &curve.points.iter().map(|p| p.stiffness).collect::<Vec<_>>(),
-            &curve
-                .points
-                .iter()
-                .map(|p| p.contact_force)
-                .collect::<Vec<_>>(),
+            &col(|p| p.d),
+            &col(|p| p.power),
+            &col(|p| p.stiffness),
+            &col(|p| p.contact_force),
         ],
     )?;
 
@@ -96,7 +142,8 @@ fn main() -> Res<()> {
     let volts: Vec<f64> = (-10..=10).map(|i| i as f64 * 0.1).collect();
     let fh = clearance_change(&model, &volts, &static_opts)?;
     let dfh: Vec<f64> = fh.iter().map(|c| c.clearance_change).collect();
-    let (a, b, c) = parabola_fit(&volts, &dfh);
+    let fit = parabola_fit(&volts, &dfh);
+    let (a, b, c) = fit;
     println!("\n# Fig. 2(b): clearance change against DC voltage");
     println!(
         "fit ΔFH = {:.4} nm/V² · V² + {:.2e} nm/V · V + {:.2e} nm",
@@ -110,34 +157,10 @@ fn main() -> Res<()> {
     }
     write_csv(
         &out.join("fig2b_clearance_vs_dc.csv"),
-        &["v_dc", "clearance_change_m"],
+        &["v_dc_minus_phi_v", "clearance_change_m"],
         &[&volts, &dfh],
     )?;
-    let fit: Vec<(f64, f64)> = (-100..=100)
-        .map(|i| {
-            let v = i as f64 * 0.01;
-            (v, nm(a * v * v + b * v + c))
-        })
-        .collect();
-    Chart {
-        title: "Fig. 2(b) clearance change against DC voltage",
-        x_label: "V_dc − φ (V)",
-        y_label: "ΔFH (nm)",
-        series: vec![
-            Series {
-                label: "static model",
-                points: volts.iter().zip(&dfh).map(|(v, d)| (*v, nm(*d))).collect(),
-                markers: true,
-            },
-            Series {
-                label: "parabolic fit",
-                points: fit,
-                markers: false,
-            },
-        ],
-        log: (false, false),
-    }
-    .to_svg(&out.join("fig2b_clearance_vs_dc.svg"), 800, 500)?;
+    fig2b_chart(&volts, &dfh, fit).to_svg(&out.join("fig2b_clearance_vs_dc.svg"), 860, 500)?;
 
     // Fig. 3(a–c): time series at 0 V and 0.6 V AC under the fixed programme.
     let mut with_series = opts;
@@ -150,37 +173,18 @@ fn main() -> Res<()> {
     };
     let c0 = simulate_cycle(&at(0.0), &fixed, &with_series)?;
     let c6 = simulate_cycle(&at(0.6), &fixed, &with_series)?;
-    for (name, cyc, title) in [
-        ("fig3a_forces_0V", &c0, "Fig. 3(a) forces, V_ac = 0 V"),
-        ("fig3c_forces_0.6V", &c6, "Fig. 3(c) forces, V_ac = 0.6 V"),
-    ] {
-        let s = series(cyc)?;
-        s.write_csv(&out.join(format!("{name}.csv")))?;
-        forces_chart(title, s, 0.0, f64::INFINITY).to_svg(
-            &out.join(format!("{name}.svg")),
-            1000,
-            550,
-        )?;
-    }
-    let s6 = series(&c6)?;
-    let (z0, z1) = (2.0e-3, 2.2e-3);
-    forces_chart("Fig. 3(b) zoom, V_ac = 0.6 V", s6, z0, z1).to_svg(
-        &out.join("fig3b_zoom_forces_0.6V.svg"),
-        1000,
-        550,
-    )?;
-    Chart {
-        title: "Fig. 3(b) zoom, spacing, V_ac = 0.6 V",
-        x_label: "t (ms)",
-        y_label: "d (nm)",
-        series: vec![Series {
-            label: "bulge gap d",
-            points: window(s6, z0, z1, |s, i| nm(s.d[i])),
-            markers: false,
-        }],
-        log: (false, false),
-    }
-    .to_svg(&out.join("fig3b_zoom_spacing_0.6V.svg"), 1000, 400)?;
+    let (s0, s6) = (series(&c0)?, series(&c6)?);
+    s0.write_csv(&out.join("fig3a_forces_0V.csv"))?;
+    s6.write_csv(&out.join("fig3c_forces_0.6V.csv"))?;
+    let (fig3a, fig3c) = fig3ac_charts(s0, s6);
+    fig3a.to_svg(&out.join("fig3a_forces_0V.svg"), 1000, 550)?;
+    fig3c.to_svg(&out.join("fig3c_forces_0.6V.svg"), 1000, 550)?;
+    figures::zoom_chart(
+        "Fig. 3(b) zoom, V_ac = 0.6 V: forces (left) and spacing (right)",
+        s6,
+        (2.0e-3, 2.2e-3),
+    )
+    .to_svg(&out.join("fig3b_zoom_0.6V.svg"), 1000, 550)?;
 
     // Fig. 3(d) and Fig. 4: sweeps under both programmes. Where the AC makes contact
     // intermittent, the running mean hovers near F_th and the detected powers depend on the
@@ -199,7 +203,7 @@ fn main() -> Res<()> {
     );
     println!("detection lags the running mean's window T_w = {:.1} µs: dynamic hysteresis is biased up by ≈ ramp × T_w", scene.detector.window_s * 1e6);
     println!(
-        "{:>6} | {:>9} {:>9} {:>9} {:>7} {:>9} {:>7} | {:>9} {:>9} {:>7} {:>9} {:>7}",
+        "{:>6} | {:>9} {:>9} {:>10} {:>7} {:>9} {:>7} | {:>9} {:>10} {:>7} {:>9} {:>7}",
         "V_ac",
         "P_TD",
         "P_TO",
@@ -217,16 +221,16 @@ fn main() -> Res<()> {
     for (fr, tr) in fixed_refined.iter().zip(&trig_refined) {
         let (f, t) = (&fr.cycle, &tr.cycle);
         println!(
-            "{:>6.2} | {:>9} {:>9} {:>9} {:>7} {:>9.3} {:>7} | {:>9} {:>9} {:>7} {:>9.3} {:>7.1}",
+            "{:>6.2} | {:>9} {:>9} {:>10} {:>7} {:>9.3} {:>7} | {:>9} {:>10} {:>7} {:>9.3} {:>7.1}",
             f.v_ac,
             opt_mw(f.touchdown.map(|d| d.power)),
             opt_mw(f.takeoff.map(|d| d.power)),
-            opt_mw(f.hysteresis),
+            hyst_mw(f.hysteresis),
             rtol(fr),
             f.mean_temperature_rise,
             fr.stats.accepted,
             opt_mw(t.touchdown.map(|d| d.power)),
-            opt_mw(t.hysteresis),
+            hyst_mw(t.hysteresis),
             rtol(tr),
             t.mean_temperature_rise,
             1e3 * (fr.wall_seconds + tr.wall_seconds),
@@ -235,7 +239,8 @@ fn main() -> Res<()> {
     println!(
         "rtol: the tolerance at which touchdown and take-off moved by less than {:.3} mW from the \
          run before (\"?\": still moving at the last of {} runs: intermittent contact, the running \
-         mean near F_th); steps and ms over all runs",
+         mean near F_th; drawn hollow); ΔP \"(neg)\": a negative hysteresis, not physical (drawn \
+         as a cross); steps and ms over all runs",
         mw(refine.power_tol),
         refine.max_runs
     );
@@ -245,109 +250,42 @@ fn main() -> Res<()> {
         1e3 * fixed_wall
     );
     println!("(powers in mW, ΔT in K)");
-    let cycles = |s: &[RefinedCycle]| s.iter().map(|r| r.cycle.clone()).collect::<Vec<_>>();
-    let (fixed_sweep, trig_sweep) = (cycles(&fixed_refined), cycles(&trig_refined));
-    sweep_csv(
-        &out.join("fig3d_hysteresis_vs_ac_fixed.csv"),
-        &fixed_refined,
+    sweep_table(&fixed_refined, options.wall_seconds)
+        .write(&out.join("fig3d_hysteresis_vs_ac_fixed.csv"))?;
+    sweep_table(&trig_refined, options.wall_seconds)
+        .write(&out.join("fig4_triggered_sweep.csv"))?;
+    let sweeps = [
+        Sweep {
+            name: "fixed programme",
+            style: FIXED,
+            results: &fixed_refined,
+        },
+        Sweep {
+            name: "touchdown-triggered programme",
+            style: TRIGGERED,
+            results: &trig_refined,
+        },
+    ];
+    fig3d_chart(&sweeps, stat.hysteresis).to_svg(
+        &out.join("fig3d_hysteresis_vs_ac.svg"),
+        1000,
+        520,
     )?;
-    sweep_csv(&out.join("fig4_triggered_sweep.csv"), &trig_refined)?;
-    let hyst = |s: &[CycleResult]| -> Vec<(f64, f64)> {
-        s.iter()
-            .filter_map(|r| r.hysteresis.map(|h| (r.v_ac, mw(h))))
-            .collect()
-    };
-    Chart {
-        title: "Fig. 3(d) hysteresis against AC amplitude, f = 10.5 kHz",
-        x_label: "V_ac (V)",
-        y_label: "P_TD − P_TO (mW)",
-        series: vec![
-            Series {
-                label: "fixed programme",
-                points: hyst(&fixed_sweep),
-                markers: true,
-            },
-            Series {
-                label: "touchdown-triggered",
-                points: hyst(&trig_sweep),
-                markers: true,
-            },
-            Series {
-                label: "static, V_ac = 0",
-                points: vec![(0.0, mw(stat.hysteresis)), (1.0, mw(stat.hysteresis))],
-                markers: false,
-            },
-        ],
-        log: (false, false),
-    }
-    .to_svg(&out.join("fig3d_hysteresis_vs_ac.svg"), 800, 500)?;
-    let temp = |s: &[CycleResult]| -> Vec<(f64, f64)> {
-        s.iter()
-            .filter_map(|r| r.hysteresis.map(|h| (mw(h), r.mean_temperature_rise)))
-            .collect()
-    };
-    Chart {
-        title: "Fig. 4 mean temperature rise against hysteresis",
-        x_label: "P_TD − P_TO (mW)",
-        y_label: "mean ΔT (K)",
-        series: vec![
-            Series {
-                label: "touchdown-triggered",
-                points: temp(&trig_sweep),
-                markers: true,
-            },
-            Series {
-                label: "fixed programme",
-                points: temp(&fixed_sweep),
-                markers: true,
-            },
-        ],
-        log: (false, false),
-    }
-    .to_svg(&out.join("fig4_temperature_vs_hysteresis.svg"), 800, 500)?;
+    fig4_chart(&sweeps).to_svg(&out.join("fig4_temperature_vs_hysteresis.svg"), 1000, 520)?;
 
     // Fig. 1: contact indicator against heater power over triggered cycles.
-    let mut trig_series = Vec::new();
+    let mut fig1 = Vec::new();
     for v in [0.0, 0.6] {
         let r = simulate_cycle(&at(v), &triggered, &with_series)?;
-        let s = series(&r)?;
-        s.write_csv(&out.join(format!("fig1_triggered_{v:.1}V.csv")))?;
-        trig_series.push((v, r));
+        series(&r)?.write_csv(&out.join(format!("fig1_triggered_{v:.1}V.csv")))?;
+        fig1.push(r);
     }
-    let mut fig1 = Vec::new();
-    let labels = ["V_ac = 0 V", "V_ac = 0.6 V"];
-    let marks = ["touchdown / take-off, 0 V", "touchdown / take-off, 0.6 V"];
-    for (k, (_, r)) in trig_series.iter().enumerate() {
-        let s = series(r)?;
-        let pts = (0..s.t.len())
-            .filter(|&i| s.indicator[i].is_finite())
-            .map(|i| (mw(s.power[i]), s.indicator[i] * 1e6))
-            .collect();
-        fig1.push(Series {
-            label: labels[k],
-            points: pts,
-            markers: false,
-        });
-        let th = scene.detector.contact_threshold_n * 1e6;
-        let m: Vec<(f64, f64)> = [r.touchdown, r.takeoff]
-            .iter()
-            .flatten()
-            .map(|d| (mw(d.power), th))
-            .collect();
-        fig1.push(Series {
-            label: marks[k],
-            points: m,
-            markers: true,
-        });
-    }
-    Chart {
-        title: "Fig. 1 contact indicator over a touchdown-triggered cycle",
-        x_label: "heater power (mW)",
-        y_label: "running mean of F_c (µN)",
-        series: fig1,
-        log: (false, false),
-    }
-    .to_svg(&out.join("fig1_indicator_vs_power.svg"), 900, 550)?;
+    fig1_chart(
+        &[("V_ac = 0 V", &fig1[0]), ("V_ac = 0.6 V", &fig1[1])],
+        scene.detector.contact_threshold_n,
+        options.fig1_absolute,
+    )?
+    .to_svg(&out.join("fig1_indicator_vs_power.svg"), 1000, 550)?;
 
     // Linear response: predicted against simulated dither at 0.6 V.
     let m6 = at(0.6);
@@ -389,6 +327,14 @@ fn opt_mw(p: Option<f64>) -> String {
     p.map_or("—".to_string(), |p| format!("{:.3}", mw(p)))
 }
 
+/// A hysteresis in mW, marked when negative (not physical).
+fn hyst_mw(h: Option<f64>) -> String {
+    match h {
+        Some(h) if h < 0.0 => format!("{:.3}(neg)", mw(h)),
+        _ => opt_mw(h),
+    }
+}
+
 /// Least-squares parabola `a x² + b x + c`.
 fn parabola_fit(x: &[f64], y: &[f64]) -> (f64, f64, f64) {
     use nalgebra::{DMatrix, DVector};
@@ -406,94 +352,316 @@ fn series(r: &CycleResult) -> Res<&TimeSeries> {
         .ok_or_else(|| "cycle kept no time series".into())
 }
 
-fn window(
-    s: &TimeSeries,
-    t0: f64,
-    t1: f64,
-    f: impl Fn(&TimeSeries, usize) -> f64,
-) -> Vec<(f64, f64)> {
-    (0..s.t.len())
-        .filter(|&i| s.t[i] >= t0 && s.t[i] <= t1)
-        .map(|i| (s.t[i] * 1e3, f(s, i)))
-        .collect()
-}
-
-fn forces_chart<'a>(title: &'a str, s: &TimeSeries, t0: f64, t1: f64) -> Chart<'a> {
-    let un = |f: fn(&TimeSeries, usize) -> f64| window(s, t0, t1, move |s, i| f(s, i) * 1e3);
-    Chart {
-        title,
-        x_label: "t (ms)",
-        y_label: "force (mN)",
-        series: vec![
-            Series {
-                label: "total",
-                points: un(|s, i| s.total[i]),
-                markers: false,
-            },
-            Series {
-                label: "air bearing",
-                points: un(|s, i| s.air_bearing[i]),
-                markers: false,
-            },
-            Series {
-                label: "intermolecular",
-                points: un(|s, i| s.intermolecular[i]),
-                markers: false,
-            },
-            Series {
-                label: "electrostatic",
-                points: un(|s, i| s.electrostatic[i]),
-                markers: false,
-            },
-            Series {
-                label: "contact",
-                points: un(|s, i| s.contact[i]),
-                markers: false,
-            },
-        ],
-        log: (false, false),
+/// The sweep table: powers in W, missing detections empty, counts as integers; the wall time
+/// only when asked for (it differs on every run).
+fn sweep_table(rs: &[RefinedCycle], wall_seconds: bool) -> CsvTable {
+    let power = |f: fn(&CycleResult) -> Option<f64>| rs.iter().map(move |r| f(&r.cycle));
+    let t = CsvTable::new()
+        .real("v_ac_v", rs.iter().map(|r| r.cycle.v_ac))
+        .optional("touchdown_power_w", power(|c| c.touchdown.map(|d| d.power)))
+        .optional("takeoff_power_w", power(|c| c.takeoff.map(|d| d.power)))
+        .optional("hysteresis_w", rs.iter().map(|r| r.cycle.hysteresis))
+        .real(
+            "mean_temperature_rise_k",
+            rs.iter().map(|r| r.cycle.mean_temperature_rise),
+        )
+        .real("rtol", rs.iter().map(|r| r.rtol))
+        .real("power_change_w", rs.iter().map(|r| r.change))
+        .flag("converged", rs.iter().map(|r| r.converged))
+        .flag(
+            "hysteresis_negative",
+            rs.iter()
+                .map(|r| r.cycle.hysteresis.is_some_and(|h| h < 0.0)),
+        )
+        .integer("runs", rs.iter().map(|r| r.runs as u64))
+        .integer("steps", rs.iter().map(|r| r.stats.accepted as u64));
+    if wall_seconds {
+        t.real("wall_seconds_s", rs.iter().map(|r| r.wall_seconds))
+    } else {
+        t
     }
 }
 
-fn sweep_csv(path: &Path, rs: &[RefinedCycle]) -> Res<()> {
-    let col = |f: &dyn Fn(&RefinedCycle) -> f64| rs.iter().map(f).collect::<Vec<f64>>();
-    write_csv(
-        path,
-        &[
-            "v_ac",
-            "touchdown_power_w",
-            "takeoff_power_w",
-            "hysteresis_w",
-            "mean_temperature_rise_k",
-            "rtol",
-            "power_change_w",
-            "converged",
-            "runs",
-            "steps",
-            "wall_seconds",
+/// One programme's refined sweep, with its colour and marker.
+struct Sweep<'a> {
+    name: &'a str,
+    style: (Colour, Marker),
+    results: &'a [RefinedCycle],
+}
+
+/// The points `point(r)` of a sweep split by status: converged and non-negative (filled),
+/// still moving at the tightest tolerance (hollow), negative hysteresis (cross). Sweeps
+/// without a hysteresis (no touchdown or no take-off) are left out.
+fn status_series<'a>(
+    sweep: &Sweep<'a>,
+    labels: [&'a str; 3],
+    point: impl Fn(&CycleResult, f64) -> (f64, f64),
+) -> Vec<Series<'a>> {
+    let (colour, marker) = sweep.style;
+    let pick = |keep: &dyn Fn(&RefinedCycle, f64) -> bool| -> Vec<(f64, f64)> {
+        sweep
+            .results
+            .iter()
+            .filter_map(|r| r.cycle.hysteresis.map(|h| (r, h)))
+            .filter(|&(r, h)| keep(r, h))
+            .map(|(r, h)| point(&r.cycle, h))
+            .collect()
+    };
+    let good = pick(&|r, h| r.converged && h >= 0.0);
+    let moving = pick(&|r, h| !r.converged && h >= 0.0);
+    let negative = pick(&|_, h| h < 0.0);
+    let mut out = vec![Series::markers(labels[0], good)
+        .colour(colour)
+        .marker(marker)
+        .width(5)];
+    if !moving.is_empty() {
+        out.push(
+            Series::markers(labels[1], moving)
+                .colour(colour)
+                .marker(marker)
+                .width(5)
+                .hollow(),
+        );
+    }
+    if !negative.is_empty() {
+        out.push(
+            Series::markers(labels[2], negative)
+                .colour(colour)
+                .marker(Marker::Cross)
+                .width(5),
+        );
+    }
+    out
+}
+
+/// [`status_series`] of both sweeps (fixed, then triggered), the first labelled `names`.
+fn sweep_series<'a>(
+    sweeps: &[Sweep<'a>; 2],
+    names: [&'a str; 2],
+    point: impl Fn(&CycleResult, f64) -> (f64, f64) + Copy,
+) -> Vec<Series<'a>> {
+    let labels = [
+        [names[0], "fixed, not converged", "fixed, negative"],
+        [names[1], "triggered, not converged", "triggered, negative"],
+    ];
+    sweeps
+        .iter()
+        .zip(labels)
+        .flat_map(|(sweep, labels)| status_series(sweep, labels, point))
+        .collect()
+}
+
+/// The name of a marker symbol, for notes on a figure.
+fn marker_name(m: Marker) -> &'static str {
+    match m {
+        Marker::Circle => "circles",
+        Marker::Square => "squares",
+        Marker::Triangle => "triangles",
+        Marker::Diamond => "diamonds",
+        Marker::Cross => "crosses",
+    }
+}
+
+/// Notes on what the hollow and crossed markers mean.
+fn status_notes() -> Vec<String> {
+    vec![
+        "Hollow: touchdown or take-off still moved by more than 1 % of the static hysteresis at \
+         the tightest tolerance (intermittent contact): not converged."
+            .into(),
+        "Cross: negative hysteresis, not physical.".into(),
+    ]
+}
+
+/// Fig. 3(d): hysteresis (mW) against AC amplitude under both programmes, with the static value.
+fn fig3d_chart<'a>(sweeps: &'a [Sweep<'a>; 2], static_hysteresis: f64) -> Chart<'a> {
+    let mut series = vec![Series::line(
+        "static, V_ac = 0",
+        vec![(0.0, mw(static_hysteresis)), (1.0, mw(static_hysteresis))],
+    )
+    .colour(palette::BLACK)
+    .width(1)
+    .dashed()];
+    series.extend(sweep_series(
+        sweeps,
+        ["fixed programme", "touchdown-triggered"],
+        |c, h| (c.v_ac, mw(h)),
+    ));
+    let mut notes = vec![format!(
+        "The letter's Fig. 3(d) uses the fixed programme ({}); the experiment's protocol is \
+             the touchdown-triggered programme ({}).",
+        marker_name(FIXED.1),
+        marker_name(TRIGGERED.1)
+    )];
+    notes.extend(status_notes());
+    Chart {
+        title: "Fig. 3(d) hysteresis against AC amplitude, f = 10.5 kHz",
+        x_label: "V_ac (V)",
+        y_label: "P_TD − P_TO (mW)",
+        series,
+        notes,
+        ..Chart::default()
+    }
+}
+
+/// Fig. 4: mean temperature rise (K) against hysteresis (mW) under both programmes.
+fn fig4_chart<'a>(sweeps: &'a [Sweep<'a>; 2]) -> Chart<'a> {
+    let series = sweep_series(
+        sweeps,
+        ["fixed programme", "touchdown-triggered (letter)"],
+        |c, h| (mw(h), c.mean_temperature_rise),
+    );
+    let mut notes = vec![format!(
+        "The letter's Fig. 4 uses the {} ({}); the {} ({}) is shown for comparison.",
+        sweeps[1].name,
+        marker_name(sweeps[1].style.1),
+        sweeps[0].name,
+        marker_name(sweeps[0].style.1),
+    )];
+    notes.extend(status_notes());
+    Chart {
+        title: "Fig. 4 mean temperature rise against hysteresis",
+        x_label: "P_TD − P_TO (mW)",
+        y_label: "mean ΔT (K)",
+        series,
+        notes,
+        ..Chart::default()
+    }
+}
+
+/// Fig. 2(b): the static clearance change (nm) against DC voltage, the parabolic fit drawn
+/// under the points.
+fn fig2b_chart<'a>(volts: &[f64], dfh: &[f64], (a, b, c): (f64, f64, f64)) -> Chart<'a> {
+    let fit: Vec<(f64, f64)> = (-100..=100)
+        .map(|i| {
+            let v = i as f64 * 0.01;
+            (v, nm(a * v * v + b * v + c))
+        })
+        .collect();
+    Chart {
+        title: "Fig. 2(b) clearance change against DC voltage",
+        x_label: "V_dc − φ (V)",
+        y_label: "ΔFH (nm)",
+        series: vec![
+            Series::line("parabolic fit", fit)
+                .colour(palette::BLACK)
+                .width(1),
+            Series::markers(
+                "static model",
+                volts.iter().zip(dfh).map(|(v, d)| (*v, nm(*d))).collect(),
+            )
+            .colour(palette::BLUE)
+            .width(5),
         ],
-        &[
-            &col(&|r| r.cycle.v_ac),
-            &col(&|r| r.cycle.touchdown.map_or(f64::NAN, |d| d.power)),
-            &col(&|r| r.cycle.takeoff.map_or(f64::NAN, |d| d.power)),
-            &col(&|r| r.cycle.hysteresis.unwrap_or(f64::NAN)),
-            &col(&|r| r.cycle.mean_temperature_rise),
-            &col(&|r| r.rtol),
-            &col(&|r| r.change),
-            &col(&|r| f64::from(u8::from(r.converged))),
-            &col(&|r| r.runs as f64),
-            &col(&|r| r.stats.accepted as f64),
-            &col(&|r| r.wall_seconds),
-        ],
-    )?;
-    Ok(())
+        ..Chart::default()
+    }
+}
+
+/// Fig. 3(a) and (c): the forces over the whole cycle at 0 V and 0.6 V, on one y range.
+fn fig3ac_charts<'a>(s0: &TimeSeries, s6: &TimeSeries) -> (Chart<'a>, Chart<'a>) {
+    let all = (f64::NEG_INFINITY, f64::INFINITY);
+    let mut a = figures::forces_chart("Fig. 3(a) forces, V_ac = 0 V", s0, all, None);
+    let mut c = figures::forces_chart("Fig. 3(c) forces, V_ac = 0.6 V", s6, all, None);
+    let range = match (a.data_y_range(), c.data_y_range()) {
+        (Some(p), Some(q)) => Some((p.0.min(q.0), p.1.max(q.1))),
+        (p, q) => p.or(q),
+    };
+    a.y_range = range;
+    c.y_range = range;
+    (a, c)
+}
+
+/// Fig. 1: the contact indicator over touchdown-triggered cycles, with their touchdown and
+/// take-off. By default normalized by the threshold F_th against the heater power from each
+/// cycle's touchdown, as the letter plots it; `absolute`: in µN against the heater power.
+fn fig1_chart<'a>(
+    cycles: &[(&'a str, &CycleResult)],
+    threshold: f64,
+    absolute: bool,
+) -> Res<Chart<'a>> {
+    let colours = [palette::BLACK, palette::VERMILION];
+    let mut lines = Vec::new();
+    let mut notes = Vec::new();
+    for (k, &(label, r)) in cycles.iter().enumerate() {
+        let s = series(r)?;
+        let colour = colours[k % colours.len()];
+        let origin = match (absolute, r.touchdown) {
+            (true, _) => 0.0,
+            (false, Some(td)) => td.power,
+            (false, None) => {
+                notes.push(format!("{label}: no touchdown detected, not drawn."));
+                continue;
+            }
+        };
+        let (x, y) = (
+            move |p: f64| mw(p - origin),
+            move |f: f64| if absolute { f * 1e6 } else { f / threshold },
+        );
+        let curve = (0..s.t.len())
+            .filter(|&i| s.indicator[i].is_finite())
+            .map(|i| (x(s.power[i]), y(s.indicator[i])))
+            .collect();
+        lines.push(Series::line(label, curve).colour(colour));
+        let events: Vec<(f64, f64)> = [r.touchdown, r.takeoff]
+            .iter()
+            .flatten()
+            .map(|d| (x(d.power), y(threshold)))
+            .collect();
+        lines.push(
+            Series::markers("", events)
+                .colour(colour)
+                .marker(Marker::Diamond)
+                .width(6)
+                .hollow(),
+        );
+    }
+    notes.insert(
+        0,
+        "Hollow diamonds: detected touchdown and take-off, where the running mean crosses F_th."
+            .into(),
+    );
+    let (title, x_label, y_label) = if absolute {
+        (
+            "Fig. 1 contact indicator over touchdown-triggered cycles",
+            "heater power (mW)",
+            "running mean of F_c (µN)",
+        )
+    } else {
+        (
+            "Fig. 1 normalized contact indicator over touchdown-triggered cycles",
+            "heater power − touchdown power (mW)",
+            "running mean of F_c / F_th",
+        )
+    };
+    Ok(Chart {
+        title,
+        x_label,
+        y_label,
+        series: lines,
+        notes,
+        ..Chart::default()
+    })
 }
 
 #[cfg(test)]
 mod tests {
-    /// `cargo test` runs the example, so CI runs every example.
+    /// `cargo test` runs the example (into a temporary directory), so CI runs every example.
     #[test]
     fn example_runs() {
-        super::main().expect("the example runs to completion");
+        let dir = tempfile::tempdir().unwrap();
+        super::run(&super::Options::default(), dir.path()).expect("the example runs to completion");
+        let table = std::fs::read_to_string(dir.path().join("fig4_triggered_sweep.csv")).unwrap();
+        let header = table.lines().next().unwrap();
+        assert!(header.starts_with("v_ac_v,") && !header.contains("wall_seconds"));
+        for name in [
+            "fig1_indicator_vs_power.svg",
+            "fig2b_clearance_vs_dc.svg",
+            "fig3a_forces_0V.svg",
+            "fig3b_zoom_0.6V.svg",
+            "fig3c_forces_0.6V.svg",
+            "fig3d_hysteresis_vs_ac.svg",
+            "fig4_temperature_vs_hysteresis.svg",
+        ] {
+            assert!(dir.path().join(name).is_file(), "{name} written");
+        }
     }
 }

@@ -6,14 +6,20 @@
 //! error against wall time per problem into the same folder.
 //!
 //! Problems: a non-stiff one with a closed-form solution, Van der Pol (μ = 1000), Robertson to
-//! 1e11 and HIRES against the Test Set for IVP Solvers, and the paper scene's fixed-programme
+//! 1e11, HIRES, OREGO, E5 and Pleiades against the Test Set for IVP Solvers, and the paper
+//! scene's fixed-programme
 //! touchdown/take-off cycle at V_ac = 0 and 0.6 V, whose errors are |ΔP − ΔP_ref| and
 //! |P_TD − P_TD,ref| against a reference computed at rtol 1e-11 (Tsit5, cross-checked with
 //! Radau5; the difference of the two is printed).
 //!
 //! Run with `cargo run --release --example work_precision`; `-- --quick` runs every second
-//! tolerance only.
+//! tolerance only, `-- --out DIR` writes into `DIR`; `-- --stepping` prints only the cost of
+//! stepping the `Integrator` by hand against `solve` (Van der Pol, interleaved runs, CPU time).
+//! Once a run has taken more than a few seconds, progress (problem and method done, time so far)
+//! goes to stderr; the table stays on stdout.
 
+#[path = "common/output.rs"]
+mod output;
 #[path = "common/problems.rs"]
 mod problems;
 #[path = "common/timing.rs"]
@@ -22,8 +28,8 @@ mod timing;
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
 use hdi_tribology::analysis::sweep::ac_sweep;
 use hdi_tribology::model::{SliderModel, Voltage};
-use hdi_tribology::ode::{solve, Method, OdeError, Stats};
-use hdi_tribology::report::{Chart, Series};
+use hdi_tribology::ode::{solve, Integrator, Method, OdeError, Stats, StepStatus};
+use hdi_tribology::report::{palette, Chart, Series};
 use hdi_tribology::scene::Scene;
 use problems::Problem;
 use std::path::Path;
@@ -85,8 +91,34 @@ fn failure_status(method: Method, stiff: bool, e: &OdeError) -> String {
     }
 }
 
-fn run_problem<const N: usize>(p: &Problem<N>, rtols: &[f64], rows: &mut Vec<Row>) {
+/// Progress on stderr once the run is longer than `PROGRESS_AFTER`.
+struct Progress(Instant);
+
+const PROGRESS_AFTER: Duration = Duration::from_secs(3);
+
+impl Progress {
+    fn done(&self, what: &str) {
+        let t = self.0.elapsed();
+        if t >= PROGRESS_AFTER {
+            eprintln!("[{:6.1} s] {what} done", t.as_secs_f64());
+        }
+    }
+}
+
+fn run_problem<const N: usize>(
+    p: &Problem<N>,
+    rtols: &[f64],
+    rows: &mut Vec<Row>,
+    progress: &Progress,
+) {
     for method in Method::ALL {
+        run_method(p, method, rtols, rows);
+        progress.done(&format!("{} {method}", p.name));
+    }
+}
+
+fn run_method<const N: usize>(p: &Problem<N>, method: Method, rtols: &[f64], rows: &mut Vec<Row>) {
+    {
         for &rtol in rtols {
             let mut opts = p.options(rtol).max_steps(2_000_000);
             if p.stiff && explicit(method) {
@@ -167,6 +199,7 @@ fn outputs(r: &CycleResult) -> Option<(f64, f64)> {
 
 fn run_slider(slider: &Slider, v_ac: f64, rtols: &[f64], rows: &mut Vec<Row>) -> Res<()> {
     let name = format!("slider_{v_ac:.1}V");
+    eprintln!("work_precision: {name}, references and every method …");
     let clock = Instant::now();
     let reference = slider.cycle(v_ac, Method::Tsit5, SLIDER_REF_RTOL)?;
     let (dp_ref, ptd_ref) = outputs(&reference).ok_or("reference cycle without touchdown")?;
@@ -241,6 +274,7 @@ const RESOLVED: f64 = 1e-8;
 /// against reference sweeps at rtol 1e-11 (Tsit5 and Radau5): wall time and largest errors over
 /// the amplitudes where the two references agree.
 fn sweep_report(slider: &Slider) -> Res<()> {
+    eprintln!("work_precision: AC sweeps of the slider …");
     let amplitudes: Vec<f64> = (0..=10).map(|i| f64::from(i) * 0.1).collect();
     let reference_sweep = |method: Method| -> Res<Vec<CycleResult>> {
         let mut o = CycleOptions::from_scene(&slider.scene)?;
@@ -408,10 +442,12 @@ fn chart(
     second: bool,
 ) -> Res<()> {
     let labels: Vec<String> = Method::ALL.iter().map(|m| m.name().to_string()).collect();
+    // Each method keeps its colour in every chart, whichever methods have points.
     let series: Vec<Series> = Method::ALL
         .iter()
         .zip(&labels)
-        .filter_map(|(&m, label)| {
+        .zip(palette::SERIES.iter().cycle())
+        .filter_map(|((&m, label), &colour)| {
             let points: Vec<(f64, f64)> = rows
                 .iter()
                 .filter(|r| r.problem == problem && r.method == m && r.status == "ok")
@@ -419,11 +455,7 @@ fn chart(
                 .filter(|&(_, e)| e > 0.0)
                 .map(|(t, e)| (t.log10(), e.log10()))
                 .collect();
-            (!points.is_empty()).then(|| Series {
-                label,
-                points,
-                markers: false,
-            })
+            (!points.is_empty()).then(|| Series::line(label, points).colour(colour))
         })
         .collect();
     if series.is_empty() {
@@ -437,7 +469,7 @@ fn chart(
         x_label: "log10 CPU time of the thread (ms)",
         y_label: &y_label,
         series,
-        log: (false, false),
+        ..Chart::default()
     }
     .to_svg(&out.join(file), 720, 480)?;
     Ok(())
@@ -445,9 +477,12 @@ fn chart(
 
 fn main() -> Res<()> {
     let clock = Instant::now();
-    let out = Path::new("out/work_precision");
-    std::fs::create_dir_all(out)?;
-    let quick = std::env::args().any(|a| a == "--quick");
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--stepping") {
+        return stepping_overhead();
+    }
+    let out = &output::out_dir("work_precision", &args)?;
+    let quick = args.iter().any(|a| a == "--quick");
     let all: Vec<f64> = (3..=12).map(|k| 10f64.powi(-k)).collect();
     let rtols: Vec<f64> = if quick {
         all.iter().copied().step_by(2).collect()
@@ -458,14 +493,19 @@ fn main() -> Res<()> {
     let slider_rtols: Vec<f64> = rtols.iter().copied().filter(|&r| r >= 1e-9).collect();
 
     let mut rows = Vec::new();
+    let progress = Progress(clock);
     print_header();
-    run_problem(&problems::exact(), &rtols, &mut rows);
-    run_problem(&problems::van_der_pol(), &rtols, &mut rows);
-    run_problem(&problems::robertson(), &rtols, &mut rows);
-    run_problem(&problems::hires(), &rtols, &mut rows);
+    run_problem(&problems::exact(), &rtols, &mut rows, &progress);
+    run_problem(&problems::van_der_pol(), &rtols, &mut rows, &progress);
+    run_problem(&problems::robertson(), &rtols, &mut rows, &progress);
+    run_problem(&problems::hires(), &rtols, &mut rows, &progress);
+    run_problem(&problems::orego(), &rtols, &mut rows, &progress);
+    run_problem(&problems::e5(), &rtols, &mut rows, &progress);
+    run_problem(&problems::pleiades(), &rtols, &mut rows, &progress);
     let slider = Slider::new()?;
     for v_ac in [0.0, 0.6] {
         run_slider(&slider, v_ac, &slider_rtols, &mut rows)?;
+        progress.done(&format!("slider at {v_ac:.1} V"));
     }
 
     sweep_report(&slider)?;
@@ -476,6 +516,9 @@ fn main() -> Res<()> {
         ("vdp", "max rel error at t = 2000"),
         ("robertson", "max rel error at t = 1e11"),
         ("hires", "max rel error at t = 321.8122"),
+        ("orego", "max rel error at t = 360"),
+        ("e5", "max rel error (floor 1e-24) at t = 1e13"),
+        ("pleiades", "max rel error at t = 3"),
     ] {
         chart(out, p, &format!("{p}.svg"), label, &rows, false)?;
     }
@@ -503,5 +546,52 @@ fn main() -> Res<()> {
         out.display(),
         clock.elapsed().as_secs_f64()
     );
+    Ok(())
+}
+
+/// CPU time of `solve` against the same integration stepped by hand (`Integrator::step` until
+/// the end), on Van der Pol with every stiff method at rtol 1e-6 and 1e-8. The two are run in
+/// alternation, 15 rounds of at least 100 ms each, so that both see the same machine load; the
+/// median of the per-round ratios is printed.
+fn stepping_overhead() -> Res<()> {
+    let p = problems::van_der_pol();
+    println!(
+        "| method | rtol | solve CPU (ms) | stepped CPU (ms) | median stepped/solve | steps |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for method in [Method::Rodas5P, Method::Radau5, Method::Auto, Method::Tsit5] {
+        for rtol in [1e-6, 1e-8] {
+            let mut opts = p.options(rtol);
+            if method == Method::Tsit5 {
+                opts = opts.max_steps(EXPLICIT_STEP_CAP * 10);
+            }
+            let mut ratios = Vec::new();
+            let (mut a_sum, mut b_sum) = (0.0, 0.0);
+            let mut steps = 0;
+            for _ in 0..15 {
+                let (sol, _, a) =
+                    timed(|| solve(&p, 0.0, p.y0_vector(), p.t_end, method, &opts, &mut []));
+                let (end, _, b) = timed(|| {
+                    let mut it = Integrator::new(&p, 0.0, p.y0_vector(), p.t_end, method, &opts)?;
+                    while it.step()? != StepStatus::ReachedEnd {}
+                    Ok::<_, OdeError>(*it.state())
+                });
+                let sol = sol?;
+                // The same steps, bit for bit.
+                assert_eq!(sol.y_final(), &end?);
+                steps = sol.stats.accepted;
+                ratios.push(b / a);
+                a_sum += a;
+                b_sum += b;
+            }
+            ratios.sort_by(f64::total_cmp);
+            println!(
+                "| {method} | {rtol:.0e} | {:.4} | {:.4} | {:.3} | {steps} |",
+                a_sum / 15.0 * 1e3,
+                b_sum / 15.0 * 1e3,
+                ratios[7]
+            );
+        }
+    }
     Ok(())
 }

@@ -1,18 +1,169 @@
-//! Writing results: CSV tables (always) and SVG line charts (feature `plot`).
+//! Writing results: CSV tables (always) and SVG charts (feature `plot`).
+//!
+//! Tables go through the [`csv`] crate. Real numbers are written in the shortest form that reads
+//! back to the same `f64` (plain decimals between 1e-4 and 1e15, exponent form outside), counts
+//! as integers and flags as `true`/`false`; a missing value is an empty field. Physical
+//! quantities carry their SI unit as a suffix of the column name (`v_dc_v`, `power_w`, `d_m`).
+//! Every file is written whole under a temporary name beside it and renamed into place, so a
+//! failure leaves neither a half-written table nor a temporary file behind.
 
 use crate::error::{Error, Result};
-use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Writes columns of equal length as CSV with a header line. Values are written with full
-/// precision (`{:e}` round-trips).
+/// One column of a [`CsvTable`].
+#[derive(Clone, Debug, PartialEq)]
+enum Column {
+    Real(Vec<f64>),
+    Optional(Vec<Option<f64>>),
+    Integer(Vec<u64>),
+    Flag(Vec<bool>),
+}
+
+impl Column {
+    fn len(&self) -> usize {
+        match self {
+            Column::Real(v) => v.len(),
+            Column::Optional(v) => v.len(),
+            Column::Integer(v) => v.len(),
+            Column::Flag(v) => v.len(),
+        }
+    }
+    fn cell(&self, row: usize) -> String {
+        match self {
+            Column::Real(v) => real_cell(v[row]),
+            Column::Optional(v) => v[row].map_or(String::new(), real_cell),
+            Column::Integer(v) => v[row].to_string(),
+            Column::Flag(v) => v[row].to_string(),
+        }
+    }
+}
+
+/// A real number in the shortest form that reads back to the same `f64`: plain decimal for
+/// magnitudes in [1e-4, 1e15), exponent form outside; `NaN`, `inf`, `-inf` as such.
 ///
 /// ```
-/// let dir = std::env::temp_dir().join("hdi_report_doc");
-/// std::fs::create_dir_all(&dir).unwrap();
-/// let path = dir.join("t.csv");
-/// hdi_tribology::report::write_csv(&path, &["x", "y"], &[&[1.0, 2.0], &[3.0, 4.0]])?;
-/// assert_eq!(std::fs::read_to_string(&path).unwrap(), "x,y\n1e0,3e0\n2e0,4e0\n");
+/// use hdi_tribology::report::real_cell;
+/// assert_eq!(real_cell(0.7), "0.7");
+/// assert_eq!(real_cell(2.0), "2");
+/// assert_eq!(real_cell(1.5e-9), "1.5e-9");
+/// assert_eq!(real_cell(-3e20), "-3e20");
+/// assert_eq!(real_cell(0.0), "0");
+/// for v in [0.1 + 0.2, 6.02214076e23, 1e-300, 1234.5678] {
+///     assert_eq!(real_cell(v).parse::<f64>().unwrap(), v);
+/// }
+/// ```
+pub fn real_cell(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// A CSV table built column by column, each column with its own kind of value.
+///
+/// ```
+/// use hdi_tribology::report::CsvTable;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("sweep.csv");
+/// CsvTable::new()
+///     .real("v_ac_v", [0.0, 0.5])
+///     .optional("hysteresis_w", [Some(6.4e-3), None])
+///     .integer("steps", [2849, 3012])
+///     .flag("converged", [true, false])
+///     .write(&path)?;
+/// assert_eq!(
+///     std::fs::read_to_string(&path).unwrap(),
+///     "v_ac_v,hysteresis_w,steps,converged\n0,0.0064,2849,true\n0.5,,3012,false\n"
+/// );
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CsvTable {
+    headers: Vec<String>,
+    columns: Vec<Column>,
+}
+
+impl CsvTable {
+    /// An empty table.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn push(mut self, header: &str, column: Column) -> Self {
+        self.headers.push(header.to_string());
+        self.columns.push(column);
+        self
+    }
+
+    /// Adds a column of real numbers (`NaN` is written as `NaN`).
+    pub fn real(self, header: &str, values: impl IntoIterator<Item = f64>) -> Self {
+        self.push(header, Column::Real(values.into_iter().collect()))
+    }
+
+    /// Adds a column of real numbers that may be missing (written as an empty field).
+    pub fn optional(self, header: &str, values: impl IntoIterator<Item = Option<f64>>) -> Self {
+        self.push(header, Column::Optional(values.into_iter().collect()))
+    }
+
+    /// Adds a column of counts, written as integers.
+    pub fn integer(self, header: &str, values: impl IntoIterator<Item = u64>) -> Self {
+        self.push(header, Column::Integer(values.into_iter().collect()))
+    }
+
+    /// Adds a column of flags, written as `true` / `false`.
+    pub fn flag(self, header: &str, values: impl IntoIterator<Item = bool>) -> Self {
+        self.push(header, Column::Flag(values.into_iter().collect()))
+    }
+
+    /// The number of data rows; an error when the columns differ in length.
+    pub fn rows(&self) -> Result<usize> {
+        let rows = self.columns.first().map_or(0, Column::len);
+        match self.columns.iter().position(|c| c.len() != rows) {
+            Some(i) => Err(Error::invalid(
+                format!("column {}", self.headers[i]),
+                format!(
+                    "has {} rows, column {} has {rows}",
+                    self.columns[i].len(),
+                    self.headers[0]
+                ),
+            )),
+            None => Ok(rows),
+        }
+    }
+
+    /// The table as CSV text, header line first.
+    pub fn to_csv_string(&self) -> Result<String> {
+        let rows = self.rows()?;
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let err = |e: csv::Error| Error::analysis("csv", e.to_string());
+        w.write_record(&self.headers).map_err(err)?;
+        for r in 0..rows {
+            w.write_record(self.columns.iter().map(|c| c.cell(r)))
+                .map_err(err)?;
+        }
+        let bytes = w
+            .into_inner()
+            .map_err(|e| Error::analysis("csv", e.to_string()))?;
+        String::from_utf8(bytes).map_err(|e| Error::analysis("csv", e.to_string()))
+    }
+
+    /// Writes the table to `path` whole (see [`write_file`]).
+    pub fn write(&self, path: &Path) -> Result<()> {
+        write_file(path, &self.to_csv_string()?)
+    }
+}
+
+/// Writes columns of real numbers of equal length as CSV with a header line (a [`CsvTable`] of
+/// [`CsvTable::real`] columns).
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("t.csv");
+/// hdi_tribology::report::write_csv(&path, &["x_m", "y_n"], &[&[1.0, 2.5], &[3e-9, 4.0]])?;
+/// assert_eq!(std::fs::read_to_string(&path).unwrap(), "x_m,y_n\n1,3e-9\n2.5,4\n");
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 pub fn write_csv(path: &Path, headers: &[&str], columns: &[&[f64]]) -> Result<()> {
@@ -22,36 +173,50 @@ pub fn write_csv(path: &Path, headers: &[&str], columns: &[&[f64]]) -> Result<()
             format!("{} headers for {} columns", headers.len(), columns.len()),
         ));
     }
-    let rows = columns.first().map_or(0, |c| c.len());
-    if let Some(i) = columns.iter().position(|c| c.len() != rows) {
-        return Err(Error::invalid(
-            format!("columns[{i}]"),
-            format!("has {} rows, the first has {rows}", columns[i].len()),
-        ));
-    }
-    let mut s = headers.join(",");
-    s.push('\n');
-    for r in 0..rows {
-        for (i, c) in columns.iter().enumerate() {
-            if i > 0 {
-                s.push(',');
-            }
-            let _ = write!(s, "{:e}", c[r]);
-        }
-        s.push('\n');
-    }
-    write_file(path, &s)
+    headers
+        .iter()
+        .zip(columns)
+        .fold(CsvTable::new(), |t, (h, c)| t.real(h, c.iter().copied()))
+        .write(path)
 }
 
-/// Writes a whole file at once (so a failure leaves no half-written table behind a name).
+/// Writes a whole file at once: the contents go to a temporary file beside `path` (its full
+/// name plus a unique suffix, so `x.csv` and `x.svg` never share one), which is then renamed
+/// onto `path`. On failure the temporary file is removed and `path` is left as it was.
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("note.txt");
+/// hdi_tribology::report::write_file(&path, "hello\n")?;
+/// assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+/// assert!(hdi_tribology::report::write_file(&dir.path().join("no/such/dir.txt"), "x").is_err());
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
 pub fn write_file(path: &Path, contents: &str) -> Result<()> {
-    let tmp = path.with_extension("partial");
-    std::fs::write(&tmp, contents)
-        .and_then(|_| std::fs::rename(&tmp, path))
-        .map_err(|source| Error::Io {
-            path: path.display().to_string(),
-            source,
-        })
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let io = |source| Error::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| {
+            io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a file name",
+            ))
+        })?
+        .to_string_lossy();
+    let tmp: PathBuf = path.with_file_name(format!(
+        ".{name}.{}-{}.partial",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let result = std::fs::write(&tmp, contents).and_then(|_| std::fs::rename(&tmp, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(io)
 }
 
 /// A short tick label: powers of ten on log axes, up to four significant digits otherwise.
@@ -82,19 +247,149 @@ pub fn tick_label(v: f64, log: bool) -> String {
     }
 }
 
-/// One line (or set of markers) of a chart.
-#[derive(Clone, Debug)]
+/// A tick label on a linear axis spanning `span`: a value that is zero up to rounding of the
+/// tick arithmetic (below 1e-9 of the span) reads `0`, not `-1.110e-16`.
+///
+/// ```
+/// use hdi_tribology::report::snapped_tick_label;
+/// assert_eq!(snapped_tick_label(-1.1102230246251565e-16, 1.2), "0");
+/// assert_eq!(snapped_tick_label(-0.2, 1.2), "-0.2");
+/// assert_eq!(snapped_tick_label(3e-12, 1e-11), "3.000e-12".replace(".000e", "e"));
+/// ```
+pub fn snapped_tick_label(v: f64, span: f64) -> String {
+    if v.abs() <= 1e-9 * span.abs() {
+        "0".into()
+    } else {
+        tick_label(v, false)
+    }
+}
+
+/// An sRGB colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Colour(pub u8, pub u8, pub u8);
+
+/// The Okabe–Ito palette, distinguishable under the common colour-vision deficiencies; charts
+/// take their default series colours from it in this order.
+pub mod palette {
+    use super::Colour;
+    /// Blue (#0072B2).
+    pub const BLUE: Colour = Colour(0x00, 0x72, 0xB2);
+    /// Vermilion (#D55E00).
+    pub const VERMILION: Colour = Colour(0xD5, 0x5E, 0x00);
+    /// Bluish green (#009E73).
+    pub const GREEN: Colour = Colour(0x00, 0x9E, 0x73);
+    /// Reddish purple (#CC79A7).
+    pub const PURPLE: Colour = Colour(0xCC, 0x79, 0xA7);
+    /// Orange (#E69F00).
+    pub const ORANGE: Colour = Colour(0xE6, 0x9F, 0x00);
+    /// Sky blue (#56B4E9).
+    pub const SKY_BLUE: Colour = Colour(0x56, 0xB4, 0xE9);
+    /// Yellow (#F0E442).
+    pub const YELLOW: Colour = Colour(0xF0, 0xE4, 0x42);
+    /// Black.
+    pub const BLACK: Colour = Colour(0, 0, 0);
+    /// The default order of series colours.
+    pub const SERIES: [Colour; 7] = [BLUE, VERMILION, GREEN, PURPLE, ORANGE, SKY_BLUE, BLACK];
+}
+
+/// The symbol of a series drawn as markers (and of its legend entry).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Marker {
+    /// A disc.
+    #[default]
+    Circle,
+    /// A square.
+    Square,
+    /// A triangle, point up.
+    Triangle,
+    /// A diamond.
+    Diamond,
+    /// A diagonal cross (never filled).
+    Cross,
+}
+
+/// One line (or set of markers) of a chart. Build one with [`Series::line`] or
+/// [`Series::markers`] and adjust it with the methods that follow.
+#[derive(Clone, Debug, Default)]
 pub struct Series<'a> {
-    /// Legend label.
+    /// Legend label; an empty label leaves the series out of the legend.
     pub label: &'a str,
-    /// Points `(x, y)`.
+    /// Points `(x, y)`; non-finite points (and non-positive ones on a log axis) are skipped.
     pub points: Vec<(f64, f64)>,
     /// Draw markers instead of a line.
     pub markers: bool,
+    /// The marker symbol, when `markers`.
+    pub marker: Marker,
+    /// Draw the markers as outlines only.
+    pub hollow: bool,
+    /// The colour; `None` takes the next one of [`palette::SERIES`].
+    pub colour: Option<Colour>,
+    /// Line width (or marker size) in pixels; 0 for the default (2 px lines, 4 px markers).
+    pub width: u32,
+    /// Draw the line dashed.
+    pub dashed: bool,
+    /// Plot against the chart's second y axis (on the right, [`Chart::y2_label`]).
+    pub secondary: bool,
 }
 
-/// A line chart written as SVG (no system fonts needed).
-#[derive(Clone, Debug)]
+/// Builder methods that switch one `bool` field of [`Series`] on.
+macro_rules! flag_setters {
+    ($($(#[$doc:meta])* $name:ident => $field:ident,)*) => {$(
+        $(#[$doc])*
+        pub fn $name(mut self) -> Self {
+            self.$field = true;
+            self
+        }
+    )*};
+}
+
+impl<'a> Series<'a> {
+    /// A solid line through `points`.
+    pub fn line(label: &'a str, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            label,
+            points,
+            ..Self::default()
+        }
+    }
+    /// Filled circles at `points`.
+    pub fn markers(label: &'a str, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            markers: true,
+            ..Self::line(label, points)
+        }
+    }
+    /// With this colour.
+    pub fn colour(mut self, c: Colour) -> Self {
+        self.colour = Some(c);
+        self
+    }
+    /// With this marker symbol.
+    pub fn marker(mut self, m: Marker) -> Self {
+        self.marker = m;
+        self
+    }
+    /// With this line width (marker size) in pixels.
+    pub fn width(mut self, px: u32) -> Self {
+        self.width = px;
+        self
+    }
+    flag_setters! {
+        /// Markers as outlines only.
+        hollow => hollow,
+        /// Dashed line.
+        dashed => dashed,
+        /// On the second y axis.
+        on_secondary => secondary,
+    }
+}
+
+/// A line chart written as SVG (no system fonts needed), its legend to the right of the plot so
+/// that it never covers data.
+///
+/// Lines are drawn first, in the order given, then markers, so that points stay on top of the
+/// curves fitted through them.
+#[derive(Clone, Debug, Default)]
 pub struct Chart<'a> {
     /// Title.
     pub title: &'a str,
@@ -106,6 +401,170 @@ pub struct Chart<'a> {
     pub series: Vec<Series<'a>>,
     /// Logarithmic axes `(x, y)`.
     pub log: (bool, bool),
+    /// The label of the second y axis, on the right (linear axes only); used when a series is
+    /// [`Series::secondary`].
+    pub y2_label: &'a str,
+    /// Fixed x range instead of the data's.
+    pub x_range: Option<(f64, f64)>,
+    /// Fixed y range instead of the data's (so that two panels can share one).
+    pub y_range: Option<(f64, f64)>,
+    /// Fixed range of the second y axis.
+    pub y2_range: Option<(f64, f64)>,
+    /// Lines of text under the legend (what the markers mean, which protocol is the letter's).
+    pub notes: Vec<String>,
+}
+
+/// Whether `(x, y)` can be drawn on axes with the given log flags.
+fn drawable((x, y): (f64, f64), log: (bool, bool)) -> bool {
+    x.is_finite() && y.is_finite() && (!log.0 || x > 0.0) && (!log.1 || y > 0.0)
+}
+
+/// The span of `values` with a margin: 5 % on linear axes, a factor 1.5 on log axes.
+fn padded_span(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    });
+    if lo > hi {
+        return None;
+    }
+    Some(if log {
+        (lo / 1.5, hi * 1.5)
+    } else {
+        let pad = if hi > lo {
+            0.05 * (hi - lo)
+        } else {
+            lo.abs().max(1e-30) * 0.1
+        };
+        (lo - pad, hi + pad)
+    })
+}
+
+impl Chart<'_> {
+    /// The y range (with margin) that shows every drawable point of the primary-axis series,
+    /// to share between panels through [`Chart::y_range`].
+    ///
+    /// ```
+    /// use hdi_tribology::report::{Chart, Series};
+    /// let a = Chart { series: vec![Series::line("a", vec![(0.0, -1.0), (1.0, 1.0)])], ..Chart::default() };
+    /// let (lo, hi) = a.data_y_range().unwrap();
+    /// assert!(lo < -1.0 && hi > 1.0);
+    /// ```
+    pub fn data_y_range(&self) -> Option<(f64, f64)> {
+        padded_span(self.points(false).map(|p| p.1), self.log.1)
+    }
+
+    fn points(&self, secondary: bool) -> impl Iterator<Item = (f64, f64)> + '_ {
+        let log = self.log;
+        self.series
+            .iter()
+            .filter(move |s| s.secondary == secondary)
+            .flat_map(|s| s.points.iter().copied())
+            .filter(move |&p| drawable(p, log))
+    }
+}
+
+/// Pixels per character of the 13 px legend font, for sizing the legend panel.
+#[cfg(feature = "plot")]
+const CHAR_PX: f64 = 7.0;
+
+/// Splits `text` into lines of at most `width` characters at spaces.
+#[cfg(feature = "plot")]
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines = Vec::new();
+    for para in text.split('\n') {
+        let mut line = String::new();
+        for word in para.split_whitespace() {
+            if !line.is_empty() && line.chars().count() + 1 + word.chars().count() > width {
+                lines.push(std::mem::take(&mut line));
+            }
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            line.push_str(word);
+        }
+        lines.push(line);
+    }
+    lines
+}
+
+/// A marker of `size` pixels centred on one point, in data or pixel coordinates.
+#[cfg(feature = "plot")]
+struct MarkerElement<C> {
+    at: C,
+    shape: Marker,
+    size: i32,
+    colour: plotters::style::RGBColor,
+    hollow: bool,
+}
+
+#[cfg(feature = "plot")]
+fn marker_element<C>(
+    shape: Marker,
+    at: C,
+    size: i32,
+    colour: plotters::style::RGBColor,
+    hollow: bool,
+) -> MarkerElement<C> {
+    MarkerElement {
+        at,
+        shape,
+        size,
+        colour,
+        hollow,
+    }
+}
+
+#[cfg(feature = "plot")]
+impl<'a, C: 'a> plotters::element::PointCollection<'a, C> for &'a MarkerElement<C> {
+    type Point = &'a C;
+    type IntoIter = std::iter::Once<&'a C>;
+    fn point_iter(self) -> Self::IntoIter {
+        std::iter::once(&self.at)
+    }
+}
+
+#[cfg(feature = "plot")]
+impl<C, DB: plotters_backend::DrawingBackend> plotters::element::Drawable<DB> for MarkerElement<C> {
+    fn draw<I: Iterator<Item = plotters_backend::BackendCoord>>(
+        &self,
+        mut pos: I,
+        backend: &mut DB,
+        _: (u32, u32),
+    ) -> std::result::Result<(), plotters_backend::DrawingErrorKind<DB::ErrorType>> {
+        use plotters::style::{Color, ShapeStyle};
+        let Some((x, y)) = pos.next() else {
+            return Ok(());
+        };
+        let s = self.size;
+        let fill = !self.hollow && self.shape != Marker::Cross;
+        let style = if fill {
+            self.colour.filled()
+        } else {
+            ShapeStyle::from(&self.colour).stroke_width(2)
+        };
+        let polygon = |backend: &mut DB, v: Vec<(i32, i32)>| {
+            let v: Vec<(i32, i32)> = v.into_iter().map(|(a, b)| (x + a, y + b)).collect();
+            if fill {
+                backend.fill_polygon(v, &style)
+            } else {
+                let first = v[0];
+                backend.draw_path(v.into_iter().chain(std::iter::once(first)), &style)
+            }
+        };
+        match self.shape {
+            Marker::Circle => backend.draw_circle((x, y), s as u32, &style, fill),
+            Marker::Square => backend.draw_rect((x - s, y - s), (x + s, y + s), &style, fill),
+            Marker::Triangle => polygon(backend, vec![(0, -s - 1), (s + 1, s), (-s - 1, s)]),
+            Marker::Diamond => polygon(
+                backend,
+                vec![(0, -s - 1), (s + 1, 0), (0, s + 1), (-s - 1, 0)],
+            ),
+            Marker::Cross => {
+                backend.draw_line((x - s, y - s), (x + s, y + s), &style)?;
+                backend.draw_line((x - s, y + s), (x + s, y - s), &style)
+            }
+        }
+    }
 }
 
 #[cfg(feature = "plot")]
@@ -114,12 +573,21 @@ impl Chart<'_> {
     /// Draws the chart into an SVG file of `width × height` pixels.
     ///
     /// ```
-    /// use hdi_tribology::report::{Chart, Series};
-    /// let path = std::env::temp_dir().join("hdi_chart_doc.svg");
-    /// Chart { title: "y = x²", x_label: "x", y_label: "y", log: (false, false),
-    ///         series: vec![Series { label: "x²", markers: false,
-    ///                               points: (0..10).map(|i| (i as f64, (i * i) as f64)).collect() }] }
-    ///     .to_svg(&path, 640, 400)?;
+    /// use hdi_tribology::report::{palette, Chart, Marker, Series};
+    /// let dir = tempfile::tempdir().unwrap();
+    /// let path = dir.path().join("chart.svg");
+    /// let pts: Vec<(f64, f64)> = (0..10).map(|i| (i as f64, (i * i) as f64)).collect();
+    /// Chart {
+    ///     title: "y = x²",
+    ///     x_label: "x",
+    ///     y_label: "y",
+    ///     series: vec![
+    ///         Series::line("x²", pts.clone()),
+    ///         Series::markers("samples", pts).marker(Marker::Square).colour(palette::VERMILION),
+    ///     ],
+    ///     ..Chart::default()
+    /// }
+    /// .to_svg(&path, 640, 400)?;
     /// assert!(std::fs::read_to_string(&path).unwrap().contains("<svg"));
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
@@ -132,106 +600,224 @@ impl Chart<'_> {
 
     fn draw(&self, out: &mut String, width: u32, height: u32) -> std::result::Result<(), String> {
         use plotters::prelude::*;
-        let finite: Vec<(f64, f64)> = self
+        let err = |e: &dyn std::fmt::Display| e.to_string();
+        let log = self.log;
+        let has2 = self.points(true).next().is_some();
+        if has2 && log != (false, false) {
+            return Err("a second y axis needs linear axes".into());
+        }
+        let xr = self
+            .x_range
+            .or_else(|| {
+                padded_span(
+                    self.points(false).chain(self.points(true)).map(|p| p.0),
+                    log.0,
+                )
+            })
+            .ok_or("no finite points to draw")?;
+        let yr = self
+            .y_range
+            .or_else(|| self.data_y_range())
+            .unwrap_or((0.0, 1.0));
+        let y2r = self
+            .y2_range
+            .or_else(|| padded_span(self.points(true).map(|p| p.1), false))
+            .unwrap_or((0.0, 1.0));
+        // Colours: explicit ones, else the palette in order.
+        let mut next = 0;
+        let colours: Vec<RGBColor> = self
             .series
             .iter()
-            .flat_map(|s| s.points.iter().copied())
-            .filter(|(x, y)| {
-                x.is_finite()
-                    && y.is_finite()
-                    && (!self.log.0 || *x > 0.0)
-                    && (!self.log.1 || *y > 0.0)
+            .map(|s| {
+                let c = s.colour.unwrap_or_else(|| {
+                    next += 1;
+                    palette::SERIES[(next - 1) % palette::SERIES.len()]
+                });
+                RGBColor(c.0, c.1, c.2)
             })
             .collect();
-        if finite.is_empty() {
-            return Err("no finite points to draw".into());
-        }
-        let span = |v: &mut dyn Iterator<Item = f64>, log: bool| {
-            let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-                (a.min(x), b.max(x))
-            });
-            if log {
-                (lo / 1.5, hi * 1.5)
-            } else {
-                let pad = if hi > lo {
-                    0.05 * (hi - lo)
-                } else {
-                    lo.abs().max(1e-30) * 0.1
-                };
-                (lo - pad, hi + pad)
-            }
-        };
-        let xr = span(&mut finite.iter().map(|p| p.0), self.log.0);
-        let yr = span(&mut finite.iter().map(|p| p.1), self.log.1);
+
         let root = SVGBackend::with_string(out, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let mut builder = ChartBuilder::on(&root);
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let labelled: Vec<usize> = (0..self.series.len())
+            .filter(|&i| !self.series[i].label.is_empty())
+            .collect();
+        let widest = labelled
+            .iter()
+            .map(|&i| self.series[i].label.chars().count() + 6)
+            .max()
+            .unwrap_or(0);
+        let legend_w = if labelled.is_empty() && self.notes.is_empty() {
+            0
+        } else {
+            ((widest as f64 * CHAR_PX) as u32 + 24).clamp(170, (width as f64 * 0.32) as u32)
+        };
+        let (plot_area, legend_area) = root.split_horizontally(width - legend_w);
+        let mut builder = ChartBuilder::on(&plot_area);
         builder
             .caption(self.title, ("sans-serif", 18))
             .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(70);
-        let colours = [&BLUE, &RED, &GREEN, &MAGENTA, &CYAN, &BLACK];
-        macro_rules! draw_series {
-            ($chart:expr) => {{
-                let mut chart = $chart;
-                chart
+            .x_label_area_size(45)
+            .y_label_area_size(75);
+        if has2 {
+            builder.right_y_label_area_size(70);
+        }
+        let (xs, ys, y2s) = (xr.1 - xr.0, yr.1 - yr.0, y2r.1 - y2r.0);
+        let grid = RGBAColor(0, 0, 0, 0.12);
+        let label = |v: f64, log: bool, span: f64| {
+            if log {
+                tick_label(v, true)
+            } else {
+                snapped_tick_label(v, span)
+            }
+        };
+        macro_rules! series_into {
+            ($chart:ident . $method:ident, $s:expr, $c:expr) => {{
+                let s: &Series = $s;
+                let c: RGBColor = $c;
+                let pts: Vec<(f64, f64)> = s
+                    .points
+                    .iter()
+                    .copied()
+                    .filter(|&p| drawable(p, log))
+                    .collect();
+                if s.markers {
+                    let size = if s.width == 0 { 4 } else { s.width as i32 };
+                    $chart
+                        .$method(
+                            pts.iter()
+                                .map(|&p| marker_element(s.marker, p, size, c, s.hollow)),
+                        )
+                        .map_err(|e| err(&e))?;
+                } else {
+                    let style = c.stroke_width(if s.width == 0 { 2 } else { s.width });
+                    if s.dashed {
+                        $chart
+                            .$method(std::iter::once(plotters::element::DashedPathElement::new(
+                                pts.into_iter(),
+                                7,
+                                5,
+                                style,
+                            )))
+                            .map_err(|e| err(&e))?;
+                    } else {
+                        $chart
+                            .$method(LineSeries::new(pts, style))
+                            .map_err(|e| err(&e))?;
+                    }
+                }
+            }};
+        }
+        // The series on one axis: lines first, then markers on top.
+        macro_rules! draw_all {
+            ($chart:ident . $method:ident, $secondary:expr) => {
+                for pass in [false, true] {
+                    for (s, c) in self.series.iter().zip(&colours) {
+                        if s.secondary == $secondary && s.markers == pass {
+                            series_into!($chart.$method, s, *c);
+                        }
+                    }
+                }
+            };
+        }
+        macro_rules! primary {
+            ($chart:ident) => {{
+                $chart
                     .configure_mesh()
                     .x_desc(self.x_label)
                     .y_desc(self.y_label)
-                    .x_label_formatter(&|v| tick_label(*v, self.log.0))
-                    .y_label_formatter(&|v| tick_label(*v, self.log.1))
+                    .x_label_formatter(&|v| label(*v, log.0, xs))
+                    .y_label_formatter(&|v| label(*v, log.1, ys))
+                    .max_light_lines(0)
+                    .bold_line_style(grid)
+                    .axis_desc_style(("sans-serif", 15))
+                    .label_style(("sans-serif", 13))
                     .draw()
-                    .map_err(|e| e.to_string())?;
-                for (i, s) in self.series.iter().enumerate() {
-                    let colour = *colours[i % colours.len()];
-                    let pts: Vec<(f64, f64)> = s
-                        .points
-                        .iter()
-                        .copied()
-                        .filter(|(x, y)| {
-                            x.is_finite()
-                                && y.is_finite()
-                                && (!self.log.0 || *x > 0.0)
-                                && (!self.log.1 || *y > 0.0)
-                        })
-                        .collect();
-                    let anno = if s.markers {
-                        chart
-                            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-                            .map_err(|e| e.to_string())?
-                    } else {
-                        chart
-                            .draw_series(LineSeries::new(pts, colour.stroke_width(2)))
-                            .map_err(|e| e.to_string())?
-                    };
-                    anno.label(s.label).legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
-                    });
-                }
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.8))
-                    .border_style(BLACK)
-                    .draw()
-                    .map_err(|e| e.to_string())?;
+                    .map_err(|e| err(&e))?;
+                draw_all!($chart.draw_series, false);
             }};
         }
-        match self.log {
-            (false, false) => draw_series!(builder
-                .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
-                .map_err(|e| e.to_string())?),
-            (true, false) => draw_series!(builder
-                .build_cartesian_2d((xr.0..xr.1).log_scale(), yr.0..yr.1)
-                .map_err(|e| e.to_string())?),
-            (false, true) => draw_series!(builder
-                .build_cartesian_2d(xr.0..xr.1, (yr.0..yr.1).log_scale())
-                .map_err(|e| e.to_string())?),
-            (true, true) => draw_series!(builder
-                .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
-                .map_err(|e| e.to_string())?),
+        macro_rules! build {
+            ($x:expr, $y:expr) => {
+                builder.build_cartesian_2d($x, $y).map_err(|e| err(&e))?
+            };
         }
-        root.present().map_err(|e| e.to_string())?;
+        match log {
+            (false, false) => {
+                let mut chart = build!(xr.0..xr.1, yr.0..yr.1);
+                if has2 {
+                    let mut chart = chart.set_secondary_coord(xr.0..xr.1, y2r.0..y2r.1);
+                    primary!(chart);
+                    chart
+                        .configure_secondary_axes()
+                        .y_desc(self.y2_label)
+                        .y_label_formatter(&|v| snapped_tick_label(*v, y2s))
+                        .axis_desc_style(("sans-serif", 15))
+                        .label_style(("sans-serif", 13))
+                        .draw()
+                        .map_err(|e| err(&e))?;
+                    draw_all!(chart.draw_secondary_series, true);
+                } else {
+                    primary!(chart);
+                }
+            }
+            (true, false) => {
+                let mut chart = build!((xr.0..xr.1).log_scale(), yr.0..yr.1);
+                primary!(chart);
+            }
+            (false, true) => {
+                let mut chart = build!(xr.0..xr.1, (yr.0..yr.1).log_scale());
+                primary!(chart);
+            }
+            (true, true) => {
+                let mut chart = build!((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale());
+                primary!(chart);
+            }
+        }
+
+        // The legend, in its own panel to the right of the plot.
+        let font = ("sans-serif", 13).into_font().color(&BLACK);
+        let mut y = 50;
+        for &i in &labelled {
+            let (s, c) = (&self.series[i], colours[i]);
+            if s.markers {
+                let size = if s.width == 0 { 4 } else { s.width as i32 };
+                legend_area
+                    .draw(&marker_element(s.marker, (20, y), size, c, s.hollow))
+                    .map_err(|e| err(&e))?;
+            } else {
+                let style = c.stroke_width(if s.width == 0 { 2 } else { s.width });
+                let line = vec![(6, y), (34, y)];
+                if s.dashed {
+                    legend_area
+                        .draw(&plotters::element::DashedPathElement::new(
+                            line, 7, 5, style,
+                        ))
+                        .map_err(|e| err(&e))?;
+                } else {
+                    legend_area
+                        .draw(&PathElement::new(line, style))
+                        .map_err(|e| err(&e))?;
+                }
+            }
+            legend_area
+                .draw(&Text::new(s.label.to_string(), (42, y - 7), font.clone()))
+                .map_err(|e| err(&e))?;
+            y += 22;
+        }
+        let note_font = ("sans-serif", 12).into_font().color(&RGBColor(60, 60, 60));
+        let chars = ((legend_w as f64 - 12.0) / 6.2).max(10.0) as usize;
+        y += 8;
+        for note in &self.notes {
+            for line in wrap(note, chars) {
+                legend_area
+                    .draw(&Text::new(line, (6, y - 7), note_font.clone()))
+                    .map_err(|e| err(&e))?;
+                y += 16;
+            }
+            y += 6;
+        }
+        root.present().map_err(|e| err(&e))?;
         Ok(())
     }
 }

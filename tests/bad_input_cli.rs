@@ -174,7 +174,42 @@ fn bad_scenes() -> Vec<(&'static str, String, &'static str)> {
         (
             "overflowing roughness",
             edit(&p, "surface", "height_sigma_m", "1e308"),
-            "table",
+            "surface.height_sigma_m",
+        ),
+        (
+            "roughness of 1e300 m, named without a 300-digit decimal",
+            edit(
+                &edit(&p, "surface", "height_sigma_m", "1e300"),
+                "surface.peaks",
+                "sigma_m",
+                "1e300",
+            ),
+            "surface.height_sigma_m: must not exceed 10 x nominal_clearance_m = 1e-7 m, got 1e300 m",
+        ),
+        (
+            "sigma set in one place only",
+            edit(&p, "surface", "height_sigma_m", "5e-10"),
+            "surface.peaks.sigma_m: is 7e-10 m but surface.height_sigma_m is 5e-10 m",
+        ),
+        (
+            "huge DC voltage",
+            edit(&p, "voltage", "dc_v", "1e200"),
+            "voltage.dc_v: must be at most 1000 V, got 1e200 V",
+        ),
+        (
+            "terahertz AC",
+            edit(&p, "voltage", "ac_frequency_hz", "1e12"),
+            "voltage.ac_frequency_hz",
+        ),
+        (
+            "unbounded step budget",
+            edit(&p, "solver", "max_steps", "1000000000000"),
+            "solver.max_steps",
+        ),
+        (
+            "wrong type inside a tagged section",
+            edit(&p, "air_bearing", "stiffness_n_per_m", "\"stiff\""),
+            "air_bearing.stiffness_n_per_m",
         ),
         (
             "wrong type",

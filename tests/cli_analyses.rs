@@ -90,13 +90,24 @@ fn cycle_and_sweep_report_every_key_and_the_csv() {
     assert_eq!(rows[1]["v_ac"].as_f64(), Some(0.6));
     assert!(rows[0]["hysteresis"].as_f64().unwrap() > rows[1]["hysteresis"].as_f64().unwrap());
 
-    // --refine: the 0.7 V amplitude needs a tighter tolerance than the scene's to settle.
-    let rows = json(&["sweep", "--paper", "--v-ac", "0,0.7", "--refine", "6e-5"]);
+    // Refined by default: the 0.7 V amplitude needs a tighter tolerance than the scene's to
+    // settle; the status says whether both the powers and the mean temperature did.
+    let rows = json(&["sweep", "--paper", "--v-ac", "0,0.7", "--refine-mw", "0.06"]);
     let rows = rows.as_array().unwrap();
     for r in rows {
         let change = r["power_change"].as_f64().unwrap();
-        assert_eq!(r["converged"].as_bool(), Some(change <= 6e-5), "{r}");
-        assert!((2..=4).contains(&r["runs"].as_u64().unwrap()), "{r}");
+        let dt = r["temperature_change"].as_f64().unwrap();
+        let converged = change <= 6e-5 && dt <= 0.05;
+        let status = if converged {
+            "converged"
+        } else {
+            "not_converged"
+        };
+        assert_eq!(r["status"].as_str(), Some(status), "{r}");
+        assert!((2..=5).contains(&r["runs"].as_u64().unwrap()), "{r}");
+        // atol is tightened with rtol
+        let (rtol, atol) = (r["rtol"].as_f64().unwrap(), r["atol_m"].as_f64().unwrap());
+        assert!((atol / rtol / 1e-8 - 1.0).abs() < 1e-9, "{r}");
     }
     assert_eq!(rows[0]["rtol"].as_f64(), Some(1e-7));
     assert!(rows[1]["rtol"].as_f64().unwrap() < 1e-7, "{}", rows[1]);
@@ -138,24 +149,67 @@ fn calibrate_finds_the_static_touchdown_within_one_step() {
 }
 
 #[test]
-fn bad_arguments_give_one_line_and_a_non_zero_exit() {
-    for args in [
-        vec!["cycle", "--paper", "--method", "euler"],
-        vec!["sweep", "--paper", "--v-ac", "0,x"],
-        vec!["static"],
-        vec!["cycle", "--paper", "--rtol", "nan"],
-        vec!["sweep", "--paper", "--v-ac", "0", "--refine", "0"],
-        vec!["calibrate", "--paper", "--detector", "microphone"],
-        vec!["calibrate", "--paper", "--step-mw", "-1"],
-        vec!["static", "no-such-scene.toml"],
+fn bad_arguments_are_usage_errors_naming_the_option_as_typed() {
+    for (args, named) in [
+        (vec!["cycle", "--paper", "--method", "euler"], "--method"),
+        (vec!["sweep", "--paper", "--v-ac", "0,x"], "--v-ac"),
+        (vec!["static"], "--paper"),
+        (vec!["cycle", "--paper", "--rtol", "nan"], "--rtol"),
+        (
+            vec!["sweep", "--paper", "--v-ac", "0", "--refine-mw", "0"],
+            "--refine-mw",
+        ),
+        (
+            vec!["calibrate", "--paper", "--detector", "microphone"],
+            "--detector",
+        ),
+        (vec!["calibrate", "--paper", "--step-mw", "-1"], "--step-mw"),
+        (vec!["calibrate", "--paper", "--max-mw", "1e9"], "--max-mw"),
+        (
+            vec!["calibrate", "--paper", "--start-mw", "70", "--max-mw", "60"],
+            "--max-mw",
+        ),
     ] {
         let out = hdi(&args);
-        assert!(!out.status.success(), "{args:?} succeeded");
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(out.stdout.is_empty(), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-        assert!(err.starts_with("hdi: "), "{err}");
-        assert!(!err.contains("panicked"));
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+        assert!(err.contains(named), "{args:?}: {err} should name {named}");
+        assert!(
+            !err.contains("panicked") && !err.contains("staircase"),
+            "{err}"
+        );
     }
+    let out = hdi(&["calibrate", "--paper", "--step-mw", "-1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("'-1'") && err.contains("> 0"), "{err}");
+    let out = hdi(&["calibrate", "--paper", "--max-mw", "1e9"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--max-mw 1e9"), "{err}");
+    // a missing file is not a usage error
+    let out = hdi(&["static", "no-such-scene.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("hdi: ") && err.contains("no-such-scene.toml"),
+        "{err}"
+    );
+}
+
+/// A dither strong enough to bring the slider into contact at the start power leaves no
+/// touchdown to find: an error, not the start power reported as touchdown.
+#[test]
+fn calibrate_refuses_contact_at_the_start_power() {
+    let out = hdi(&["calibrate", "--paper", "--dither-v", "5"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("start power") && err.contains("--dither-v 5"),
+        "{err}"
+    );
 }
 
 #[test]

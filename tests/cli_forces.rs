@@ -316,7 +316,18 @@ fn bad_command_lines_are_usage_errors() {
             "0",
         ],
     ] {
-        one_line_error(&hdi(&args), 2);
+        let out = hdi(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(out.stdout.is_empty(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        // no command at all: the overview of the commands, on stderr
+        let expected = if args.is_empty() {
+            "Usage: hdi"
+        } else {
+            "error: "
+        };
+        assert!(err.contains(expected), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
     }
     assert!(hdi(&["help"]).status.success());
 }

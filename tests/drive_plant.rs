@@ -2,23 +2,23 @@
 //! harmonic-ratio clearance change against the true one, typed errors.
 
 use hdi_tribology::analysis::{flying_equilibrium, ScanGrid};
-use hdi_tribology::drive::{scene_zone, Command, DiskSpec, Drive, DriveOptions, Readback, Sensors};
+use hdi_tribology::drive::{scene_zone, Command, DiskSpec, Drive, DriveOptions, Plant, Sensors};
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
 
 const DT: f64 = 50e-6;
 
-fn drive(seed: u64, disk: DiskSpec) -> Drive {
+fn plant(seed: u64, disk: DiskSpec) -> Plant {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).unwrap();
     let opts = DriveOptions {
         disk,
         ..DriveOptions::default()
     };
-    Drive::new(&scene, &zone, seed, opts).unwrap()
+    Plant::new(&scene, &zone, seed, opts).unwrap()
 }
 
-fn hold(d: &mut Drive, p_mw: f64, steps: usize) -> Vec<Sensors> {
+fn hold(d: &mut Drive<'_>, p_mw: f64, steps: usize) -> Vec<Sensors> {
     (0..steps)
         .map(|_| d.step(&Command::heater_mw(p_mw), DT).unwrap())
         .collect()
@@ -26,7 +26,8 @@ fn hold(d: &mut Drive, p_mw: f64, steps: usize) -> Vec<Sensors> {
 
 #[test]
 fn steady_gap_is_the_static_flying_equilibrium() {
-    let mut d = drive(3, DiskSpec::flat());
+    let p = plant(3, DiskSpec::flat());
+    let mut d = p.drive().unwrap();
     let model = d.model().clone();
     for p_mw in [60.0, 66.0, 72.0] {
         // 4 ms: 40 heater time constants, ~90 decay times of the air-bearing mode.
@@ -44,7 +45,8 @@ fn steady_gap_is_the_static_flying_equilibrium() {
 #[test]
 fn same_seed_same_stream_bit_for_bit() {
     let run = |seed| {
-        let mut d = drive(seed, DiskSpec::default());
+        let p = plant(seed, DiskSpec::default());
+        let mut d = p.drive().unwrap();
         let mut v = hold(&mut d, 70.0, 30);
         v.extend(hold(&mut d, 75.0, 30));
         v
@@ -70,7 +72,8 @@ fn same_seed_same_stream_bit_for_bit() {
 
 #[test]
 fn bad_commands_are_typed_errors() {
-    let mut d = drive(1, DiskSpec::flat());
+    let p = plant(1, DiskSpec::flat());
+    let mut d = p.drive().unwrap();
     let e = d.step(&Command::heater_mw(-1.0), DT).unwrap_err();
     assert!(
         matches!(e, Error::InvalidInput { ref field, .. } if field == "command.heater_power"),

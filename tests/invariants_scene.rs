@@ -81,6 +81,7 @@ prop_compose! {
         s.nominal_clearance_m = h0;
         s.surface.height_sigma_m = sigma;
         s.surface.peaks = peaks;
+        s.surface.independent_peak_sigma = true; // drawn independently on purpose
         s.intermolecular = lj.map(|(a, b, footprint, gap)| IntermolecularSpec {
             hamaker_attractive_j: a,
             hamaker_repulsive_j_m6: b,

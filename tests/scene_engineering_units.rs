@@ -167,19 +167,24 @@ fn an_engineering_field_that_is_not_a_number_is_refused_by_name_and_unit() {
 }
 
 #[test]
-fn validation_errors_name_both_spellings() {
+fn validation_errors_name_the_field_as_given_in_its_unit() {
     let text = paper_in_engineering_units()
         .replace("asperity_radius_nm = 100.0", "asperity_radius_nm = -1");
-    let (field, _) = invalid_field(Scene::from_toml_str(&text));
-    assert_eq!(
-        field,
-        "contact.asperity_radius_m (given as contact.asperity_radius_nm)"
-    );
+    let (field, reason) = invalid_field(Scene::from_toml_str(&text));
+    assert_eq!(field, "contact.asperity_radius_nm");
+    assert!(reason.ends_with("got -1 nm"), "{reason}");
+    let text =
+        paper_in_engineering_units().replace("ac_frequency_khz = 10.5", "ac_frequency_khz = 1e12");
+    let (field, reason) = invalid_field(Scene::from_toml_str(&text));
+    assert_eq!(field, "voltage.ac_frequency_khz");
+    assert!(reason.ends_with("got 1e12 kHz"), "{reason}");
+    // the pairs of the programme have two units: both spellings are named
+    // (the reason stays in SI)
     let text = paper_in_engineering_units()
         .replace("[3.6, 78.0], [4.0, 78.0]", "[4.0, 78.0], [3.6, 78.0]");
     let (field, _) = invalid_field(Scene::from_toml_str(&text));
     assert!(
-        field.contains("(given as heater.programme_ms_mw)"),
+        field.contains("(given as heater.programme_ms_mw["),
         "{field}"
     );
 }

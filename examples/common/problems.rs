@@ -1,8 +1,9 @@
 //! Test problems for the work–precision report and the peer comparison, with their reference
-//! solutions: one non-stiff problem with a closed-form solution, and three stiff problems of the
-//! Test Set for IVP Solvers (F. Mazzia, C. Magherini et al., Univ. Bari): Van der Pol (μ = 1000),
-//! Robertson to t = 1e11 and HIRES. The reference values are those of the test set; the crate's
-//! stiff validation tests (`tests/ode_stiff.rs`) use these same definitions.
+//! solutions: one non-stiff problem with a closed-form solution, the non-stiff Pleiades (28
+//! states), and five stiff problems of the Test Set for IVP Solvers (F. Mazzia, C. Magherini et
+//! al., Univ. Bari): Van der Pol (μ = 1000), Robertson to t = 1e11, HIRES, OREGO and the badly
+//! scaled E5. The reference values are those of the test set; the crate's validation tests
+//! (`tests/ode_stiff.rs`, `tests/ode_testset.rs`) use these same definitions.
 //!
 //! Right-hand sides and Jacobians work on plain slices so that any solver can call them.
 #![allow(dead_code)]
@@ -58,10 +59,8 @@ impl<const N: usize> Problem<N> {
 
     /// `J·v` from the row-major Jacobian (for solvers that ask for Jacobian–vector products).
     pub fn jac_times(&self, t: f64, y: &[f64], v: &[f64], out: &mut [f64]) {
-        // Stack buffer: every problem here has at most 8 components.
-        let mut buf = [0.0; 64];
-        let j = &mut buf[..N * N];
-        (self.jac)(t, y, j);
+        let mut j = vec![0.0; N * N];
+        (self.jac)(t, y, &mut j);
         for i in 0..N {
             out[i] = (0..N).map(|k| j[i * N + k] * v[k]).sum();
         }
@@ -239,5 +238,207 @@ pub fn hires() -> Problem<8> {
         ],
         floor: 1e-30,
         atol: |rtol| [rtol * 1e-3; 8],
+    }
+}
+
+/// OREGO, the Oregonator (Field & Noyes), to t = 360 (test set "orego"); relative error.
+pub fn orego() -> Problem<3> {
+    const S: f64 = 77.27;
+    const W: f64 = 0.161;
+    const Q: f64 = 8.375e-6;
+    Problem {
+        name: "orego",
+        stiff: true,
+        rhs: |_, y, f| {
+            f[0] = S * (y[1] + y[0] * (1.0 - Q * y[0] - y[1]));
+            f[1] = (y[2] - (1.0 + y[0]) * y[1]) / S;
+            f[2] = W * (y[0] - y[2]);
+        },
+        jac: |_, y, j| {
+            j.copy_from_slice(&[
+                S * (1.0 - 2.0 * Q * y[0] - y[1]),
+                S * (1.0 - y[0]),
+                0.0,
+                -y[1] / S,
+                -(1.0 + y[0]) / S,
+                1.0 / S,
+                W,
+                0.0,
+                -W,
+            ]);
+        },
+        y0: [1.0, 2.0, 3.0],
+        t_end: 360.0,
+        reference: [
+            0.100_081_487_031_852_3e1,
+            0.122_817_852_154_991_7e4,
+            0.132_055_494_284_670_6e3,
+        ],
+        floor: 1e-30,
+        // Components range over 1 … 1e5: the tolerance is relative, with a small floor.
+        atol: |rtol| [rtol * 1e-2; 3],
+    }
+}
+
+/// E5 rate constants (test set "e5", a chemical pyrolysis).
+const E5_A: f64 = 7.89e-10;
+const E5_B: f64 = 1.1e7;
+const E5_C: f64 = 1.13e3;
+const E5_M: f64 = 1e6;
+
+/// E5 to t = 1e13 (test set "e5"): badly scaled (y₁ starts at 1.76e-3 and ends near 1e-291,
+/// the others never exceed ~1.5e-10 and end near 1e-22), with the linear invariant
+/// y₂ − y₃ − y₄ = 0. The end values y₂ ≈ y₃ ≈ 1/(MCt) are right only while the invariant holds
+/// to well below 1e-22, i.e. to 1e-12 of y₂'s peak: the right-hand side is written so that
+/// f₂ − f₃ − f₄ = 0 holds in floating point too (f₃ = f₂ − f₄, algebraically the test set's
+/// f₃ = Ay₁ − By₁y₃ − MCy₂y₃ + Cy₄, whose rounding of the nearly cancelling ±1.5e-7 terms alone
+/// breaks the invariant by ~1e-20 over the run). Error: relative, with floor 1e-24 (the test
+/// set's absolute tolerance for E5), so y₁ ≈ 1e-291 and y₄ = 0 only have to be tiny.
+/// Absolute tolerance 1e-20·rtol, as in the test set's runs.
+pub fn e5() -> Problem<4> {
+    Problem {
+        name: "e5",
+        stiff: true,
+        rhs: |_, y, f| {
+            let (a, b, mc) = (E5_A * y[0], E5_B * y[0] * y[2], E5_M * E5_C * y[1] * y[2]);
+            let c = E5_C * y[3];
+            f[0] = -a - b;
+            f[1] = a - mc;
+            f[3] = b - c;
+            f[2] = f[1] - f[3];
+        },
+        jac: |_, y, j| {
+            let mc = E5_M * E5_C;
+            j.copy_from_slice(&[
+                -E5_A - E5_B * y[2],
+                0.0,
+                -E5_B * y[0],
+                0.0,
+                E5_A,
+                -mc * y[2],
+                -mc * y[1],
+                0.0,
+                E5_A - E5_B * y[2],
+                -mc * y[2],
+                -E5_B * y[0] - mc * y[1],
+                E5_C,
+                E5_B * y[2],
+                0.0,
+                E5_B * y[0],
+                -E5_C,
+            ]);
+        },
+        y0: [1.76e-3, 0.0, 0.0, 0.0],
+        t_end: 1e13,
+        reference: [
+            0.115_290_327_871_182_9e-290,
+            0.886_765_551_764_212e-22,
+            0.885_481_462_626_883_8e-22,
+            0.0,
+        ],
+        floor: 1e-24,
+        atol: |rtol| [1e-20 * rtol; 4],
+    }
+}
+
+/// Pleiades (test set "plei"): seven bodies in the plane with masses 1 … 7 under gravity,
+/// 28 states (x, y, x', y'), to t = 3. Non-stiff; close encounters make the step size vary by
+/// orders of magnitude. Relative error (all end components are 0.24 … 5.3 in size).
+pub fn pleiades() -> Problem<28> {
+    Problem {
+        name: "pleiades",
+        stiff: false,
+        rhs: |_, y, f| {
+            for i in 0..7 {
+                let (mut ax, mut ay) = (0.0, 0.0);
+                for j in 0..7 {
+                    if j != i {
+                        let (dx, dy) = (y[j] - y[i], y[j + 7] - y[i + 7]);
+                        let r2 = dx * dx + dy * dy;
+                        let r3 = r2 * r2.sqrt();
+                        let m = (j + 1) as f64;
+                        ax += m * dx / r3;
+                        ay += m * dy / r3;
+                    }
+                }
+                f[i + 14] = ax;
+                f[i + 21] = ay;
+            }
+            f[..14].copy_from_slice(&y[14..28]);
+        },
+        jac: |_, y, jac| {
+            jac.fill(0.0);
+            let mut set = |i: usize, k: usize, v: f64| jac[i * 28 + k] = v;
+            for i in 0..14 {
+                set(i, 14 + i, 1.0);
+            }
+            // ∂a_i/∂r_j for j ≠ i, and the diagonal blocks as minus their row sums.
+            let mut diag = [[0.0; 3]; 7];
+            for i in 0..7 {
+                for j in 0..7 {
+                    if j == i {
+                        continue;
+                    }
+                    let (dx, dy) = (y[j] - y[i], y[j + 7] - y[i + 7]);
+                    let r2 = dx * dx + dy * dy;
+                    let r = r2.sqrt();
+                    let (r3, r5) = (r2 * r, r2 * r2 * r);
+                    let m = (j + 1) as f64;
+                    let xx = m * (1.0 / r3 - 3.0 * dx * dx / r5);
+                    let yy = m * (1.0 / r3 - 3.0 * dy * dy / r5);
+                    let xy = -m * 3.0 * dx * dy / r5;
+                    set(14 + i, j, xx);
+                    set(14 + i, 7 + j, xy);
+                    set(21 + i, j, xy);
+                    set(21 + i, 7 + j, yy);
+                    diag[i][0] += xx;
+                    diag[i][1] += xy;
+                    diag[i][2] += yy;
+                }
+                set(14 + i, i, -diag[i][0]);
+                set(14 + i, 7 + i, -diag[i][1]);
+                set(21 + i, i, -diag[i][1]);
+                set(21 + i, 7 + i, -diag[i][2]);
+            }
+        },
+        y0: [
+            3.0, 3.0, -1.0, -3.0, 2.0, -2.0, 2.0, // x
+            3.0, -3.0, 2.0, 0.0, 0.0, -4.0, 4.0, // y
+            0.0, 0.0, 0.0, 0.0, 0.0, 1.75, -1.5, // x'
+            0.0, 0.0, 0.0, -1.25, 1.0, 0.0, 0.0, // y'
+        ],
+        t_end: 3.0,
+        reference: [
+            0.370_613_914_397_050_2,
+            0.323_728_409_205_723_3e1,
+            -0.322_255_903_241_832_4e1,
+            0.659_709_145_577_531,
+            0.342_558_170_715_658_4,
+            0.156_217_210_140_063_1e1,
+            -0.700_309_292_221_249_5,
+            -0.394_343_758_551_739_2e1,
+            -0.327_138_097_397_255e1,
+            0.522_508_184_345_654_3e1,
+            -0.259_061_243_497_747e1,
+            0.119_821_369_339_227_5e1,
+            -0.242_968_234_493_582_4,
+            0.109_144_924_042_898e1,
+            0.341_700_380_631_431_3e1,
+            0.135_458_450_162_550_1e1,
+            -0.259_006_559_781_077_5e1,
+            0.202_505_373_471_424_2e1,
+            -0.115_581_510_016_044_8e1,
+            -0.807_298_817_022_302_1,
+            0.595_239_635_420_871,
+            -0.374_124_496_123_401e1,
+            0.377_345_968_575_063,
+            0.938_685_886_955_107_3,
+            0.366_792_222_720_057_1,
+            -0.347_404_635_380_849,
+            0.234_491_544_818_093_7e1,
+            -0.194_702_043_426_329_2e1,
+        ],
+        floor: 1e-30,
+        atol: |rtol| [rtol; 28],
     }
 }

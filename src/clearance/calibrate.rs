@@ -48,7 +48,7 @@ impl Staircase {
         }
         if (self.max_power - self.start_power) / self.step > MAX_LEVELS as f64 {
             return Err(Error::invalid(
-                "staircase.max_power",
+                "staircase.step",
                 format!(
                     "more than {MAX_LEVELS} levels of step = {:?} W between start_power = {:?} W \
                      and max_power = {:?} W",

@@ -1,19 +1,21 @@
 //! A simulated drive that firmware code can drive: step it at the controller's rate, read its
 //! sensors, close the loop.
 //!
-//! [`Drive`] is the plant: the slider of a scene in a [`crate::clearance::Zone`], over a disk
+//! [`Plant`] is the drive before it runs: the slider of a scene in a [`crate::clearance::Zone`], over a disk
 //! with run-out and waviness ([`DiskSpec`]), with a heater behind its thermal lag and a
-//! head–disk voltage ([`Command`]). [`Drive::step`] advances it by one controller period and
+//! head–disk voltage ([`Command`]); [`Plant::drive`] starts a [`Drive`] on it, and
+//! [`Drive::step`] advances it by one controller period and
 //! returns the [`Sensors`] firmware reads: the embedded contact sensor, acoustic emission and
 //! the read-back amplitudes, each with its bandwidth and seeded noise, plus the [`Truth`] for
 //! test oracles.
 //!
 //! ```
-//! use hdi_tribology::drive::{scene_zone, Command, Drive, DriveOptions};
+//! use hdi_tribology::drive::{scene_zone, Command, DriveOptions, Plant};
 //! use hdi_tribology::scene::Scene;
 //! let scene = Scene::paper();
 //! let zone = scene_zone(&scene, 0.025)?;
-//! let mut drive = Drive::new(&scene, &zone, 1, DriveOptions::default())?;
+//! let plant = Plant::new(&scene, &zone, 1, DriveOptions::default())?;
+//! let mut drive = plant.drive()?;
 //! // The firmware loop at 20 kHz: read, decide, repeat.
 //! let mut power_mw = 60.0;
 //! for _ in 0..100 {
@@ -26,13 +28,25 @@
 //! # Ok::<(), hdi_tribology::Error>(())
 //! ```
 
+mod controller;
 mod disk;
 mod plant;
+mod replay;
 mod rng;
+mod roc;
 mod sensors;
 
+pub use controller::{
+    run, AcousticLevel, Action, Channel, ClearanceHold, ContactSensorSlope, Controller, HoldPhase,
+    HoldSettings, LevelDetector, LevelStats, Staircase, StaircaseOutcome, StaircaseSettings,
+    TrueContact,
+};
 pub use disk::{DiskSpec, Harmonic};
-pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions};
+pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions, Plant};
+pub use replay::{
+    read_commands, replay, CommandRow, ReplaySummary, MAX_REPLAY_PERIODS, SENSOR_COLUMNS,
+};
+pub use roc::{touchdown_roc, RocPoint};
 pub use sensors::{
     AcousticSpec, ContactSensorSpec, Readback, ReadbackSpec, SensorSpec, Sensors, Truth,
 };

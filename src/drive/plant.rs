@@ -7,9 +7,10 @@ use crate::clearance::Zone;
 use crate::error::{check_finite, check_non_negative, Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem, StateLayout, Voltage};
-use crate::ode::{self, Method, OdeSystem, Options, SaveAt, Stats};
+use crate::ode::{Integrator, Method, OdeSystem, Options, Stats};
 use crate::scene::Scene;
-use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector, SVector};
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector, U4, U5, U6};
+use std::cell::RefCell;
 use std::f64::consts::PI;
 
 /// What the controller sets for the next period.
@@ -128,10 +129,15 @@ pub struct DriveOptions {
     pub ambient: Ambient,
     /// The sensors.
     pub sensors: SensorSpec,
+    /// ODE method. The scene's tolerances are used, not its method: a controller period is
+    /// several air-bearing periods long, and a stiff method steps over it in one step near
+    /// equilibrium, where an explicit one needs many (docs/benchmarks.md, "Drive").
+    pub method: Method,
 }
 
 impl Default for DriveOptions {
-    /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift.
+    /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift;
+    /// Rodas5P.
     fn default() -> Self {
         DriveOptions {
             initial_power: 0.060,
@@ -139,6 +145,7 @@ impl Default for DriveOptions {
             disk: DiskSpec::default(),
             ambient: Ambient::default(),
             sensors: SensorSpec::default(),
+            method: Method::Rodas5P,
         }
     }
 }
@@ -167,29 +174,40 @@ pub fn scene_zone(scene: &Scene, radius: f64) -> Result<Zone> {
 ///
 /// The state is relative to the disk surface `w(t)` (every force of the model depends on the
 /// gap and its rate only), so the surface's motion enters as the inertial force `−m ẅ(t)`;
-/// everything else is the model's own [`SliderSystem`].
-struct DriveSystem<'a> {
-    slider: SliderSystem<'a>,
-    disk: &'a Disk,
+/// everything else is the model's own [`SliderSystem`], evaluated on the model of the current
+/// command (heater, voltage, ambient clearance), which [`Drive::step`] sets before each period.
+struct DriveSystem {
+    current: RefCell<SliderModel>,
+    programme: Programme,
+    disk: Disk,
 }
 
-impl<D: Dim> OdeSystem<D> for DriveSystem<'_>
+impl DriveSystem {
+    /// The model's ODE for the current command. Cloning the programme shares its knots: no
+    /// allocation.
+    fn with_slider<R>(&self, f: impl FnOnce(&SliderSystem<'_>) -> R) -> R {
+        let m = self.current.borrow();
+        f(&SliderSystem::new(&m, self.programme.clone(), true))
+    }
+}
+
+impl<D: Dim> OdeSystem<D> for DriveSystem
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     fn rhs(&self, t: f64, y: &OVector<f64, D>, dy: &mut OVector<f64, D>) {
-        self.slider.rhs(t, y, dy);
+        self.with_slider(|s| s.rhs(t, y, dy));
         if !self.disk.is_flat() {
             dy[1] -= self.disk.acceleration(t).0;
         }
     }
 
     fn jacobian(&self, t: f64, y: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
-        self.slider.jacobian(t, y, j)
+        self.with_slider(|s| s.jacobian(t, y, j))
     }
 
     fn time_derivative(&self, t: f64, y: &OVector<f64, D>, d: &mut OVector<f64, D>) -> bool {
-        let ok = self.slider.time_derivative(t, y, d);
+        let ok = self.with_slider(|s| s.time_derivative(t, y, d));
         if ok && !self.disk.is_flat() {
             d[1] -= self.disk.acceleration(t).1;
         }
@@ -197,37 +215,16 @@ where
     }
 }
 
-/// The state vector, sized at compile time for the layouts a scene can have.
-#[derive(Clone, Debug)]
-enum State {
-    S4(SVector<f64, 4>),
-    S5(SVector<f64, 5>),
-    S6(SVector<f64, 6>),
-}
-
-macro_rules! with_state {
-    ($state:expr, $y:ident => $body:expr) => {
-        match $state {
-            State::S4($y) => $body,
-            State::S5($y) => $body,
-            State::S6($y) => $body,
-        }
-    };
-}
-
-/// A simulated drive: the slider of a scene flying in a zone over a wavy disk, with a heater, a
-/// head–disk voltage and the sensors firmware reads, stepped at the controller's rate.
-///
-/// Each [`Drive::step`] holds the [`Command`] over one period, advances the slider dynamics
-/// from where the last period ended (the model's [`SliderSystem`], any structure it supports,
-/// plus the disk's motion) and returns the [`Sensors`] at its end. The same seed gives the same
-/// disk and the same sensor noise, bit for bit.
+/// A drive before it runs: the slider of a scene in a zone, its disk, heater, sensors and
+/// solver settings. [`Plant::drive`] starts a [`Drive`] on it (several in turn, each from the
+/// same start).
 ///
 /// ```
-/// use hdi_tribology::drive::{scene_zone, Command, Drive, DriveOptions};
+/// use hdi_tribology::drive::{scene_zone, Command, DriveOptions, Plant};
 /// use hdi_tribology::scene::Scene;
 /// let scene = Scene::paper();
-/// let mut drive = Drive::new(&scene, &scene_zone(&scene, 0.025)?, 7, DriveOptions::default())?;
+/// let plant = Plant::new(&scene, &scene_zone(&scene, 0.025)?, 7, DriveOptions::default())?;
+/// let mut drive = plant.drive()?;
 /// let mut s = drive.step(&Command::heater_mw(60.0), 50e-6)?;
 /// for _ in 0..40 {
 ///     s = drive.step(&Command::heater_mw(65.0), 50e-6)?;
@@ -237,32 +234,37 @@ macro_rules! with_state {
 /// assert!(s.truth.gap < 4.5e-9);
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
-#[derive(Clone, Debug)]
-pub struct Drive {
+pub struct Plant {
+    system: DriveSystem,
     base: SliderModel,
-    programme: Programme,
     layout: StateLayout,
-    disk: Disk,
-    sensors: SensorState,
+    start: [f64; 3],
+    start_sensors: Physical,
+    sensors: SensorSpec,
     ambient: Ambient,
     method: Method,
     ode: Options,
-    /// Dither frequency `ode` was made for (its step cap depends on it).
-    ode_frequency: f64,
-    atol: Vec<f64>,
-    rtol: f64,
     max_steps: usize,
-    state: State,
-    t: f64,
-    stats: Stats,
     zone: Zone,
     seed: u64,
+    disk_spec: DiskSpec,
+    rpm: f64,
 }
 
-impl Drive {
-    /// The drive of `scene` moved to `zone` (see [`Zone::scene`]), its noise and disk seeded by
-    /// `seed`. The slider starts at rest in its flying equilibrium at `opts.initial_power` with
-    /// no voltage.
+impl std::fmt::Debug for Plant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Plant")
+            .field("zone", &self.zone)
+            .field("seed", &self.seed)
+            .field("layout", &self.layout)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Plant {
+    /// The drive of `scene` moved to `zone` (see [`Zone::scene`]), its disk and noise seeded by
+    /// `seed`. Every drive started on it begins at rest in the flying equilibrium at
+    /// `opts.initial_power` with no voltage.
     ///
     /// # Errors
     /// Invalid scene, zone or options (named field); no flying equilibrium at the initial power.
@@ -299,34 +301,7 @@ impl Drive {
             dc.voltage.squared(0.0),
             &ScanGrid::default(),
         )?;
-        let slider = SliderSystem::new(&base, programme.clone(), true);
-        let layout = slider.layout();
-        let state = match layout.len() {
-            4 => State::S4(slider.initial_state(
-                nalgebra::U4,
-                eq.y,
-                eq.protrusion,
-                eq.interface_force,
-            )),
-            5 => State::S5(slider.initial_state(
-                nalgebra::U5,
-                eq.y,
-                eq.protrusion,
-                eq.interface_force,
-            )),
-            6 => State::S6(slider.initial_state(
-                nalgebra::U6,
-                eq.y,
-                eq.protrusion,
-                eq.interface_force,
-            )),
-            n => {
-                return Err(Error::analysis(
-                    "drive",
-                    format!("no fixed-size state of {n} components"),
-                ))
-            }
-        };
+        let layout = SliderSystem::new(&base, programme.clone(), true).layout();
         let k = base.bearing().stiffness(0.0);
         let a = solver.atol_displacement;
         let mut atol = vec![a; layout.len()];
@@ -341,139 +316,120 @@ impl Drive {
         if let Some(i) = layout.heat {
             atol[i] = 1e-3 * 5e-5;
         }
+        let ode = Options::default()
+            .rtol(solver.rtol)
+            .atol_per_component(atol)
+            .h_max(solver.max_step.unwrap_or(f64::INFINITY))
+            // Bounded per period in `Drive::step`; the integrator lives as long as the drive.
+            .max_steps(usize::MAX)
+            .dense(false);
+        ode.validate(layout.len())
+            .map_err(|e| Error::invalid("solver", e.to_string()))?;
         let friction = base.friction.coefficient * zone.disk_speed;
-        let start = Physical {
+        let start_sensors = Physical {
             gap: eq.d,
             heater_power: opts.initial_power,
             friction_power: friction * base.contact_force(base.gaps(eq.y, eq.protrusion)),
             ambient: 0.0,
         };
-        let mut drive = Drive {
-            sensors: SensorState::new(opts.sensors, seed, &start),
+        Ok(Plant {
+            system: DriveSystem {
+                current: RefCell::new(base.clone()),
+                programme,
+                disk,
+            },
             base,
-            programme,
             layout,
-            disk,
+            start: [eq.y, eq.protrusion, eq.interface_force],
+            start_sensors,
+            sensors: opts.sensors,
             ambient: opts.ambient,
-            method: solver.method,
-            ode: Options::default(),
-            ode_frequency: f64::NAN,
-            atol,
-            rtol: solver.rtol,
+            method: opts.method,
+            ode,
             max_steps: solver.max_steps,
-            state,
-            t: 0.0,
-            stats: Stats::default(),
             zone: zone.clone(),
             seed,
-        };
-        drive.ode_for(0.0)?;
-        Ok(drive)
-    }
-
-    /// (Re)builds the integration options when the dither frequency changes: with a dither the
-    /// step is capped at 1/40 of its period so no peak of `V²` is skipped.
-    fn ode_for(&mut self, frequency: f64) -> Result<()> {
-        if frequency == self.ode_frequency {
-            return Ok(());
-        }
-        let h_max = if frequency > 0.0 {
-            1.0 / (40.0 * frequency)
-        } else {
-            f64::INFINITY
-        };
-        let o = Options::default()
-            .rtol(self.rtol)
-            .atol_per_component(self.atol.clone())
-            .h_max(h_max)
-            .max_steps(self.max_steps)
-            .save(SaveAt::Final)
-            .dense(false);
-        o.validate(self.layout.len())
-            .map_err(|e| Error::invalid("solver", e.to_string()))?;
-        self.ode = o;
-        self.ode_frequency = frequency;
-        Ok(())
-    }
-
-    /// Holds `command` for `dt` seconds, advances the slider and returns the sensors at the end.
-    ///
-    /// # Errors
-    /// An invalid command or period (named field); an integration failure (the state is then
-    /// left at the start of the period).
-    pub fn step(&mut self, command: &Command, dt: f64) -> Result<Sensors> {
-        command.validate()?;
-        crate::error::check_positive("dt", dt)?;
-        if dt > 1.0 {
-            return Err(Error::invalid(
-                "dt",
-                format!("a controller period must not exceed 1 s, got {dt} s"),
-            ));
-        }
-        let freq = if command.ac_amplitude != 0.0 {
-            command.ac_frequency
-        } else {
-            0.0
-        };
-        self.ode_for(freq)?;
-        let (t0, t1) = (self.t, self.t + dt);
-        let ambient = self.ambient.temperature(t0);
-        // Cloning the model shares its tables (reference counts): no allocation.
-        let mut model = self.base.clone();
-        model.efficiency = self.base.efficiency * command.heater_power;
-        model.nominal_clearance += self.ambient.clearance_per_kelvin * ambient;
-        model.voltage = Voltage {
-            dc: command.dc_voltage,
-            ac_amplitude: command.ac_amplitude,
-            frequency: command.ac_frequency,
-            contact_potential: self.base.voltage.contact_potential,
-        };
-        let sys = DriveSystem {
-            slider: SliderSystem::new(&model, self.programme.clone(), true),
-            disk: &self.disk,
-        };
-        let layout = self.layout;
-        let (method, ode) = (self.method, &self.ode);
-        let mut stats = Stats::default();
-        let truth = with_state!(&mut self.state, y => {
-            advance(&sys, y, &layout, t0, t1, method, ode, &mut stats)?;
-            observe(&sys, y, &layout, t1, dt)
-        });
-        self.stats += &stats;
-        self.t = t1;
-        let friction_power =
-            model.friction.coefficient * self.zone.disk_speed * truth.mean_contact_force;
-        let phys = Physical {
-            gap: truth.gap,
-            heater_power: command.heater_power,
-            friction_power,
-            ambient,
-        };
-        let (r, ae, readback, temp) = self.sensors.sample(t1, dt, &phys);
-        Ok(Sensors {
-            t: t1,
-            contact_resistance: r,
-            acoustic: ae,
-            readback,
-            heater_power: command.heater_power,
-            truth: Truth {
-                friction_power,
-                sensor_temperature: temp,
-                disk_height: self.disk.height(t1).0,
-                ambient,
-                ..truth
-            },
+            disk_spec: opts.disk,
+            rpm,
         })
     }
 
-    /// Simulated time so far (s).
-    pub fn time(&self) -> f64 {
-        self.t
+    /// The same plant with another seed: a new random disk and new sensor noise, the model's
+    /// tables shared (no rebuild), for runs over many seeds.
+    ///
+    /// # Errors
+    /// None in practice (the disk was valid for the first seed).
+    pub fn with_seed(&self, seed: u64) -> Result<Plant> {
+        Ok(Plant {
+            system: DriveSystem {
+                current: RefCell::new(self.base.clone()),
+                programme: self.system.programme.clone(),
+                disk: Disk::new(&self.disk_spec, self.rpm, seed)?,
+            },
+            base: self.base.clone(),
+            layout: self.layout,
+            start: self.start,
+            start_sensors: self.start_sensors,
+            sensors: self.sensors,
+            ambient: self.ambient,
+            method: self.method,
+            ode: self.ode.clone(),
+            max_steps: self.max_steps,
+            zone: self.zone.clone(),
+            seed,
+            disk_spec: self.disk_spec.clone(),
+            rpm: self.rpm,
+        })
     }
 
-    /// Solver work so far.
-    pub fn stats(&self) -> &Stats {
-        &self.stats
+    /// Starts a drive: at rest in the flying equilibrium at the initial power, time 0, the
+    /// sensor noise at the start of its seeded stream.
+    ///
+    /// # Errors
+    /// A state size the drive has no fixed-size vector for; integrator set-up failures.
+    pub fn drive(&self) -> Result<Drive<'_>> {
+        let sys = &self.system;
+        let [y, delta, f] = self.start;
+        let (m, o) = (self.method, &self.ode);
+        let probe = SliderSystem::new(&self.base, sys.programme.clone(), true);
+        let integ = match self.layout.len() {
+            4 => Integ::S4(Integrator::new(
+                sys,
+                0.0,
+                probe.initial_state(U4, y, delta, f),
+                1.0,
+                m,
+                o,
+            )?),
+            5 => Integ::S5(Integrator::new(
+                sys,
+                0.0,
+                probe.initial_state(U5, y, delta, f),
+                1.0,
+                m,
+                o,
+            )?),
+            6 => Integ::S6(Integrator::new(
+                sys,
+                0.0,
+                probe.initial_state(U6, y, delta, f),
+                1.0,
+                m,
+                o,
+            )?),
+            n => {
+                return Err(Error::analysis(
+                    "drive",
+                    format!("no fixed-size state of {n} components"),
+                ))
+            }
+        };
+        Ok(Drive {
+            plant: self,
+            integ,
+            sensors: SensorState::new(self.sensors, self.seed, &self.start_sensors),
+            t: 0.0,
+        })
     }
 
     /// The zone.
@@ -490,36 +446,176 @@ impl Drive {
     pub fn model(&self) -> &SliderModel {
         &self.base
     }
+
+    /// The sensor models.
+    pub fn sensor_spec(&self) -> &SensorSpec {
+        &self.sensors
+    }
+}
+
+/// The integrator, on a state sized at compile time for the layouts a scene can have.
+enum Integ<'p> {
+    S4(Integrator<'p, U4, DriveSystem>),
+    S5(Integrator<'p, U5, DriveSystem>),
+    S6(Integrator<'p, U6, DriveSystem>),
+}
+
+macro_rules! with_integ {
+    ($integ:expr, $it:ident => $body:expr) => {
+        match $integ {
+            Integ::S4($it) => $body,
+            Integ::S5($it) => $body,
+            Integ::S6($it) => $body,
+        }
+    };
+}
+
+/// A simulated drive: the slider of a [`Plant`] flying over its wavy disk, with a heater, a
+/// head–disk voltage and the sensors firmware reads, stepped at the controller's rate.
+///
+/// Each [`Drive::step`] holds the [`Command`] over one period, advances the slider dynamics
+/// from where the last period ended with the crate's steppable [`Integrator`] (the model's
+/// [`SliderSystem`] plus the disk's motion; nothing is re-solved and nothing allocated) and
+/// returns the [`Sensors`] at its end. The same seed gives the same disk and the same sensor
+/// noise, bit for bit.
+pub struct Drive<'p> {
+    plant: &'p Plant,
+    integ: Integ<'p>,
+    sensors: SensorState,
+    t: f64,
+}
+
+impl std::fmt::Debug for Drive<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Drive")
+            .field("plant", self.plant)
+            .field("t", &self.t)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Drive<'_> {
+    /// Holds `command` for `dt` seconds, advances the slider and returns the sensors at the end.
+    ///
+    /// # Errors
+    /// An invalid command or period (named field); an integration failure.
+    pub fn step(&mut self, command: &Command, dt: f64) -> Result<Sensors> {
+        command.validate()?;
+        crate::error::check_positive("dt", dt)?;
+        if dt > 1.0 {
+            return Err(Error::invalid(
+                "dt",
+                format!("a controller period must not exceed 1 s, got {dt} s"),
+            ));
+        }
+        let plant = self.plant;
+        let (t0, t1) = (self.t, self.t + dt);
+        let ambient = plant.ambient.temperature(t0);
+        {
+            // Cloning the model shares its tables (reference counts): no allocation.
+            let mut m = plant.system.current.borrow_mut();
+            *m = plant.base.clone();
+            m.efficiency = plant.base.efficiency * command.heater_power;
+            m.nominal_clearance += plant.ambient.clearance_per_kelvin * ambient;
+            m.voltage = Voltage {
+                dc: command.dc_voltage,
+                ac_amplitude: command.ac_amplitude,
+                frequency: command.ac_frequency,
+                contact_potential: plant.base.voltage.contact_potential,
+            };
+        }
+        let layout = plant.layout;
+        let max_steps = plant.max_steps;
+        let truth = with_integ!(&mut self.integ, it => {
+            advance(it, &layout, t0, t1, max_steps)?;
+            plant.system.with_slider(|s| observe(s, it.state(), &layout, t1, dt))
+        });
+        self.t = t1;
+        let m = plant.system.current.borrow();
+        let friction_power =
+            m.friction.coefficient * plant.zone.disk_speed * truth.mean_contact_force;
+        let phys = Physical {
+            gap: truth.gap,
+            heater_power: command.heater_power,
+            friction_power,
+            ambient,
+        };
+        let (r, ae, readback, temp) = self.sensors.sample(t1, dt, &phys);
+        Ok(Sensors {
+            t: t1,
+            contact_resistance: r,
+            acoustic: ae,
+            readback,
+            heater_power: command.heater_power,
+            truth: Truth {
+                friction_power,
+                sensor_temperature: temp,
+                disk_height: plant.system.disk.height(t1).0,
+                ambient,
+                ..truth
+            },
+        })
+    }
+
+    /// Simulated time so far (s).
+    pub fn time(&self) -> f64 {
+        self.t
+    }
+
+    /// Solver work so far.
+    pub fn stats(&self) -> Stats {
+        with_integ!(&self.integ, it => it.stats())
+    }
+
+    /// The plant.
+    pub fn plant(&self) -> &Plant {
+        self.plant
+    }
+
+    /// The slider model of the zone (with the heater time constant the drive uses).
+    pub fn model(&self) -> &SliderModel {
+        &self.plant.base
+    }
 }
 
 /// Integrates one period; the one place the drive calls the ODE stepper.
-#[allow(clippy::too_many_arguments)]
+///
+/// The command may have changed, and the period integrals restart at zero: both are
+/// discontinuities, so the integrator restarts at `t0` (its first step is the whole period,
+/// which the step control cuts down in a transient) and steps to `t1`.
 fn advance<D: Dim>(
-    sys: &DriveSystem<'_>,
-    y: &mut OVector<f64, D>,
+    it: &mut Integrator<'_, D, DriveSystem>,
     layout: &StateLayout,
     t0: f64,
     t1: f64,
-    method: Method,
-    opts: &Options,
-    stats: &mut Stats,
+    max_steps: usize,
 ) -> Result<()>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    // The integrals restart every period: their end values are the period's sums.
+    let mut y = it.state().clone();
     for i in [layout.contact_impulse, layout.heat].into_iter().flatten() {
         y[i] = 0.0;
     }
-    let sol = ode::solve(sys, t0, y.clone(), t1, method, opts, &mut [])?;
-    *stats += &sol.stats;
-    *y = sol.y_end;
+    it.set_tf(t1)?;
+    it.reinit(t0, y)?;
+    let mut n = 0usize;
+    while it.t() < t1 {
+        if n >= max_steps {
+            return Err(Error::no_convergence(
+                "drive period",
+                format!("more than {max_steps} steps (solver.max_steps) in [{t0}, {t1}] s"),
+            ));
+        }
+        it.step()?;
+        n += 1;
+    }
     Ok(())
 }
 
 /// The true values at the end of a period.
 fn observe<D: Dim>(
-    sys: &DriveSystem<'_>,
+    sys: &SliderSystem<'_>,
     y: &OVector<f64, D>,
     layout: &StateLayout,
     t: f64,
@@ -528,15 +624,15 @@ fn observe<D: Dim>(
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    let m = sys.slider.model();
-    let g = sys.slider.gaps(t, y);
+    let m = sys.model();
+    let g = sys.gaps(t, y);
     let mean = |i: Option<usize>| i.map_or(0.0, |i| y[i] / dt);
     Truth {
         gap: g.bulge,
         pad_gap: g.pad,
         displacement: y[0],
         velocity: y[1],
-        protrusion: sys.slider.protrusion(t, y),
+        protrusion: sys.protrusion(t, y),
         mean_contact_force: mean(layout.contact_impulse),
         contact_force: m.contact_force(g),
         interface_force: m.interface_force(g, m.voltage.squared(t)).value,

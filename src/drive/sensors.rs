@@ -250,6 +250,7 @@ pub struct Sensors {
 }
 
 /// The physical inputs of the sensors at the end of one period.
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct Physical {
     pub gap: f64,
     pub heater_power: f64,

@@ -89,18 +89,10 @@ pub fn write_plots(result: &FitResult, dir: &Path) -> crate::Result<Vec<PathBuf>
             x_label: &t.x_column,
             y_label: &t.column,
             series: vec![
-                Series {
-                    label: "measured",
-                    points: pts(|r| r.measured),
-                    markers: true,
-                },
-                Series {
-                    label: "fitted model",
-                    points: fitted,
-                    markers: false,
-                },
+                Series::line("fitted model", fitted),
+                Series::markers("measured", pts(|r| r.measured)),
             ],
-            log: (false, false),
+            ..Chart::default()
         }
         .to_svg(&path, 720, 440)?;
         written.push(path);
@@ -119,18 +111,10 @@ pub fn write_plots(result: &FitResult, dir: &Path) -> crate::Result<Vec<PathBuf>
             x_label: &t.x_column,
             y_label: &t.column,
             series: vec![
-                Series {
-                    label: "residual",
-                    points: pts(|r| r.residual),
-                    markers: true,
-                },
-                Series {
-                    label: "zero",
-                    points: zero,
-                    markers: false,
-                },
+                Series::line("zero", zero),
+                Series::markers("residual", pts(|r| r.residual)),
             ],
-            log: (false, false),
+            ..Chart::default()
         }
         .to_svg(&path, 720, 320)?;
         written.push(path);

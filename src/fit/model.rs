@@ -36,6 +36,9 @@ pub(super) struct Evaluator<'a> {
     pub params: &'a [Resolved],
     pub data: &'a [DataSet],
     static_table_rel_tol: f64,
+    /// Upper end of the static curves' tables, pinned to the starting scene's so that the
+    /// nominal clearance does not change the tables (beyond it forces are exact quadrature).
+    static_d_max: Option<f64>,
     tables: Mutex<Vec<(String, InterfaceForces)>>,
     pub evaluations: AtomicUsize,
 }
@@ -47,7 +50,12 @@ impl<'a> Evaluator<'a> {
         data: &'a [DataSet],
         static_table_rel_tol: f64,
     ) -> Self {
+        let static_d_max = serde_json::from_value::<Scene>(base.clone())
+            .ok()
+            .filter(|s| s.table.d_max_m.is_none())
+            .map(|s| s.table_range().1);
         Evaluator {
+            static_d_max,
             base,
             params,
             data,
@@ -108,10 +116,21 @@ impl<'a> Evaluator<'a> {
                     if static_model.is_none() {
                         let mut s = scene.clone();
                         s.table.rel_tol = s.table.rel_tol.max(self.static_table_rel_tol);
+                        s.table.d_max_m = s.table.d_max_m.or(self.static_d_max);
                         static_model = Some(self.model(&s)?);
                     }
                     let m = static_model.as_ref().expect("built above");
-                    predict_static(m, &scene, ds)?
+                    match predict_static(m, &scene, ds) {
+                        Ok(c) => c,
+                        // The coarse tables can lose a bracket of the scan: the scene's own.
+                        Err(_) => {
+                            if dynamic_model.is_none() {
+                                dynamic_model = Some(self.model(&scene)?);
+                            }
+                            let m = dynamic_model.as_ref().expect("built above");
+                            predict_static(m, &scene, ds)?
+                        }
+                    }
                 }
                 CurveKind::CycleVsAc => {
                     if dynamic_model.is_none() {

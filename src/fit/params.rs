@@ -237,6 +237,10 @@ fn reader_factor(base: &Value, leaf: &[String], key: &str) -> Option<f64> {
         .as_object_mut()?;
     obj.remove(last.as_str());
     obj.insert(key.to_string(), Value::from(1.0));
+    // the probe moves one σ of the surface alone: say so, or the reader refuses it
+    if let Some(Value::Object(surface)) = trial.get_mut("surface") {
+        surface.insert("independent_peak_sigma".into(), Value::Bool(true));
+    }
     let scene = Scene::from_json_str(&trial.to_string()).ok()?;
     let back = serde_json::to_value(&scene).ok()?;
     get(&back, leaf)?

@@ -625,10 +625,15 @@ fn analyse(
                 cov[(j, j)].sqrt()
             };
             let determined = rel <= tol;
+            // Within a thousandth of the range (or of the scale, for a one-sided bound).
+            let width = match (p.lower, p.upper) {
+                (Some(lo), Some(hi)) => hi - lo,
+                _ => p.scale,
+            };
             let at_bound = [p.lower, p.upper]
                 .iter()
                 .flatten()
-                .any(|b| (x[j] - b).abs() <= 1e-6 * p.scale.max((p.upper.unwrap_or(*b) - b).abs()));
+                .any(|b| (x[j] - b).abs() <= 1e-3 * width);
             FittedParameter {
                 name: p.name.clone(),
                 unit: p.unit.clone(),
@@ -644,6 +649,26 @@ fn analyse(
             }
         })
         .collect();
+    // Other starts that ended as good a fit (χ² within n·s² of the best) but elsewhere: the
+    // linearisation at one minimum cannot see them, so the parameters that differ by more than
+    // three of their error bars are not determined.
+    let mut parameters = parameters;
+    let mut elsewhere: Vec<String> = Vec::new();
+    for o in starts
+        .iter()
+        .filter(|o| o.cost <= chi2 + n as f64 * s * s && o.end.len() == n)
+    {
+        for (j, p) in parameters.iter_mut().enumerate() {
+            let far = (o.end[j] - x[j]).abs() > 3.0 * p.linear_error;
+            if far && p.determined {
+                p.determined = false;
+                p.standard_error = None;
+            }
+            if far && !elsewhere.contains(&p.name) {
+                elsewhere.push(p.name.clone());
+            }
+        }
+    }
     let correlation: Vec<Vec<f64>> = (0..n)
         .map(|a| {
             (0..n)
@@ -651,7 +676,16 @@ fn analyse(
                 .collect()
         })
         .collect();
-    let statements = identifiability_words(&parameters, &directions, params, tol);
+    let mut statements = Vec::new();
+    if !elsewhere.is_empty() {
+        statements.push(format!(
+            "starts that ended elsewhere fit as well (χ² within {n}·s² of the best): {} differ(s) \
+             between them by more than three error bars, so the data do not determine {}",
+            elsewhere.join(", "),
+            if elsewhere.len() == 1 { "it" } else { "them" }
+        ));
+    }
+    statements.extend(identifiability_words(&parameters, &directions, params, tol));
     let condition = if sv.iter().any(|&v| v <= 0.0) {
         f64::INFINITY
     } else {
@@ -732,7 +766,7 @@ fn analyse(
 
 fn percent(v: f64) -> String {
     if v.is_finite() {
-        format!("{:.0} %", 100.0 * v)
+        format!("{:.2} %", 100.0 * v)
     } else {
         "unbounded".into()
     }

@@ -215,6 +215,16 @@ impl Slot {
     }
 }
 
+/// A contact force (and area) is never negative: an interpolation undershoot below zero, of the
+/// order of the table's absolute tolerance, is clamped to zero with zero slope.
+fn non_negative(e: ForceEval) -> ForceEval {
+    if e.value < 0.0 {
+        ForceEval::default()
+    } else {
+        e
+    }
+}
+
 fn next_toward(x: f64, toward: f64) -> f64 {
     let step = (x.abs() * f64::EPSILON).max(f64::MIN_POSITIVE);
     if toward > x {
@@ -446,11 +456,12 @@ impl InterfaceForces {
         self.sum(&self.per_volt2, g)
     }
 
-    /// Contact force only (N; included in [`InterfaceForces::static_part`]). Hot path. Where the
-    /// force is below the table's absolute tolerance it may undershoot zero by that much.
+    /// Contact force only (N; included in [`InterfaceForces::static_part`]). Hot path. Never
+    /// negative: where the force is below the table's absolute tolerance an interpolation
+    /// undershoot is clamped to zero (with zero slope).
     #[inline]
     pub fn contact(&self, g: Gaps) -> ForceEval {
-        self.sum(&self.contact, g)
+        non_negative(self.sum(&self.contact, g))
     }
 
     /// [`InterfaceForces::static_part`], [`InterfaceForces::per_volt2_part`] and
@@ -469,7 +480,7 @@ impl InterfaceForces {
                 return HotForces {
                     static_part: e(s),
                     per_volt2: e(v),
-                    contact: e(c),
+                    contact: non_negative(e(c)),
                 };
             }
         }
@@ -513,6 +524,8 @@ impl InterfaceForces {
                 TermKind::Other => b.other += x,
             }
         }
+        // a contact force is never negative (see `InterfaceForces::contact`)
+        b.contact = b.contact.max(0.0);
         b.real_contact_area = self.real_contact_area(g);
         b.total = b.intermolecular + b.contact + b.electrostatic + b.other;
         b

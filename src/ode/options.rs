@@ -26,7 +26,9 @@ pub enum Method {
     Rodas5P,
     /// Radau IIA, 3 stages, order 5, L-stable, with simplified Newton iterations.
     Radau5,
-    /// Tsit5 while the problem is non-stiff, Rodas5P while it is stiff, switching both ways.
+    /// Tsit5 while the problem is non-stiff, a stiff method while it is stiff, switching both
+    /// ways. The stiff method is Radau5 for `rtol` below 1e-6 and Rodas5P from 1e-6 on (by
+    /// the measured work–precision of both; the tolerance at the start decides).
     Auto,
 }
 

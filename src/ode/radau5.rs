@@ -5,7 +5,7 @@
 //! dense output (order 3).
 
 use super::dense::StepPoly;
-use super::jacobian::eval_jacobian;
+use super::jacobian::{eval_jacobian, spectral_radius};
 use super::lu::Lu;
 use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
@@ -160,6 +160,8 @@ where
     /// the tolerance; Hairer's code uses 0.1 rtol^(2/3) instead).
     tol_scale: f64,
     newton_tol: f64,
+    /// Spectral radius of the last Jacobian, when stiffness switching asks for it.
+    rho: Option<f64>,
 }
 
 impl<D: Dim> Radau5<D>
@@ -194,6 +196,7 @@ where
             last_rejected: false,
             tol_scale: rtol_inner / rtol,
             newton_tol: (10.0 * f64::EPSILON / rtol_inner).max(0.03f64.min(rtol_inner.sqrt())),
+            rho: None,
         }
     }
 
@@ -294,6 +297,9 @@ where
             self.jac_stale = false;
             self.jac_fresh = true;
             self.lu_h = f64::NAN;
+            if ctx.want_stiffness {
+                self.rho = Some(spectral_radius(&self.jac, y));
+            }
         }
         if self.lu_h != h && !self.factor(h, ctx) {
             return Trial::Failed {
@@ -492,7 +498,7 @@ where
     }
 
     fn stiffness(&self) -> Option<f64> {
-        None
+        self.rho
     }
 
     fn propose(&self, h_acc: f64, h_new: f64) -> f64 {

@@ -87,52 +87,115 @@ pub fn engineering_unit(key: &str) -> Option<(String, f64, &'static str)> {
     }
 }
 
+/// A renamed field: its path as the file gave it, and for a field scaled by one factor, that
+/// factor to SI and the unit's name.
+#[derive(Debug)]
+struct Given {
+    path: String,
+    scale: Option<(f64, &'static str)>,
+}
+
 /// The renames made, as dotted paths: SI field → the field as the file gave it.
 #[derive(Debug, Default)]
-pub(super) struct Renames(BTreeMap<String, String>);
+pub(super) struct Renames(BTreeMap<String, Given>);
 
 impl Renames {
-    fn insert(&mut self, prefix: &str, si_key: &str, eng_key: &str) {
-        self.0.insert(path(prefix, si_key), path(prefix, eng_key));
+    fn insert(&mut self, prefix: &str, rule: &Rule, eng_key: &str) {
+        let scale = match rule.factors {
+            Factors::All(f) => Some((f, rule.unit)),
+            Factors::Pairs(_) => None,
+        };
+        self.0.insert(
+            path(prefix, &rule.si_key),
+            Given {
+                path: path(prefix, eng_key),
+                scale,
+            },
+        );
     }
 
     pub(super) fn is_empty(&self) -> bool {
         self.0.is_empty()
     }
 
+    /// A dotted path as the file gave it (an SI path the reader renamed is named as given).
+    pub(super) fn given(&self, path: &str) -> String {
+        self.lookup(path)
+            .map_or_else(|| path.to_string(), |(g, rest)| format!("{}{rest}", g.path))
+    }
+
+    /// The renamed field that `path` is, or lies inside, and the rest of `path` after it.
+    fn lookup<'a>(&self, path: &'a str) -> Option<(&Given, &'a str)> {
+        self.0.iter().find_map(|(si, given)| {
+            let rest = path.strip_prefix(si.as_str())?;
+            (rest.is_empty() || rest.starts_with(['[', '.'])).then_some((given, rest))
+        })
+    }
+
     /// A deserialiser's "unknown field" message names the key as the file spelt it.
     pub(super) fn respell(&self, msg: String) -> String {
         let last = |p: &str| p.rsplit('.').next().unwrap_or(p).to_string();
-        self.0.iter().fold(msg, |m, (si, eng)| {
+        self.0.iter().fold(msg, |m, (si, given)| {
             m.replace(
                 &format!("unknown field `{}`", last(si)),
-                &format!("unknown field `{}`", last(eng)),
+                &format!("unknown field `{}`", last(&given.path)),
             )
         })
     }
 
-    /// A validation error on a renamed field also names the field as the file gave it (the
-    /// reason is in SI units, as the field it names).
+    /// A validation error on a renamed field names the field as the file gave it, with the value
+    /// seen (`got …`) in the file's unit.
     pub(super) fn annotate(&self, e: Error) -> Error {
         match e {
-            Error::InvalidInput { field, reason } => {
-                let given = self.0.iter().find(|(si, _)| {
-                    field == **si
-                        || field
-                            .strip_prefix(si.as_str())
-                            .is_some_and(|rest| rest.starts_with(['[', '.']))
-                });
-                match given {
-                    Some((_, eng)) => Error::InvalidInput {
-                        field: format!("{field} (given as {eng})"),
-                        reason,
+            Error::InvalidInput { field, reason } => match self.lookup(&field) {
+                Some((
+                    Given {
+                        path,
+                        scale: Some((f, unit)),
                     },
-                    None => Error::InvalidInput { field, reason },
-                }
-            }
+                    rest,
+                )) => Error::InvalidInput {
+                    field: format!("{path}{rest}"),
+                    reason: in_unit(&reason, *f, unit),
+                },
+                Some((Given { path, scale: None }, rest)) => Error::InvalidInput {
+                    field: format!("{field} (given as {path}{rest})"),
+                    reason,
+                },
+                None => Error::InvalidInput { field, reason },
+            },
             other => other,
         }
     }
+}
+
+/// SI unit names a message may write after a value, dropped when the value is rewritten.
+const SI_UNITS: &[&str] = &["m", "m²", "m⁻²", "s", "W", "Hz", "Pa", "N", "m/W", "W/s"];
+
+/// `reason` with the value after `got ` (in SI) rewritten in the engineering unit (`factor` to
+/// SI): `got -5e-10` becomes `got -0.5 nm`.
+fn in_unit(reason: &str, factor: f64, unit: &str) -> String {
+    let Some(at) = reason.find("got ") else {
+        return reason.to_string();
+    };
+    let (head, tail) = reason.split_at(at + 4);
+    let end = tail
+        .find(|c: char| c.is_whitespace() || c == ',' || c == ')')
+        .unwrap_or(tail.len());
+    let Ok(x) = tail[..end].parse::<f64>() else {
+        return reason.to_string();
+    };
+    let mut rest = &tail[end..];
+    if let Some(r) = rest.strip_prefix(' ') {
+        let word = r
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .next()
+            .unwrap_or("");
+        if SI_UNITS.contains(&word) {
+            rest = &r[word.len()..];
+        }
+    }
+    format!("{head}{} {unit}{rest}", crate::units::fmt_short(x / factor))
 }
 
 fn path(prefix: &str, key: &str) -> String {
@@ -234,7 +297,7 @@ pub(super) mod toml_doc {
                     }
                     convert(v, &r.factors, &field, r.unit, edits)?;
                     edits.push(k.span(), r.si_key.clone());
-                    renames.insert(prefix, &r.si_key, key);
+                    renames.insert(prefix, &r, key);
                 }
                 None => {
                     if let DeValue::Table(t) = v.get_ref() {
@@ -302,7 +365,7 @@ pub(super) mod json_doc {
                         continue;
                     };
                     convert(&mut v, &r.factors, &field, r.unit)?;
-                    renames.insert(prefix, &r.si_key, &key);
+                    renames.insert(prefix, &r, &key);
                     obj.insert(r.si_key, v);
                 }
                 None => {
@@ -319,6 +382,23 @@ pub(super) mod json_doc {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_are_rewritten_in_the_given_unit() {
+        assert_eq!(
+            in_unit("must be finite and >= 0, got -5e-10", 1e-9, "nm"),
+            "must be finite and >= 0, got -0.5 nm"
+        );
+        assert_eq!(
+            in_unit("must not exceed 1e-7 m, got 1e291 m", 1e-9, "nm"),
+            "must not exceed 1e-7 m, got 1e300 nm"
+        );
+        assert_eq!(
+            in_unit("got 0.5 W, too much", 1e-3, "mW"),
+            "got 500 mW, too much"
+        );
+        assert_eq!(in_unit("no value", 1e-3, "mW"), "no value");
+    }
 
     #[test]
     fn longest_suffix_wins() {

@@ -129,7 +129,8 @@ fn read_toml(s: &str, origin: &str) -> Result<(Scene, Renames)> {
 }
 
 /// A JSON scene, with engineering-unit fields converted. Without such fields it is read
-/// straight from the text, so the parser's errors keep their line and column.
+/// straight from the text, so the parser's errors keep their line and column. Errors name the
+/// dotted path of the field.
 fn read_json(s: &str, origin: &str) -> Result<(Scene, Renames)> {
     let mut value: serde_json::Value =
         serde_json::from_str(s).map_err(|e| scene_error(origin, e.to_string()))?;
@@ -138,13 +139,73 @@ fn read_json(s: &str, origin: &str) -> Result<(Scene, Renames)> {
         json_doc::convert_object(o, "", &mut renames)?;
     }
     let scene = if renames.is_empty() {
-        serde_json::from_str::<Scene>(s)
+        serde_path_to_error::deserialize::<_, Scene>(&mut serde_json::Deserializer::from_str(s))
     } else {
-        serde_json::from_value::<Scene>(value)
+        serde_path_to_error::deserialize::<_, Scene>(value.clone())
     };
     match scene {
         Ok(scene) => Ok((scene, renames)),
-        Err(e) => Err(scene_error(origin, renames.respell(e.to_string()))),
+        Err(e) => {
+            let msg = e.inner().to_string();
+            let mut path = e.path().to_string();
+            // Inside a tagged section (`air_bearing`, `peaks`, …) serde loses the field: find
+            // the one field there whose value the message names.
+            if let Some(key) = json_at(&value, &path).and_then(|v| field_with(v, &msg)) {
+                path = if path == "." {
+                    key
+                } else {
+                    format!("{path}.{key}")
+                };
+            }
+            let msg = renames.respell(msg);
+            Err(scene_error(
+                origin,
+                format!("{}: {msg}", renames.given(&path)),
+            ))
+        }
+    }
+}
+
+/// The value at a dotted path (`a.b[2].c`, `.` for the root) of a JSON document.
+fn json_at<'a>(v: &'a serde_json::Value, path: &str) -> Option<&'a serde_json::Value> {
+    if path == "." {
+        return Some(v);
+    }
+    path.split('.').try_fold(v, |v, part| {
+        let (key, indices) = part.split_once('[').unwrap_or((part, ""));
+        let v = if key.is_empty() { v } else { v.get(key)? };
+        indices
+            .split('[')
+            .filter(|i| !i.is_empty())
+            .try_fold(v, |v, i| {
+                v.get(i.trim_end_matches(']').parse::<usize>().ok()?)
+            })
+    })
+}
+
+/// The one key of `v` (an object) whose value is the "invalid type" value of `msg`.
+fn field_with(v: &serde_json::Value, msg: &str) -> Option<String> {
+    use serde_json::Value;
+    let unexpected = msg
+        .strip_prefix("invalid type: ")?
+        .split(", expected")
+        .next()?;
+    let shown = |x: &Value| match x {
+        Value::String(s) => format!("string {s:?}"),
+        Value::Bool(b) => format!("boolean `{b}`"),
+        Value::Number(n) if n.is_f64() => format!("floating point `{n}`"),
+        Value::Number(n) => format!("integer `{n}`"),
+        Value::Null => "null".into(),
+        Value::Array(_) => "sequence".into(),
+        Value::Object(_) => "map".into(),
+    };
+    let mut hits = v
+        .as_object()?
+        .iter()
+        .filter(|(_, x)| shown(x) == unexpected);
+    match (hits.next(), hits.next()) {
+        (Some((k, _)), None) => Some(k.clone()),
+        _ => None,
     }
 }
 
@@ -158,12 +219,48 @@ fn toml_message(s: &str, e: &toml::de::Error, edits: Option<&Edits>) -> String {
             let before = s.get(..start).unwrap_or(s);
             let line = before.matches('\n').count() + 1;
             let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-            match field_at(s, start) {
+            match field_at(s, start).or_else(|| field_in_table(s, start, &msg)) {
                 Some(field) => format!("line {line}, column {col}, {field}: {msg}"),
                 None => format!("line {line}, column {col}: {msg}"),
             }
         }
         None => msg,
+    }
+}
+
+/// The field of the `[table]` whose header holds byte `at` (the parser points at the header when
+/// a tagged section such as `[air_bearing]` fails) and whose value is the "invalid type" value
+/// of `msg`, when exactly one is.
+fn field_in_table(s: &str, at: usize, msg: &str) -> Option<String> {
+    let start = s.get(..at)?.rfind('\n').map_or(0, |i| i + 1);
+    let mut lines = s.get(start..)?.lines();
+    let header = lines.next()?.trim();
+    let table = header
+        .strip_prefix('[')?
+        .split(']')
+        .next()?
+        .trim()
+        .to_string();
+    let unexpected = msg
+        .strip_prefix("invalid type: ")?
+        .split(", expected")
+        .next()?;
+    // `string "x"` is written `"x"`, `integer `5`` is written `5`
+    let token = unexpected
+        .split_once(' ')
+        .map(|(_, t)| t.trim_matches('`'))
+        .unwrap_or(unexpected);
+    let mut hits = lines
+        .take_while(|l| !l.trim_start().starts_with('['))
+        .filter_map(|l| l.split_once('='))
+        .filter(|(_, v)| {
+            let v = v.split(" #").next().unwrap_or(v).trim();
+            v == token
+        })
+        .map(|(k, _)| k.trim().trim_matches('"').to_string());
+    match (hits.next(), hits.next()) {
+        (Some(k), None) => Some(format!("{table}.{k}")),
+        _ => None,
     }
 }
 

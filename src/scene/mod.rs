@@ -40,19 +40,21 @@
 //! | `heater.programme` (s, W) | `heater.programme_ms_mw` (ms, mW) |
 //!
 //! A field given in two units, or an engineering-unit field that is not a number, is refused by
-//! name; a validation error on a converted field names both spellings.
+//! name; a validation error on a converted field names it as given, with the value in its unit
+//! (the heater programme, two units in one field, names both spellings).
 //!
 //! ```
 //! use hdi_tribology::scene::Scene;
 //! # fn main() -> hdi_tribology::Result<()> {
 //! let text = Scene::paper()
 //!     .to_toml_string()?
-//!     .replace("height_sigma_m = 7e-10", "height_sigma_nm = 0.5");
+//!     .replace("height_sigma_m = 7e-10", "height_sigma_nm = 0.5")
+//!     .replace("sigma_m = 7e-10", "sigma_nm = 0.5"); // σ of the Rice-maxima peaks: the same
 //! let s = Scene::from_toml_str(&text)?;
 //! assert!((s.surface.height_sigma_m - 0.5e-9).abs() < 1e-24);
 //! let bad = text.replace("height_sigma_nm = 0.5", "height_sigma_nm = -0.5");
 //! let err = Scene::from_toml_str(&bad).unwrap_err().to_string();
-//! assert!(err.contains("surface.height_sigma_m (given as surface.height_sigma_nm)"), "{err}");
+//! assert!(err.contains("surface.height_sigma_nm: must be finite and >= 0, got -0.5 nm"), "{err}");
 //! # Ok(()) }
 //! ```
 

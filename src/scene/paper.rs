@@ -20,15 +20,18 @@ impl Scene {
         };
         let (stiffness, mass, zeta) = (3.0e5, 1.0e-6, 0.05);
         let f_ac = 1.05e4;
+        // one σ for the surface heights and the Rice-maxima peaks of the same surface
+        let sigma = 7.0e-10;
         Scene {
             name: "paper".into(),
             nominal_clearance_m: 1.0e-8,
             surface: SurfaceSpec {
-                height_sigma_m: 7.0e-10,
+                height_sigma_m: sigma,
                 peaks: PeakModel::RiceMaxima {
-                    sigma_m: 7.0e-10,
+                    sigma_m: sigma,
                     epsilon: 0.7,
                 },
+                independent_peak_sigma: false,
             },
             intermolecular: Some(IntermolecularSpec {
                 hamaker_attractive_j: 1.0e-19,

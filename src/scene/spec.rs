@@ -51,10 +51,15 @@ pub struct Scene {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceSpec {
-    /// Standard deviation of the (combined) surface heights σ (m), ≥ 0; 0 = smooth.
+    /// Standard deviation of the (combined) surface heights σ (m), ≥ 0; 0 = smooth. The one σ
+    /// of the surface: with `rice_maxima` peaks, `peaks.sigma_m` must equal it.
     pub height_sigma_m: f64,
     /// Asperity peak-height distribution (used by the contact term).
     pub peaks: PeakModel,
+    /// Set when `peaks.sigma_m` of `rice_maxima` peaks differs from `height_sigma_m` on purpose
+    /// (default false: a difference is refused as a slip).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub independent_peak_sigma: bool,
 }
 
 /// Lennard-Jones 3–9 term.

@@ -2,7 +2,46 @@
 
 use super::Scene;
 use crate::error::{check_finite, check_non_negative, check_positive};
+use crate::surface::PeakModel;
+use crate::units::fmt_short;
 use crate::{Error, Result};
+
+/// Largest voltage magnitude (V) a scene may apply: far above any head–disk interface (pull-in
+/// happens at a few volts), far below where `V²` loses meaning.
+pub const MAX_VOLTAGE_V: f64 = 1e3;
+
+/// Highest AC frequency (Hz): a cycle resolves every period of `V²`, so its work grows with the
+/// frequency; 10 MHz keeps a paper-length cycle to a few million steps.
+pub const MAX_AC_FREQUENCY_HZ: f64 = 1e7;
+
+/// Largest step limit of a scene's solver: a work budget of about a few minutes per cycle.
+pub const MAX_STEPS: usize = 100_000_000;
+
+/// Largest roughness (surface-height or peak-height standard deviation) relative to the nominal
+/// clearance: beyond it the slider flies inside the roughness and the averaged forces lose
+/// meaning (and, far beyond, overflow).
+pub const MAX_SIGMA_OVER_CLEARANCE: f64 = 10.0;
+
+/// Checks `|value| ≤ bound`, naming `field` and the unit.
+fn check_magnitude(field: &str, value: f64, bound: f64, unit: &str) -> Result<()> {
+    check_finite(field, value)?;
+    if value.abs() > bound {
+        let within = if value < 0.0 {
+            "lie within ±"
+        } else {
+            "be at most "
+        };
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must {within}{} {unit}, got {} {unit}",
+                fmt_short(bound),
+                fmt_short(value)
+            ),
+        ));
+    }
+    Ok(())
+}
 
 impl Scene {
     /// Checks every field; the error names the field (dotted path) and the reason.
@@ -12,9 +51,7 @@ impl Scene {
         }
         check_positive("nominal_clearance_m", self.nominal_clearance_m)?;
         check_non_negative("surface.height_sigma_m", self.surface.height_sigma_m)?;
-        if self.contact.is_some() {
-            self.peaks().map(|_| ())?;
-        }
+        self.validate_sigma()?;
         if let Some(m) = &self.intermolecular {
             check_positive(
                 "intermolecular.hamaker_attractive_j",
@@ -30,7 +67,12 @@ impl Scene {
             m.footprint.validate("intermolecular.footprint")?;
         }
         if let Some(e) = &self.electrostatic {
-            check_finite("electrostatic.contact_potential_v", e.contact_potential_v)?;
+            check_magnitude(
+                "electrostatic.contact_potential_v",
+                e.contact_potential_v,
+                MAX_VOLTAGE_V,
+                "V",
+            )?;
             check_non_negative(
                 "electrostatic.dielectric_thickness_m",
                 e.dielectric_thickness_m,
@@ -60,9 +102,21 @@ impl Scene {
         check_non_negative("slider.interface_lag_s", self.slider.interface_lag_s)?;
         self.validate_heater()?;
         let v = &self.voltage;
-        check_finite("voltage.dc_v", v.dc_v)?;
+        check_magnitude("voltage.dc_v", v.dc_v, MAX_VOLTAGE_V, "V")?;
         check_non_negative("voltage.ac_amplitude_v", v.ac_amplitude_v)?;
+        check_magnitude(
+            "voltage.ac_amplitude_v",
+            v.ac_amplitude_v,
+            MAX_VOLTAGE_V,
+            "V",
+        )?;
         check_positive("voltage.ac_frequency_hz", v.ac_frequency_hz)?;
+        check_magnitude(
+            "voltage.ac_frequency_hz",
+            v.ac_frequency_hz,
+            MAX_AC_FREQUENCY_HZ,
+            "Hz",
+        )?;
         check_positive(
             "detector.contact_threshold_n",
             self.detector.contact_threshold_n,
@@ -77,7 +131,57 @@ impl Scene {
         )?;
         self.validate_solver()?;
         for (i, &a) in self.sweep.ac_amplitudes_v.iter().enumerate() {
-            check_non_negative(&format!("sweep.ac_amplitudes_v[{i}]"), a)?;
+            let field = format!("sweep.ac_amplitudes_v[{i}]");
+            check_non_negative(&field, a)?;
+            check_magnitude(&field, a, MAX_VOLTAGE_V, "V")?;
+        }
+        Ok(())
+    }
+
+    /// σ: bounded by the clearance, and one value for one surface. The Rice-maxima peak law
+    /// describes the maxima of the surface whose heights have `surface.height_sigma_m`, so its
+    /// `sigma_m` must be that σ, unless `surface.independent_peak_sigma` says they differ on
+    /// purpose.
+    fn validate_sigma(&self) -> Result<()> {
+        let h0 = self.nominal_clearance_m;
+        let bound = MAX_SIGMA_OVER_CLEARANCE * h0;
+        let too_rough = |field: &str, s: f64| {
+            Error::invalid(
+                field,
+                format!(
+                    "must not exceed {} x nominal_clearance_m = {} m, got {} m",
+                    fmt_short(MAX_SIGMA_OVER_CLEARANCE),
+                    fmt_short(bound),
+                    fmt_short(s)
+                ),
+            )
+        };
+        let sigma = self.surface.height_sigma_m;
+        if sigma > bound {
+            return Err(too_rough("surface.height_sigma_m", sigma));
+        }
+        if self.contact.is_none() {
+            return Ok(());
+        }
+        let p = self.peaks()?;
+        if p.std_dev() > bound || p.mean().abs() > bound {
+            return Err(too_rough("surface.peaks", p.std_dev().max(p.mean().abs())));
+        }
+        if let PeakModel::RiceMaxima { sigma_m, .. } = self.surface.peaks {
+            // equal up to rounding (one may be given in nm, the other in m)
+            let differ = (sigma_m - sigma).abs() > 1e-12 * sigma_m.abs().max(sigma.abs());
+            if differ && !self.surface.independent_peak_sigma {
+                return Err(Error::invalid(
+                    "surface.peaks.sigma_m",
+                    format!(
+                        "is {} m but surface.height_sigma_m is {} m: the Rice-maxima peaks are \
+                         those of the same surface, give both the same σ (or set \
+                         surface.independent_peak_sigma = true if they differ on purpose)",
+                        fmt_short(sigma_m),
+                        fmt_short(sigma)
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -102,8 +206,9 @@ impl Scene {
                 return Err(Error::invalid(
                     format!("heater.programme[{i}].t_s"),
                     format!(
-                        "times must increase strictly, got {t} after {}",
-                        h.programme[i - 1][0]
+                        "times must increase strictly, got {} s after {} s",
+                        fmt_short(t),
+                        fmt_short(h.programme[i - 1][0])
                     ),
                 ));
             }
@@ -123,22 +228,29 @@ impl Scene {
         if !(s.rtol > 0.0 && s.rtol < 1.0) {
             return Err(Error::invalid(
                 "solver.rtol",
-                format!("must lie in (0, 1), got {}", s.rtol),
+                format!("must lie in (0, 1), got {}", fmt_short(s.rtol)),
             ));
         }
         check_positive("solver.atol_m", s.atol_m)?;
         if let Some(h) = s.max_step_s {
             check_positive("solver.max_step_s", h)?;
         }
-        if s.max_steps == 0 {
-            return Err(Error::invalid("solver.max_steps", "must be at least 1"));
+        if s.max_steps == 0 || s.max_steps > MAX_STEPS {
+            return Err(Error::invalid(
+                "solver.max_steps",
+                format!(
+                    "must lie in 1..={} (a work budget), got {}",
+                    fmt_short(MAX_STEPS as f64),
+                    s.max_steps
+                ),
+            ));
         }
         let t = &self.table;
         // the direct quadrature behind the tables is good to about 1e-12
         if !(t.rel_tol >= 1e-11 && t.rel_tol <= 1e-2) {
             return Err(Error::invalid(
                 "table.rel_tol",
-                format!("must lie in [1e-11, 0.01], got {}", t.rel_tol),
+                format!("must lie in [1e-11, 0.01], got {}", fmt_short(t.rel_tol)),
             ));
         }
         if let Some(lo) = t.d_min_m {
@@ -151,13 +263,21 @@ impl Scene {
         if !(lo.is_finite() && hi.is_finite()) {
             return Err(Error::invalid(
                 "table",
-                format!("the range ({lo}, {hi}) is not finite: the lengths of the scene overflow"),
+                format!(
+                    "the range ({}, {}) m is not finite: the lengths of the scene overflow",
+                    fmt_short(lo),
+                    fmt_short(hi)
+                ),
             ));
         }
         if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
             return Err(Error::invalid(
                 "table",
-                format!("d_min_m must be below d_max_m, got range ({lo}, {hi})"),
+                format!(
+                    "d_min_m must be below d_max_m, got range ({}, {}) m",
+                    fmt_short(lo),
+                    fmt_short(hi)
+                ),
             ));
         }
         // The range must cover the scene: the flying gap at zero heater power (about h0), and
@@ -166,8 +286,9 @@ impl Scene {
             return Err(Error::invalid(
                 "table.d_max_m",
                 format!(
-                    "must reach the nominal clearance {} m (the flying gap at zero heater power), got {hi}",
-                    self.nominal_clearance_m
+                    "must reach the nominal clearance {} m (the flying gap at zero heater power), got {} m",
+                    fmt_short(self.nominal_clearance_m),
+                    fmt_short(hi)
                 ),
             ));
         }
@@ -177,8 +298,9 @@ impl Scene {
                     return Err(Error::invalid(
                         "table.d_min_m",
                         format!(
-                            "must reach down to the mean asperity peak height {:e} m, where contact starts, got {lo}",
-                            p.mean()
+                            "must reach down to the mean asperity peak height {} m, where contact starts, got {} m",
+                            fmt_short(p.mean()),
+                            fmt_short(lo)
                         ),
                     ));
                 }

@@ -124,7 +124,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
             hdi_tribology::Error::InvalidInput { ref field, .. } if field == "margin" => {
                 format!("--margin-mw {}: {e}", fmt_short(a.margin_mw))
             }
-            _ => format!("{e} ({start_shown}, --step-mw {})", fmt_short(a.step_mw)),
+            _ => {
+                let dither = a
+                    .dither_v
+                    .map_or_else(String::new, |v| format!(", --dither-v {}", fmt_short(v)));
+                format!(
+                    "{e} ({start_shown}, --step-mw {}{dither})",
+                    fmt_short(a.step_mw)
+                )
+            }
         })
     })?;
     let mut flags = Vec::new();

@@ -52,7 +52,14 @@ impl SceneArgs {
             } else {
                 Scene::from_toml_str(&text)
             };
-            return scene.map_err(|e| CliError::Failed(format!("standard input: {e}")));
+            return scene.map_err(|e| {
+                CliError::Failed(match e {
+                    hdi_tribology::Error::Scene { reason, .. } => {
+                        format!("scene on standard input: {reason}")
+                    }
+                    other => format!("scene on standard input: {other}"),
+                })
+            });
         }
         let name = path.display();
         // parse errors already carry the file name; validation errors get it here

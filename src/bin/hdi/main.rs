@@ -10,6 +10,8 @@
 mod calibrate;
 mod common;
 mod cycle;
+mod drive;
+mod fit;
 mod forces;
 mod scene;
 mod static_cmd;
@@ -42,8 +44,13 @@ enum Command {
     Sweep(sweep::Args),
     /// Touchdown calibration as drive firmware does it: a heater staircase up to touchdown.
     Calibrate(calibrate::Args),
+    /// Fit scene fields to measured curves (CSV), with errors and an identifiability report.
+    Fit(fit::Args),
     /// The scene, validated, as TOML (or JSON): a starting point for scenes of your own.
     Scene(scene::Args),
+    /// A command file (time, heater power, voltage) replayed through the simulated drive; the
+    /// sensor CSV written.
+    Drive(drive::Args),
 }
 
 fn main() -> ExitCode {
@@ -55,7 +62,9 @@ fn main() -> ExitCode {
         Command::Cycle(a) => cycle::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Fit(a) => fit::run(a),
         Command::Scene(a) => scene::run(a),
+        Command::Drive(a) => drive::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,76 @@
+//! `Drive::step` at a 20 kHz controller rate against real time: in flight and in contact, on a
+//! flat and on the default wavy disk, with and without an AC dither. Prints a table.
+//!
+//! `cargo bench --bench drive`. Each case settles 20 ms at its heater power, then times blocks
+//! of 200 periods (10 ms of drive time) for at least 1 s; the table gives the fastest block's
+//! wall-clock time and the mean CPU time of the thread per period, and the ratio of the period
+//! (50 µs) to each: how many times faster than real time the drive runs on one core.
+
+#[path = "../examples/common/timing.rs"]
+mod timing;
+
+use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, Plant};
+use hdi_tribology::scene::Scene;
+use std::time::Duration;
+
+const DT: f64 = 50e-6;
+const BLOCK: usize = 200;
+
+fn main() {
+    let scene = Scene::paper();
+    let zone = scene_zone(&scene, 0.025).expect("zone");
+    println!("| disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for (disk_name, disk) in [("flat", DiskSpec::flat()), ("wavy", DiskSpec::default())] {
+        let plant = Plant::new(
+            &scene,
+            &zone,
+            1,
+            DriveOptions {
+                disk: disk.clone(),
+                ..DriveOptions::default()
+            },
+        )
+        .expect("plant");
+        for (state, mw) in [("flight", 70.0), ("contact", 80.0)] {
+            for dither in [None, Some((0.5, 10.5e3))] {
+                let mut d = plant.drive().expect("drive");
+                let mut cmd = Command::heater_mw(mw);
+                if let Some((a, f)) = dither {
+                    cmd = cmd.with_dither(a, f);
+                }
+                for _ in 0..400 {
+                    d.step(&cmd, DT).expect("settle");
+                }
+                let s0 = d.stats().accepted;
+                let t0 = d.time();
+                let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
+                    let mut s = None;
+                    for _ in 0..BLOCK {
+                        s = Some(d.step(&cmd, DT).expect("step"));
+                    }
+                    s
+                });
+                let periods = (d.time() - t0) / DT;
+                let steps = (d.stats().accepted - s0) as f64 / periods;
+                let last = last.expect("ran");
+                // The state the case claims: in contact the true contact force is far above F_th.
+                let in_contact = last.truth.mean_contact_force > 5e-5;
+                assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
+                let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
+                println!(
+                    "| {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} |",
+                    dither.map_or("off".to_string(), |(a, f)| format!(
+                        "{a} V, {:.1} kHz",
+                        f / 1e3
+                    )),
+                    wall * 1e6,
+                    cpu * 1e6,
+                    DT / wall,
+                    DT / cpu,
+                    steps
+                );
+            }
+        }
+    }
+}

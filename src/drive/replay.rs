@@ -1,0 +1,220 @@
+//! Replaying a command file through a drive: the way in for tools that are not Rust.
+
+use super::plant::{Command, Plant};
+use super::sensors::Readback;
+use crate::error::{Error, Result};
+use std::io::{Read, Write};
+
+/// One row of a command file: from `time` on, until the next row, the drive holds this command.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
+pub struct CommandRow {
+    /// Time the row takes effect (s).
+    pub time_s: f64,
+    /// Heater power (mW).
+    pub heater_mw: f64,
+    /// DC head–disk voltage (V).
+    pub voltage_dc_v: f64,
+    /// AC dither amplitude (V); 0 when the column is absent.
+    #[serde(default)]
+    pub voltage_ac_v: f64,
+    /// AC dither frequency (kHz); 0 when the column is absent.
+    #[serde(default)]
+    pub ac_frequency_khz: f64,
+}
+
+/// The columns of the sensor file [`replay`] writes, with their units, in order.
+pub const SENSOR_COLUMNS: [&str; 12] = [
+    "time_s",
+    "heater_mw",
+    "contact_resistance_ohm",
+    "acoustic_v",
+    "readback_fundamental_v",
+    "readback_third_v",
+    "hr_clearance_change_nm",
+    "true_gap_nm",
+    "true_contact_force_un",
+    "true_sensor_temperature_k",
+    "true_disk_height_nm",
+    "true_ambient_k",
+];
+
+/// Most periods one replay may run.
+pub const MAX_REPLAY_PERIODS: f64 = 1e7;
+
+/// Reads a command file (CSV with a header naming the columns of [`CommandRow`]; the AC columns
+/// may be left out). `origin` names the file in errors.
+///
+/// # Errors
+/// A row that does not parse, a value out of range, times that are not strictly increasing
+/// from 0: an [`Error::InvalidInput`] naming the file, the line and the column.
+///
+/// ```
+/// use hdi_tribology::drive::read_commands;
+/// let csv = "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,70,0\n0.002,70,0\n";
+/// let rows = read_commands(csv.as_bytes(), "commands.csv")?;
+/// assert_eq!(rows.len(), 3);
+/// assert_eq!(rows[1].heater_mw, 70.0);
+/// let bad = "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,-5,0\n";
+/// let e = read_commands(bad.as_bytes(), "commands.csv").unwrap_err();
+/// assert!(e.to_string().contains("commands.csv line 3, heater_mw"), "{e}");
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn read_commands<R: Read>(input: R, origin: &str) -> Result<Vec<CommandRow>> {
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(input);
+    let mut rows: Vec<CommandRow> = Vec::new();
+    for (i, rec) in rdr.deserialize::<CommandRow>().enumerate() {
+        let line = i + 2;
+        let row =
+            rec.map_err(|e| Error::invalid(format!("{origin} line {line}"), e.to_string()))?;
+        let field = |name: &str| format!("{origin} line {line}, {name}");
+        let check = |name: &str, v: f64, ok: bool, want: &str| -> Result<()> {
+            if v.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(Error::invalid(
+                    field(name),
+                    format!("must be {want}, got {v}"),
+                ))
+            }
+        };
+        check("time_s", row.time_s, row.time_s >= 0.0, "≥ 0 s")?;
+        check("heater_mw", row.heater_mw, row.heater_mw >= 0.0, "≥ 0 mW")?;
+        check("voltage_dc_v", row.voltage_dc_v, true, "finite (V)")?;
+        check("voltage_ac_v", row.voltage_ac_v, true, "finite (V)")?;
+        check(
+            "ac_frequency_khz",
+            row.ac_frequency_khz,
+            row.ac_frequency_khz >= 0.0,
+            "≥ 0 kHz",
+        )?;
+        match rows.last() {
+            None if row.time_s != 0.0 => {
+                return Err(Error::invalid(
+                    field("time_s"),
+                    format!("the first row must be at 0 s, got {} s", row.time_s),
+                ))
+            }
+            Some(prev) if row.time_s <= prev.time_s => {
+                return Err(Error::invalid(
+                    field("time_s"),
+                    format!(
+                        "times must increase strictly, got {} s after {} s",
+                        row.time_s, prev.time_s
+                    ),
+                ))
+            }
+            _ => {}
+        }
+        rows.push(row);
+    }
+    if rows.len() < 2 {
+        return Err(Error::invalid(
+            origin,
+            "needs at least two rows: the first command and the end time",
+        ));
+    }
+    Ok(rows)
+}
+
+/// What a replay did.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ReplaySummary {
+    /// Periods run.
+    pub periods: usize,
+    /// Drive time simulated (s).
+    pub simulated_time: f64,
+}
+
+/// Replays `rows` (see [`read_commands`]) through a drive started on `plant`, stepping at period
+/// `dt` (s), and writes one CSV row of sensors per period to `out` ([`SENSOR_COLUMNS`]: time in
+/// s, heater in mW, resistance in Ω, AE and read-back amplitudes in V, the harmonic-ratio
+/// clearance change since the first period in nm, then the true gap in nm, the period-mean
+/// contact force in µN, the contact-sensor temperature and the ambient change in K and the disk
+/// height in nm). Each row's command holds from its time until the next row's; the last row's
+/// time ends the run. A period takes the command in force at its start.
+///
+/// # Errors
+/// Invalid `dt`; more than [`MAX_REPLAY_PERIODS`] periods (checked before anything is
+/// written); a command out of range; integration and write failures.
+///
+/// ```
+/// use hdi_tribology::drive::{read_commands, replay, scene_zone, DriveOptions, Plant};
+/// use hdi_tribology::scene::Scene;
+/// let scene = Scene::paper();
+/// let plant = Plant::new(&scene, &scene_zone(&scene, 0.025)?, 1, DriveOptions::default())?;
+/// let rows = read_commands("time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,65,0\n0.002,65,0\n".as_bytes(), "c.csv")?;
+/// let mut out = Vec::new();
+/// let summary = replay(&plant, &rows, 50e-6, &mut out)?;
+/// assert_eq!(summary.periods, 40);
+/// let text = String::from_utf8(out).unwrap();
+/// assert_eq!(text.lines().count(), 41); // header + one row per period
+/// assert!(text.starts_with("time_s,heater_mw,contact_resistance_ohm"));
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn replay<W: Write>(
+    plant: &Plant,
+    rows: &[CommandRow],
+    dt: f64,
+    out: W,
+) -> Result<ReplaySummary> {
+    crate::error::check_positive("dt", dt)?;
+    let end = rows.last().map_or(0.0, |r| r.time_s);
+    let periods = (end / dt * (1.0 + 1e-12)).floor();
+    if periods > MAX_REPLAY_PERIODS {
+        return Err(Error::invalid(
+            "dt",
+            format!(
+                "{end} s at {} µs is more than {MAX_REPLAY_PERIODS} periods",
+                dt * 1e6
+            ),
+        ));
+    }
+    let periods = periods as usize;
+    let wavelength = plant.sensor_spec().readback.wavelength;
+    let io = |e: csv::Error| Error::invalid("output", e.to_string());
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(SENSOR_COLUMNS).map_err(io)?;
+    let mut drive = plant.drive()?;
+    let mut k = 0usize;
+    let mut reference = None;
+    for n in 0..periods {
+        let t0 = n as f64 * dt;
+        while k + 1 < rows.len() && rows[k + 1].time_s <= t0 * (1.0 + 1e-12) {
+            k += 1;
+        }
+        let r = rows[k];
+        let cmd = Command {
+            heater_power: r.heater_mw * 1e-3,
+            dc_voltage: r.voltage_dc_v,
+            ac_amplitude: r.voltage_ac_v,
+            ac_frequency: r.ac_frequency_khz * 1e3,
+        };
+        let s = drive.step(&cmd, dt)?;
+        let lr = s.readback.log_ratio();
+        let lr0 = *reference.get_or_insert(lr);
+        let tr = &s.truth;
+        w.serialize([
+            s.t,
+            s.heater_power * 1e3,
+            s.contact_resistance,
+            s.acoustic,
+            s.readback.fundamental,
+            s.readback.third,
+            Readback::clearance_change(lr0, lr, wavelength) * 1e9,
+            tr.gap * 1e9,
+            tr.mean_contact_force * 1e6,
+            tr.sensor_temperature,
+            tr.disk_height * 1e9,
+            tr.ambient,
+        ])
+        .map_err(io)?;
+    }
+    w.flush()
+        .map_err(|e| Error::invalid("output", e.to_string()))?;
+    Ok(ReplaySummary {
+        periods,
+        simulated_time: drive.time(),
+    })
+}
