@@ -359,22 +359,3 @@ def fit(
     ``residual_scale``, ``converged``, ``termination``, ``evaluations``, ``starts``,
     ``integration``, ``trusted``, ``warnings``. Raises DataFileError on a bad file."""
 
-class Drive:
-    """A simulated drive that firmware code steps at its controller's rate: the scene's slider
-    in a zone at ``radius_m`` (m), over a disk with run-out and waviness, a heater behind its
-    thermal lag, and sensors with seeded noise. Starts at rest flying at ``initial_power_mw``."""
-
-    def __init__(self, scene: Scene, radius_m: float = 0.025, seed: int = 1, initial_power_mw: float = 60.0) -> None: ...
-    def step(self, heater_mw: float, dt_s: float, *, dc_v: float = 0.0, ac_v: float = 0.0, ac_hz: float = 0.0) -> Dict[str, Any]:
-        """Advances by ``dt_s`` (s) under heater power (mW), DC voltage (V) and AC dither (V, Hz).
-        Returns the sensors, SI as the crate names them: ``t`` (s), ``contact_resistance``,
-        ``acoustic``, ``readback`` {``fundamental``, ``third``}, ``heater_power`` (W), and
-        ``truth`` {``gap``, ``pad_gap``, ``displacement`` (m), ``velocity`` (m/s),
-        ``protrusion`` (m), ``mean_contact_force``, ``contact_force``, ``interface_force`` (N),
-        ``mean_flash_temperature`` (K), ``friction_power`` (W)}."""
-    @property
-    def time_s(self) -> float:
-        """Simulated time (s)."""
-    @property
-    def seed(self) -> int:
-        """The noise seed."""

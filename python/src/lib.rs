@@ -1360,91 +1360,6 @@ fn fit<'py>(
 }
 
 // ---------------------------------------------------------------------------------------------
-// Drive
-
-/// A simulated drive that firmware code can step at its controller's rate: the scene's slider
-/// in a zone at `radius_m` (m) over a disk with run-out and waviness, a heater behind its thermal
-/// lag, the head–disk voltage, and sensors with seeded noise (`seed`). It starts at rest in its
-/// flying equilibrium at `initial_power_mw` (mW).
-#[pyclass(module = "hdi_tribology", name = "Drive")]
-struct Drive {
-    inner: hdi_tribology::drive::Drive,
-}
-
-#[pymethods]
-impl Drive {
-    #[new]
-    #[pyo3(signature = (scene, radius_m = 0.025, seed = 1, initial_power_mw = 60.0))]
-    fn new(
-        py: Python<'_>,
-        scene: &Scene,
-        radius_m: f64,
-        seed: u64,
-        initial_power_mw: f64,
-    ) -> PyResult<Self> {
-        let scene = scene.inner.clone();
-        let inner = py
-            .detach(|| {
-                let zone = hdi_tribology::drive::scene_zone(&scene, radius_m)?;
-                let opts = hdi_tribology::drive::DriveOptions {
-                    initial_power: units::mw(initial_power_mw),
-                    ..Default::default()
-                };
-                hdi_tribology::drive::Drive::new(&scene, &zone, seed, opts)
-            })
-            .py()?;
-        Ok(Drive { inner })
-    }
-
-    /// Advances the drive by `dt_s` (s) under the command: heater power (mW), DC voltage (V),
-    /// AC dither amplitude (V) and frequency (Hz). Returns what firmware reads, as the crate
-    /// names it (SI): `t` (s), `contact_resistance`, `acoustic`, `readback` (`fundamental`,
-    /// `third`), `heater_power` (W), and `truth` (`gap`, `pad_gap`, `displacement`, `velocity`,
-    /// `protrusion` in m/m·s⁻¹; `mean_contact_force`, `contact_force`, `interface_force` in N;
-    /// `mean_flash_temperature` in K; `friction_power` in W), the plant's state for test oracles.
-    #[pyo3(signature = (heater_mw, dt_s, *, dc_v = 0.0, ac_v = 0.0, ac_hz = 0.0))]
-    fn step<'py>(
-        &mut self,
-        py: Python<'py>,
-        heater_mw: f64,
-        dt_s: f64,
-        dc_v: f64,
-        ac_v: f64,
-        ac_hz: f64,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let command = hdi_tribology::drive::Command {
-            dc_voltage: dc_v,
-            ..hdi_tribology::drive::Command::heater_mw(heater_mw).with_dither(ac_v, ac_hz)
-        };
-        let inner = &mut self.inner;
-        let sensors = py.detach(|| inner.step(&command, dt_s)).py()?;
-        let text = serde_json::to_string(&sensors)
-            .map_err(|e| invalid("drive", format!("cannot convert the sensors: {e}")))?;
-        json_module(py)?.call_method1("loads", (text,))
-    }
-
-    /// Simulated time (s).
-    #[getter]
-    fn time_s(&self) -> f64 {
-        self.inner.time()
-    }
-
-    /// The noise seed.
-    #[getter]
-    fn seed(&self) -> u64 {
-        self.inner.seed()
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "Drive(time_s={:.6e}, seed={})",
-            self.inner.time(),
-            self.inner.seed()
-        )
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
 
 /// The native core of the `hdi_tribology` Python package.
 #[pymodule]
@@ -1460,7 +1375,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RefinedCycle>()?;
     m.add_class::<LinearResponse>()?;
     m.add_class::<Calibration>()?;
-    m.add_class::<Drive>()?;
     m.add_function(wrap_pyfunction!(forces, m)?)?;
     m.add_function(wrap_pyfunction!(static_hysteresis, m)?)?;
     m.add_function(wrap_pyfunction!(pull_in_voltage, m)?)?;
