@@ -358,3 +358,4 @@ def fit(
     ``correlation``, ``residuals``, ``identifiability``, ``points``, ``chi2``,
     ``residual_scale``, ``converged``, ``termination``, ``evaluations``, ``starts``,
     ``integration``, ``trusted``, ``warnings``. Raises DataFileError on a bad file."""
+
