@@ -83,13 +83,8 @@ fn run(options: &Options, out: &Path) -> Res<()> {
     if let Some(m) = options.method {
         opts.solver.method = m;
     }
-    let fixed = HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?);
-    let t = &scene.heater.triggered;
-    let triggered = HeaterProgramme::Triggered {
-        start_power: t.start_power_w,
-        ramp_rate: t.ramp_rate_w_per_s,
-        overshoot: t.overshoot_w,
-    };
+    let fixed = HeaterProgramme::fixed_from_scene(&scene)?;
+    let triggered = HeaterProgramme::triggered_from_scene(&scene);
     let amplitudes: Vec<f64> = (0..=10).map(|i| i as f64 * 0.1).collect();
 
     // Static analyses.

@@ -833,14 +833,9 @@ fn cycle_setup(
         opts.solver.atol_displacement = units::nm(a);
     }
     let programme = if triggered {
-        let t = &scene.heater.triggered;
-        HeaterProgramme::Triggered {
-            start_power: t.start_power_w,
-            ramp_rate: t.ramp_rate_w_per_s,
-            overshoot: t.overshoot_w,
-        }
+        HeaterProgramme::triggered_from_scene(&scene)
     } else {
-        HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme).py()?)
+        HeaterProgramme::fixed_from_scene(&scene).py()?
     };
     Ok(CycleSetup {
         scene,

@@ -96,14 +96,9 @@ impl CycleArgs {
             opts.solver.atol_displacement = from_nm(a);
         }
         let programme = if self.triggered {
-            let t = &scene.heater.triggered;
-            HeaterProgramme::Triggered {
-                start_power: t.start_power_w,
-                ramp_rate: t.ramp_rate_w_per_s,
-                overshoot: t.overshoot_w,
-            }
+            HeaterProgramme::triggered_from_scene(scene)
         } else {
-            HeaterProgramme::Fixed(SliderModel::programme_from_knots(&scene.heater.programme)?)
+            HeaterProgramme::fixed_from_scene(scene)?
         };
         Ok((model, programme, opts))
     }
