@@ -452,13 +452,13 @@ impl Plant {
 // One per drive, built once and never moved per step: the size difference costs nothing.
 #[allow(clippy::large_enum_variant)]
 enum Integ<'p> {
-    S4(Integrator<'p, U4, DriveSystem>),
-    S5(Integrator<'p, U5, DriveSystem>),
-    S6(Integrator<'p, U6, DriveSystem>),
-    S7(Integrator<'p, U7, DriveSystem>),
-    S8(Integrator<'p, U8, DriveSystem>),
-    S9(Integrator<'p, U9, DriveSystem>),
-    S10(Integrator<'p, U10, DriveSystem>),
+    S4(Integrator<'p, U4, &'p DriveSystem>),
+    S5(Integrator<'p, U5, &'p DriveSystem>),
+    S6(Integrator<'p, U6, &'p DriveSystem>),
+    S7(Integrator<'p, U7, &'p DriveSystem>),
+    S8(Integrator<'p, U8, &'p DriveSystem>),
+    S9(Integrator<'p, U9, &'p DriveSystem>),
+    S10(Integrator<'p, U10, &'p DriveSystem>),
 }
 
 macro_rules! with_integ {
@@ -589,7 +589,7 @@ impl Drive<'_> {
 /// discontinuities, so the integrator restarts at `t0` (its first step is the whole period,
 /// which the step control cuts down in a transient) and steps to `t1`.
 fn advance<D: Dim>(
-    it: &mut Integrator<'_, D, DriveSystem>,
+    it: &mut Integrator<'_, D, &DriveSystem>,
     layout: &StateLayout,
     t0: f64,
     t1: f64,

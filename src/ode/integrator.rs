@@ -174,11 +174,11 @@ where
 /// println!("{} steps", it.stats().accepted);
 /// # Ok::<(), hdi_tribology::ode::OdeError>(())
 /// ```
-pub struct Integrator<'a, D: Dim, S: OdeSystem<D> + ?Sized>
+pub struct Integrator<'a, D: Dim, S: OdeSystem<D>>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    sys: &'a S,
+    sys: S,
     method: Method,
     steppers: Steppers<D>,
     active: usize,
@@ -211,6 +211,9 @@ where
     h: f64,
     h_needs_init: bool,
     needs_restart: bool,
+    /// The system was changed through `system_mut`: the events' values at the current point
+    /// are evaluated again before the next step.
+    events_stale: bool,
     err_prev: f64,
     last_rejected: bool,
     fails: (usize, FailKind),
@@ -224,7 +227,7 @@ where
     jac_work: Option<OMatrix<f64, D, D>>,
 }
 
-impl<'a, D: Dim, S: OdeSystem<D> + ?Sized> Integrator<'a, D, S>
+impl<'a, D: Dim, S: OdeSystem<D>> Integrator<'a, D, S>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
@@ -237,7 +240,7 @@ where
     /// [`OdeError::InvalidInput`] for bad arguments or options; [`OdeError::NonFinite`] when
     /// `f(t0, y0)` is not finite.
     pub fn new(
-        sys: &'a S,
+        sys: S,
         t0: f64,
         y0: OVector<f64, D>,
         tf: f64,
@@ -249,7 +252,7 @@ where
 
     /// Shared constructor; `need_poly` says whether step interpolants are built.
     pub(crate) fn build(
-        sys: &'a S,
+        sys: S,
         t0: f64,
         y0: OVector<f64, D>,
         tf: f64,
@@ -324,6 +327,7 @@ where
             h: f64::NAN,
             h_needs_init: true,
             needs_restart: true,
+            events_stale: false,
             err_prev: 1.0,
             last_rejected: false,
             fails: (0, FailKind::NonFinite),
@@ -363,7 +367,7 @@ where
     /// size when none is pending.
     fn restart(&mut self) -> Result<(), OdeError> {
         let stepper = self.steppers.get::<S>(self.active);
-        stepper.restart(self.sys, self.t, &self.y, &mut self.ctx);
+        stepper.restart(&self.sys, self.t, &self.y, &mut self.ctx);
         if !all_finite(stepper.f0()) {
             return Err(OdeError::NonFinite {
                 t: self.t,
@@ -381,7 +385,7 @@ where
             self.h = match self.h_init {
                 Some(h) => h,
                 None => initial_step(
-                    self.sys,
+                    &self.sys,
                     self.t,
                     &self.y,
                     self.steppers.get::<S>(self.active).f0(),
@@ -415,6 +419,42 @@ where
     /// Current state.
     pub fn state(&self) -> &OVector<f64, D> {
         &self.y
+    }
+
+    /// The system being integrated.
+    pub fn system(&self) -> &S {
+        &self.sys
+    }
+
+    /// The system, to change its parameters between steps (a new input held over the next
+    /// interval, a switched model). The method restarts at the current point before the next
+    /// step: `f` and the events are evaluated again there, and the step size is kept (use
+    /// [`reinit`](Integrator::reinit) when the state jumps too). The last step's interpolant
+    /// stays as it was computed.
+    ///
+    /// ```
+    /// use hdi_tribology::nalgebra::Vector1;
+    /// use hdi_tribology::ode::{Integrator, Method, OdeSystem, Options};
+    /// use hdi_tribology::nalgebra::U1;
+    /// /// y' = u, with the input u held by the system.
+    /// struct Held { u: f64 }
+    /// impl OdeSystem<U1> for Held {
+    ///     fn rhs(&self, _t: f64, _y: &Vector1<f64>, dy: &mut Vector1<f64>) { dy[0] = self.u; }
+    ///     fn is_autonomous(&self) -> bool { true }
+    /// }
+    /// let opts = Options::default().rtol(1e-10).atol(1e-12);
+    /// // The integrator owns the system.
+    /// let mut it = Integrator::new(Held { u: 1.0 }, 0.0, Vector1::new(0.0), 2.0, Method::Tsit5, &opts)?;
+    /// it.advance_to(1.0)?;
+    /// it.system_mut().u = -3.0;
+    /// it.advance_to(2.0)?;
+    /// assert!((it.state()[0] - (1.0 - 3.0)).abs() < 1e-12);
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    pub fn system_mut(&mut self) -> &mut S {
+        self.needs_restart = true;
+        self.events_stale = true;
+        &mut self.sys
     }
 
     /// End time.
@@ -633,6 +673,10 @@ where
         if self.needs_restart {
             self.restart()?;
         }
+        if self.events_stale {
+            self.init_events(events);
+            self.events_stale = false;
+        }
         while self.kink_idx < self.kinks.len() && self.kinks[self.kink_idx] <= self.t {
             self.kink_idx += 1;
         }
@@ -646,7 +690,7 @@ where
             stop = stop.min(tg);
         }
         let h_max = self.h_max_opt.min(self.tf - self.t_span0);
-        let sys = self.sys;
+        let sys = &self.sys;
         let t = self.t;
         let mut h = self.h;
         let (err, k, stiff, hit_stop) = loop {
@@ -888,7 +932,7 @@ where
     }
 
     fn switch_check(&mut self, stiff: bool, h_acc: f64) {
-        let sys = self.sys;
+        let sys = &self.sys;
         let switch = if !stiff {
             self.since_check += 1;
             // The cheap indicator of the explicit method flags growing stiff components;
@@ -939,7 +983,7 @@ where
     }
 }
 
-impl<D: Dim, S: OdeSystem<D> + ?Sized> Integrator<'_, D, S>
+impl<D: Dim, S: OdeSystem<D>> Integrator<'_, D, S>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {

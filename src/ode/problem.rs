@@ -92,7 +92,7 @@ where
         &self,
         method: Method,
         opts: &Options,
-    ) -> Result<Integrator<'_, D, S>, OdeError> {
+    ) -> Result<Integrator<'_, D, &S>, OdeError> {
         Integrator::new(
             &self.system,
             self.t0,
