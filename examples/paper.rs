@@ -147,7 +147,10 @@ fn run(options: &Options, out: &Path) -> Res<()> {
     share_ranges(&mut fig3d);
     share_ranges(&mut fig4);
     let files = [
-        ["fig3d_hysteresis_vs_ac.svg", "fig3d_hysteresis_vs_ac_bulge.svg"],
+        [
+            "fig3d_hysteresis_vs_ac.svg",
+            "fig3d_hysteresis_vs_ac_bulge.svg",
+        ],
         [
             "fig4_temperature_vs_hysteresis.svg",
             "fig4_temperature_vs_hysteresis_bulge.svg",
@@ -333,7 +336,7 @@ fn rigid_slider(
         refine.max_runs
     );
     println!(
-        "fixed-programme refined sweep of {} amplitudes: {:.1} ms wall",
+        "fixed-programme refined sweep of {} amplitudes: {:.1} ms wall (beside the bulge's sweep)",
         amplitudes.len(),
         1e3 * fixed_wall
     );
