@@ -11,8 +11,14 @@
 //! - Fig. 3(d): hysteresis against AC amplitude under both programmes;
 //! - Fig. 4: mean temperature rise against hysteresis, under both programmes.
 //!
+//! Fig. 3(d) and Fig. 4 come in two panels on the same axes, to be shown side by side: the rigid
+//! slider of the paper scene, and the deformable slider of `scenes/paper_bulge.toml` (`_bulge`
+//! in the file name). The summary prints the bulge's touchdown, take-off and hysteresis next to
+//! the rigid slider's, with the status and flags `hdi sweep` reports.
+//!
 //! In Fig. 3(d) and Fig. 4 a point whose powers were still moving at the tightest tolerance is
-//! drawn hollow, and a negative hysteresis (not physical) as a cross.
+//! drawn hollow, a negative hysteresis (not physical) as a cross, and an amplitude without a
+//! touchdown or take-off is named in a note on the figure.
 //!
 //! Run with `cargo run --release --example paper -- [--out DIR] [--method NAME]
 //! [--fig1-absolute] [--wall-seconds]`. The output directory is `DIR`, else
@@ -78,19 +84,114 @@ fn run(options: &Options, out: &Path) -> Res<()> {
     let clock = Instant::now();
     let scene = Scene::paper();
     let model = SliderModel::from_scene(&scene)?;
-    let static_opts = StaticOptions::new(scene.detector.contact_threshold_n);
-    let mut opts = CycleOptions::from_scene(&scene)?;
+    let static_opts = StaticOptions::from_scene(&scene);
+    let stat = static_hysteresis(&model, &static_opts)?;
+    let amplitudes: Vec<f64> = (0..=10).map(|i| i as f64 * 0.1).collect();
+    // Where the AC makes contact intermittent, the running mean hovers near F_th and the
+    // detected powers depend on the tolerance: each amplitude is rerun with a tenfold tighter
+    // tolerance until touchdown and take-off move by less than 1 % of the rigid slider's static
+    // hysteresis, on both structures.
+    let refine = Refinement::new(0.01 * stat.hysteresis);
+
+    // The bulge's refined sweep is the longest single job (its 0.8 V point runs four cycles,
+    // down to rtol 1e-9): it starts first and runs beside the rigid slider's figures.
+    let (rigid, bulge) = std::thread::scope(|s| -> Res<_> {
+        let bulge = s.spawn(|| Bulge::run(options, &amplitudes, &refine));
+        let rigid = rigid_slider(options, out, &scene, &model, &stat, &refine, &amplitudes);
+        let bulge = bulge
+            .join()
+            .map_err(|_| "the bulge sweep stopped unexpectedly")?;
+        Ok((rigid?, bulge?))
+    })?;
+    let (fixed_refined, trig_refined) = rigid;
+
+    // The rigid and bulge panels of Fig. 3(d) and Fig. 4, on the same axes.
+    bulge.print(&fixed_refined, &stat);
+    sweep_table(&bulge.fixed, options.wall_seconds)
+        .write(&out.join("fig3d_hysteresis_vs_ac_bulge_fixed.csv"))?;
+    let rigid_sweeps = [
+        Sweep {
+            name: "fixed programme",
+            style: FIXED,
+            results: &fixed_refined,
+        },
+        Sweep {
+            name: "touchdown-triggered programme",
+            style: TRIGGERED,
+            results: &trig_refined,
+        },
+    ];
+    let bulge_sweeps = [Sweep {
+        name: "fixed programme",
+        style: FIXED,
+        results: &bulge.fixed,
+    }];
+    let mut fig3d = [
+        fig3d_chart(
+            RIGID_TITLES[0],
+            &rigid_sweeps,
+            stat.hysteresis,
+            refine.power_tol,
+        ),
+        fig3d_chart(
+            BULGE_TITLES[0],
+            &bulge_sweeps,
+            bulge.stat.hysteresis,
+            refine.power_tol,
+        ),
+    ];
+    let mut fig4 = [
+        fig4_chart(RIGID_TITLES[1], &rigid_sweeps, refine.power_tol),
+        fig4_chart(BULGE_TITLES[1], &bulge_sweeps, refine.power_tol),
+    ];
+    share_ranges(&mut fig3d);
+    share_ranges(&mut fig4);
+    let files = [
+        [
+            "fig3d_hysteresis_vs_ac.svg",
+            "fig3d_hysteresis_vs_ac_bulge.svg",
+        ],
+        [
+            "fig4_temperature_vs_hysteresis.svg",
+            "fig4_temperature_vs_hysteresis_bulge.svg",
+        ],
+    ];
+    for (charts, names) in [fig3d, fig4].iter().zip(files) {
+        for (chart, name) in charts.iter().zip(names) {
+            chart.to_svg(&out.join(name), PANEL.0, PANEL.1)?;
+        }
+    }
+    println!(
+        "\nwrote SVG and CSV files to {}; total {:.2} s",
+        out.display(),
+        clock.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// The rigid slider of the paper scene: prints its static analyses, writes every figure but
+/// Fig. 3(d) and Fig. 4, and returns its refined sweeps under the fixed and the triggered
+/// programme.
+fn rigid_slider(
+    options: &Options,
+    out: &Path,
+    scene: &Scene,
+    model: &SliderModel,
+    stat: &StaticHysteresis,
+    refine: &Refinement,
+    amplitudes: &[f64],
+) -> Res<(Vec<RefinedCycle>, Vec<RefinedCycle>)> {
+    let static_opts = StaticOptions::from_scene(scene);
+    let mut opts = CycleOptions::from_scene(scene)?;
     if let Some(m) = options.method {
         opts.solver.method = m;
     }
-    let fixed = HeaterProgramme::fixed_from_scene(&scene)?;
-    let triggered = HeaterProgramme::triggered_from_scene(&scene);
-    let amplitudes: Vec<f64> = (0..=10).map(|i| i as f64 * 0.1).collect();
+    let fixed = HeaterProgramme::fixed_from_scene(scene)?;
+    let triggered = HeaterProgramme::triggered_from_scene(scene);
 
     // Static analyses.
-    let curve = s_curve(&model, None, &ScanGrid::default())?;
-    let stat = static_hysteresis(&model, &static_opts)?;
-    let pull_in = pull_in_voltage(&model, 0.0, &static_opts)?;
+    let curve = s_curve(model, None, &ScanGrid::default())?;
+    let pull_in = pull_in_voltage(model, 0.0, &static_opts)?;
     println!("# Paper scene: static analyses (V_dc = φ)");
     println!(
         "touchdown power   {:8.3} mW  ({:?} at d = {:.3} nm)",
@@ -135,7 +236,7 @@ fn run(options: &Options, out: &Path) -> Res<()> {
 
     // Fig. 2(b): clearance change against DC voltage.
     let volts: Vec<f64> = (-10..=10).map(|i| i as f64 * 0.1).collect();
-    let fh = clearance_change(&model, &volts, &static_opts)?;
+    let fh = clearance_change(model, &volts, &static_opts)?;
     let dfh: Vec<f64> = fh.iter().map(|c| c.clearance_change).collect();
     let fit = parabola_fit(&volts, &dfh);
     let (a, b, c) = fit;
@@ -181,15 +282,11 @@ fn run(options: &Options, out: &Path) -> Res<()> {
     )
     .to_svg(&out.join("fig3b_zoom_0.6V.svg"), 1000, 550)?;
 
-    // Fig. 3(d) and Fig. 4: sweeps under both programmes. Where the AC makes contact
-    // intermittent, the running mean hovers near F_th and the detected powers depend on the
-    // tolerance: each amplitude is rerun with a tenfold tighter tolerance until touchdown and
-    // take-off move by less than 1 % of the static hysteresis.
-    let refine = Refinement::new(0.01 * stat.hysteresis);
+    // Fig. 3(d) and Fig. 4: refined sweeps under both programmes.
     let sweep_clock = Instant::now();
-    let fixed_refined = ac_sweep_refined(&model, &fixed, &opts, &amplitudes, &refine)?;
+    let fixed_refined = ac_sweep_refined(model, &fixed, &opts, amplitudes, refine)?;
     let fixed_wall = sweep_clock.elapsed().as_secs_f64();
-    let trig_refined = ac_sweep_refined(&model, &triggered, &opts, &amplitudes, &refine)?;
+    let trig_refined = ac_sweep_refined(model, &triggered, &opts, amplitudes, refine)?;
     println!(
         "\n# Fig. 3(d) / Fig. 4: cycles against AC amplitude (f = {} kHz, {}, rtol from {:e})",
         scene.voltage.ac_frequency_hz / 1e3,
@@ -212,7 +309,6 @@ fn run(options: &Options, out: &Path) -> Res<()> {
         "ΔT trig",
         "ms"
     );
-    let rtol = |r: &RefinedCycle| format!("{:.0e}{}", r.rtol, if r.converged { " " } else { "?" });
     for (fr, tr) in fixed_refined.iter().zip(&trig_refined) {
         let (f, t) = (&fr.cycle, &tr.cycle);
         println!(
@@ -221,12 +317,12 @@ fn run(options: &Options, out: &Path) -> Res<()> {
             opt_mw(f.touchdown.map(|d| d.power)),
             opt_mw(f.takeoff.map(|d| d.power)),
             hyst_mw(f.hysteresis),
-            rtol(fr),
+            rtol_mark(fr),
             f.mean_temperature_rise,
             fr.stats.accepted,
             opt_mw(t.touchdown.map(|d| d.power)),
             hyst_mw(t.hysteresis),
-            rtol(tr),
+            rtol_mark(tr),
             t.mean_temperature_rise,
             1e3 * (fr.wall_seconds + tr.wall_seconds),
         );
@@ -240,7 +336,7 @@ fn run(options: &Options, out: &Path) -> Res<()> {
         refine.max_runs
     );
     println!(
-        "fixed-programme refined sweep of {} amplitudes: {:.1} ms wall",
+        "fixed-programme refined sweep of {} amplitudes: {:.1} ms wall (beside the bulge's sweep)",
         amplitudes.len(),
         1e3 * fixed_wall
     );
@@ -249,24 +345,6 @@ fn run(options: &Options, out: &Path) -> Res<()> {
         .write(&out.join("fig3d_hysteresis_vs_ac_fixed.csv"))?;
     sweep_table(&trig_refined, options.wall_seconds)
         .write(&out.join("fig4_triggered_sweep.csv"))?;
-    let sweeps = [
-        Sweep {
-            name: "fixed programme",
-            style: FIXED,
-            results: &fixed_refined,
-        },
-        Sweep {
-            name: "touchdown-triggered programme",
-            style: TRIGGERED,
-            results: &trig_refined,
-        },
-    ];
-    fig3d_chart(&sweeps, stat.hysteresis).to_svg(
-        &out.join("fig3d_hysteresis_vs_ac.svg"),
-        1000,
-        520,
-    )?;
-    fig4_chart(&sweeps).to_svg(&out.join("fig4_temperature_vs_hysteresis.svg"), 1000, 520)?;
 
     // Fig. 1: contact indicator against heater power over triggered cycles.
     let mut fig1 = Vec::new();
@@ -302,12 +380,169 @@ fn run(options: &Options, out: &Path) -> Res<()> {
         nm(lr.dither_amplitude),
         nm(sim)
     );
-    println!(
-        "\nwrote SVG and CSV files to {}; total {:.2} s",
-        out.display(),
-        clock.elapsed().as_secs_f64()
-    );
-    Ok(())
+    Ok((fixed_refined, trig_refined))
+}
+
+/// Size of each figure panel (px); the rigid and bulge panels of a figure are shown side by side.
+const PANEL: (u32, u32) = (900, 560);
+/// Titles of the rigid panels of Fig. 3(d) and Fig. 4.
+const RIGID_TITLES: [&str; 2] = [
+    "Fig. 3(d) hysteresis against V_ac — rigid slider (paper scene)",
+    "Fig. 4 mean ΔT against hysteresis — rigid slider (paper scene)",
+];
+/// Titles of the bulge panels of Fig. 3(d) and Fig. 4.
+const BULGE_TITLES: [&str; 2] = [
+    "Fig. 3(d) hysteresis against V_ac — bulge (paper_bulge scene)",
+    "Fig. 4 mean ΔT against hysteresis — bulge (paper_bulge scene)",
+];
+
+/// The deformable slider of `scenes/paper_bulge.toml`: its static loop and its refined sweep
+/// under the fixed programme.
+struct Bulge {
+    stat: StaticHysteresis,
+    fixed: Vec<RefinedCycle>,
+    refine: Refinement,
+    /// Wall time of the sweep (s).
+    wall: f64,
+}
+
+impl Bulge {
+    /// Static analyses and the refined fixed-programme sweep of the shipped bulge scene, refined
+    /// to the same power tolerance as the rigid slider's (`refine`), so that both panels carry
+    /// the same error bar.
+    fn run(
+        options: &Options,
+        amplitudes: &[f64],
+        refine: &Refinement,
+    ) -> hdi_tribology::Result<Self> {
+        let scene = Scene::from_toml_str(include_str!("../scenes/paper_bulge.toml"))?;
+        let model = SliderModel::from_scene(&scene)?;
+        let p = Protocol::from_scene(&scene)?;
+        let mut opts = p.cycle;
+        if let Some(m) = options.method {
+            opts.solver.method = m;
+        }
+        let stat = static_hysteresis(&model, &p.statics)?;
+        let clock = Instant::now();
+        let fixed = ac_sweep_refined(&model, &p.fixed, &opts, amplitudes, refine)?;
+        Ok(Bulge {
+            stat,
+            fixed,
+            refine: *refine,
+            wall: clock.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The bulge's numbers beside the rigid slider's, fixed programme, with the status and
+    /// flags `hdi sweep` prints.
+    fn print(&self, rigid: &[RefinedCycle], rigid_stat: &StaticHysteresis) {
+        println!(
+            "\n# Rigid (paper scene) against bulge (scenes/paper_bulge.toml), fixed programme"
+        );
+        println!(
+            "static: rigid P_TD {:.3} / P_TO {:.3} / ΔP {:.3} mW; bulge {:.3} / {:.3} / {:.3} mW",
+            mw(rigid_stat.touchdown.power),
+            mw(rigid_stat.takeoff.power),
+            mw(rigid_stat.hysteresis),
+            mw(self.stat.touchdown.power),
+            mw(self.stat.takeoff.power),
+            mw(self.stat.hysteresis),
+        );
+        println!(
+            "{:>6} | {:>8} {:>8} {:>10} {:>7} {:>13} {:<22} | {:>8} {:>8} {:>10} {:>7} {:>13} {:<22}",
+            "V_ac", "P_TD", "P_TO", "ΔP", "rtol", "status", "flags", "P_TD", "P_TO", "ΔP", "rtol",
+            "status", "flags"
+        );
+        for (r, b) in rigid.iter().zip(&self.fixed) {
+            println!(
+                "{:>6.2} | {} | {}",
+                r.cycle.v_ac,
+                summary_cells(r),
+                summary_cells(b)
+            );
+        }
+        println!(
+            "left: rigid, right: bulge, both refined to {:.3} mW (\"?\": not converged); flags \
+             as `hdi sweep` prints them; bulge sweep {:.1} ms wall",
+            mw(self.refine.power_tol),
+            1e3 * self.wall
+        );
+    }
+}
+
+/// The tolerance a refined cycle ended at, "?" when it had not converged there.
+fn rtol_mark(r: &RefinedCycle) -> String {
+    format!("{:.0e}{}", r.rtol, if r.converged { " " } else { "?" })
+}
+
+/// P_TD, P_TO, ΔP (mW), rtol, status and flags of one refined cycle, as `hdi sweep` names them.
+fn summary_cells(r: &RefinedCycle) -> String {
+    let c = &r.cycle;
+    let flags: Vec<String> = r
+        .flags()
+        .iter()
+        .map(|f| {
+            serde_json::to_value(f)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_else(|| f.to_string())
+        })
+        .collect();
+    format!(
+        "{:>8} {:>8} {:>10} {:>7} {:>13} {:<22}",
+        opt_mw(c.touchdown.map(|d| d.power)),
+        opt_mw(c.takeoff.map(|d| d.power)),
+        hyst_mw(c.hysteresis),
+        rtol_mark(r),
+        if r.converged {
+            "converged"
+        } else {
+            "not_converged"
+        },
+        if flags.is_empty() {
+            "—".to_string()
+        } else {
+            flags.join(",")
+        }
+    )
+}
+
+/// Width of the legend panel of Fig. 3(d) and Fig. 4 (px), the same on both panels.
+const LEGEND_WIDTH: u32 = 260;
+
+/// Gives the panels of one figure (all on the same kind of axes) the same x and y ranges, those
+/// that show every point of every panel, and the same legend width, so that the rigid and bulge
+/// panels compare at a glance.
+fn share_ranges(charts: &mut [Chart<'_>]) {
+    let log = charts.first().map_or((false, false), |c| c.log);
+    let points = || {
+        charts
+            .iter()
+            .flat_map(|c| c.series.iter())
+            .flat_map(|s| s.points.iter().copied())
+            .filter(|&(x, y)| {
+                x.is_finite() && y.is_finite() && (!log.0 || x > 0.0) && (!log.1 || y > 0.0)
+            })
+    };
+    let span = |v: &mut dyn Iterator<Item = f64>, log: bool| {
+        let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+        (lo <= hi).then(|| match log {
+            true => (lo / 1.3, hi * 1.3),
+            false => {
+                let pad = if hi > lo { 0.05 * (hi - lo) } else { 1.0 };
+                (lo - pad, hi + pad)
+            }
+        })
+    };
+    let x = span(&mut points().map(|p| p.0), log.0);
+    let y = span(&mut points().map(|p| p.1), log.1);
+    for c in charts.iter_mut() {
+        c.x_range = x;
+        c.y_range = y;
+        c.legend_width = Some(LEGEND_WIDTH);
+    }
 }
 
 fn mw(p: f64) -> f64 {
@@ -429,9 +664,9 @@ fn status_series<'a>(
     out
 }
 
-/// [`status_series`] of both sweeps (fixed, then triggered), the first labelled `names`.
+/// [`status_series`] of the sweeps (fixed, then triggered if run), the first labelled `names`.
 fn sweep_series<'a>(
-    sweeps: &[Sweep<'a>; 2],
+    sweeps: &[Sweep<'a>],
     names: [&'a str; 2],
     point: impl Fn(&CycleResult, f64) -> (f64, f64) + Copy,
 ) -> Vec<Series<'a>> {
@@ -457,18 +692,54 @@ fn marker_name(m: Marker) -> &'static str {
     }
 }
 
-/// Notes on what the hollow and crossed markers mean.
-fn status_notes() -> Vec<String> {
-    vec![
-        "Hollow: touchdown or take-off still moved by more than 1 % of the static hysteresis at \
-         the tightest tolerance (intermittent contact): not converged."
-            .into(),
-        "Cross: negative hysteresis, not physical.".into(),
-    ]
+/// Notes on what the hollow and crossed markers mean, and which amplitudes have no hysteresis
+/// to draw.
+fn status_notes(sweeps: &[Sweep<'_>], power_tol: f64) -> Vec<String> {
+    let mut notes = vec![
+        format!(
+            "Hollow: touchdown or take-off still moved by more than {:.3} mW at the tightest \
+             tolerance (intermittent contact): not converged.",
+            mw(power_tol)
+        ),
+        "Cross: negative hysteresis, not physical.".to_string(),
+    ];
+    for sweep in sweeps {
+        let missing: Vec<String> = sweep
+            .results
+            .iter()
+            .filter(|r| r.cycle.hysteresis.is_none())
+            .map(|r| {
+                let what = if r.cycle.touchdown.is_none() {
+                    "no touchdown"
+                } else {
+                    "no take-off"
+                };
+                format!("{:.1} V ({what})", r.cycle.v_ac)
+            })
+            .collect();
+        if !missing.is_empty() {
+            notes.push(format!(
+                "Not drawn, {}: {}.",
+                sweep.name,
+                missing.join(", ")
+            ));
+        }
+    }
+    notes
 }
 
-/// Fig. 3(d): hysteresis (mW) against AC amplitude under both programmes, with the static value.
-fn fig3d_chart<'a>(sweeps: &'a [Sweep<'a>; 2], static_hysteresis: f64) -> Chart<'a> {
+/// A note on a panel whose touchdown-triggered programme was not run.
+const FIXED_ONLY: &str = "Fixed programme only: the rigid and bulge panels compare it; the \
+                          touchdown-triggered programme is not run on the bulge.";
+
+/// Fig. 3(d): hysteresis (mW) against AC amplitude under the programmes of `sweeps` (fixed,
+/// then triggered if run), with the static value.
+fn fig3d_chart<'a>(
+    title: &'a str,
+    sweeps: &'a [Sweep<'a>],
+    static_hysteresis: f64,
+    power_tol: f64,
+) -> Chart<'a> {
     let mut series = vec![Series::line(
         "static, V_ac = 0",
         vec![(0.0, mw(static_hysteresis)), (1.0, mw(static_hysteresis))],
@@ -481,15 +752,19 @@ fn fig3d_chart<'a>(sweeps: &'a [Sweep<'a>; 2], static_hysteresis: f64) -> Chart<
         ["fixed programme", "touchdown-triggered"],
         |c, h| (c.v_ac, mw(h)),
     ));
-    let mut notes = vec![format!(
-        "The letter's Fig. 3(d) uses the fixed programme ({}); the experiment's protocol is \
-             the touchdown-triggered programme ({}).",
-        marker_name(FIXED.1),
-        marker_name(TRIGGERED.1)
-    )];
-    notes.extend(status_notes());
+    let mut notes = vec![if sweeps.len() > 1 {
+        format!(
+            "The letter's Fig. 3(d) uses the fixed programme ({}); the experiment's protocol \
+             is the touchdown-triggered programme ({}).",
+            marker_name(FIXED.1),
+            marker_name(TRIGGERED.1)
+        )
+    } else {
+        FIXED_ONLY.to_string()
+    }];
+    notes.extend(status_notes(sweeps, power_tol));
     Chart {
-        title: "Fig. 3(d) hysteresis against AC amplitude, f = 10.5 kHz",
+        title,
         x_label: "V_ac (V)",
         y_label: "P_TD − P_TO (mW)",
         series,
@@ -498,23 +773,27 @@ fn fig3d_chart<'a>(sweeps: &'a [Sweep<'a>; 2], static_hysteresis: f64) -> Chart<
     }
 }
 
-/// Fig. 4: mean temperature rise (K) against hysteresis (mW) under both programmes.
-fn fig4_chart<'a>(sweeps: &'a [Sweep<'a>; 2]) -> Chart<'a> {
+/// Fig. 4: mean temperature rise (K) against hysteresis (mW) under the programmes of `sweeps`
+/// (fixed, then triggered if run).
+fn fig4_chart<'a>(title: &'a str, sweeps: &'a [Sweep<'a>], power_tol: f64) -> Chart<'a> {
     let series = sweep_series(
         sweeps,
         ["fixed programme", "touchdown-triggered (letter)"],
         |c, h| (mw(h), c.mean_temperature_rise),
     );
-    let mut notes = vec![format!(
-        "The letter's Fig. 4 uses the {} ({}); the {} ({}) is shown for comparison.",
-        sweeps[1].name,
-        marker_name(sweeps[1].style.1),
-        sweeps[0].name,
-        marker_name(sweeps[0].style.1),
-    )];
-    notes.extend(status_notes());
+    let mut notes = vec![match sweeps {
+        [fixed, triggered, ..] => format!(
+            "The letter's Fig. 4 uses the {} ({}); the {} ({}) is shown for comparison.",
+            triggered.name,
+            marker_name(triggered.style.1),
+            fixed.name,
+            marker_name(fixed.style.1),
+        ),
+        _ => FIXED_ONLY.to_string(),
+    }];
+    notes.extend(status_notes(sweeps, power_tol));
     Chart {
-        title: "Fig. 4 mean temperature rise against hysteresis",
+        title,
         x_label: "P_TD − P_TO (mW)",
         y_label: "mean ΔT (K)",
         series,
@@ -654,7 +933,10 @@ mod tests {
             "fig3b_zoom_0.6V.svg",
             "fig3c_forces_0.6V.svg",
             "fig3d_hysteresis_vs_ac.svg",
+            "fig3d_hysteresis_vs_ac_bulge.svg",
+            "fig3d_hysteresis_vs_ac_bulge_fixed.csv",
             "fig4_temperature_vs_hysteresis.svg",
+            "fig4_temperature_vs_hysteresis_bulge.svg",
         ] {
             assert!(dir.path().join(name).is_file(), "{name} written");
         }

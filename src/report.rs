@@ -412,6 +412,21 @@ pub struct Chart<'a> {
     pub y2_range: Option<(f64, f64)>,
     /// Lines of text under the legend (what the markers mean, which protocol is the letter's).
     pub notes: Vec<String>,
+    /// Width of the legend panel (px) instead of one sized to the longest label, so that panels
+    /// shown side by side get plot areas of one size; at most half the chart's width.
+    ///
+    /// ```
+    /// use hdi_tribology::report::{Chart, Series};
+    /// let panel = |label| Chart {
+    ///     series: vec![Series::line(label, vec![(0.0, 0.0), (1.0, 1.0)])],
+    ///     legend_width: Some(260),
+    ///     ..Chart::default()
+    /// };
+    /// // Both panels keep 260 px for the legend, whatever their labels.
+    /// let (a, b) = (panel("a"), panel("a much longer label"));
+    /// assert_eq!(a.legend_width, b.legend_width);
+    /// ```
+    pub legend_width: Option<u32>,
 }
 
 /// Whether `(x, y)` can be drawn on axes with the given log flags.
@@ -647,7 +662,9 @@ impl Chart<'_> {
             .map(|&i| self.series[i].label.chars().count() + 6)
             .max()
             .unwrap_or(0);
-        let legend_w = if labelled.is_empty() && self.notes.is_empty() {
+        let legend_w = if let Some(w) = self.legend_width {
+            w.min(width / 2)
+        } else if labelled.is_empty() && self.notes.is_empty() {
             0
         } else {
             ((widest as f64 * CHAR_PX) as u32 + 24).clamp(170, (width as f64 * 0.32) as u32)
