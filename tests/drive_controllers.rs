@@ -17,7 +17,7 @@ fn plant(seed: u64, opts: DriveOptions) -> Plant {
 }
 
 fn calibrate<D: LevelDetector>(
-    d: &mut Drive<'_>,
+    d: &mut Drive,
     settings: StaircaseSettings,
     det: D,
 ) -> Staircase<D> {
@@ -28,7 +28,7 @@ fn calibrate<D: LevelDetector>(
 }
 
 /// Static touchdown and take-off of the drive's model (the paper scene: 74.324 / 68.317 mW).
-fn static_td_to(d: &Drive<'_>) -> (f64, f64) {
+fn static_td_to(d: &Drive) -> (f64, f64) {
     let h = static_hysteresis(d.model(), &StaticOptions::new(5e-5)).unwrap();
     (h.touchdown.power, h.takeoff.power)
 }
@@ -113,7 +113,7 @@ fn harmonic_ratio_clearance_change_matches_the_true_one_within_the_noise() {
     let p = plant(9, opts);
     let mut d = p.drive().unwrap();
     let n = 400;
-    let window = |d: &mut Drive<'_>, mw: f64| {
+    let window = |d: &mut Drive, mw: f64| {
         // Settle 2 ms, then average.
         for _ in 0..40 {
             d.step(&Command::heater_mw(mw), DT).unwrap();

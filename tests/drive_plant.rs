@@ -18,7 +18,7 @@ fn plant(seed: u64, disk: DiskSpec) -> Plant {
     Plant::new(&scene, &zone, seed, opts).unwrap()
 }
 
-fn hold(d: &mut Drive<'_>, p_mw: f64, steps: usize) -> Vec<Sensors> {
+fn hold(d: &mut Drive, p_mw: f64, steps: usize) -> Vec<Sensors> {
     (0..steps)
         .map(|_| d.step(&Command::heater_mw(p_mw), DT).unwrap())
         .collect()

@@ -47,7 +47,7 @@ pub trait Controller {
 /// Those of [`Drive::step`]; an [`Error::Analysis`] when the controller has not stopped after
 /// `max_periods`.
 pub fn run(
-    drive: &mut Drive<'_>,
+    drive: &mut Drive,
     controller: &mut dyn Controller,
     dt: f64,
     max_periods: usize,
