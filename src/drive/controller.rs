@@ -175,6 +175,13 @@ pub trait LevelDetector {
     /// Whether the level is in contact. Levels come in the order run: up the staircase, then
     /// (`level.descending`) down it.
     fn judge(&mut self, level: &LevelStats) -> bool;
+    /// Sees the sensors of every period of a level before it is judged; `measuring` is true in
+    /// its measurement window. The default ignores them (a detector that judges the window's
+    /// statistics); a detector that follows the signal period by period (a filter, a running
+    /// mean) uses it.
+    fn observe(&mut self, sensors: &Sensors, measuring: bool) {
+        let _ = (sensors, measuring);
+    }
 }
 
 /// The oracle: the true contact force, averaged over the window, against a threshold `F_th` (the
@@ -367,6 +374,11 @@ pub struct StaircaseSettings {
     pub margin: f64,
     /// AC dither `(amplitude V, frequency Hz)` during the calibration.
     pub dither: Option<(f64, f64)>,
+    /// DC head–disk voltage during the calibration (V).
+    pub dc_voltage: f64,
+    /// Time of the linear heater ramp from one level to the next (s, ≤ `settle_time`; 0: a
+    /// step). Each period of the ramp holds the ramp's mean over that period.
+    pub rise_time: f64,
 }
 
 impl StaircaseSettings {
@@ -390,10 +402,12 @@ impl StaircaseSettings {
             find_takeoff: true,
             margin: mw(margin_mw),
             dither: None,
+            dc_voltage: 0.0,
+            rise_time: 0.0,
         }
     }
 
-    fn validate(&self, dt: f64) -> Result<(usize, usize)> {
+    fn validate(&self, dt: f64) -> Result<(usize, usize, usize)> {
         check_non_negative("staircase.start_power", self.start_power)?;
         check_positive("staircase.step", self.step)?;
         crate::error::check_finite("staircase.max_power", self.max_power)?;
@@ -416,8 +430,21 @@ impl StaircaseSettings {
         check_non_negative("staircase.settle_time", self.settle_time)?;
         check_positive("staircase.measure_time", self.measure_time)?;
         check_non_negative("staircase.margin", self.margin)?;
+        crate::error::check_finite("staircase.dc_voltage", self.dc_voltage)?;
+        check_non_negative("staircase.rise_time", self.rise_time)?;
+        if self.rise_time > self.settle_time {
+            return Err(Error::invalid(
+                "staircase.rise_time",
+                format!(
+                    "must not exceed settle_time = {} µs, got {} µs",
+                    self.settle_time * 1e6,
+                    self.rise_time * 1e6
+                ),
+            ));
+        }
         check_positive("dt", dt)?;
         let settle = (self.settle_time / dt).round() as usize;
+        let rise = (self.rise_time / dt).round() as usize;
         let measure = (self.measure_time / dt).round() as usize;
         if measure < 2 {
             return Err(Error::invalid(
@@ -429,7 +456,7 @@ impl StaircaseSettings {
                 ),
             ));
         }
-        Ok((settle, measure))
+        Ok((settle, measure, rise))
     }
 }
 
@@ -477,7 +504,12 @@ pub struct Staircase<D: LevelDetector> {
     detector: D,
     settle: usize,
     measure: usize,
+    rise: usize,
     phase: Phase,
+    /// The level: `start_power + level·step`.
+    level: i64,
+    /// The power of the level before (the ramp's start).
+    previous: f64,
     power: f64,
     k: usize,
     meter: Meter,
@@ -490,13 +522,16 @@ impl<D: LevelDetector> Staircase<D> {
     /// # Errors
     /// Invalid settings (named field).
     pub fn new(settings: StaircaseSettings, mut detector: D, dt: f64) -> Result<Self> {
-        let (settle, measure) = settings.validate(dt)?;
+        let (settle, measure, rise) = settings.validate(dt)?;
         detector.reset();
         Ok(Staircase {
             settings,
             settle,
             measure,
+            rise,
             phase: Phase::Up,
+            level: 0,
+            previous: settings.start_power,
             power: settings.start_power,
             k: 0,
             meter: Meter::default(),
@@ -526,9 +561,24 @@ impl<D: LevelDetector> Staircase<D> {
         self.phase == Phase::Done
     }
 
+    /// The detector, to change.
+    pub fn detector_mut(&mut self) -> &mut D {
+        &mut self.detector
+    }
+
+    /// The command of the next period (period `k + 1` of the level): on the ramp, its mean
+    /// over that period.
     fn command(&self) -> Command {
+        let j = self.k + 1;
+        let heater_power = if j <= self.rise {
+            let f = (j as f64 - 0.5) / self.rise as f64;
+            self.previous + (self.power - self.previous) * f
+        } else {
+            self.power
+        };
         let c = Command {
-            heater_power: self.power,
+            heater_power,
+            dc_voltage: self.settings.dc_voltage,
             ..Command::default()
         };
         match self.settings.dither {
@@ -557,7 +607,9 @@ impl<D: LevelDetector> Controller for Staircase<D> {
             return Action::Stop;
         }
         self.k += 1;
-        if self.k > self.settle {
+        let measuring = self.k > self.settle;
+        self.detector.observe(s, measuring);
+        if measuring {
             self.meter.add(s);
         }
         if self.k < self.settle + self.measure {
@@ -571,37 +623,31 @@ impl<D: LevelDetector> Controller for Staircase<D> {
         self.outcome.levels.push(stats);
         self.meter = Meter::default();
         self.k = 0;
-        match (self.phase, stats.contact) {
+        let below_start = |level: i64| level < 0;
+        let next = match (self.phase, stats.contact) {
             (Phase::Up, true) => {
                 self.outcome.touchdown_power = Some(self.power);
                 if !sc.find_takeoff {
                     return self.finish();
                 }
                 self.phase = Phase::Down;
-                self.power -= sc.step;
-                if self.power < sc.start_power - 1e-9 * sc.step {
-                    return self.finish();
-                }
+                self.level - 1
             }
-            (Phase::Up, false) => {
-                let next = self.power + sc.step;
-                if next > sc.max_power + 1e-9 * sc.step {
-                    return self.finish();
-                }
-                self.power = next;
-            }
+            (Phase::Up, false) => self.level + 1,
             (Phase::Down, false) => {
                 self.outcome.takeoff_power = Some(self.power);
                 return self.finish();
             }
-            (Phase::Down, true) => {
-                self.power -= sc.step;
-                if self.power < sc.start_power - 1e-9 * sc.step {
-                    return self.finish();
-                }
-            }
+            (Phase::Down, true) => self.level - 1,
             (Phase::Done, _) => return Action::Stop,
+        };
+        let p = sc.start_power + next as f64 * sc.step;
+        if below_start(next) || p > sc.max_power + 1e-9 * sc.step {
+            return self.finish();
         }
+        self.previous = self.power;
+        self.level = next;
+        self.power = p;
         Action::Continue(self.command())
     }
 }
