@@ -138,7 +138,7 @@ fn main() -> Result<(), hdi_tribology::Error> {
     };
     for n in [2.0, 3.0, 5.0, 8.0] {
         let r = touchdown_roc(&plant, settings, th, seeds.clone(), || {
-            ContactSensorSlope::new(n, 4)
+            ContactSensorSlope::new(n, 6)
         })?;
         row(&r, n);
     }

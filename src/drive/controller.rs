@@ -220,9 +220,15 @@ impl LevelDetector for TrueContact {
 ///
 /// On the way up, a straight line is fitted to the last `fit_levels` levels judged flying; a
 /// level is in contact when its mean resistance exceeds the line's prediction by more than
-/// `n_sigma` standard errors (of a level mean and of the prediction, both from the scatter
-/// measured on the flying levels). Before contact the gap cooling bends the curve down, below the line; frictional
-/// heat in contact lifts it above. On the way down the line of the flying levels is kept.
+/// `n_sigma` standard errors. The standard error has two parts. The noise of a level mean
+/// comes from the scatter measured on the flying levels (a level whose own scatter is large,
+/// because the head jumped into contact inside its window, must not widen its own band). The
+/// model error of the line is taken as the amount by which the last flying level exceeded its
+/// own prediction. Just below the fold the asperity tail already carries a few µN, and its
+/// frictional heat lifts the resistance above the line smoothly, level after level. A level
+/// must stand out from that trend as well as from the noise; the jump into contact stands out
+/// by orders of magnitude. Before contact the gap cooling bends the curve down, below the line.
+/// On the way down the line of the flying levels is kept.
 ///
 /// ```
 /// use hdi_tribology::drive::ContactSensorSlope;
@@ -234,6 +240,8 @@ pub struct ContactSensorSlope {
     n_sigma: f64,
     fit_levels: usize,
     flying: Vec<(f64, Channel)>,
+    /// How far the last flying level rose above its own prediction (Ω, ≥ 0).
+    trend: f64,
 }
 
 impl ContactSensorSlope {
@@ -250,12 +258,26 @@ impl ContactSensorSlope {
             n_sigma,
             fit_levels,
             flying: Vec::with_capacity(64),
+            trend: 0.0,
         })
     }
 
-    /// Excess of `level` over the line of the flying levels, and its standard error (Ω); `None`
+    /// Excess of `level` over the line of the flying levels, and its standard error (Ω): the
+    /// noise of a level mean plus the line's model error (see the type's documentation); `None`
     /// until `fit_levels` flying levels are known.
     pub fn excess(&self, level: &LevelStats) -> Option<(f64, f64)> {
+        let (e, noise2) = self.prediction_error(level)?;
+        let pts = &self.flying[self.flying.len() - self.fit_levels..];
+        let n = pts.len() as f64;
+        let pm = pts.iter().map(|p| p.0).sum::<f64>() / n;
+        let sxx: f64 = pts.iter().map(|p| (p.0 - pm).powi(2)).sum();
+        let v = noise2 + self.trend * self.trend;
+        let var_pred = v * (1.0 / n + (level.power - pm).powi(2) / sxx.max(f64::MIN_POSITIVE));
+        Some((e, (v + var_pred).sqrt()))
+    }
+
+    /// Excess of `level` over the line, and the noise variance of a flying level mean.
+    fn prediction_error(&self, level: &LevelStats) -> Option<(f64, f64)> {
         if self.flying.len() < self.fit_levels {
             return None;
         }
@@ -268,11 +290,7 @@ impl ContactSensorSlope {
         let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
         let pred = rm + slope * (level.power - pm);
         let s2 = pts.iter().map(|p| p.1.sem * p.1.sem).sum::<f64>() / n;
-        let var_pred = s2 * (1.0 / n + (level.power - pm).powi(2) / sxx.max(f64::MIN_POSITIVE));
-        // The noise of a level mean is that of the flying levels: a level whose own scatter is
-        // large (the head jumped into contact inside its window) must not widen its own band.
-        let se = (s2 + var_pred).sqrt();
-        Some((level.contact_resistance.mean - pred, se))
+        Some((level.contact_resistance.mean - pred, s2))
     }
 }
 
@@ -282,12 +300,14 @@ impl LevelDetector for ContactSensorSlope {
     }
     fn reset(&mut self) {
         self.flying.clear();
+        self.trend = 0.0;
     }
     fn judge(&mut self, level: &LevelStats) -> bool {
         let contact = self
             .excess(level)
             .is_some_and(|(e, se)| e > self.n_sigma * se);
         if !contact && !level.descending {
+            self.trend = self.prediction_error(level).map_or(0.0, |(e, _)| e.max(0.0));
             self.flying.push((level.power, level.contact_resistance));
         }
         contact
