@@ -14,7 +14,8 @@
 use hdi_tribology::analysis::{static_hysteresis, StaticOptions};
 use hdi_tribology::drive::{
     run, scene_zone, touchdown_roc, AcousticLevel, Action, Command, ContactSensorSlope, Controller,
-    DriveOptions, LevelDetector, Plant, RocPoint, Sensors, Staircase, StaircaseSettings, TrueContact,
+    DriveOptions, LevelDetector, Plant, RocPoint, Sensors, Staircase, StaircaseSettings,
+    TrueContact,
 };
 use hdi_tribology::scene::Scene;
 
@@ -195,15 +196,16 @@ fn main() -> Result<(), hdi_tribology::Error> {
 fn erfc(x: f64) -> f64 {
     let z = x.abs();
     let t = 1.0 / (1.0 + 0.5 * z);
-    let r = t * (-z * z - 1.26551223
-        + t * (1.00002368
-            + t * (0.37409196
-                + t * (0.09678418
-                    + t * (-0.18628806
-                        + t * (0.27886807
-                            + t * (-1.13520398
-                                + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
-        .exp();
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398
+                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
     if x >= 0.0 {
         r
     } else {

@@ -30,7 +30,13 @@ fn linear_response(plant: &Plant, omega: f64, amplitude: f64) -> (f64, f64) {
         sys.rhs(0.0, y, &mut dy);
         dy
     };
-    let scale = |i: usize| if i < 2 * lay.dofs { 1e-12 * (1.0 + y0[i].abs() * 1e9) } else { 1e-12 };
+    let scale = |i: usize| {
+        if i < 2 * lay.dofs {
+            1e-12 * (1.0 + y0[i].abs() * 1e9)
+        } else {
+            1e-12
+        }
+    };
     let mut j = DMatrix::zeros(n, n);
     let mut grad = DVector::zeros(n);
     for c in 0..n {
@@ -134,7 +140,10 @@ fn check(structure: StructureSpec, order: u32, amplitude: f64, what: &str) -> f6
         err / mag
     );
     assert!(mag > 1e-13, "{what}: response too small to test: {mag}");
-    assert!(err < 5e-3 * mag, "{what}: drive ({mre}, {mim}) vs linear ({re}, {im})");
+    assert!(
+        err < 5e-3 * mag,
+        "{what}: drive ({mre}, {mim}) vs linear ({re}, {im})"
+    );
     mag
 }
 

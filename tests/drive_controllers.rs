@@ -4,8 +4,8 @@
 
 use hdi_tribology::analysis::{static_hysteresis, StaticOptions};
 use hdi_tribology::drive::{
-    run, scene_zone, AcousticLevel, Command, ContactSensorSlope, Drive, DriveOptions,
-    LevelDetector, Plant, Readback, Staircase, StaircaseSettings, TrueContact, touchdown_roc,
+    run, scene_zone, touchdown_roc, AcousticLevel, Command, ContactSensorSlope, Drive,
+    DriveOptions, LevelDetector, Plant, Readback, Staircase, StaircaseSettings, TrueContact,
 };
 use hdi_tribology::scene::Scene;
 
@@ -16,11 +16,7 @@ fn plant(seed: u64, opts: DriveOptions) -> Plant {
     Plant::new(&scene, &scene_zone(&scene, 0.025).unwrap(), seed, opts).unwrap()
 }
 
-fn calibrate<D: LevelDetector>(
-    d: &mut Drive,
-    settings: StaircaseSettings,
-    det: D,
-) -> Staircase<D> {
+fn calibrate<D: LevelDetector>(d: &mut Drive, settings: StaircaseSettings, det: D) -> Staircase<D> {
     let mut st = Staircase::new(settings, det, DT).unwrap();
     run(d, &mut st, DT, 1_000_000).unwrap();
     assert!(st.is_done());
@@ -126,7 +122,10 @@ fn contact_sensor_slope_false_alarms_are_rare() {
     }
     println!("{fired3} (3σ) and {fired5} (5σ) of {judged} flying levels fired");
     assert!(judged > 500);
-    assert!((fired3 as f64) < 0.01 * judged as f64, "3σ: {fired3} of {judged}");
+    assert!(
+        (fired3 as f64) < 0.01 * judged as f64,
+        "3σ: {fired3} of {judged}"
+    );
     assert_eq!(fired5, 0, "5σ fired on noise");
 
     let scene = Scene::paper();

@@ -133,8 +133,8 @@ fn spanning_steps_agree_with_a_tight_reference() {
             worst_at = (contact, y.truth.mean_contact_force);
         }
         worst_gap = worst_gap.max((x.truth.gap - y.truth.gap).abs());
-        worst_force = worst_force
-            .max((x.truth.mean_contact_force - y.truth.mean_contact_force).abs());
+        worst_force =
+            worst_force.max((x.truth.mean_contact_force - y.truth.mean_contact_force).abs());
         worst_r = worst_r.max((x.contact_resistance - y.contact_resistance).abs());
         ms_r += (x.contact_resistance - y.contact_resistance).powi(2) / programme.len() as f64;
         if y.truth.mean_contact_force > 5e-5 {
@@ -155,7 +155,10 @@ fn spanning_steps_agree_with_a_tight_reference() {
     // contact sensor resolves ~0.2 µN per period in contact, where the force changes by ~4 µN
     // per pm of gap).
     assert!(worst_gap < 1e-13, "gap differs by {worst_gap} m");
-    assert!(worst_force < 1e-7, "mean contact force differs by {worst_force} N");
+    assert!(
+        worst_force < 1e-7,
+        "mean contact force differs by {worst_force} N"
+    );
     // The worst period is the jump into contact, where the mean contact force rises from a few
     // µN to a millinewton within the period; even there the contact sensor differs by a small
     // fraction of its noise, and over the run by a tiny one.

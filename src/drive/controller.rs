@@ -307,7 +307,9 @@ impl LevelDetector for ContactSensorSlope {
             .excess(level)
             .is_some_and(|(e, se)| e > self.n_sigma * se);
         if !contact && !level.descending {
-            self.trend = self.prediction_error(level).map_or(0.0, |(e, _)| e.max(0.0));
+            self.trend = self
+                .prediction_error(level)
+                .map_or(0.0, |(e, _)| e.max(0.0));
             self.flying.push((level.power, level.contact_resistance));
         }
         contact

@@ -12,8 +12,8 @@ use crate::scene::Scene;
 use nalgebra::{
     allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector, U10, U4, U5, U6, U7, U8, U9,
 };
-use std::sync::Arc;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// What the controller sets for the next period.
 ///
@@ -638,8 +638,7 @@ impl Drive {
         let plant = &*self.plant;
         let (t0, t1) = (self.t, self.t + dt);
         let ambient = plant.ambient.temperature(t0);
-        let clearance =
-            plant.base.nominal_clearance + plant.ambient.clearance_per_kelvin * ambient;
+        let clearance = plant.base.nominal_clearance + plant.ambient.clearance_per_kelvin * ambient;
         let changed = self.held != Some((*command, clearance));
         self.unchanged = if changed { 0 } else { self.unchanged + 1 };
         let layout = plant.layout;
