@@ -54,7 +54,7 @@ fn main() {
                         let mut c = cmd;
                         if alternate {
                             k += 1;
-                            c.heater_power += if k % 2 == 0 { 1e-6 } else { -1e-6 };
+                            c.heater_power += if k.is_multiple_of(2) { 1e-6 } else { -1e-6 };
                         }
                         s = Some(d.step(&c, DT).expect("step"));
                     }

@@ -116,9 +116,10 @@ fn spanning_steps_agree_with_a_tight_reference() {
     .unwrap();
     let mut programme: Vec<Command> = Vec::new();
     for mw in [62.0, 68.0, 72.0, 76.0, 78.0, 74.0, 70.0] {
-        programme.extend(std::iter::repeat(Command::heater_mw(mw)).take(60));
+        programme.extend(std::iter::repeat_n(Command::heater_mw(mw), 60));
     }
-    programme.extend(std::iter::repeat(Command::heater_mw(72.0).with_dither(0.5, 10.5e3)).take(40));
+    let dithered = Command::heater_mw(72.0).with_dither(0.5, 10.5e3);
+    programme.extend(std::iter::repeat_n(dithered, 40));
     // A controller that changes the command every period.
     programme.extend((0..40).map(|k| Command::heater_mw(70.0 + 0.05 * k as f64)));
     let (mut a, mut b) = (fast.drive().unwrap(), tight.drive().unwrap());
