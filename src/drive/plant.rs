@@ -331,8 +331,11 @@ impl Plant {
     /// let model = SliderModel::from_scene(&Scene::paper())?;
     /// let opts = DriveOptions { disk: DiskSpec::flat(), ..DriveOptions::default() };
     /// let mut drive = Plant::from_model(&model, 0.025, 1, opts)?.into_drive()?;
-    /// let s = drive.step(&Command::heater_mw(60.0), 50e-6)?;
-    /// assert!(s.truth.gap > 4e-9);
+    /// // The commands carry the model's own DC voltage.
+    /// let cmd = Command { dc_voltage: model.voltage.dc, ..Command::heater_mw(60.0) };
+    /// let s = drive.step(&cmd, 50e-6)?;
+    /// // Flying: the heater has closed part of the nominal clearance.
+    /// assert!(s.truth.gap > 1e-9 && s.truth.gap < model.nominal_clearance);
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
     ///
