@@ -178,3 +178,14 @@ fn spanning_steps_agree_with_a_tight_reference() {
         ms_r.sqrt()
     );
 }
+
+/// A `Drive` owns its plant: no borrow, `'static`, so another language's runtime can hold one.
+/// (It is not `Send`: the integrator's events are boxed closures without `Send`.)
+#[test]
+fn a_drive_is_owned() {
+    fn owned<T: 'static>(t: T) -> T {
+        t
+    }
+    let mut d = owned(plant(1, DiskSpec::flat()).into_drive().unwrap());
+    assert!(d.step(&Command::heater_mw(60.0), DT).unwrap().truth.gap > 0.0);
+}

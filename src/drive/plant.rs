@@ -252,8 +252,7 @@ where
 /// A drive before it runs: the slider of a scene in a zone, its disk, heater, sensors and
 /// solver settings. [`Plant::drive`] starts a [`Drive`] on it (several in turn, each from the
 /// same start); [`Plant::into_drive`] and [`Drive::new`] start one that shares the plant
-/// (`Arc`), with no borrow: a `Drive` is `'static` and `Send`, so another language's runtime can
-/// hold one.
+/// (`Arc`), with no borrow: a `Drive` is `'static`, so another language's runtime can hold one.
 ///
 /// ```
 /// use hdi_tribology::drive::{scene_zone, Command, DriveOptions, Plant};
@@ -552,7 +551,7 @@ macro_rules! with_integ {
 /// the integrator's system and the method restarts there; while the command holds, steps run
 /// on across period ends under the error control, and the sensors read the step's interpolant
 /// at each period end. The same seed gives the same disk and the same sensor noise, bit for
-/// bit. A `Drive` owns its plant (`Arc<Plant>`): no borrow, `'static`, `Send`.
+/// bit. A `Drive` owns its plant (`Arc<Plant>`): no borrow, `'static`.
 pub struct Drive {
     plant: Arc<Plant>,
     integ: Integ,
