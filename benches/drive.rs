@@ -1,5 +1,6 @@
 //! `Drive::step` at a 20 kHz controller rate against real time: in flight and in contact, on a
-//! flat and on the default wavy disk, with and without an AC dither. Prints a table.
+//! flat and on the default wavy disk, with and without an AC dither, and with a command that
+//! changes every period. Prints a table.
 //!
 //! `cargo bench --bench drive`. Each case settles 20 ms at its heater power, then times blocks
 //! of 200 periods (10 ms of drive time) for at least 1 s; the table gives the fastest block's
@@ -33,7 +34,9 @@ fn main() {
         )
         .expect("plant");
         for (state, mw) in [("flight", 70.0), ("contact", 80.0)] {
-            for dither in [None, Some((0.5, 10.5e3))] {
+            // Held commands, with and without dither; then a command that changes every period
+            // (a heater dithered by ±1 µW, alternating): the worst case, a restart per period.
+            for (dither, alternate) in [(None, false), (Some((0.5, 10.5e3)), false), (None, true)] {
                 let mut d = plant.drive().expect("drive");
                 let mut cmd = Command::heater_mw(mw);
                 if let Some((a, f)) = dither {
@@ -44,10 +47,16 @@ fn main() {
                 }
                 let s0 = d.stats().accepted;
                 let t0 = d.time();
+                let mut k = 0usize;
                 let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
                     let mut s = None;
                     for _ in 0..BLOCK {
-                        s = Some(d.step(&cmd, DT).expect("step"));
+                        let mut c = cmd;
+                        if alternate {
+                            k += 1;
+                            c.heater_power += if k.is_multiple_of(2) { 1e-6 } else { -1e-6 };
+                        }
+                        s = Some(d.step(&c, DT).expect("step"));
                     }
                     s
                 });
@@ -60,10 +69,11 @@ fn main() {
                 let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
                 println!(
                     "| {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} |",
-                    dither.map_or("off".to_string(), |(a, f)| format!(
-                        "{a} V, {:.1} kHz",
-                        f / 1e3
-                    )),
+                    match (dither, alternate) {
+                        (Some((a, f)), _) => format!("{a} V, {:.1} kHz", f / 1e3),
+                        (None, true) => "off, ±1 µW every period".to_string(),
+                        (None, false) => "off".to_string(),
+                    },
                     wall * 1e6,
                     cpu * 1e6,
                     DT / wall,

@@ -6,14 +6,16 @@
 //! of the AE is six standard errors above that baseline, then backs off 10 mW and holds there.
 //! The run prints what the controller saw and compares its touchdown with the static model's.
 //! Then it runs the crate's own staircase detectors over 20 noise seeds and prints their ROC
-//! points (false alarms, missed touchdowns, the clearance error left).
+//! points (false alarms, missed touchdowns, the clearance error left), and the contact-sensor
+//! slope's alarms on noise alone.
 //!
 //! `cargo run --release --example firmware_loop [SEED]`
 
 use hdi_tribology::analysis::{static_hysteresis, StaticOptions};
 use hdi_tribology::drive::{
     run, scene_zone, touchdown_roc, AcousticLevel, Action, Command, ContactSensorSlope, Controller,
-    DriveOptions, Plant, RocPoint, Sensors, StaircaseSettings,
+    DriveOptions, LevelDetector, Plant, RocPoint, Sensors, Staircase, StaircaseSettings,
+    TrueContact,
 };
 use hdi_tribology::scene::Scene;
 
@@ -138,7 +140,7 @@ fn main() -> Result<(), hdi_tribology::Error> {
     };
     for n in [2.0, 3.0, 5.0, 8.0] {
         let r = touchdown_roc(&plant, settings, th, seeds.clone(), || {
-            ContactSensorSlope::new(n, 4)
+            ContactSensorSlope::new(n, 6)
         })?;
         row(&r, n);
     }
@@ -153,5 +155,60 @@ fn main() -> Result<(), hdi_tribology::Error> {
         h.touchdown.power_mw(),
         clock.elapsed().as_secs_f64()
     );
+
+    // Noise alone: the contact-sensor slope judged on flying levels far below touchdown
+    // (50–66 mW), where the asperity tail carries well under 1 µN, for the same seeds, each run
+    // up to its first alarm (where a staircase stops): alarms per level judged.
+    let mut flying = StaircaseSettings::from_mw(50.0, 0.25, 66.0, 10.0);
+    flying.find_takeoff = false;
+    let mut levels = Vec::new();
+    for seed in seeds.clone() {
+        let mut d = plant.with_seed(seed)?.drive()?;
+        let mut st = Staircase::new(flying, TrueContact::new(th)?, DT)?;
+        run(&mut d, &mut st, DT, 1_000_000)?;
+        levels.push(st.outcome().levels.clone());
+    }
+    println!("\n| n_sigma | flying levels judged | alarms per level on noise | one-sided Gaussian tail |");
+    println!("|---|---|---|---|");
+    for n in [2.0, 3.0, 5.0, 8.0] {
+        let (mut judged, mut fired) = (0usize, 0usize);
+        for run_levels in &levels {
+            let mut det = ContactSensorSlope::new(n, 6)?;
+            // As the staircase does: up to the first alarm.
+            for l in run_levels {
+                judged += det.excess(l).is_some() as usize;
+                if det.judge(l) {
+                    fired += 1;
+                    break;
+                }
+            }
+        }
+        println!(
+            "| {n} | {judged} | {:.2} % | {:.2} % |",
+            100.0 * fired as f64 / judged as f64,
+            50.0 * erfc(n / std::f64::consts::SQRT_2)
+        );
+    }
     Ok(())
+}
+
+/// Complementary error function (Numerical Recipes' Chebyshev fit, relative error < 1.2e-7).
+fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398
+                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
+    if x >= 0.0 {
+        r
+    } else {
+        2.0 - r
+    }
 }

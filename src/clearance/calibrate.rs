@@ -3,11 +3,13 @@
 
 use super::detector::{Sample, TouchdownDetector};
 use crate::analysis::equilibrium::{flying_equilibrium, ScanGrid};
+use crate::drive::{
+    run, DiskSpec, DriveOptions, LevelDetector, LevelStats, Plant, Sensors,
+    Staircase as DriveStaircase, StaircaseSettings,
+};
 use crate::error::{check_finite, check_non_negative, check_positive, Error, Result};
-use crate::heater::Programme;
-use crate::model::{SliderModel, SliderSystem};
-use crate::ode::{self, Method, Options, SaveAt, Stats};
-use nalgebra::{DVector, Dyn};
+use crate::model::SliderModel;
+use crate::ode::{Method, Stats};
 use serde::Serialize;
 
 /// The heater staircase: levels `start_power + k·step` up to `max_power`, each reached by a linear
@@ -262,82 +264,79 @@ pub fn calibrate(
 ) -> Result<Calibration> {
     opts.validate()?;
     let sc = opts.staircase;
-    let grid = ScanGrid::default();
-    let eq = flying_equilibrium(model, sc.start_power, model.voltage.squared(0.0), &grid)?;
-    let probe = SliderSystem::new(model, Programme::constant(sc.start_power, 1.0)?, false);
-    let n = probe.layout().len();
-    let mut state = Run {
-        model,
-        opts,
-        t: 0.0,
-        y: probe.initial_state(Dyn(n), &eq.rest()),
-        power: sc.start_power,
-        stats: Stats::default(),
-        steps: Vec::new(),
+    let dt = opts.sample_interval;
+    // The drive of the model as it is: a flat disk, the model's own heater (no added lag), its
+    // voltage carried by every command; the detector reads the true values of each sample.
+    let h_max = model.max_step(None);
+    let drive_opts = DriveOptions {
+        initial_power: sc.start_power,
+        heater_time_constant: 0.0,
+        disk: DiskSpec::flat(),
+        method: opts.method,
+        rtol: opts.rtol,
+        atol_displacement: opts.atol_displacement,
+        max_step: h_max.is_finite().then_some(h_max),
+        ..DriveOptions::default()
+    };
+    let mut drive = Plant::from_model(model, 0.025, 0, drive_opts)?.into_drive()?;
+    let v = model.voltage;
+    let settings = StaircaseSettings {
+        start_power: sc.start_power,
+        step: sc.step,
+        max_power: sc.max_power,
+        settle_time: sc.settle_time,
+        measure_time: sc.measure_time,
+        find_takeoff: opts.find_takeoff,
+        margin: opts.margin,
+        dither: (v.ac_amplitude != 0.0).then_some((v.ac_amplitude, v.frequency)),
+        dc_voltage: v.dc,
+        rise_time: sc.rise_time,
     };
     detector.reset();
+    let mut staircase = DriveStaircase::new(
+        settings,
+        PerSample {
+            inner: detector,
+            record: None,
+            steps: Vec::new(),
+        },
+        dt,
+    )?;
+    // Up and back down at most once over every level, each `dwell / dt` samples.
+    let levels = ((sc.max_power - sc.start_power) / sc.step).floor() as usize + 1;
+    let per_level = (sc.dwell() / dt).round() as usize + 1;
+    run(&mut drive, &mut staircase, dt, 2 * (levels + 1) * per_level)?;
+    let outcome = staircase.outcome().clone();
+    let steps = std::mem::take(&mut staircase.detector_mut().steps);
+    let name = staircase.detector().inner.name().to_string();
 
-    // Up: levels start_power + k·step; the first level is the start power itself (a baseline).
-    let levels = ((sc.max_power - sc.start_power) / sc.step * (1.0 + 1e-12)).floor() as usize;
-    let mut touchdown = None;
-    for k in 0..=levels {
-        let p = sc.start_power + k as f64 * sc.step;
-        if state.level(p, false, detector)?.contact {
-            touchdown = Some(p);
-            break;
-        }
-    }
-    let Some(touchdown_power) = touchdown else {
+    let Some(touchdown_power) = outcome.touchdown_power else {
         return Err(Error::analysis(
             "clearance calibration",
-            format!(
-                "{} saw no contact up to {} W",
-                detector.name(),
-                sc.max_power
-            ),
+            format!("{name} saw no contact up to {} W", sc.max_power),
         ));
     };
-    if state.steps.len() == 1 {
+    let up = steps.iter().take_while(|s| !s.descending).count();
+    if up == 1 {
         // Fired at the baseline level: the slider was in contact before the staircase began, so
         // there is no touchdown power to find and no contrast to measure.
         return Err(Error::analysis(
             "clearance calibration",
             format!(
-                "{} fired at the start power {:?} W already, before the first heater step: \
+                "{name} fired at the start power {:?} W already, before the first heater step: \
                  contact before the staircase began (start lower, or with less dither)",
-                detector.name(),
                 sc.start_power
             ),
         ));
     }
-    let contrast = match state.steps.len() {
-        0 | 1 => f64::INFINITY,
-        m => {
-            let (a, b) = (state.steps[m - 1].peak_level, state.steps[m - 2].peak_level);
-            if b > 0.0 {
-                a / b
-            } else {
-                f64::INFINITY
-            }
+    let contrast = {
+        let (a, b) = (steps[up - 1].peak_level, steps[up - 2].peak_level);
+        if b > 0.0 {
+            a / b
+        } else {
+            f64::INFINITY
         }
     };
-
-    let mut takeoff_power = None;
-    if opts.find_takeoff {
-        let mut k = 1usize;
-        loop {
-            let p = touchdown_power - k as f64 * sc.step;
-            if p < sc.start_power - 1e-12 * sc.step {
-                break;
-            }
-            if !state.level(p, true, detector)?.contact {
-                takeoff_power = Some(p);
-                break;
-            }
-            k += 1;
-        }
-    }
-
     let set_power = touchdown_power - opts.margin;
     if set_power < 0.0 {
         return Err(Error::invalid(
@@ -349,112 +348,75 @@ pub fn calibrate(
         ));
     }
     let dc2 = model.voltage.dc_squared();
-    let clearance = flying_equilibrium(model, set_power, dc2, &grid)?.d;
+    let clearance = flying_equilibrium(model, set_power, dc2, &ScanGrid::default())?.d;
     Ok(Calibration {
-        detector: detector.name().to_string(),
+        detector: name,
         touchdown_power,
-        takeoff_power,
+        takeoff_power: outcome.takeoff_power,
         set_power,
         clearance,
         contrast,
-        simulated_time: state.t,
-        stats: state.stats,
-        steps: state.steps,
+        simulated_time: drive.time(),
+        stats: drive.stats(),
+        steps,
     })
 }
 
-/// The drive being calibrated: time, state and heater level so far.
-struct Run<'a> {
-    model: &'a SliderModel,
-    opts: &'a CalibrationOptions,
-    t: f64,
-    y: DVector<f64>,
-    power: f64,
-    stats: Stats,
+/// A [`TouchdownDetector`] fed every sample of the drive's staircase: the level is in contact
+/// when it fires in the measurement window.
+struct PerSample<'a> {
+    inner: &'a mut dyn TouchdownDetector,
+    record: Option<StepRecord>,
     steps: Vec<StepRecord>,
 }
 
-impl Run<'_> {
-    /// Moves the heater to `p` and holds it there for one dwell, feeding the detector.
-    fn level(
-        &mut self,
-        p: f64,
-        descending: bool,
-        detector: &mut dyn TouchdownDetector,
-    ) -> Result<StepRecord> {
-        let sc = self.opts.staircase;
-        let (t0, t1) = (self.t, self.t + sc.dwell());
-        let knots = if p == self.power {
-            vec![(t0, p), (t1, p)]
-        } else {
-            vec![(t0, self.power), (t0 + sc.rise_time, p), (t1, p)]
-        };
-        let programme = Programme::new(knots)?;
-        let sys = SliderSystem::new(self.model, programme.clone(), false);
-        let dt = self.opts.sample_interval;
-        let count = (sc.dwell() / dt).floor() as usize;
-        let times: Vec<f64> = (1..=count)
-            .map(|j| t0 + j as f64 * dt)
-            .filter(|&t| t <= t1)
-            .collect();
-        let sol = ode::solve(
-            &sys,
-            t0,
-            self.y.clone(),
-            t1,
-            self.opts.method,
-            &self.ode_options(&programme, times),
-            &mut [],
-        )?;
-        self.stats += &sol.stats;
+impl LevelDetector for PerSample<'_> {
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
 
-        let m = self.model;
-        let judge_from = t0 + sc.settle_time;
-        let mut rec = StepRecord {
-            power: p,
-            descending,
+    fn reset(&mut self) {
+        self.inner.reset();
+        self.record = None;
+        self.steps.clear();
+    }
+
+    fn observe(&mut self, s: &Sensors, measuring: bool) {
+        let tr = &s.truth;
+        let fired = self.inner.update(&Sample {
+            t: s.t,
+            power: s.heater_power,
+            displacement: tr.displacement,
+            velocity: tr.velocity,
+            gap: tr.gap,
+            contact_force: tr.contact_force,
+            interface_force: tr.interface_force,
+        });
+        let rec = self.record.get_or_insert(StepRecord {
+            power: 0.0,
+            descending: false,
             peak_level: 0.0,
             min_gap: f64::INFINITY,
             contact: false,
-        };
-        for (&t, s) in sol.t.iter().zip(&sol.y) {
-            let g = sys.gaps(t, s);
-            let f = m.interface_force(g, m.voltage.squared(t));
-            let sample = Sample {
-                t,
-                power: programme.power(t),
-                displacement: s[0],
-                velocity: s[sys.layout().velocity(0)],
-                gap: g.bulge,
-                contact_force: m.contact_force(g),
-                interface_force: f.value,
-            };
-            let fired = detector.update(&sample);
-            rec.min_gap = rec.min_gap.min(g.bulge);
-            if t >= judge_from {
-                rec.contact |= fired;
-                rec.peak_level = rec.peak_level.max(detector.level());
-            }
+        });
+        rec.min_gap = rec.min_gap.min(tr.gap);
+        if measuring {
+            rec.contact |= fired;
+            rec.peak_level = rec.peak_level.max(self.inner.level());
         }
-        self.t = t1;
-        self.y = sol.y_end;
-        self.power = p;
-        self.steps.push(rec);
-        Ok(rec)
     }
 
-    fn ode_options(&self, programme: &Programme, times: Vec<f64>) -> Options {
-        let m = self.model;
-        let sys = SliderSystem::new(m, programme.clone(), false);
-        let atol = sys.tolerances(self.opts.atol_displacement, 0.0, 0.0);
-        let h_max = m.max_step(None);
-        Options::default()
-            .rtol(self.opts.rtol)
-            .atol_per_component(atol)
-            .h_max(h_max)
-            .max_steps(10_000_000)
-            .t_stops(programme.knots().iter().map(|k| k.0).collect())
-            .save(SaveAt::Times(times))
-            .dense(false)
+    fn judge(&mut self, level: &LevelStats) -> bool {
+        let mut rec = self.record.take().unwrap_or(StepRecord {
+            power: 0.0,
+            descending: false,
+            peak_level: 0.0,
+            min_gap: f64::INFINITY,
+            contact: false,
+        });
+        rec.power = level.power;
+        rec.descending = level.descending;
+        self.steps.push(rec);
+        rec.contact
     }
 }

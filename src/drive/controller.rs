@@ -47,7 +47,7 @@ pub trait Controller {
 /// Those of [`Drive::step`]; an [`Error::Analysis`] when the controller has not stopped after
 /// `max_periods`.
 pub fn run(
-    drive: &mut Drive<'_>,
+    drive: &mut Drive,
     controller: &mut dyn Controller,
     dt: f64,
     max_periods: usize,
@@ -175,6 +175,13 @@ pub trait LevelDetector {
     /// Whether the level is in contact. Levels come in the order run: up the staircase, then
     /// (`level.descending`) down it.
     fn judge(&mut self, level: &LevelStats) -> bool;
+    /// Sees the sensors of every period of a level before it is judged; `measuring` is true in
+    /// its measurement window. The default ignores them (a detector that judges the window's
+    /// statistics); a detector that follows the signal period by period (a filter, a running
+    /// mean) uses it.
+    fn observe(&mut self, sensors: &Sensors, measuring: bool) {
+        let _ = (sensors, measuring);
+    }
 }
 
 /// The oracle: the true contact force, averaged over the window, against a threshold `F_th` (the
@@ -213,9 +220,15 @@ impl LevelDetector for TrueContact {
 ///
 /// On the way up, a straight line is fitted to the last `fit_levels` levels judged flying; a
 /// level is in contact when its mean resistance exceeds the line's prediction by more than
-/// `n_sigma` standard errors (of a level mean and of the prediction, both from the scatter
-/// measured on the flying levels). Before contact the gap cooling bends the curve down, below the line; frictional
-/// heat in contact lifts it above. On the way down the line of the flying levels is kept.
+/// `n_sigma` standard errors. The standard error has two parts. The noise of a level mean
+/// comes from the scatter measured on the flying levels (a level whose own scatter is large,
+/// because the head jumped into contact inside its window, must not widen its own band). The
+/// model error of the line is taken as the amount by which the last flying level exceeded its
+/// own prediction. Just below the fold the asperity tail already carries a few µN, and its
+/// frictional heat lifts the resistance above the line smoothly, level after level. A level
+/// must stand out from that trend as well as from the noise; the jump into contact stands out
+/// by orders of magnitude. Before contact the gap cooling bends the curve down, below the line.
+/// On the way down the line of the flying levels is kept.
 ///
 /// ```
 /// use hdi_tribology::drive::ContactSensorSlope;
@@ -227,6 +240,8 @@ pub struct ContactSensorSlope {
     n_sigma: f64,
     fit_levels: usize,
     flying: Vec<(f64, Channel)>,
+    /// How far the last flying level rose above its own prediction (Ω, ≥ 0).
+    trend: f64,
 }
 
 impl ContactSensorSlope {
@@ -243,12 +258,26 @@ impl ContactSensorSlope {
             n_sigma,
             fit_levels,
             flying: Vec::with_capacity(64),
+            trend: 0.0,
         })
     }
 
-    /// Excess of `level` over the line of the flying levels, and its standard error (Ω); `None`
+    /// Excess of `level` over the line of the flying levels, and its standard error (Ω): the
+    /// noise of a level mean plus the line's model error (see the type's documentation); `None`
     /// until `fit_levels` flying levels are known.
     pub fn excess(&self, level: &LevelStats) -> Option<(f64, f64)> {
+        let (e, noise2) = self.prediction_error(level)?;
+        let pts = &self.flying[self.flying.len() - self.fit_levels..];
+        let n = pts.len() as f64;
+        let pm = pts.iter().map(|p| p.0).sum::<f64>() / n;
+        let sxx: f64 = pts.iter().map(|p| (p.0 - pm).powi(2)).sum();
+        let v = noise2 + self.trend * self.trend;
+        let var_pred = v * (1.0 / n + (level.power - pm).powi(2) / sxx.max(f64::MIN_POSITIVE));
+        Some((e, (v + var_pred).sqrt()))
+    }
+
+    /// Excess of `level` over the line, and the noise variance of a flying level mean.
+    fn prediction_error(&self, level: &LevelStats) -> Option<(f64, f64)> {
         if self.flying.len() < self.fit_levels {
             return None;
         }
@@ -261,11 +290,7 @@ impl ContactSensorSlope {
         let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
         let pred = rm + slope * (level.power - pm);
         let s2 = pts.iter().map(|p| p.1.sem * p.1.sem).sum::<f64>() / n;
-        let var_pred = s2 * (1.0 / n + (level.power - pm).powi(2) / sxx.max(f64::MIN_POSITIVE));
-        // The noise of a level mean is that of the flying levels: a level whose own scatter is
-        // large (the head jumped into contact inside its window) must not widen its own band.
-        let se = (s2 + var_pred).sqrt();
-        Some((level.contact_resistance.mean - pred, se))
+        Some((level.contact_resistance.mean - pred, s2))
     }
 }
 
@@ -275,12 +300,16 @@ impl LevelDetector for ContactSensorSlope {
     }
     fn reset(&mut self) {
         self.flying.clear();
+        self.trend = 0.0;
     }
     fn judge(&mut self, level: &LevelStats) -> bool {
         let contact = self
             .excess(level)
             .is_some_and(|(e, se)| e > self.n_sigma * se);
         if !contact && !level.descending {
+            self.trend = self
+                .prediction_error(level)
+                .map_or(0.0, |(e, _)| e.max(0.0));
             self.flying.push((level.power, level.contact_resistance));
         }
         contact
@@ -367,6 +396,11 @@ pub struct StaircaseSettings {
     pub margin: f64,
     /// AC dither `(amplitude V, frequency Hz)` during the calibration.
     pub dither: Option<(f64, f64)>,
+    /// DC head–disk voltage during the calibration (V).
+    pub dc_voltage: f64,
+    /// Time of the linear heater ramp from one level to the next (s, ≤ `settle_time`; 0: a
+    /// step). Each period of the ramp holds the ramp's mean over that period.
+    pub rise_time: f64,
 }
 
 impl StaircaseSettings {
@@ -390,10 +424,12 @@ impl StaircaseSettings {
             find_takeoff: true,
             margin: mw(margin_mw),
             dither: None,
+            dc_voltage: 0.0,
+            rise_time: 0.0,
         }
     }
 
-    fn validate(&self, dt: f64) -> Result<(usize, usize)> {
+    fn validate(&self, dt: f64) -> Result<(usize, usize, usize)> {
         check_non_negative("staircase.start_power", self.start_power)?;
         check_positive("staircase.step", self.step)?;
         crate::error::check_finite("staircase.max_power", self.max_power)?;
@@ -416,8 +452,21 @@ impl StaircaseSettings {
         check_non_negative("staircase.settle_time", self.settle_time)?;
         check_positive("staircase.measure_time", self.measure_time)?;
         check_non_negative("staircase.margin", self.margin)?;
+        crate::error::check_finite("staircase.dc_voltage", self.dc_voltage)?;
+        check_non_negative("staircase.rise_time", self.rise_time)?;
+        if self.rise_time > self.settle_time {
+            return Err(Error::invalid(
+                "staircase.rise_time",
+                format!(
+                    "must not exceed settle_time = {} µs, got {} µs",
+                    self.settle_time * 1e6,
+                    self.rise_time * 1e6
+                ),
+            ));
+        }
         check_positive("dt", dt)?;
         let settle = (self.settle_time / dt).round() as usize;
+        let rise = (self.rise_time / dt).round() as usize;
         let measure = (self.measure_time / dt).round() as usize;
         if measure < 2 {
             return Err(Error::invalid(
@@ -429,7 +478,7 @@ impl StaircaseSettings {
                 ),
             ));
         }
-        Ok((settle, measure))
+        Ok((settle, measure, rise))
     }
 }
 
@@ -477,7 +526,12 @@ pub struct Staircase<D: LevelDetector> {
     detector: D,
     settle: usize,
     measure: usize,
+    rise: usize,
     phase: Phase,
+    /// The level: `start_power + level·step`.
+    level: i64,
+    /// The power of the level before (the ramp's start).
+    previous: f64,
     power: f64,
     k: usize,
     meter: Meter,
@@ -490,13 +544,16 @@ impl<D: LevelDetector> Staircase<D> {
     /// # Errors
     /// Invalid settings (named field).
     pub fn new(settings: StaircaseSettings, mut detector: D, dt: f64) -> Result<Self> {
-        let (settle, measure) = settings.validate(dt)?;
+        let (settle, measure, rise) = settings.validate(dt)?;
         detector.reset();
         Ok(Staircase {
             settings,
             settle,
             measure,
+            rise,
             phase: Phase::Up,
+            level: 0,
+            previous: settings.start_power,
             power: settings.start_power,
             k: 0,
             meter: Meter::default(),
@@ -526,9 +583,24 @@ impl<D: LevelDetector> Staircase<D> {
         self.phase == Phase::Done
     }
 
+    /// The detector, to change.
+    pub fn detector_mut(&mut self) -> &mut D {
+        &mut self.detector
+    }
+
+    /// The command of the next period (period `k + 1` of the level): on the ramp, its mean
+    /// over that period.
     fn command(&self) -> Command {
+        let j = self.k + 1;
+        let heater_power = if j <= self.rise {
+            let f = (j as f64 - 0.5) / self.rise as f64;
+            self.previous + (self.power - self.previous) * f
+        } else {
+            self.power
+        };
         let c = Command {
-            heater_power: self.power,
+            heater_power,
+            dc_voltage: self.settings.dc_voltage,
             ..Command::default()
         };
         match self.settings.dither {
@@ -557,7 +629,9 @@ impl<D: LevelDetector> Controller for Staircase<D> {
             return Action::Stop;
         }
         self.k += 1;
-        if self.k > self.settle {
+        let measuring = self.k > self.settle;
+        self.detector.observe(s, measuring);
+        if measuring {
             self.meter.add(s);
         }
         if self.k < self.settle + self.measure {
@@ -571,37 +645,31 @@ impl<D: LevelDetector> Controller for Staircase<D> {
         self.outcome.levels.push(stats);
         self.meter = Meter::default();
         self.k = 0;
-        match (self.phase, stats.contact) {
+        let below_start = |level: i64| level < 0;
+        let next = match (self.phase, stats.contact) {
             (Phase::Up, true) => {
                 self.outcome.touchdown_power = Some(self.power);
                 if !sc.find_takeoff {
                     return self.finish();
                 }
                 self.phase = Phase::Down;
-                self.power -= sc.step;
-                if self.power < sc.start_power - 1e-9 * sc.step {
-                    return self.finish();
-                }
+                self.level - 1
             }
-            (Phase::Up, false) => {
-                let next = self.power + sc.step;
-                if next > sc.max_power + 1e-9 * sc.step {
-                    return self.finish();
-                }
-                self.power = next;
-            }
+            (Phase::Up, false) => self.level + 1,
             (Phase::Down, false) => {
                 self.outcome.takeoff_power = Some(self.power);
                 return self.finish();
             }
-            (Phase::Down, true) => {
-                self.power -= sc.step;
-                if self.power < sc.start_power - 1e-9 * sc.step {
-                    return self.finish();
-                }
-            }
+            (Phase::Down, true) => self.level - 1,
             (Phase::Done, _) => return Action::Stop,
+        };
+        let p = sc.start_power + next as f64 * sc.step;
+        if below_start(next) || p > sc.max_power + 1e-9 * sc.step {
+            return self.finish();
         }
+        self.previous = self.power;
+        self.level = next;
+        self.power = p;
         Action::Continue(self.command())
     }
 }

@@ -12,8 +12,8 @@ use crate::scene::Scene;
 use nalgebra::{
     allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector, U10, U4, U5, U6, U7, U8, U9,
 };
-use std::cell::RefCell;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// What the controller sets for the next period.
 ///
@@ -117,6 +117,7 @@ impl Ambient {
 /// use hdi_tribology::drive::DriveOptions;
 /// let o = DriveOptions::default();
 /// assert_eq!(o.initial_power, 0.060);
+/// assert_eq!(o.atol_displacement, 1e-14);
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct DriveOptions {
@@ -131,15 +132,30 @@ pub struct DriveOptions {
     pub ambient: Ambient,
     /// The sensors.
     pub sensors: SensorSpec,
-    /// ODE method. The scene's tolerances are used, not its method: a controller period is
-    /// several air-bearing periods long, and a stiff method steps over it in one step near
-    /// equilibrium, where an explicit one needs many (docs/benchmarks.md, "Drive").
+    /// ODE method. A controller period is several air-bearing periods long, and a stiff method
+    /// steps over many periods in one step near equilibrium, where an explicit one needs many
+    /// steps per period (docs/benchmarks.md, "Drive").
     pub method: Method,
+    /// Relative tolerance of the slider integration.
+    pub rtol: f64,
+    /// Absolute tolerance on the displacements (m; velocities scaled by their modal
+    /// frequencies). The default, 0.01 pm (the scene's own default), keeps the integration
+    /// error below what the sensors resolve in one period, in flight and in contact. The
+    /// read-back harmonic ratio resolves `λ/(4π)·√2·noise ≈ 22 pm` of spacing per period and
+    /// the contact sensor about 0.1 nm in flight; in contact, though, the contact sensor
+    /// resolves about 0.2 µN of contact force per period, and the contact force grows by
+    /// ~4 µN per pm of gap: 0.05 pm. At 0.1 pm the contact sensor's integration error in
+    /// contact reaches 0.4 of its noise (rms) when the command changes every period;
+    /// tests/drive_plant.rs checks the default against a tight reference.
+    pub atol_displacement: f64,
+    /// Largest integration step (s); `None`: unlimited (a step may span many controller
+    /// periods; the sensors are read on its interpolant).
+    pub max_step: Option<f64>,
 }
 
 impl Default for DriveOptions {
     /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift;
-    /// Rodas5P.
+    /// Rodas5P at `rtol = 1e-6`, `atol = 0.01 pm`; no step limit.
     fn default() -> Self {
         DriveOptions {
             initial_power: 0.060,
@@ -148,6 +164,9 @@ impl Default for DriveOptions {
             ambient: Ambient::default(),
             sensors: SensorSpec::default(),
             method: Method::Rodas5P,
+            rtol: 1e-6,
+            atol_displacement: 1e-14,
+            max_step: None,
         }
     }
 }
@@ -175,21 +194,28 @@ pub fn scene_zone(scene: &Scene, radius: f64) -> Result<Zone> {
 /// The slider's ODE with the disk surface moving under it.
 ///
 /// The state is relative to the disk surface `w(t)` (every force of the model depends on the
-/// gap and its rate only), so the surface's motion enters as the inertial force `−m ẅ(t)`;
-/// everything else is the model's own [`SliderSystem`], evaluated on the model of the current
-/// command (heater, voltage, ambient clearance), which [`Drive::step`] sets before each period.
+/// gaps and their rates only), so the surface's motion enters as the base excitation
+/// `−M r ẅ(t)`, with `r` the structure's influence of a rigid disk translation on each
+/// coordinate ([`crate::model::Structure::base_influence`]): `−r_i ẅ` on each acceleration.
+/// Everything else is the model's own [`SliderSystem`], evaluated on `model`, the model of the
+/// current command (heater, voltage, ambient clearance), which [`Drive::step`] sets through
+/// [`Integrator::system_mut`] when the command changes.
+#[derive(Clone)]
 struct DriveSystem {
-    current: RefCell<SliderModel>,
+    model: SliderModel,
     programme: Programme,
     disk: Disk,
+    /// `(velocity index, r_i)` of the coordinates a disk translation moves.
+    base: [(usize, f64); crate::scene::MAX_DOF],
+    n_base: usize,
 }
 
 impl DriveSystem {
     /// The model's ODE for the current command. Cloning the programme shares its knots: no
     /// allocation.
-    fn with_slider<R>(&self, f: impl FnOnce(&SliderSystem<'_>) -> R) -> R {
-        let m = self.current.borrow();
-        f(&SliderSystem::new(&m, self.programme.clone(), true))
+    #[inline]
+    fn slider(&self) -> SliderSystem<'_> {
+        SliderSystem::new(&self.model, self.programme.clone(), true)
     }
 }
 
@@ -198,22 +224,26 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     fn rhs(&self, t: f64, y: &OVector<f64, D>, dy: &mut OVector<f64, D>) {
-        self.with_slider(|s| s.rhs(t, y, dy));
+        self.slider().rhs(t, y, dy);
         if !self.disk.is_flat() {
-            // The disk's motion enters the (rigid) slider's relative coordinate as −ẅ; the
-            // plant refuses a moving disk under other structures.
-            dy[1] -= self.disk.acceleration(t).0;
+            let a = self.disk.acceleration_value(t);
+            for &(i, r) in &self.base[..self.n_base] {
+                dy[i] -= r * a;
+            }
         }
     }
 
     fn jacobian(&self, t: f64, y: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
-        self.with_slider(|s| s.jacobian(t, y, j))
+        self.slider().jacobian(t, y, j)
     }
 
     fn time_derivative(&self, t: f64, y: &OVector<f64, D>, d: &mut OVector<f64, D>) -> bool {
-        let ok = self.with_slider(|s| s.time_derivative(t, y, d));
+        let ok = self.slider().time_derivative(t, y, d);
         if ok && !self.disk.is_flat() {
-            d[1] -= self.disk.acceleration(t).1;
+            let jerk = self.disk.acceleration(t).1;
+            for &(i, r) in &self.base[..self.n_base] {
+                d[i] -= r * jerk;
+            }
         }
         ok
     }
@@ -221,14 +251,15 @@ where
 
 /// A drive before it runs: the slider of a scene in a zone, its disk, heater, sensors and
 /// solver settings. [`Plant::drive`] starts a [`Drive`] on it (several in turn, each from the
-/// same start).
+/// same start); [`Plant::into_drive`] and [`Drive::new`] start one that shares the plant
+/// (`Arc`), with no borrow: a `Drive` is `'static`, so another language's runtime can hold one.
 ///
 /// ```
 /// use hdi_tribology::drive::{scene_zone, Command, DriveOptions, Plant};
 /// use hdi_tribology::scene::Scene;
 /// let scene = Scene::paper();
 /// let plant = Plant::new(&scene, &scene_zone(&scene, 0.025)?, 7, DriveOptions::default())?;
-/// let mut drive = plant.drive()?;
+/// let mut drive = plant.into_drive()?; // owns the plant
 /// let mut s = drive.step(&Command::heater_mw(60.0), 50e-6)?;
 /// for _ in 0..40 {
 ///     s = drive.step(&Command::heater_mw(65.0), 50e-6)?;
@@ -238,16 +269,20 @@ where
 /// assert!(s.truth.gap < 4.5e-9);
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
+#[derive(Clone)]
 pub struct Plant {
     system: DriveSystem,
     base: SliderModel,
     layout: StateLayout,
     start: Rest,
+    start_voltage: Voltage,
     start_sensors: Physical,
     sensors: SensorSpec,
     ambient: Ambient,
     method: Method,
     ode: Options,
+    /// See `Span::rebase`.
+    rebase: [f64; 2],
     max_steps: usize,
     zone: Zone,
     seed: u64,
@@ -273,6 +308,71 @@ impl Plant {
     /// # Errors
     /// Invalid scene, zone or options (named field); no flying equilibrium at the initial power.
     pub fn new(scene: &Scene, zone: &Zone, seed: u64, opts: DriveOptions) -> Result<Self> {
+        let zoned = zone.scene(scene)?;
+        let max_steps = CycleOptions::from_scene(&zoned)?.solver.max_steps;
+        let base = SliderModel::from_scene(&zoned)?;
+        let start_voltage = Voltage {
+            dc: 0.0,
+            ac_amplitude: 0.0,
+            ..base.voltage
+        };
+        Self::build(base, zone.clone(), seed, opts, start_voltage, max_steps)
+    }
+
+    /// The drive of a model as it is (its clearance, bearing, structure and disk speed), at
+    /// `radius` (m, for the disk's rpm); every drive started on it begins at rest in the flying
+    /// equilibrium at `opts.initial_power` under the model's own voltage at `t = 0`, which the
+    /// commands should then carry (`clearance::calibrate` runs this way).
+    ///
+    /// ```
+    /// use hdi_tribology::drive::{Command, DiskSpec, DriveOptions, Plant};
+    /// use hdi_tribology::{model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let opts = DriveOptions { disk: DiskSpec::flat(), ..DriveOptions::default() };
+    /// let mut drive = Plant::from_model(&model, 0.025, 1, opts)?.into_drive()?;
+    /// // The commands carry the model's own DC voltage.
+    /// let cmd = Command { dc_voltage: model.voltage.dc, ..Command::heater_mw(60.0) };
+    /// let s = drive.step(&cmd, 50e-6)?;
+    /// // Flying: the heater has closed part of the nominal clearance.
+    /// assert!(s.truth.gap > 1e-9 && s.truth.gap < model.nominal_clearance);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// Invalid radius or options (named field); no flying equilibrium at the initial power.
+    pub fn from_model(
+        model: &SliderModel,
+        radius: f64,
+        seed: u64,
+        opts: DriveOptions,
+    ) -> Result<Self> {
+        crate::error::check_positive("radius", radius)?;
+        let zone = Zone {
+            name: "model".into(),
+            radius,
+            disk_speed: model.friction.disk_speed,
+            nominal_clearance: model.nominal_clearance,
+            bearing_stiffness: model.bearing().stiffness(0.0),
+        };
+        let v = model.voltage;
+        Self::build(
+            model.clone(),
+            zone,
+            seed,
+            opts,
+            v,
+            crate::scene::SolverSpec::default().max_steps,
+        )
+    }
+
+    fn build(
+        mut base: SliderModel,
+        zone: Zone,
+        seed: u64,
+        opts: DriveOptions,
+        start_voltage: Voltage,
+        max_steps: usize,
+    ) -> Result<Self> {
         check_non_negative("initial_power", opts.initial_power)?;
         check_non_negative("heater_time_constant", opts.heater_time_constant)?;
         check_finite("ambient.rate", opts.ambient.rate)?;
@@ -283,9 +383,11 @@ impl Plant {
             opts.ambient.clearance_per_kelvin,
         )?;
         opts.sensors.validate()?;
-        let zoned = zone.scene(scene)?;
-        let solver = CycleOptions::from_scene(&zoned)?.solver;
-        let mut base = SliderModel::from_scene(&zoned)?;
+        crate::error::check_positive("rtol", opts.rtol)?;
+        crate::error::check_positive("atol_displacement", opts.atol_displacement)?;
+        if let Some(h) = opts.max_step {
+            crate::error::check_positive("max_step", h)?;
+        }
         if base.thermal_lag == 0.0 {
             base.thermal_lag = opts.heater_time_constant;
         }
@@ -294,35 +396,30 @@ impl Plant {
         // The heater command enters as the protrusion per unit power of a constant 1 W programme
         // (`η P` = `(η P) · 1 W`), so a new command needs no new programme.
         let programme = Programme::constant(1.0, 1.0)?;
-        let dc = base.with_voltage(Voltage {
-            dc: 0.0,
-            ac_amplitude: 0.0,
-            ..base.voltage
-        });
+        let at_start = base.with_voltage(start_voltage);
         let eq = flying_equilibrium(
-            &dc,
+            &at_start,
             opts.initial_power,
-            dc.voltage.squared(0.0),
+            at_start.voltage.squared(0.0),
             &ScanGrid::default(),
         )?;
         let probe = SliderSystem::new(&base, programme.clone(), true);
         let layout = probe.layout();
-        if layout.dofs > 1 && !disk.is_flat() {
-            return Err(Error::invalid(
-                "drive.disk",
-                "run-out and waviness are modelled for the rigid structure only; \
-                 use a flat disk with the scene's [structure]",
-            ));
-        }
-        // The period means of the contact force and flash temperature: 1 µN and 1 mK over 50 µs.
-        let atol = probe.tolerances(solver.atol_displacement, 1e-6 * 5e-5, 1e-3 * 5e-5);
+        // The period means of the contact force and flash temperature: 0.1 µN and 0.1 K over
+        // 50 µs (the contact sensor resolves about 0.2 µN of contact force per period in
+        // contact; the flash temperature is a truth value only, hundreds of kelvin in contact).
+        let (impulse, heat) = (3e-8 * 5e-5, 0.1 * 5e-5);
+        let atol = probe.tolerances(opts.atol_displacement, impulse, heat);
+        // Beyond these the relative tolerance allows ten times the absolute one.
+        let rebase = [10.0 * impulse / opts.rtol, 10.0 * heat / opts.rtol];
         let ode = Options::default()
-            .rtol(solver.rtol)
+            .rtol(opts.rtol)
             .atol_per_component(atol)
-            .h_max(solver.max_step.unwrap_or(f64::INFINITY))
+            .h_max(opts.max_step.unwrap_or(f64::INFINITY))
             // Bounded per period in `Drive::step`; the integrator lives as long as the drive.
             .max_steps(usize::MAX)
-            .dense(false);
+            // The sensors are read on the interpolant of a step that spans the period's end.
+            .dense(true);
         ode.validate(layout.len())
             .map_err(|e| Error::invalid("solver", e.to_string()))?;
         let friction = base.friction.coefficient * zone.disk_speed;
@@ -332,22 +429,34 @@ impl Plant {
             friction_power: friction * base.contact_force(base.gaps(&eq.q, eq.protrusion)),
             ambient: 0.0,
         };
+        let mut bases = [(0usize, 0.0); crate::scene::MAX_DOF];
+        let mut n_base = 0;
+        for (i, &r) in base.structure.base_influence().iter().enumerate() {
+            if r != 0.0 {
+                bases[n_base] = (layout.velocity(i), r);
+                n_base += 1;
+            }
+        }
         Ok(Plant {
             system: DriveSystem {
-                current: RefCell::new(base.clone()),
+                model: base.clone(),
                 programme,
                 disk,
+                base: bases,
+                n_base,
             },
             base,
             layout,
             start: eq.rest(),
+            start_voltage,
             start_sensors,
             sensors: opts.sensors,
             ambient: opts.ambient,
             method: opts.method,
             ode,
-            max_steps: solver.max_steps,
-            zone: zone.clone(),
+            rebase,
+            max_steps,
+            zone,
             seed,
             disk_spec: opts.disk,
             rpm,
@@ -360,71 +469,28 @@ impl Plant {
     /// # Errors
     /// None in practice (the disk was valid for the first seed).
     pub fn with_seed(&self, seed: u64) -> Result<Plant> {
-        Ok(Plant {
-            system: DriveSystem {
-                current: RefCell::new(self.base.clone()),
-                programme: self.system.programme.clone(),
-                disk: Disk::new(&self.disk_spec, self.rpm, seed)?,
-            },
-            base: self.base.clone(),
-            layout: self.layout,
-            start: self.start,
-            start_sensors: self.start_sensors,
-            sensors: self.sensors,
-            ambient: self.ambient,
-            method: self.method,
-            ode: self.ode.clone(),
-            max_steps: self.max_steps,
-            zone: self.zone.clone(),
-            seed,
-            disk_spec: self.disk_spec.clone(),
-            rpm: self.rpm,
-        })
+        let mut p = self.clone();
+        p.system.disk = Disk::new(&self.disk_spec, self.rpm, seed)?;
+        p.seed = seed;
+        Ok(p)
     }
 
-    /// Starts a drive: at rest in the flying equilibrium at the initial power, time 0, the
-    /// sensor noise at the start of its seeded stream.
+    /// Starts a drive on a copy of this plant (the model's tables are shared, not rebuilt): at
+    /// rest in the flying equilibrium at the initial power, time 0, the sensor noise at the
+    /// start of its seeded stream.
     ///
     /// # Errors
-    /// A state size the drive has no fixed-size vector for; integrator set-up failures.
-    pub fn drive(&self) -> Result<Drive<'_>> {
-        let sys = &self.system;
-        let (m, o) = (self.method, &self.ode);
-        let probe = SliderSystem::new(&self.base, sys.programme.clone(), true);
-        let rest = &self.start;
-        macro_rules! start {
-            ($variant:ident, $dim:expr) => {
-                Integ::$variant(Integrator::new(
-                    sys,
-                    0.0,
-                    probe.initial_state($dim, rest),
-                    1.0,
-                    m,
-                    o,
-                )?)
-            };
-        }
-        let integ = match self.layout.len() {
-            4 => start!(S4, U4),
-            5 => start!(S5, U5),
-            6 => start!(S6, U6),
-            7 => start!(S7, U7),
-            8 => start!(S8, U8),
-            9 => start!(S9, U9),
-            10 => start!(S10, U10),
-            n => {
-                return Err(Error::analysis(
-                    "drive",
-                    format!("no fixed-size state of {n} components"),
-                ))
-            }
-        };
-        Ok(Drive {
-            plant: self,
-            integ,
-            sensors: SensorState::new(self.sensors, self.seed, &self.start_sensors),
-            t: 0.0,
-        })
+    /// See [`Drive::new`].
+    pub fn drive(&self) -> Result<Drive> {
+        Drive::new(Arc::new(self.clone()))
+    }
+
+    /// Starts a drive that owns this plant (see [`Plant::drive`]).
+    ///
+    /// # Errors
+    /// See [`Drive::new`].
+    pub fn into_drive(self) -> Result<Drive> {
+        Drive::new(Arc::new(self))
     }
 
     /// The zone.
@@ -451,14 +517,14 @@ impl Plant {
 /// The integrator, on a state sized at compile time for the layouts a scene can have.
 // One per drive, built once and never moved per step: the size difference costs nothing.
 #[allow(clippy::large_enum_variant)]
-enum Integ<'p> {
-    S4(Integrator<'p, U4, &'p DriveSystem>),
-    S5(Integrator<'p, U5, &'p DriveSystem>),
-    S6(Integrator<'p, U6, &'p DriveSystem>),
-    S7(Integrator<'p, U7, &'p DriveSystem>),
-    S8(Integrator<'p, U8, &'p DriveSystem>),
-    S9(Integrator<'p, U9, &'p DriveSystem>),
-    S10(Integrator<'p, U10, &'p DriveSystem>),
+enum Integ {
+    S4(Integrator<'static, U4, DriveSystem>),
+    S5(Integrator<'static, U5, DriveSystem>),
+    S6(Integrator<'static, U6, DriveSystem>),
+    S7(Integrator<'static, U7, DriveSystem>),
+    S8(Integrator<'static, U8, DriveSystem>),
+    S9(Integrator<'static, U9, DriveSystem>),
+    S10(Integrator<'static, U10, DriveSystem>),
 }
 
 macro_rules! with_integ {
@@ -478,28 +544,86 @@ macro_rules! with_integ {
 /// A simulated drive: the slider of a [`Plant`] flying over its wavy disk, with a heater, a
 /// head–disk voltage and the sensors firmware reads, stepped at the controller's rate.
 ///
-/// Each [`Drive::step`] holds the [`Command`] over one period, advances the slider dynamics
-/// from where the last period ended with the crate's steppable [`Integrator`] (the model's
-/// [`SliderSystem`] plus the disk's motion; nothing is re-solved and nothing allocated) and
-/// returns the [`Sensors`] at its end. The same seed gives the same disk and the same sensor
-/// noise, bit for bit.
-pub struct Drive<'p> {
-    plant: &'p Plant,
-    integ: Integ<'p>,
+/// Each [`Drive::step`] holds the [`Command`] over one period and returns the [`Sensors`] at
+/// its end. The slider is advanced by the crate's steppable [`Integrator`], which owns the
+/// model's [`SliderSystem`] plus the disk's motion and lives as long as the drive: nothing is
+/// re-solved and nothing allocated per period. A new command (or ambient clearance) is set in
+/// the integrator's system and the method restarts there; while the command holds, steps run
+/// on across period ends under the error control, and the sensors read the step's interpolant
+/// at each period end. The same seed gives the same disk and the same sensor noise, bit for
+/// bit. A `Drive` owns its plant (`Arc<Plant>`): no borrow, `'static`.
+pub struct Drive {
+    plant: Arc<Plant>,
+    integ: Integ,
     sensors: SensorState,
     t: f64,
+    /// The command and ambient clearance the integrator's system holds (`None` before the first
+    /// period).
+    held: Option<(Command, f64)>,
+    /// Periods since the command last changed: right after a change the controller is likely
+    /// to change it again, so the period's last step ends on its end (no step past it wasted).
+    unchanged: usize,
+    /// The contact impulse and heat integrals at the start of the period.
+    integrals0: (f64, f64),
 }
 
-impl std::fmt::Debug for Drive<'_> {
+impl std::fmt::Debug for Drive {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Drive")
-            .field("plant", self.plant)
+            .field("plant", &self.plant)
             .field("t", &self.t)
             .finish_non_exhaustive()
     }
 }
 
-impl Drive<'_> {
+/// How far ahead of the drive's time the integrator's end time is kept (s): it only bounds
+/// the first step after a restart.
+const HORIZON: f64 = 1.0;
+
+impl Drive {
+    /// Starts a drive on `plant`: at rest in the flying equilibrium at the initial power, time
+    /// 0, the sensor noise at the start of its seeded stream.
+    ///
+    /// # Errors
+    /// A state size the drive has no fixed-size vector for; integrator set-up failures.
+    pub fn new(plant: Arc<Plant>) -> Result<Self> {
+        let mut sys = plant.system.clone();
+        sys.model.voltage = plant.start_voltage;
+        sys.model.efficiency = plant.base.efficiency * plant.start_sensors.heater_power;
+        let (m, o) = (plant.method, &plant.ode);
+        let rest = plant.start;
+        macro_rules! start {
+            ($variant:ident, $dim:expr) => {{
+                let y0 = sys.slider().initial_state($dim, &rest);
+                Integ::$variant(Integrator::new(sys, 0.0, y0, HORIZON, m, o)?)
+            }};
+        }
+        let integ = match plant.layout.len() {
+            4 => start!(S4, U4),
+            5 => start!(S5, U5),
+            6 => start!(S6, U6),
+            7 => start!(S7, U7),
+            8 => start!(S8, U8),
+            9 => start!(S9, U9),
+            10 => start!(S10, U10),
+            n => {
+                return Err(Error::analysis(
+                    "drive",
+                    format!("no fixed-size state of {n} components"),
+                ))
+            }
+        };
+        Ok(Drive {
+            sensors: SensorState::new(plant.sensors, plant.seed, &plant.start_sensors),
+            plant,
+            integ,
+            t: 0.0,
+            held: None,
+            unchanged: 0,
+            integrals0: (0.0, 0.0),
+        })
+    }
+
     /// Holds `command` for `dt` seconds, advances the slider and returns the sensors at the end.
     ///
     /// # Errors
@@ -513,32 +637,39 @@ impl Drive<'_> {
                 format!("a controller period must not exceed 1 s, got {dt} s"),
             ));
         }
-        let plant = self.plant;
+        let plant = &*self.plant;
         let (t0, t1) = (self.t, self.t + dt);
         let ambient = plant.ambient.temperature(t0);
-        {
-            // Cloning the model shares its tables (reference counts): no allocation.
-            let mut m = plant.system.current.borrow_mut();
-            *m = plant.base.clone();
-            m.efficiency = plant.base.efficiency * command.heater_power;
-            m.nominal_clearance += plant.ambient.clearance_per_kelvin * ambient;
-            m.voltage = Voltage {
-                dc: command.dc_voltage,
-                ac_amplitude: command.ac_amplitude,
-                frequency: command.ac_frequency,
-                contact_potential: plant.base.voltage.contact_potential,
-            };
-        }
+        let clearance = plant.base.nominal_clearance + plant.ambient.clearance_per_kelvin * ambient;
+        let changed = self.held != Some((*command, clearance));
+        self.unchanged = if changed { 0 } else { self.unchanged + 1 };
         let layout = plant.layout;
-        let max_steps = plant.max_steps;
-        let truth = with_integ!(&mut self.integ, it => {
-            advance(it, &layout, t0, t1, max_steps)?;
-            plant.system.with_slider(|s| observe(s, it.state(), &layout, t1, dt))
+        let span = Span {
+            t0,
+            t1,
+            max_steps: plant.max_steps,
+            land: self.unchanged < 2,
+            rebase: plant.rebase,
+        };
+        let set = changed.then_some(Held {
+            command,
+            clearance,
+            base: &plant.base,
         });
+        let (truth, integrals) = with_integ!(&mut self.integ, it => {
+            let y1 = advance(it, &layout, set, &mut self.integrals0, span)?;
+            let s = it.system().slider();
+            let integrals = (
+                layout.contact_impulse.map_or(0.0, |i| y1[i]),
+                layout.heat.map_or(0.0, |i| y1[i]),
+            );
+            (observe(&s, &y1, &layout, t1, dt, self.integrals0), integrals)
+        });
+        self.held = Some((*command, clearance));
+        self.integrals0 = integrals;
         self.t = t1;
-        let m = plant.system.current.borrow();
         let friction_power =
-            m.friction.coefficient * plant.zone.disk_speed * truth.mean_contact_force;
+            plant.base.friction.coefficient * plant.zone.disk_speed * truth.mean_contact_force;
         let phys = Physical {
             gap: truth.gap,
             heater_power: command.heater_power,
@@ -574,7 +705,12 @@ impl Drive<'_> {
 
     /// The plant.
     pub fn plant(&self) -> &Plant {
-        self.plant
+        &self.plant
+    }
+
+    /// The plant, shared.
+    pub fn plant_arc(&self) -> &Arc<Plant> {
+        &self.plant
     }
 
     /// The slider model of the zone (with the heater time constant the drive uses).
@@ -583,27 +719,102 @@ impl Drive<'_> {
     }
 }
 
-/// Integrates one period; the one place the drive calls the ODE stepper.
-///
-/// The command may have changed, and the period integrals restart at zero: both are
-/// discontinuities, so the integrator restarts at `t0` (its first step is the whole period,
-/// which the step control cuts down in a transient) and steps to `t1`.
-fn advance<D: Dim>(
-    it: &mut Integrator<'_, D, &DriveSystem>,
-    layout: &StateLayout,
+/// A new command to set in the integrator's system.
+struct Held<'a> {
+    command: &'a Command,
+    clearance: f64,
+    base: &'a SliderModel,
+}
+
+impl Held<'_> {
+    /// The model of the command: no clone, four numbers written.
+    fn apply(&self, m: &mut SliderModel) {
+        m.efficiency = self.base.efficiency * self.command.heater_power;
+        m.nominal_clearance = self.clearance;
+        m.voltage = Voltage {
+            dc: self.command.dc_voltage,
+            ac_amplitude: self.command.ac_amplitude,
+            frequency: self.command.ac_frequency,
+            contact_potential: self.base.voltage.contact_potential,
+        };
+    }
+}
+
+/// One period `[t0, t1]`.
+#[derive(Clone, Copy)]
+struct Span {
     t0: f64,
     t1: f64,
     max_steps: usize,
-) -> Result<()>
+    /// End the period's last step on `t1` rather than step past it.
+    land: bool,
+    /// Sizes of the contact impulse and heat integrals beyond which they are set back to zero.
+    rebase: [f64; 2],
+}
+
+/// Integrates one period and returns the state at its end; the one place the drive calls the
+/// ODE stepper.
+///
+/// A new command is a discontinuity of the right-hand side at `t0`: it is set in the
+/// integrator's system (`system_mut`) and the method restarts at `t0` with a fresh step-size
+/// estimate (`reinit`); when the last step ran past `t0`, the state there is read on that
+/// step's interpolant first. (Keeping the old step size instead is worse here: after a step
+/// shortened onto a period's end it is small, and grows back only by the controller's bounded
+/// factor per step.) Without a new command nothing restarts: steps run on under the error
+/// control, across period ends, and the state at `t1` is read on the interpolant of the step
+/// that spans it.
+///
+/// The period integrals (contact impulse, heat) run on across periods; the period means are
+/// their differences. They are set back to zero at a restart once they have grown so large
+/// that the relative tolerance would loosen their error control more than tenfold.
+fn advance<D: Dim>(
+    it: &mut Integrator<'static, D, DriveSystem>,
+    layout: &StateLayout,
+    set: Option<Held<'_>>,
+    integrals0: &mut (f64, f64),
+    span: Span,
+) -> Result<OVector<f64, D>>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    let mut y = it.state().clone();
-    for i in [layout.contact_impulse, layout.heat].into_iter().flatten() {
-        y[i] = 0.0;
+    let Span {
+        t0,
+        t1,
+        max_steps,
+        land,
+        rebase,
+    } = span;
+    let integrals = [layout.contact_impulse, layout.heat];
+    let grown = integrals
+        .iter()
+        .zip(rebase)
+        .any(|(i, bound)| i.is_some_and(|i| it.state()[i].abs() > bound));
+    if set.is_some() || grown {
+        let mut y = if it.t() > t0 {
+            it.interpolate(t0)?
+        } else {
+            it.state().clone()
+        };
+        if grown {
+            for i in integrals.into_iter().flatten() {
+                y[i] = 0.0;
+            }
+            *integrals0 = (0.0, 0.0);
+        }
+        if let Some(held) = set {
+            held.apply(&mut it.system_mut().model);
+        }
+        if it.tf() <= t0 {
+            it.set_tf(t1)?;
+        }
+        it.reinit(t0, y)?;
     }
-    it.set_tf(t1)?;
-    it.reinit(t0, y)?;
+    // Landing: the period's end is the integrator's end time, so the last step is shortened
+    // onto it. Otherwise the end time stays a horizon ahead.
+    let tf = if land { t1 } else { t1 + HORIZON };
+    if (land && it.tf() != t1) || (!land && it.tf() < t1 + 0.5 * HORIZON) {
+        it.set_tf(tf)?;
+    }
     let mut n = 0usize;
     while it.t() < t1 {
         if n >= max_steps {
@@ -615,33 +826,39 @@ where
         it.step()?;
         n += 1;
     }
-    Ok(())
+    Ok(if it.t() == t1 {
+        it.state().clone()
+    } else {
+        it.interpolate(t1)?
+    })
 }
 
-/// The true values at the end of a period.
+/// The true values at the end of a period, the period means from the integrals' change since
+/// `integrals0`.
 fn observe<D: Dim>(
     sys: &SliderSystem<'_>,
     y: &OVector<f64, D>,
     layout: &StateLayout,
     t: f64,
     dt: f64,
+    integrals0: (f64, f64),
 ) -> Truth
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     let m = sys.model();
     let g = sys.gaps(t, y);
-    let mean = |i: Option<usize>| i.map_or(0.0, |i| y[i] / dt);
+    let mean = |i: Option<usize>, i0: f64| i.map_or(0.0, |i| (y[i] - i0) / dt);
     Truth {
         gap: g.bulge,
         pad_gap: g.pad,
         displacement: y[0],
         velocity: y[layout.velocity(0)],
         protrusion: sys.protrusion(t, y),
-        mean_contact_force: mean(layout.contact_impulse),
+        mean_contact_force: mean(layout.contact_impulse, integrals0.0),
         contact_force: m.contact_force(g),
         interface_force: m.interface_force(g, m.voltage.squared(t)).value,
-        mean_flash_temperature: mean(layout.heat),
+        mean_flash_temperature: mean(layout.heat, integrals0.1),
         ..Truth::default()
     }
 }

@@ -268,6 +268,8 @@ pub(crate) struct SensorState {
     ecs_noise: Rng,
     ae_noise: Rng,
     rb_noise: Rng,
+    /// The low-pass factors of the last period length `(dt, [contact, acoustic, read-back])`.
+    lp: (f64, [f64; 3]),
 }
 
 impl SensorState {
@@ -280,6 +282,7 @@ impl SensorState {
             ecs_noise: Rng::new(seed, 0xEC5),
             ae_noise: Rng::new(seed, 0xAE),
             rb_noise: Rng::new(seed, 0xB7),
+            lp: (f64::NAN, [0.0; 3]),
         };
         s.temperature = s.steady_temperature(start);
         s
@@ -296,13 +299,23 @@ impl SensorState {
     /// Advances the filters by `dt` with the physical inputs held over the period, then samples.
     /// Returns (resistance, AE, readback, sensor temperature).
     pub(crate) fn sample(&mut self, t: f64, dt: f64, p: &Physical) -> (f64, f64, Readback, f64) {
-        let lp = |bw: f64| 1.0 - (-2.0 * PI * bw * dt).exp();
         let spec = self.spec;
+        if self.lp.0 != dt {
+            let lp = |bw: f64| 1.0 - (-2.0 * PI * bw * dt).exp();
+            self.lp = (
+                dt,
+                [
+                    lp(spec.contact.bandwidth),
+                    lp(spec.acoustic.bandwidth),
+                    lp(spec.readback.bandwidth),
+                ],
+            );
+        }
+        let [lp_c, lp_a, lp_r] = self.lp.1;
         let target = self.steady_temperature(p);
-        self.temperature += lp(spec.contact.bandwidth) * (target - self.temperature);
-        self.friction_power +=
-            lp(spec.acoustic.bandwidth) * (p.friction_power - self.friction_power);
-        self.spacing += lp(spec.readback.bandwidth) * (p.gap - self.spacing);
+        self.temperature += lp_c * (target - self.temperature);
+        self.friction_power += lp_a * (p.friction_power - self.friction_power);
+        self.spacing += lp_r * (p.gap - self.spacing);
 
         let c = &spec.contact;
         let r = c.resistance * (1.0 + c.tcr * self.temperature) + c.noise * self.ecs_noise.normal();

@@ -52,6 +52,9 @@ pub struct Structure {
     /// Length per unit of each coordinate (1 for translations, the lever for rotations): makes
     /// the convergence tests of the static solvers dimensionally consistent.
     length_scale: Dofs,
+    /// Influence of a rigid translation of the disk on each coordinate (see
+    /// [`Structure::base_influence`]).
+    base: Dofs,
 }
 
 impl Structure {
@@ -64,7 +67,9 @@ impl Structure {
     /// ```
     pub fn rigid(mass: f64) -> Result<Self> {
         check_positive("slider.mass_kg", mass)?;
-        Self::build(1, &[[mass]], &[[0.0]], &[[0.0]], &[1.0], "structure")
+        let mut s = Self::build(1, &[[mass]], &[[0.0]], &[[0.0]], &[1.0], "structure")?;
+        s.base[0] = 1.0;
+        Ok(s)
     }
 
     /// Body of mass `body_mass` (kg) on the air bearing, and the bulge of mass `bulge_mass` (kg)
@@ -84,14 +89,18 @@ impl Structure {
             stiffness,
             2.0 * damping_ratio * (stiffness * bulge_mass).sqrt(),
         );
-        Self::build(
+        let mut s = Self::build(
             2,
             &[[body_mass, 0.0], [0.0, bulge_mass]],
             &[[c, -c], [-c, c]],
             &[[k, -k], [-k, k]],
             &[0.0, 1.0],
             "structure",
-        )
+        )?;
+        // Both coordinates are absolute translations: a disk translation moves both.
+        s.base[0] = 1.0;
+        s.base[1] = 1.0;
+        Ok(s)
     }
 
     /// Body heave (mass `body_mass`, kg) and pitch (inertia `inertia`, kg m²) with the air
@@ -119,6 +128,9 @@ impl Structure {
         if trailing_edge != 0.0 {
             s.length_scale[1] = trailing_edge.abs();
         }
+        // The pitch and its stiffness are relative to the disk plane; a disk translation does
+        // not rotate the slider.
+        s.base[0] = 1.0;
         Ok(s)
     }
 
@@ -160,14 +172,16 @@ impl Structure {
         };
         let mut b = [0.0; MAX_DOF];
         b[..n].copy_from_slice(bulge_influence);
-        Self::build(
+        let mut s = Self::build(
             n,
             &rows(mass),
             &rows(damping),
             &rows(stiffness),
             &b,
             "structure",
-        )
+        )?;
+        s.base = s.rigid_translation();
+        Ok(s)
     }
 
     /// The structure a scene describes, with the body mass of `slider.mass_kg`.
@@ -256,6 +270,7 @@ impl Structure {
             stiffness: k,
             bulge: b,
             length_scale,
+            base: Dofs::zeros(),
         })
     }
 
@@ -282,6 +297,50 @@ impl Structure {
     /// The structural stiffness matrix `K` (n × n), without the air bearing's heave stiffness.
     pub fn stiffness_matrix(&self) -> DMatrix<f64> {
         self.stiffness.view((0, 0), (self.n, self.n)).into_owned()
+    }
+
+    /// The influence vector `r` of a rigid translation of the disk on each coordinate: a disk
+    /// surface at height `w(t)` moves coordinate `i` by `r_i w` without loading the structure.
+    ///
+    /// The drive takes the state relative to the moving disk; every force of the model depends
+    /// on those relative coordinates, and the disk's motion enters only through the inertia as
+    /// the base excitation `−M r ẅ` (that is, `−r_i ẅ` on each acceleration). `r` is 1 on the
+    /// rigid slider; `(1, 1)` on `bulge` (body and bulge are absolute translations); `(1, 0)` on
+    /// `pitch` (a disk translation does not rotate the slider). For a `general` structure,
+    /// `r₀ = 1` and coordinates `1..n` follow a unit heave with no structural force on them
+    /// (`(K r)_i = 0` for `i ≥ 1`), exact when `K` holds the internal springs only; if that
+    /// block of `K` is singular only the heave moves. A disk translation moves the bulge by
+    /// `bᵀr` (1 for the presets).
+    ///
+    /// ```
+    /// use hdi_tribology::model::Structure;
+    /// assert_eq!(Structure::bulge(1e-6, 1e-13, 4e5, 0.05)?.base_influence(), &[1.0, 1.0][..]);
+    /// let p = Structure::pitch(1e-6, 1e-12, [1e-3, 0.0], [0.0, 0.0], 5e-4)?;
+    /// assert_eq!(p.base_influence(), &[1.0, 0.0][..]);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn base_influence(&self) -> &[f64] {
+        &self.base.as_slice()[..self.n]
+    }
+
+    /// `r` of a general structure (see [`Structure::base_influence`]).
+    fn rigid_translation(&self) -> Dofs {
+        let mut r = Dofs::zeros();
+        r[0] = 1.0;
+        let m = self.n - 1;
+        if m == 0 {
+            return r;
+        }
+        let k = nalgebra::DMatrix::from_fn(m, m, |i, j| self.stiffness[(i + 1, j + 1)]);
+        let rhs = nalgebra::DVector::from_fn(m, |i, _| -self.stiffness[(i + 1, 0)]);
+        if let Some(x) = k.lu().solve(&rhs) {
+            if x.iter().all(|v| v.is_finite()) {
+                for i in 0..m {
+                    r[i + 1] = x[i];
+                }
+            }
+        }
+        r
     }
 
     /// The body mass `M₀₀` (kg).
