@@ -206,8 +206,22 @@ impl<'a> Evaluator<'a> {
     /// The slider model of the scene at `x` for direct (untabulated) evaluation only: its tables
     /// cover a short stretch of gaps above every scan, coarsely, so building it costs almost
     /// nothing; every force near a transition is then evaluated directly.
-    pub fn direct_model(&self, x: &[f64]) -> Result<SliderModel> {
+    /// `like` is another direct model with the key of its forces: when the scene at `x` has the
+    /// same forces (the parameter does not touch them), they are shared. Returns the model and
+    /// the key of its forces.
+    pub fn direct_model(
+        &self,
+        x: &[f64],
+        like: Option<&(SliderModel, String)>,
+    ) -> Result<(SliderModel, String)> {
         let scene = self.scene(x)?;
+        let key = force_key(&scene);
+        if let Some((m, _)) = like.filter(|(_, k)| *k == key) {
+            return Ok((
+                SliderModel::from_scene_with_forces(&scene, m.forces().clone())?,
+                key,
+            ));
+        }
         let hi = 2.0 * scene.table_range().1.max(self.static_d_max.unwrap_or(0.0));
         let forces = InterfaceForces::build(
             scene.interface_terms()?,
@@ -217,7 +231,7 @@ impl<'a> Evaluator<'a> {
                 ..TableOptions::default()
             },
         )?;
-        SliderModel::from_scene_with_forces(&scene, forces)
+        Ok((SliderModel::from_scene_with_forces(&scene, forces)?, key))
     }
 
     /// `∂(model value)/∂x_j` of every static value (W per unit of the parameter), by the
@@ -231,12 +245,13 @@ impl<'a> Evaluator<'a> {
         steps: &[(f64, bool)],
     ) -> Result<Vec<Vec<Option<f64>>>> {
         let n = x.len();
-        let base = self.direct_model(x)?;
+        let base = self.direct_model(x, None)?;
         let moved = |j: usize, h: f64| -> Result<SliderModel> {
             let mut xs = x.to_vec();
             xs[j] += h;
-            self.direct_model(&xs)
+            Ok(self.direct_model(&xs, Some(&base))?.0)
         };
+        let base = &base.0;
         let column = |j: usize| -> Result<Vec<Option<f64>>> {
             let (h, central) = steps[j];
             let plus = moved(j, h)?;
@@ -256,7 +271,7 @@ impl<'a> Evaluator<'a> {
                                 ..m.voltage
                             })
                         };
-                        let b = at(&base);
+                        let b = at(base);
                         let up = transition_shift(&b, &at(&plus), &t)?;
                         col.push(Some(match &minus {
                             Some(mi) => (up - transition_shift(&b, &at(mi), &t)?) / (2.0 * h),
