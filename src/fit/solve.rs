@@ -180,7 +180,7 @@ pub struct ResidualRow {
     /// programme's end, a bound).
     pub clipped: bool,
     /// Left out of the fit: a dynamic value whose detected power did not settle under tighter
-    /// tolerances at the start (its residual is shown, not fitted).
+    /// tolerances at the start or at an optimum (its residual is shown, not fitted).
     pub excluded: bool,
 }
 
@@ -216,7 +216,7 @@ pub struct IntegrationCheck {
     pub ratio_to_scatter: f64,
     /// Dynamic values in the fit whose refinement did not converge at the optimum.
     pub unconverged: usize,
-    /// Dynamic values left out of the fit (not settled at the start).
+    /// Dynamic values left out of the fit (not settled at the start or at an optimum).
     pub excluded: usize,
     /// Whether the integration noise is small enough not to drive the fit: every value in the
     /// fit converged and `ratio_to_scatter ≤ 0.1`.
@@ -618,63 +618,24 @@ pub fn fit(
             }
         }
     }
-    let ev = ev;
 
     let mut outcomes = Vec::new();
     let mut best: Option<(f64, Vec<f64>, bool, String)> = None;
     let mut first_error = None;
     for start in start_points(&params, opts.starts, opts.seed) {
-        let budget = ev.evaluations.load(Ordering::Relaxed) + opts.max_evaluations;
-        let u0: Vec<f64> = params
-            .iter()
-            .zip(&start)
-            .map(|(p, &x)| p.transform.u(x))
-            .collect();
-        let problem = Problem {
-            ev: &ev,
-            u: u0.clone(),
-            opts,
-            budget,
-            last: RefCell::new(None),
-            error: RefCell::new(None),
-        };
-        if problem.residuals_at(&u0).is_none() {
-            let e = problem.error.borrow().clone().unwrap_or_default();
-            first_error.get_or_insert_with(|| e.clone());
-            outcomes.push(StartOutcome {
-                start,
-                end: Vec::new(),
-                cost: f64::INFINITY,
-                termination: format!("start not evaluated: {e}"),
-            });
-            continue;
+        let (outcome, end) = run_start(&ev, opts, start);
+        if end.is_none() {
+            first_error.get_or_insert_with(|| outcome.termination.clone());
         }
-        let (solved, report) = LevenbergMarquardt::new()
-            .with_ftol(opts.tolerance)
-            .with_xtol(opts.tolerance)
-            .with_patience(opts.max_evaluations)
-            .minimize(problem);
-        let u = solved.u.clone();
-        let x = solved.x(&u);
-        let cost = solved
-            .residuals_at(&u)
-            .map_or(f64::INFINITY, |r| r.iter().map(|v| v * v).sum());
-        let mut termination = format!("{:?}", report.termination);
-        if let Some(e) = solved.error.borrow().as_ref() {
-            termination.push_str(&format!(" (last model error: {e})"));
-        }
-        let converged = report.termination.was_successful();
-        outcomes.push(StartOutcome {
-            start,
-            end: x.clone(),
-            cost,
-            termination: termination.clone(),
-        });
-        if best.as_ref().is_none_or(|b| cost < b.0) {
-            best = Some((cost, x, converged, termination));
+        outcomes.push(outcome);
+        if let Some(e) = end {
+            if best.as_ref().is_none_or(|b| e.0 < b.0) {
+                best = Some(e);
+            }
         }
     }
-    let Some((_, x, converged, termination)) = best.filter(|b| b.0.is_finite()) else {
+    let Some((_, mut x, mut converged, mut termination)) = best.filter(|b| b.0.is_finite())
+    else {
         return Err(Error::analysis(
             "fit",
             format!(
@@ -689,7 +650,92 @@ pub fn fit(
         .find(|o| o.end == x)
         .map(|o| o.start.clone())
         .unwrap_or_else(|| params.iter().map(|p| p.start).collect());
+    // Dynamic values that settled at the start but not at the optimum are left out too, and
+    // the fit is resumed from the optimum without them (at most twice).
+    for _ in 0..2 {
+        let Ok(pred) = ev.predict(&x) else { break };
+        let newly: Vec<usize> = flatten(&pred)
+            .iter()
+            .enumerate()
+            .filter(|(i, q)| {
+                !ev.excluded.get(*i).copied().unwrap_or(false)
+                    && q.refined.is_some_and(|r| !r.converged)
+            })
+            .map(|(i, _)| i)
+            .collect();
+        let included = ev.excluded.iter().filter(|e| !**e).count();
+        if newly.is_empty() || included - newly.len() <= params.len() {
+            break;
+        }
+        if ev.excluded.is_empty() {
+            ev.excluded = vec![false; points];
+        }
+        for i in newly {
+            ev.excluded[i] = true;
+        }
+        let (outcome, end) = run_start(&ev, opts, x.clone());
+        outcomes.push(outcome);
+        let Some((_, x1, c1, t1)) = end else { break };
+        (x, converged, termination) = (x1, c1, t1);
+    }
     analyse(&ev, opts, x, best_start, converged, termination, outcomes)
+}
+
+/// One start of the optimiser: its outcome, and (cost, end, converged, termination) when the
+/// start could be evaluated.
+#[allow(clippy::type_complexity)]
+fn run_start(
+    ev: &Evaluator<'_>,
+    opts: &FitOptions,
+    start: Vec<f64>,
+) -> (StartOutcome, Option<(f64, Vec<f64>, bool, String)>) {
+    let params = ev.params;
+    let budget = ev.evaluations.load(Ordering::Relaxed) + opts.max_evaluations;
+    let u0: Vec<f64> = params
+        .iter()
+        .zip(&start)
+        .map(|(p, &x)| p.transform.u(x))
+        .collect();
+    let problem = Problem {
+        ev,
+        u: u0.clone(),
+        opts,
+        budget,
+        last: RefCell::new(None),
+        error: RefCell::new(None),
+    };
+    if problem.residuals_at(&u0).is_none() {
+        let e = problem.error.borrow().clone().unwrap_or_default();
+        let outcome = StartOutcome {
+            start,
+            end: Vec::new(),
+            cost: f64::INFINITY,
+            termination: format!("start not evaluated: {e}"),
+        };
+        return (outcome, None);
+    }
+    let (solved, report) = LevenbergMarquardt::new()
+        .with_ftol(opts.tolerance)
+        .with_xtol(opts.tolerance)
+        .with_patience(opts.max_evaluations)
+        .minimize(problem);
+    let u = solved.u.clone();
+    let x = solved.x(&u);
+    let cost = solved
+        .residuals_at(&u)
+        .map_or(f64::INFINITY, |r| r.iter().map(|v| v * v).sum());
+    let mut termination = format!("{:?}", report.termination);
+    if let Some(e) = solved.error.borrow().as_ref() {
+        termination.push_str(&format!(" (last model error: {e})"));
+    }
+    let converged = report.termination.was_successful();
+    let outcome = StartOutcome {
+        start,
+        end: x.clone(),
+        cost,
+        termination: termination.clone(),
+    };
+    (outcome, Some((cost, x, converged, termination)))
 }
 
 /// Errors, correlations, identifiability and residual tables at the optimum `x`.
@@ -879,7 +925,8 @@ fn analyse(
         if !left_out.is_empty() {
             warnings.push(format!(
                 "{} dynamic value(s) left out of the fit: their detected powers did not settle \
-                 within {} mW under tenfold tighter tolerances at the start: {}",
+                 within {} mW under tenfold tighter tolerances (at the start, or at an optimum \
+                 the fit was then resumed from): {}",
                 left_out.len(),
                 opts.dynamic_power_tol_mw,
                 left_out.join(", ")
