@@ -12,14 +12,12 @@ use crate::analysis::{
     ac_sweep_refined, static_hysteresis, touchdown_power, transition_shift, CycleOptions,
     HeaterProgramme, StaticOptions, Transition,
 };
+use crate::analysis::{s_curve, ScanGrid};
 use crate::force::InterfaceForces;
-use crate::quadrature::TableOptions;
 use crate::model::{SliderModel, Voltage};
+use crate::quadrature::TableOptions;
 use crate::scene::Scene;
 use crate::Result;
-
-/// Weight of a value whose file gives no uncertainty (W): residuals are then in milliwatts.
-pub(super) const DEFAULT_WEIGHT_W: f64 = 1e-3;
 
 /// Force tables kept for reuse (parameters that do not touch the forces share them).
 const CACHED_TABLES: usize = 16;
@@ -53,8 +51,8 @@ pub(super) struct Refined {
 pub(super) enum Sets {
     /// Every data set.
     All,
-    /// Only the dynamic ones (the static ones are left empty).
-    Dynamic,
+    /// Only those without static transitions (cycles, the indicator); the others left empty.
+    NoTransitions,
 }
 
 /// Evaluates the model for parameter vectors (in the parameters' own units).
@@ -163,7 +161,16 @@ impl<'a> Evaluator<'a> {
         let mut out = Vec::with_capacity(self.data.len());
         for ds in self.data {
             let cols = match ds.kind {
-                _ if sets == Sets::Dynamic && !ds.is_dynamic() => Vec::new(),
+                _ if sets == Sets::NoTransitions && ds.is_transitions() => Vec::new(),
+                CurveKind::IndicatorVsPower => {
+                    if static_model.is_none() {
+                        let mut s = scene.clone();
+                        s.table.rel_tol = s.table.rel_tol.max(self.static_table_rel_tol);
+                        s.table.d_max_m = s.table.d_max_m.or(self.static_d_max);
+                        static_model = Some(self.model(&s)?);
+                    }
+                    predict_indicator(static_model.as_ref().expect("built above"), ds)?
+                }
                 CurveKind::StaticVsDc => {
                     if static_model.is_none() {
                         let mut s = scene.clone();
@@ -299,14 +306,24 @@ pub(super) type Preds = Vec<Vec<Vec<Predicted>>>;
 
 /// Weighted residuals of predictions.
 /// `excluded` (flattened, may be empty) sets residuals to 0; a data set left empty by
-/// [`Sets::Dynamic`] gives NaN residuals.
-pub(super) fn weighted(data: &[DataSet], pred: &[Vec<Vec<Predicted>>], excluded: &[bool]) -> Vec<f64> {
+/// [`Sets::NoTransitions`] gives NaN residuals.
+pub(super) fn weighted(
+    data: &[DataSet],
+    pred: &[Vec<Vec<Predicted>>],
+    excluded: &[bool],
+) -> Vec<f64> {
     let mut r = Vec::new();
     for (ds, p) in data.iter().zip(pred) {
         for (k, o) in ds.observed.iter().enumerate() {
             for (i, y) in o.values.iter().enumerate() {
-                let w = o.errors.as_ref().map_or(DEFAULT_WEIGHT_W, |e| e[i]);
-                let v = p.get(k).and_then(|pc| pc.get(i)).map_or(f64::NAN, |q| (q.value - y) / w);
+                let w = o
+                    .errors
+                    .as_ref()
+                    .map_or(o.quantity.default_weight(), |e| e[i]);
+                let v = p
+                    .get(k)
+                    .and_then(|pc| pc.get(i))
+                    .map_or(f64::NAN, |q| (q.value - y) / w);
                 let out = excluded.get(r.len()).copied().unwrap_or(false);
                 r.push(if out { 0.0 } else { v });
             }
@@ -321,7 +338,11 @@ pub(super) fn weights(data: &[DataSet]) -> Vec<f64> {
     for ds in data {
         for o in &ds.observed {
             for i in 0..o.values.len() {
-                w.push(o.errors.as_ref().map_or(DEFAULT_WEIGHT_W, |e| e[i]));
+                w.push(
+                    o.errors
+                        .as_ref()
+                        .map_or(o.quantity.default_weight(), |e| e[i]),
+                );
             }
         }
     }
@@ -389,6 +410,48 @@ fn predict_static(m: &SliderModel, scene: &Scene, ds: &DataSet) -> Result<Vec<Ve
         .collect())
 }
 
+/// The contact indicator in its quasi-static limit: the contact force of the equilibrium reached
+/// as the heater power rises to each x (the stable flying branch up to touchdown, then the stable
+/// contact branch), at the model's DC voltage; between the scan's equilibria the force is
+/// interpolated linearly in power.
+fn predict_indicator(m: &SliderModel, ds: &DataSet) -> Result<Vec<Vec<Predicted>>> {
+    let curve = s_curve(m, None, &ScanGrid::default())?;
+    // The path of rising power: stable equilibria, in order of decreasing gap, each above the
+    // power of the last one kept (a fold's jump lands where the contact branch passes its power).
+    let mut path: Vec<(f64, f64)> = Vec::new();
+    for e in curve.points.iter().filter(|e| e.is_stable()) {
+        if path.last().is_none_or(|&(p, _)| e.power > p) {
+            path.push((e.power, e.contact_force));
+        }
+    }
+    let mut values = Vec::with_capacity(ds.x.len());
+    for &p in &ds.x {
+        let k = path.partition_point(|&(pk, _)| pk < p);
+        let v = match (k.checked_sub(1).and_then(|i| path.get(i)), path.get(k)) {
+            (Some(&(p0, f0)), Some(&(p1, f1))) => f0 + (f1 - f0) * (p - p0) / (p1 - p0),
+            (None, Some(&(_, f1))) => f1,
+            _ => {
+                return Err(crate::Error::analysis(
+                    "contact indicator",
+                    format!(
+                        "{}: the heater power {p} W lies beyond the equilibria of the table range \
+                         (up to {} W)",
+                        ds.origin,
+                        path.last().map_or(f64::NAN, |l| l.0)
+                    ),
+                ))
+            }
+        };
+        values.push(Predicted {
+            value: v,
+            clipped: false,
+            transition: None,
+            refined: None,
+        });
+    }
+    Ok(vec![values; ds.observed.len()])
+}
+
 fn predict_cycles(
     m: &SliderModel,
     scene: &Scene,
@@ -414,7 +477,8 @@ fn predict_cycles(
                     let c = &r.cycle;
                     let (d, fallback) = match o.quantity {
                         Quantity::TouchdownPower => (c.touchdown, p_max),
-                        Quantity::TakeoffPower => (c.takeoff, p_min),
+                        // (the reader pairs the indicator with heater power, never with cycles)
+                        Quantity::TakeoffPower | Quantity::ContactIndicator => (c.takeoff, p_min),
                     };
                     Predicted {
                         value: d.map_or(fallback, |d| d.power),

@@ -9,10 +9,10 @@ use nalgebra_lm::{storage::Owned, DMatrix as LmMatrix, DVector as LmVector, Dyn}
 use serde::Serialize;
 
 use super::data::{DataError, DataSet};
-use super::model::{weighted, weights, Evaluator, Predicted, Sets, DEFAULT_WEIGHT_W};
-use crate::analysis::sweep::Refinement;
+use super::model::{weighted, weights, Evaluator, Predicted, Sets};
 use super::params::{resolve, FreeParameter, Resolved};
 use super::FitError;
+use crate::analysis::sweep::Refinement;
 use crate::scene::Scene;
 use crate::surface::Xoshiro256;
 use crate::Error;
@@ -174,7 +174,8 @@ pub struct ResidualRow {
     pub fitted: f64,
     /// `fitted − measured` (file unit).
     pub residual: f64,
-    /// The residual divided by the uncertainty (1 mW where the file gives none).
+    /// The residual divided by the uncertainty (1 mW, or 1 µN for the indicator, where the file
+    /// gives none).
     pub weighted: f64,
     /// The model did not detect this transition inside the heater programme (the value is the
     /// programme's end, a bound).
@@ -469,23 +470,29 @@ fn jacobian_columns(
             .map(|(a, b)| (a - b) / span)
             .collect())
     };
-    let par_map = |f: &(dyn Fn(usize) -> crate::Result<Vec<f64>> + Sync)| -> crate::Result<Vec<Vec<f64>>> {
-        #[cfg(feature = "parallel")]
-        {
-            use rayon::prelude::*;
-            (0..n).into_par_iter().map(f).collect()
-        }
-        #[cfg(not(feature = "parallel"))]
-        {
-            (0..n).map(f).collect()
-        }
-    };
+    let par_map =
+        |f: &(dyn Fn(usize) -> crate::Result<Vec<f64>> + Sync)| -> crate::Result<Vec<Vec<f64>>> {
+            #[cfg(feature = "parallel")]
+            {
+                use rayon::prelude::*;
+                (0..n).into_par_iter().map(f).collect()
+            }
+            #[cfg(not(feature = "parallel"))]
+            {
+                (0..n).map(f).collect()
+            }
+        };
     if opts.finite_difference_jacobian {
         return par_map(&|j| fd(j, opts.rel_step, Sets::All));
     }
-    let dynamic = ev.data.iter().any(|d| d.is_dynamic());
-    let mut cols = if dynamic {
-        par_map(&|j| fd(j, opts.dynamic_rel_step, Sets::Dynamic))?
+    // Cycles need the larger step (integration noise); the indicator alone takes `rel_step`.
+    let rel = if ev.data.iter().any(DataSet::is_dynamic) {
+        opts.dynamic_rel_step
+    } else {
+        opts.rel_step
+    };
+    let mut cols = if ev.data.iter().any(|d| !d.is_transitions()) {
+        par_map(&|j| fd(j, rel, Sets::NoTransitions))?
     } else {
         vec![vec![0.0; r0.len()]; n]
     };
@@ -634,8 +641,7 @@ pub fn fit(
             }
         }
     }
-    let Some((_, mut x, mut converged, mut termination)) = best.filter(|b| b.0.is_finite())
-    else {
+    let Some((_, mut x, mut converged, mut termination)) = best.filter(|b| b.0.is_finite()) else {
         return Err(Error::analysis(
             "fit",
             format!(
@@ -1072,7 +1078,10 @@ fn residual_tables(
             let f = o.unit.to_si;
             let rows = (0..ds.x.len())
                 .map(|i| {
-                    let w = o.errors.as_ref().map_or(DEFAULT_WEIGHT_W, |e| e[i]);
+                    let w = o
+                        .errors
+                        .as_ref()
+                        .map_or(o.quantity.default_weight(), |e| e[i]);
                     ResidualRow {
                         line: ds.lines[i],
                         x: ds.x[i] / ds.x_unit.to_si,

@@ -401,7 +401,12 @@ impl SliderModel {
     /// coordinates `q`, with direct (untabulated) forces: the step (`None` where the tangent is
     /// singular) and the interface force at `q`. From the balance of a slightly different model
     /// it is the first-order change of `q` (used for the sensitivities of static transitions).
-    pub fn exact_balance_step(&self, d: f64, volt2: f64, q: &Dofs) -> Result<(Option<Dofs>, ForceEval)> {
+    pub fn exact_balance_step(
+        &self,
+        d: f64,
+        volt2: f64,
+        q: &Dofs,
+    ) -> Result<(Option<Dofs>, ForceEval)> {
         let st = &self.structure;
         let g = Gaps {
             bulge: d,
