@@ -10,6 +10,7 @@ use hdi_tribology::scene::Scene;
 use hdi_tribology::surface::PeakModel;
 
 type Setter = fn(&mut Scene, f64);
+type Getter = fn(&Scene) -> f64;
 
 fn set_sigma(s: &mut Scene, v: f64) {
     s.surface.height_sigma_m = v;
@@ -18,7 +19,7 @@ fn set_sigma(s: &mut Scene, v: f64) {
     }
 }
 
-fn params() -> Vec<(&'static str, Setter, fn(&Scene) -> f64)> {
+fn params() -> Vec<(&'static str, Setter, Getter)> {
     vec![
         ("height_sigma", set_sigma, |s| s.surface.height_sigma_m),
         (
