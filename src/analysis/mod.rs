@@ -10,6 +10,7 @@ pub mod protocol;
 pub mod pull_in;
 pub mod response;
 pub mod roots;
+pub mod sensitivity;
 pub mod sweep;
 pub mod touchdown;
 
@@ -23,6 +24,7 @@ pub use equilibrium::{
 pub use protocol::Protocol;
 pub use pull_in::{clearance_change, pull_in_voltage, ClearanceChange, PullIn};
 pub use response::{linear_response, LinearResponse, Mode};
+pub use sensitivity::transition_shift;
 pub use sweep::{ac_sweep, ac_sweep_refined, RefinedCycle, Refinement};
 pub use touchdown::{
     static_hysteresis, takeoff_power, touchdown_power, Cause, StaticHysteresis, StaticOptions,

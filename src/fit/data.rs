@@ -56,6 +56,11 @@ pub enum CurveKind {
     /// Dynamic touchdown and take-off power against AC amplitude (Fig. 2d), one cycle of the
     /// scene's fixed heater programme per amplitude: x column `ac_amplitude_*`.
     CycleVsAc,
+    /// The contact indicator against heater power (the letter's Fig. 1), in its quasi-static
+    /// limit: the contact force of the equilibrium the head reaches as the heater power rises to
+    /// this value (the flying branch, then the contact branch after touchdown), at the scene's
+    /// DC voltage with the AC off: x column `heater_power_*`.
+    IndicatorVsPower,
 }
 
 /// A measured quantity of a curve.
@@ -66,6 +71,8 @@ pub enum Quantity {
     TouchdownPower,
     /// Take-off power.
     TakeoffPower,
+    /// Contact indicator, as a contact force.
+    ContactIndicator,
 }
 
 impl Quantity {
@@ -74,6 +81,16 @@ impl Quantity {
         match self {
             Quantity::TouchdownPower => "touchdown_power",
             Quantity::TakeoffPower => "takeoff_power",
+            Quantity::ContactIndicator => "contact_indicator",
+        }
+    }
+
+    /// The weight (SI) of a value whose file gives no uncertainty: 1 mW for powers, 1 µN for the
+    /// contact indicator; the overall scale is then estimated from the scatter.
+    pub fn default_weight(self) -> f64 {
+        match self {
+            Quantity::TouchdownPower | Quantity::TakeoffPower => 1e-3,
+            Quantity::ContactIndicator => 1e-6,
         }
     }
 }
@@ -112,6 +129,25 @@ const WATTS: &[Unit] = &[
     },
 ];
 
+const NEWTONS: &[Unit] = &[
+    Unit {
+        suffix: "un",
+        to_si: 1e-6,
+    },
+    Unit {
+        suffix: "n",
+        to_si: 1.0,
+    },
+    Unit {
+        suffix: "mn",
+        to_si: 1e-3,
+    },
+    Unit {
+        suffix: "nn",
+        to_si: 1e-9,
+    },
+];
+
 /// The role of a column.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Role {
@@ -124,6 +160,7 @@ enum Role {
 const COLUMNS: &[(&str, Role, &[Unit])] = &[
     ("dc_voltage", Role::X(CurveKind::StaticVsDc), VOLTS),
     ("ac_amplitude", Role::X(CurveKind::CycleVsAc), VOLTS),
+    ("heater_power", Role::X(CurveKind::IndicatorVsPower), WATTS),
     ("touchdown_power", Role::Y(Quantity::TouchdownPower), WATTS),
     ("takeoff_power", Role::Y(Quantity::TakeoffPower), WATTS),
     (
@@ -135,6 +172,16 @@ const COLUMNS: &[(&str, Role, &[Unit])] = &[
         "takeoff_power_err",
         Role::Err(Quantity::TakeoffPower),
         WATTS,
+    ),
+    (
+        "contact_indicator",
+        Role::Y(Quantity::ContactIndicator),
+        NEWTONS,
+    ),
+    (
+        "contact_indicator_err",
+        Role::Err(Quantity::ContactIndicator),
+        NEWTONS,
     ),
 ];
 
@@ -153,10 +200,11 @@ pub struct Observed {
 
 /// One measured curve: an x column and one or more measured columns.
 ///
-/// Columns are named `<quantity>_<unit>`: x is `dc_voltage_v` (or `_mv`) or `ac_amplitude_v`
-/// (or `_mv`); measured columns are `touchdown_power_mw` and `takeoff_power_mw` (or `_w`,
-/// `_uw`), each with an optional uncertainty column `touchdown_power_err_mw` etc. Lines starting
-/// with `#` are comments.
+/// Columns are named `<quantity>_<unit>`: x is `dc_voltage_v` (or `_mv`), `ac_amplitude_v`
+/// (or `_mv`) or `heater_power_mw` (or `_w`, `_uw`); measured columns are `touchdown_power_mw`
+/// and `takeoff_power_mw` (or `_w`, `_uw`) against a voltage, `contact_indicator_un` (or `_n`,
+/// `_mn`, `_nn`) against heater power, each with an optional uncertainty column
+/// `touchdown_power_err_mw` etc. Lines starting with `#` are comments.
 ///
 /// ```
 /// use hdi_tribology::fit::{CurveKind, DataSet};
@@ -275,7 +323,8 @@ impl DataSet {
             roles.iter().find(|(_, r, _)| matches!(r, Role::X(_)))
         else {
             return Err(at_header(
-                "missing column: no x column (`dc_voltage_v` or `ac_amplitude_v`)".into(),
+                "missing column: no x column (`dc_voltage_v`, `ac_amplitude_v` or `heater_power_mw`)"
+                    .into(),
             ));
         };
         let ys: Vec<(usize, Quantity, Unit)> = roles
@@ -286,10 +335,31 @@ impl DataSet {
             })
             .collect();
         if ys.is_empty() {
-            return Err(at_header(
+            return Err(at_header(if kind == CurveKind::IndicatorVsPower {
+                "missing column: no measured column (`contact_indicator_un`)".into()
+            } else {
                 "missing column: no measured column (`touchdown_power_mw` or `takeoff_power_mw`)"
-                    .into(),
-            ));
+                    .into()
+            }));
+        }
+        // The indicator is measured against power, the transitions against a voltage.
+        for &(i, q, _) in &ys {
+            if (q == Quantity::ContactIndicator) != (kind == CurveKind::IndicatorVsPower) {
+                return Err(err(
+                    origin,
+                    Some(header_line),
+                    Some((i, &headers[i])),
+                    format!(
+                        "cannot be measured against `{}`: {}",
+                        &headers[xi],
+                        if kind == CurveKind::IndicatorVsPower {
+                            "against heater power give `contact_indicator_un`"
+                        } else {
+                            "the contact indicator is given against `heater_power_mw`"
+                        }
+                    ),
+                ));
+            }
         }
         for &(i, r, _) in &roles {
             if let Role::Err(q) = r {
@@ -402,6 +472,11 @@ impl DataSet {
     /// Whether its model needs time integration.
     pub fn is_dynamic(&self) -> bool {
         self.kind == CurveKind::CycleVsAc
+    }
+
+    /// Whether its values are static transitions (whose sensitivities need no re-solve).
+    pub fn is_transitions(&self) -> bool {
+        self.kind == CurveKind::StaticVsDc
     }
 }
 

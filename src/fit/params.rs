@@ -173,14 +173,6 @@ pub(super) struct Resolved {
     pub transform: Transform,
 }
 
-/// The roughness σ is held both by the surface heights and by a Rice-maxima peak law. Until the
-/// scene keeps it in one field, freeing one sets the other too when the two are equal in the
-/// scene.
-const SAME_SIGMA: [&[&str]; 2] = [
-    &["surface", "height_sigma_m"],
-    &["surface", "peaks", "sigma_m"],
-];
-
 pub(super) fn get<'a>(v: &'a Value, path: &[String]) -> Option<&'a Value> {
     path.iter().try_fold(v, |v, k| v.get(k))
 }
@@ -295,7 +287,7 @@ pub(super) fn resolve(base: &Value, p: &FreeParameter) -> Result<Resolved> {
         }
     };
     let si = get(base, &path).and_then(Value::as_f64).unwrap_or(f64::NAN);
-    let linked = linked_fields(base, &path, si);
+    let linked = linked_fields(base, &path);
     let start = p.start.unwrap_or(si / factor);
     let unit = unit_suffix(key, &path);
     let bad = |what: &str, v: f64| {
@@ -402,17 +394,29 @@ fn unit_suffix(key: &str, path: &[String]) -> String {
     key.get(common..).unwrap_or("").to_string()
 }
 
-fn linked_fields(base: &Value, path: &[String], si: f64) -> Vec<Vec<String>> {
+/// The other fields that hold the same quantity as `path`: the surface's σ is held by its heights
+/// and, for Rice-maxima peaks, by the peak law, one value unless the scene says they differ on
+/// purpose (`surface.independent_peak_sigma`, which its validation enforces); freeing either sets
+/// both.
+fn linked_fields(base: &Value, path: &[String]) -> Vec<Vec<String>> {
+    let height = ["surface", "height_sigma_m"];
+    let peak = ["surface", "peaks", "sigma_m"];
     let as_path = |p: &[&str]| p.iter().map(|s| s.to_string()).collect::<Vec<_>>();
-    let is_sigma = SAME_SIGMA.iter().any(|p| as_path(p) == path);
-    if !is_sigma {
+    let independent = base
+        .pointer("/surface/independent_peak_sigma")
+        .and_then(Value::as_bool)
+        .unwrap_or(false);
+    let other = if path == height {
+        as_path(&peak)
+    } else if path == peak {
+        as_path(&height)
+    } else {
+        return Vec::new();
+    };
+    if independent || get(base, &other).is_none() {
         return Vec::new();
     }
-    SAME_SIGMA
-        .iter()
-        .map(|p| as_path(p))
-        .filter(|p| p != path && get(base, p).and_then(Value::as_f64) == Some(si))
-        .collect()
+    vec![other]
 }
 
 #[cfg(test)]
@@ -431,6 +435,15 @@ mod tests {
         assert!((r.factor - 1e-9).abs() < 1e-24 && (r.start - 0.7).abs() < 1e-12);
         assert_eq!(r.unit, "nm");
         assert_eq!(r.linked, vec![vec!["surface", "peaks", "sigma_m"]]);
+        // σ of the peaks set apart on purpose: freeing one σ leaves the other alone.
+        let mut apart = Scene::paper();
+        apart.surface.independent_peak_sigma = true;
+        if let crate::surface::PeakModel::RiceMaxima { sigma_m, .. } = &mut apart.surface.peaks {
+            *sigma_m = 0.8e-9;
+        }
+        let apart = serde_json::to_value(apart).unwrap();
+        let r = resolve(&apart, &FreeParameter::new("height_sigma_nm")).unwrap();
+        assert!(r.linked.is_empty(), "{:?}", r.linked);
         let r = resolve(&base, &FreeParameter::new("efficiency_nm_per_mw")).unwrap();
         assert_eq!(r.path, ["heater", "efficiency_m_per_w"]);
         assert!((r.start - 0.1).abs() < 1e-12, "{}", r.start);

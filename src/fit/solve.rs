@@ -9,9 +9,10 @@ use nalgebra_lm::{storage::Owned, DMatrix as LmMatrix, DVector as LmVector, Dyn}
 use serde::Serialize;
 
 use super::data::{DataError, DataSet};
-use super::model::{weighted, Evaluator, Predicted, DEFAULT_WEIGHT_W};
+use super::model::{weighted, weights, Evaluator, Predicted, Sets};
 use super::params::{resolve, FreeParameter, Resolved};
 use super::FitError;
+use crate::analysis::sweep::Refinement;
 use crate::scene::Scene;
 use crate::surface::Xoshiro256;
 use crate::Error;
@@ -21,6 +22,7 @@ use crate::Error;
 /// ```
 /// let o = hdi_tribology::fit::FitOptions::default();
 /// assert_eq!((o.starts, o.undetermined_rel_error), (1, 0.5));
+/// assert!(!o.finite_difference_jacobian);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct FitOptions {
@@ -33,6 +35,11 @@ pub struct FitOptions {
     pub max_evaluations: usize,
     /// Finite-difference step, relative to each parameter's scale.
     pub rel_step: f64,
+    /// The optimiser stops when an iteration reduces χ² by at most this fraction (actual and
+    /// predicted), or moves the parameters by at most this fraction. At a χ² of about `m − n`
+    /// residual scales that leaves the parameters within `√(tolerance·(m − n))` of their error
+    /// bars of the minimum (0.013 error bars for 20 points and 4 parameters at 1e-5).
+    pub tolerance: f64,
     /// A parameter, or a combination of parameters, whose 1σ error exceeds this fraction of its
     /// scale (its value, or half its range for one that may change sign) is reported as not
     /// determined, without an error bar.
@@ -40,6 +47,19 @@ pub struct FitOptions {
     /// Relative tolerance of the force tables for static curves (touchdown and take-off are
     /// refined on direct quadrature, so tables only guide the scan and a coarse one is as exact).
     pub static_table_rel_tol: f64,
+    /// Dynamic curves: the cycle at each amplitude is run with tolerances tightened tenfold
+    /// until its detected touchdown and take-off powers move by at most this (mW) between two
+    /// tolerances ([`crate::analysis::ac_sweep_refined`], at most four runs). Points that do not
+    /// settle at the start are left out of the fit and reported.
+    pub dynamic_power_tol_mw: f64,
+    /// Finite-difference step of the dynamic curves' Jacobian, relative to each parameter's scale
+    /// (larger than `rel_step`, so that the step moves the powers by far more than the
+    /// integration noise left after refinement).
+    pub dynamic_rel_step: f64,
+    /// Compute the whole Jacobian by finite differences of the model (every column a full
+    /// evaluation, rebuilding force tables where the parameter changes them) instead of the
+    /// static transitions' sensitivities. Slower; kept to check the sensitivities.
+    pub finite_difference_jacobian: bool,
 }
 
 impl Default for FitOptions {
@@ -49,8 +69,12 @@ impl Default for FitOptions {
             seed: 1,
             max_evaluations: 400,
             rel_step: 1e-3,
+            tolerance: 1e-5,
             undetermined_rel_error: 0.5,
             static_table_rel_tol: 1e-6,
+            dynamic_power_tol_mw: 1e-3,
+            dynamic_rel_step: 1e-2,
+            finite_difference_jacobian: false,
         }
     }
 }
@@ -68,8 +92,11 @@ impl FitOptions {
         }
         for (f, v, hi) in [
             ("rel_step", self.rel_step, 0.1),
+            ("tolerance", self.tolerance, 0.01),
             ("undetermined_rel_error", self.undetermined_rel_error, 1e6),
             ("static_table_rel_tol", self.static_table_rel_tol, 0.01),
+            ("dynamic_power_tol_mw", self.dynamic_power_tol_mw, 10.0),
+            ("dynamic_rel_step", self.dynamic_rel_step, 0.1),
         ] {
             if !(v > 0.0 && v <= hi) {
                 return Err(Error::invalid(
@@ -147,11 +174,15 @@ pub struct ResidualRow {
     pub fitted: f64,
     /// `fitted − measured` (file unit).
     pub residual: f64,
-    /// The residual divided by the uncertainty (1 mW where the file gives none).
+    /// The residual divided by the uncertainty (1 mW, or 1 µN for the indicator, where the file
+    /// gives none).
     pub weighted: f64,
     /// The model did not detect this transition inside the heater programme (the value is the
     /// programme's end, a bound).
     pub clipped: bool,
+    /// Left out of the fit: a dynamic value whose detected power did not settle under tighter
+    /// tolerances at the start or at an optimum (its residual is shown, not fitted).
+    pub excluded: bool,
 }
 
 /// Residuals of one measured column.
@@ -167,17 +198,71 @@ pub struct ResidualTable {
     pub rows: Vec<ResidualRow>,
 }
 
-/// How much the integration error of the cycles moves the residuals.
+/// How much the integration error of the cycles moves the residuals, at the optimum.
+///
+/// Every cycle is refined ([`crate::analysis::ac_sweep_refined`]): its tolerances are tightened
+/// tenfold until the detected powers move by at most the power tolerance; the last change is the
+/// error estimate of the value kept.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct IntegrationCheck {
-    /// Relative tolerance of the fit's cycles.
+    /// The power tolerance of the refinement (mW).
+    pub power_tol_mw: f64,
+    /// Tightest relative tolerance any cycle needed.
     pub rtol: f64,
-    /// Largest change of a weighted residual when the tolerances are tightened tenfold.
+    /// Loosest relative tolerance any cycle needed.
+    pub loosest_rtol: f64,
+    /// Largest last change of a fitted dynamic value, weighted (over its uncertainty).
     pub max_weighted_change: f64,
     /// That change over the residual scale `s`; it should be well below 1 (0.1 is the limit used).
     pub ratio_to_scatter: f64,
-    /// Whether the integration noise is small enough not to drive the fit.
+    /// Dynamic values in the fit whose refinement did not converge at the optimum.
+    pub unconverged: usize,
+    /// Dynamic values left out of the fit (not settled at the start or at an optimum).
+    pub excluded: usize,
+    /// Whether the integration noise is small enough not to drive the fit: every value in the
+    /// fit converged and `ratio_to_scatter ≤ 0.1`.
     pub ok: bool,
+}
+
+/// Predictions flattened in the order of the residuals.
+fn flatten(pred: &[Vec<Vec<Predicted>>]) -> Vec<Predicted> {
+    pred.iter().flatten().flatten().copied().collect()
+}
+
+/// The integration check of the dynamic values of `pred` (residual scale `s`).
+fn integration_check(
+    data: &[DataSet],
+    pred: &[Vec<Vec<Predicted>>],
+    excluded: &[bool],
+    s: f64,
+    opts: &FitOptions,
+) -> IntegrationCheck {
+    let w = weights(data);
+    let (mut change, mut tight, mut loose) = (0.0_f64, f64::INFINITY, 0.0_f64);
+    let mut unconverged = 0;
+    for (i, q) in flatten(pred).iter().enumerate() {
+        let Some(r) = q.refined else { continue };
+        if excluded.get(i).copied().unwrap_or(false) {
+            continue;
+        }
+        change = change.max(r.change / w[i]);
+        tight = tight.min(r.rtol);
+        loose = loose.max(r.rtol);
+        if !r.converged {
+            unconverged += 1;
+        }
+    }
+    let ratio = change / s.max(f64::MIN_POSITIVE);
+    IntegrationCheck {
+        power_tol_mw: opts.dynamic_power_tol_mw,
+        rtol: tight,
+        loosest_rtol: loose,
+        max_weighted_change: change,
+        ratio_to_scatter: ratio,
+        unconverged,
+        excluded: excluded.iter().filter(|e| **e).count(),
+        ok: unconverged == 0 && ratio <= 0.1,
+    }
 }
 
 /// One start of a multi-start fit.
@@ -232,7 +317,7 @@ pub struct FitResult {
 struct Problem<'e, 'a> {
     ev: &'e Evaluator<'a>,
     u: Vec<f64>,
-    rel_step: f64,
+    opts: &'e FitOptions,
     budget: usize,
     /// Residuals at the last point that could be evaluated.
     last: RefCell<Option<(Vec<f64>, Vec<f64>)>>,
@@ -315,19 +400,18 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
             return None;
         }
         let x = self.x(&self.u);
-        let r0 = self.residuals_at(&self.u)?;
-        let cols = jacobian_columns(self.ev, &x, &r0, self.rel_step, false);
-        let m = r0.len();
+        self.residuals_at(&self.u)?;
+        let cols = match jacobian_columns(self.ev, &x, self.opts, false) {
+            Ok(c) => c,
+            Err(e) => {
+                *self.error.borrow_mut() = Some(e.to_string());
+                return None;
+            }
+        };
+        let m = cols.first().map_or(0, Vec::len);
         let mut j = LmMatrix::zeros(m, self.u.len());
-        for (c, (col, p)) in cols.iter().zip(self.ev.params).enumerate() {
-            let col = match col {
-                Ok(col) => col,
-                Err(e) => {
-                    *self.error.borrow_mut() = Some(e.to_string());
-                    return None;
-                }
-            };
-            let d = p.transform.dx_du(self.u[c]);
+        for (c, col) in cols.iter().enumerate() {
+            let d = self.ev.params[c].transform.dx_du(self.u[c]);
             for (i, v) in col.iter().enumerate() {
                 j[(i, c)] = v * d;
             }
@@ -336,31 +420,49 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
     }
 }
 
-/// `∂r/∂x_j` by finite differences (forward from `r0`, or central), each column on its own
-/// thread with the `parallel` feature. Steps that would leave the bounds go the other way.
+/// `∂r/∂x_j` of the weighted residuals, one column per parameter.
+///
+/// Static values come from the transitions' first-order shifts ([`Evaluator::static_sensitivities`]:
+/// no rescan and no table build), dynamic values from finite differences of the cycles alone,
+/// each column on its own thread with the `parallel` feature; with
+/// `finite_difference_jacobian` every value by finite differences of the whole model. Steps that
+/// would leave the bounds go the other way; `central` takes central differences where both
+/// sides lie inside the bounds.
 fn jacobian_columns(
     ev: &Evaluator<'_>,
     x: &[f64],
-    r0: &[f64],
-    rel_step: f64,
+    opts: &FitOptions,
     central: bool,
-) -> Vec<crate::Result<Vec<f64>>> {
-    let column = |j: usize| -> crate::Result<Vec<f64>> {
+) -> crate::Result<Vec<Vec<f64>>> {
+    let n = x.len();
+    let pred = ev.predict(x)?;
+    let r0 = weighted(ev.data, &pred, &ev.excluded);
+    let w = weights(ev.data);
+    // The step of parameter j and whether it can be taken both ways.
+    let step = |j: usize, rel: f64| -> (f64, bool) {
         let p = &ev.params[j];
-        let mut h = rel_step * p.scale;
+        let mut h = rel * p.scale;
         if p.upper.is_some_and(|hi| x[j] + h > hi) {
             h = -h;
         }
+        let both = central
+            && p.lower.is_none_or(|lo| x[j] - h.abs() >= lo)
+            && p.upper.is_none_or(|hi| x[j] + h.abs() <= hi);
+        (h, both)
+    };
+    let fd = |j: usize, rel: f64, sets: Sets| -> crate::Result<Vec<f64>> {
+        let (h, both) = step(j, rel);
         let at = |h: f64| {
             let mut xs = x.to_vec();
             xs[j] += h;
-            ev.residuals(&xs)
+            ev.predict_sets(&xs, sets)
+                .map(|p| weighted(ev.data, &p, &ev.excluded))
         };
         let plus = at(h)?;
-        let (minus, span) = if central && p.lower.is_none_or(|lo| x[j] - h >= lo) {
+        let (minus, span) = if both {
             (at(-h)?, 2.0 * h)
         } else {
-            (r0.to_vec(), h)
+            (r0.clone(), h)
         };
         Ok(plus
             .iter()
@@ -368,16 +470,46 @@ fn jacobian_columns(
             .map(|(a, b)| (a - b) / span)
             .collect())
     };
-    let n = x.len();
-    #[cfg(feature = "parallel")]
-    {
-        use rayon::prelude::*;
-        (0..n).into_par_iter().map(column).collect()
+    let par_map =
+        |f: &(dyn Fn(usize) -> crate::Result<Vec<f64>> + Sync)| -> crate::Result<Vec<Vec<f64>>> {
+            #[cfg(feature = "parallel")]
+            {
+                use rayon::prelude::*;
+                (0..n).into_par_iter().map(f).collect()
+            }
+            #[cfg(not(feature = "parallel"))]
+            {
+                (0..n).map(f).collect()
+            }
+        };
+    if opts.finite_difference_jacobian {
+        return par_map(&|j| fd(j, opts.rel_step, Sets::All));
     }
-    #[cfg(not(feature = "parallel"))]
-    {
-        (0..n).map(column).collect()
+    // Cycles need the larger step (integration noise); the indicator alone takes `rel_step`.
+    let rel = if ev.data.iter().any(DataSet::is_dynamic) {
+        opts.dynamic_rel_step
+    } else {
+        opts.rel_step
+    };
+    let mut cols = if ev.data.iter().any(|d| !d.is_transitions()) {
+        par_map(&|j| fd(j, rel, Sets::NoTransitions))?
+    } else {
+        vec![vec![0.0; r0.len()]; n]
+    };
+    let steps: Vec<(f64, bool)> = (0..n).map(|j| step(j, opts.rel_step)).collect();
+    let sens = ev.static_sensitivities(x, &pred, &steps)?;
+    for (col, s) in cols.iter_mut().zip(&sens) {
+        for (i, v) in s.iter().enumerate() {
+            if let Some(v) = v {
+                col[i] = if ev.excluded.get(i).copied().unwrap_or(false) {
+                    0.0
+                } else {
+                    v / w[i]
+                };
+            }
+        }
     }
+    Ok(cols)
 }
 
 /// Starting points: the given one, then `starts − 1` drawn inside the bounds.
@@ -468,61 +600,48 @@ pub fn fit(
             ),
         }));
     }
-    let ev = Evaluator::new(base, &params, data, opts.static_table_rel_tol);
+    let refinement = Refinement::new(opts.dynamic_power_tol_mw * 1e-3);
+    let mut ev = Evaluator::new(base, &params, data, opts.static_table_rel_tol, refinement);
+    // Dynamic points whose detected powers do not settle under tighter tolerances at the first
+    // start are left out of the fit (their residual would be integration noise), and reported.
+    if data.iter().any(DataSet::is_dynamic) {
+        let x0: Vec<f64> = params.iter().map(|p| p.start).collect();
+        if let Ok(pred) = ev.predict(&x0) {
+            ev.excluded = flatten(&pred)
+                .iter()
+                .map(|q| q.refined.is_some_and(|r| !r.converged))
+                .collect();
+            let included = ev.excluded.iter().filter(|e| !**e).count();
+            if included <= params.len() {
+                return Err(Error::analysis(
+                    "fit",
+                    format!(
+                        "only {included} of {points} values remain once the dynamic points whose                          detected powers do not settle within {} mW under tighter tolerances are                          left out: too few for {} free parameters (raise dynamic_power_tol_mw or                          tighten solver.rtol)",
+                        opts.dynamic_power_tol_mw,
+                        params.len()
+                    ),
+                )
+                .into());
+            }
+        }
+    }
 
     let mut outcomes = Vec::new();
     let mut best: Option<(f64, Vec<f64>, bool, String)> = None;
     let mut first_error = None;
     for start in start_points(&params, opts.starts, opts.seed) {
-        let budget = ev.evaluations.load(Ordering::Relaxed) + opts.max_evaluations;
-        let u0: Vec<f64> = params
-            .iter()
-            .zip(&start)
-            .map(|(p, &x)| p.transform.u(x))
-            .collect();
-        let problem = Problem {
-            ev: &ev,
-            u: u0.clone(),
-            rel_step: opts.rel_step,
-            budget,
-            last: RefCell::new(None),
-            error: RefCell::new(None),
-        };
-        if problem.residuals_at(&u0).is_none() {
-            let e = problem.error.borrow().clone().unwrap_or_default();
-            first_error.get_or_insert_with(|| e.clone());
-            outcomes.push(StartOutcome {
-                start,
-                end: Vec::new(),
-                cost: f64::INFINITY,
-                termination: format!("start not evaluated: {e}"),
-            });
-            continue;
+        let (outcome, end) = run_start(&ev, opts, start);
+        if end.is_none() {
+            first_error.get_or_insert_with(|| outcome.termination.clone());
         }
-        let (solved, report) = LevenbergMarquardt::new()
-            .with_patience(opts.max_evaluations)
-            .minimize(problem);
-        let u = solved.u.clone();
-        let x = solved.x(&u);
-        let cost = solved
-            .residuals_at(&u)
-            .map_or(f64::INFINITY, |r| r.iter().map(|v| v * v).sum());
-        let mut termination = format!("{:?}", report.termination);
-        if let Some(e) = solved.error.borrow().as_ref() {
-            termination.push_str(&format!(" (last model error: {e})"));
-        }
-        let converged = report.termination.was_successful();
-        outcomes.push(StartOutcome {
-            start,
-            end: x.clone(),
-            cost,
-            termination: termination.clone(),
-        });
-        if best.as_ref().is_none_or(|b| cost < b.0) {
-            best = Some((cost, x, converged, termination));
+        outcomes.push(outcome);
+        if let Some(e) = end {
+            if best.as_ref().is_none_or(|b| e.0 < b.0) {
+                best = Some(e);
+            }
         }
     }
-    let Some((_, x, converged, termination)) = best.filter(|b| b.0.is_finite()) else {
+    let Some((_, mut x, mut converged, mut termination)) = best.filter(|b| b.0.is_finite()) else {
         return Err(Error::analysis(
             "fit",
             format!(
@@ -537,7 +656,92 @@ pub fn fit(
         .find(|o| o.end == x)
         .map(|o| o.start.clone())
         .unwrap_or_else(|| params.iter().map(|p| p.start).collect());
+    // Dynamic values that settled at the start but not at the optimum are left out too, and
+    // the fit is resumed from the optimum without them (at most twice).
+    for _ in 0..2 {
+        let Ok(pred) = ev.predict(&x) else { break };
+        let newly: Vec<usize> = flatten(&pred)
+            .iter()
+            .enumerate()
+            .filter(|(i, q)| {
+                !ev.excluded.get(*i).copied().unwrap_or(false)
+                    && q.refined.is_some_and(|r| !r.converged)
+            })
+            .map(|(i, _)| i)
+            .collect();
+        let included = ev.excluded.iter().filter(|e| !**e).count();
+        if newly.is_empty() || included - newly.len() <= params.len() {
+            break;
+        }
+        if ev.excluded.is_empty() {
+            ev.excluded = vec![false; points];
+        }
+        for i in newly {
+            ev.excluded[i] = true;
+        }
+        let (outcome, end) = run_start(&ev, opts, x.clone());
+        outcomes.push(outcome);
+        let Some((_, x1, c1, t1)) = end else { break };
+        (x, converged, termination) = (x1, c1, t1);
+    }
     analyse(&ev, opts, x, best_start, converged, termination, outcomes)
+}
+
+/// One start of the optimiser: its outcome, and (cost, end, converged, termination) when the
+/// start could be evaluated.
+#[allow(clippy::type_complexity)]
+fn run_start(
+    ev: &Evaluator<'_>,
+    opts: &FitOptions,
+    start: Vec<f64>,
+) -> (StartOutcome, Option<(f64, Vec<f64>, bool, String)>) {
+    let params = ev.params;
+    let budget = ev.evaluations.load(Ordering::Relaxed) + opts.max_evaluations;
+    let u0: Vec<f64> = params
+        .iter()
+        .zip(&start)
+        .map(|(p, &x)| p.transform.u(x))
+        .collect();
+    let problem = Problem {
+        ev,
+        u: u0.clone(),
+        opts,
+        budget,
+        last: RefCell::new(None),
+        error: RefCell::new(None),
+    };
+    if problem.residuals_at(&u0).is_none() {
+        let e = problem.error.borrow().clone().unwrap_or_default();
+        let outcome = StartOutcome {
+            start,
+            end: Vec::new(),
+            cost: f64::INFINITY,
+            termination: format!("start not evaluated: {e}"),
+        };
+        return (outcome, None);
+    }
+    let (solved, report) = LevenbergMarquardt::new()
+        .with_ftol(opts.tolerance)
+        .with_xtol(opts.tolerance)
+        .with_patience(opts.max_evaluations)
+        .minimize(problem);
+    let u = solved.u.clone();
+    let x = solved.x(&u);
+    let cost = solved
+        .residuals_at(&u)
+        .map_or(f64::INFINITY, |r| r.iter().map(|v| v * v).sum());
+    let mut termination = format!("{:?}", report.termination);
+    if let Some(e) = solved.error.borrow().as_ref() {
+        termination.push_str(&format!(" (last model error: {e})"));
+    }
+    let converged = report.termination.was_successful();
+    let outcome = StartOutcome {
+        start,
+        end: x.clone(),
+        cost,
+        termination: termination.clone(),
+    };
+    (outcome, Some((cost, x, converged, termination)))
 }
 
 /// Errors, correlations, identifiability and residual tables at the optimum `x`.
@@ -552,17 +756,19 @@ fn analyse(
 ) -> Result<FitResult, FitError> {
     let params = ev.params;
     let data = ev.data;
-    let pred = ev.predict(&x, 1.0)?;
-    let r0 = weighted(data, &pred);
-    let (m, n) = (r0.len(), params.len());
+    let pred = ev.predict(&x)?;
+    let r0 = weighted(data, &pred, &ev.excluded);
+    let n = params.len();
+    // Residuals left out (unsettled dynamic points) count neither as points nor in χ².
+    let m = r0.len() - ev.excluded.iter().filter(|e| **e).count();
     let chi2: f64 = r0.iter().map(|v| v * v).sum();
     let s = (chi2 / (m - n) as f64).sqrt();
 
     // Central differences, in each parameter's scale: J_s = J · diag(scale).
-    let cols = jacobian_columns(ev, &x, &r0, opts.rel_step, true);
-    let mut js = DMatrix::<f64>::zeros(m, n);
+    let cols = jacobian_columns(ev, &x, opts, true)?;
+    let mut js = DMatrix::<f64>::zeros(r0.len(), n);
     for (c, col) in cols.into_iter().enumerate() {
-        for (i, v) in col?.into_iter().enumerate() {
+        for (i, v) in col.into_iter().enumerate() {
             js[(i, c)] = v * params[c].scale;
         }
     }
@@ -692,15 +898,15 @@ fn analyse(
         s_max / sv.iter().copied().fold(f64::INFINITY, f64::min)
     };
 
-    let residuals = residual_tables(data, &pred);
+    let residuals = residual_tables(data, &pred, &ev.excluded);
     let mut warnings = Vec::new();
     if !converged {
         warnings.push(format!("the optimiser did not converge: {termination}"));
     }
     let clipped = residuals
         .iter()
-        .flat_map(|t| t.rows.iter().map(move |r| (t, r)))
-        .filter(|(_, r)| r.clipped)
+        .flat_map(|t| t.rows.iter())
+        .filter(|r| r.clipped && !r.excluded)
         .count();
     if clipped > 0 {
         warnings.push(format!(
@@ -715,28 +921,38 @@ fn analyse(
         ));
     }
     let integration = if data.iter().any(DataSet::is_dynamic) {
-        let tight = weighted(data, &ev.predict(&x, 0.1)?);
-        let change = tight
+        let check = integration_check(data, &pred, &ev.excluded, s, opts);
+        let left_out: Vec<String> = residuals
             .iter()
-            .zip(&r0)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
-        let ratio = change / s.max(f64::MIN_POSITIVE);
-        let scene = ev.scene(&x)?;
-        let ok = ratio <= 0.1;
-        if !ok {
+            .flat_map(|t| t.rows.iter().map(move |r| (t, r)))
+            .filter(|(_, r)| r.excluded)
+            .map(|(t, r)| format!("{} line {} ({})", t.file, r.line, t.column))
+            .collect();
+        if !left_out.is_empty() {
             warnings.push(format!(
-                "integration noise {change:.3e} (weighted) is {ratio:.2} of the scatter: tighten \
-                 solver.rtol (now {:e})",
-                scene.solver.rtol
+                "{} dynamic value(s) left out of the fit: their detected powers did not settle \
+                 within {} mW under tenfold tighter tolerances (at the start, or at an optimum \
+                 the fit was then resumed from): {}",
+                left_out.len(),
+                opts.dynamic_power_tol_mw,
+                left_out.join(", ")
             ));
         }
-        Some(IntegrationCheck {
-            rtol: scene.solver.rtol,
-            max_weighted_change: change,
-            ratio_to_scatter: ratio,
-            ok,
-        })
+        if check.unconverged > 0 {
+            warnings.push(format!(
+                "{} dynamic value(s) in the fit did not settle within {} mW at the optimum: \
+                 their residuals carry integration noise",
+                check.unconverged, opts.dynamic_power_tol_mw
+            ));
+        }
+        if check.ratio_to_scatter > 0.1 {
+            warnings.push(format!(
+                "integration noise {:.3e} (weighted) is {:.2} of the scatter: lower \
+                 dynamic_power_tol_mw or tighten solver.rtol",
+                check.max_weighted_change, check.ratio_to_scatter
+            ));
+        }
+        Some(check)
     } else {
         None
     };
@@ -850,14 +1066,22 @@ fn identifiability_words(
     out
 }
 
-fn residual_tables(data: &[DataSet], pred: &[Vec<Vec<Predicted>>]) -> Vec<ResidualTable> {
+fn residual_tables(
+    data: &[DataSet],
+    pred: &[Vec<Vec<Predicted>>],
+    excluded: &[bool],
+) -> Vec<ResidualTable> {
     let mut out = Vec::new();
+    let mut k = 0;
     for (ds, p) in data.iter().zip(pred) {
         for (o, pc) in ds.observed.iter().zip(p) {
             let f = o.unit.to_si;
             let rows = (0..ds.x.len())
                 .map(|i| {
-                    let w = o.errors.as_ref().map_or(DEFAULT_WEIGHT_W, |e| e[i]);
+                    let w = o
+                        .errors
+                        .as_ref()
+                        .map_or(o.quantity.default_weight(), |e| e[i]);
                     ResidualRow {
                         line: ds.lines[i],
                         x: ds.x[i] / ds.x_unit.to_si,
@@ -866,9 +1090,11 @@ fn residual_tables(data: &[DataSet], pred: &[Vec<Vec<Predicted>>]) -> Vec<Residu
                         residual: (pc[i].value - o.values[i]) / f,
                         weighted: (pc[i].value - o.values[i]) / w,
                         clipped: pc[i].clipped,
+                        excluded: excluded.get(k + i).copied().unwrap_or(false),
                     }
                 })
                 .collect();
+            k += ds.x.len();
             let stem = o.quantity.stem();
             out.push(ResidualTable {
                 file: ds.origin.clone(),
@@ -894,8 +1120,15 @@ fn residual_tables(data: &[DataSet], pred: &[Vec<Vec<Predicted>>]) -> Vec<Residu
 pub fn model_curves(scene: &Scene, data: &[DataSet]) -> Result<Vec<DataSet>, FitError> {
     let base = serde_json::to_value(scene)
         .map_err(|e| Error::invalid("scene", format!("cannot be represented: {e}")))?;
-    let ev = Evaluator::new(base, &[], data, FitOptions::default().static_table_rel_tol);
-    let pred = ev.predict(&[], 1.0)?;
+    let o = FitOptions::default();
+    let ev = Evaluator::new(
+        base,
+        &[],
+        data,
+        o.static_table_rel_tol,
+        Refinement::new(o.dynamic_power_tol_mw * 1e-3),
+    );
+    let pred = ev.predict(&[])?;
     let mut out = data.to_vec();
     for (ds, p) in out.iter_mut().zip(&pred) {
         for (o, pc) in ds.observed.iter_mut().zip(p) {

@@ -336,11 +336,7 @@ impl SliderModel {
             bulge: d,
             pad: h0 + q0,
         };
-        let residual = |q: &Dofs, f: &ForceEval| {
-            let r = st.generalised_force(q, &Dofs::zeros(), self.bearing.force(q[0], 0.0), f.value);
-            let j = st.tangent(self.bearing.stiffness(q[0]), 0.0, f.d_pad);
-            (r, j)
-        };
+        let residual = |q: &Dofs, f: &ForceEval| self.balance_residual(q, f);
         // Start from the linearised bearing.
         let f0 = self.interface_force(at(0.0), volt2);
         let j0 = st.tangent(self.bearing.stiffness(0.0), 0.0, 0.0);
@@ -389,9 +385,9 @@ impl SliderModel {
         if exact {
             // Newton on the balance with direct forces, from the tabulated solution.
             for _ in 0..50 {
-                f = self.interface_force_exact(at(q[0]), volt2)?;
-                let (r, j) = residual(&q, &f);
-                let Some(step) = st.solve(&j, &r) else { break };
+                let (step, fe) = self.exact_balance_step(d, volt2, &q)?;
+                f = fe;
+                let Some(step) = step else { break };
                 q += step;
                 if st.step_converged(&step, &q, 1e-16 * h0, 1e-13) {
                     break;
@@ -399,6 +395,34 @@ impl SliderModel {
             }
         }
         Ok((q, f))
+    }
+
+    /// One Newton step of the static balance of [`SliderModel::balance`] at bulge gap `d` from
+    /// coordinates `q`, with direct (untabulated) forces: the step (`None` where the tangent is
+    /// singular) and the interface force at `q`. From the balance of a slightly different model
+    /// it is the first-order change of `q` (used for the sensitivities of static transitions).
+    pub fn exact_balance_step(
+        &self,
+        d: f64,
+        volt2: f64,
+        q: &Dofs,
+    ) -> Result<(Option<Dofs>, ForceEval)> {
+        let st = &self.structure;
+        let g = Gaps {
+            bulge: d,
+            pad: self.nominal_clearance + q[0],
+        };
+        let f = self.interface_force_exact(g, volt2)?;
+        let (r, j) = self.balance_residual(q, &f);
+        Ok((st.solve(&j, &r), f))
+    }
+
+    /// The static balance's residual and tangent at coordinates `q` under interface force `f`.
+    fn balance_residual(&self, q: &Dofs, f: &ForceEval) -> (Dofs, structure::DofMatrix) {
+        let st = &self.structure;
+        let r = st.generalised_force(q, &Dofs::zeros(), self.bearing.force(q[0], 0.0), f.value);
+        let j = st.tangent(self.bearing.stiffness(q[0]), 0.0, f.d_pad);
+        (r, j)
     }
 
     /// The one home of the total stiffness: the stiffness that the bulge meets at coordinates

@@ -10,7 +10,8 @@ use crate::common::{self, CliError, SceneArgs};
 /// its standard error (null where the data do not determine it), the correlation matrix, the
 /// residuals, the identifiability report in words, and `trusted` with its warnings. Data files
 /// are CSV in engineering units (docs/fit.md): `dc_voltage_v` or `ac_amplitude_v`, then
-/// `touchdown_power_mw` and/or `takeoff_power_mw`, optionally `touchdown_power_err_mw`.
+/// `touchdown_power_mw` and/or `takeoff_power_mw`, optionally `touchdown_power_err_mw`; or
+/// `heater_power_mw`, then `contact_indicator_un` (Fig. 1).
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
