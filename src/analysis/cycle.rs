@@ -13,7 +13,7 @@ use super::roots::brent;
 use crate::error::{check_positive, Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem, StateLayout};
-use crate::ode::{self, Method, Options, SaveAt, Solution, Stats};
+use crate::ode::{self, DenseOutput, Integrator, Method, Options, Stats, StepStatus};
 use nalgebra::{
     allocator::Allocator, DefaultAllocator, DimName, OVector, U10, U4, U5, U6, U7, U8, U9,
 };
@@ -201,7 +201,7 @@ pub struct CycleResult {
     /// The programme actually run (for the triggered protocol: as fixed by the detection).
     #[serde(skip)]
     pub programme: Programme,
-    /// Solver statistics, summed over the segments.
+    /// Solver statistics of the cycle's integration.
     pub stats: Stats,
     /// Wall-clock time of the simulation (s).
     pub wall_seconds: f64,
@@ -273,29 +273,46 @@ pub fn simulate_cycle(
     }
 }
 
-/// Solutions of consecutive segments, sampled as one trajectory.
-struct Trajectory<D: DimName>
+/// What the cycle keeps of its one integration: every step time, the step interpolants (the
+/// detector reads the contact impulse at `t` and `t − T_w` on them), and the states when a time
+/// series is asked for.
+struct Record<D: DimName>
 where
     DefaultAllocator: Allocator<D>,
 {
-    segments: Vec<Solution<D>>,
+    times: Vec<f64>,
+    dense: DenseOutput,
+    states: Option<Vec<OVector<f64, D>>>,
+    work: std::cell::RefCell<OVector<f64, D>>,
 }
 
-impl<D: DimName> Trajectory<D>
+impl<D: DimName> Record<D>
 where
     DefaultAllocator: Allocator<D>,
 {
-    fn sample(&self, t: f64) -> Option<OVector<f64, D>> {
-        // The last segment that starts at or before t.
-        let i = self
-            .segments
-            .partition_point(|s| s.t.first().is_some_and(|&t0| t0 <= t));
-        let seg = self.segments.get(i.checked_sub(1)?)?;
-        seg.sample(t.min(seg.t_final()))
+    fn new(t0: f64, y0: &OVector<f64, D>, keep_states: bool) -> Self {
+        Record {
+            times: vec![t0],
+            dense: DenseOutput::new(y0.len()),
+            states: keep_states.then(|| vec![y0.clone()]),
+            work: std::cell::RefCell::new(y0.clone()),
+        }
     }
 
-    fn step_times(&self) -> impl Iterator<Item = f64> + '_ {
-        self.segments.iter().flat_map(|s| s.t.iter().copied())
+    /// Component `i` at time `t` on the interpolants; `None` outside the integrated range.
+    fn sample(&self, t: f64, i: usize) -> Option<f64> {
+        let mut w = self.work.borrow_mut();
+        self.dense.eval_into(t, &mut w).then(|| w[i])
+    }
+
+    /// Drops everything after `t` (inside the last step).
+    fn truncate(&mut self, t: f64) {
+        self.dense.truncate_last(t);
+        let keep = self.times.partition_point(|&s| s <= t);
+        self.times.truncate(keep);
+        if let Some(st) = self.states.as_mut() {
+            st.truncate(keep);
+        }
     }
 }
 
@@ -303,7 +320,7 @@ struct Detecting<'a, D: DimName>
 where
     DefaultAllocator: Allocator<D>,
 {
-    traj: &'a Trajectory<D>,
+    rec: &'a Record<D>,
     q: usize,
     detector: Detector,
 }
@@ -315,8 +332,8 @@ where
     /// Running mean of the contact force at `t ≥ T_w`.
     fn indicator(&self, t: f64) -> f64 {
         let w = self.detector.window;
-        match (self.traj.sample(t), self.traj.sample(t - w)) {
-            (Some(a), Some(b)) => (a[self.q] - b[self.q]) / w,
+        match (self.rec.sample(t, self.q), self.rec.sample(t - w, self.q)) {
+            (Some(a), Some(b)) => (a - b) / w,
             _ => f64::NAN,
         }
     }
@@ -332,10 +349,17 @@ where
         if a > b {
             return Ok(None);
         }
-        let mut samples: Vec<f64> = self
-            .traj
-            .step_times()
-            .flat_map(|t| [t, t + w])
+        // Step times in (a, b) and in (a − T_w, b − T_w), the latter shifted by T_w.
+        let times = &self.rec.times;
+        let inside = |lo: f64, hi: f64| {
+            let i = times.partition_point(|&t| t <= lo);
+            let j = times.partition_point(|&t| t < hi);
+            &times[i..j.max(i)]
+        };
+        let mut samples: Vec<f64> = inside(a, b)
+            .iter()
+            .copied()
+            .chain(inside(a - w, b - w).iter().map(|&t| t + w))
             .filter(|&t| t > a && t < b)
             .collect();
         samples.push(a);
@@ -360,6 +384,52 @@ where
             }
         }
         Ok(None)
+    }
+}
+
+/// The one integration of a cycle, with what the detector and the time series need.
+struct Run<'m, D: DimName>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    it: Integrator<'static, D, SliderSystem<'m>>,
+    rec: Record<D>,
+    model: &'m SliderModel,
+    opts: &'m CycleOptions,
+}
+
+impl<D: DimName> Run<'_, D>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// One accepted step, recorded; the pad-contact guard ends the cycle with an error.
+    fn step(&mut self) -> Result<StepStatus> {
+        let (model, opts) = (self.model, self.opts);
+        let status = self
+            .it
+            .step()
+            .map_err(|e| explain_ode_error(model, opts, e))?;
+        self.rec.dense.push(&self.it.poly);
+        if let StepStatus::Terminated(_) = status {
+            self.rec.dense.truncate_last(self.it.t());
+            return Err(left_the_model(
+                model,
+                self.it.system(),
+                self.it.t(),
+                self.it.state(),
+            ));
+        }
+        self.rec.times.push(self.it.t());
+        if let Some(st) = self.rec.states.as_mut() {
+            st.push(self.it.state().clone());
+        }
+        Ok(status)
+    }
+
+    /// Steps until the end time.
+    fn to_end(&mut self) -> Result<()> {
+        while self.step()? != StepStatus::ReachedEnd {}
+        Ok(())
     }
 }
 
@@ -415,7 +485,7 @@ where
         volt2_0,
         &ScanGrid::default(),
     )?;
-    let mut sys = SliderSystem::new(model, initial_programme.clone(), true);
+    let sys = SliderSystem::new(model, initial_programme.clone(), true);
     let layout = sys.layout();
     let q = layout
         .contact_impulse
@@ -425,61 +495,55 @@ where
         .ok_or_else(|| Error::analysis("cycle", "no heat state"))?;
     let y0: OVector<f64, D> = sys.initial_state(D::name(), &eq.rest());
 
-    let ode_opts = ode_options(&sys, opts, &initial_programme)?;
-    let mut traj = Trajectory::<D> {
-        segments: Vec::new(),
+    // The fixed programme's knots are kinks of the right-hand side; the triggered programme's
+    // only interior knot, its turning point, is where the programme is replaced (a restart).
+    let kinks = match triggered {
+        None => initial_programme.knots().iter().map(|k| k.0).collect(),
+        Some(_) => Vec::new(),
     };
-    let mut stats = Stats::default();
-    let mut solve = |sys: &SliderSystem,
-                     a: f64,
-                     y: OVector<f64, D>,
-                     b: f64,
-                     o: &Options|
-     -> Result<Solution<D>> {
-        // Stop where the lumped model ends: the pad gap h0 + y reaching zero puts the slider body
-        // into the disk (no pad contact is modelled; a power-law bearing is singular there).
-        let h0 = model.nominal_clearance;
-        let mut guard = [ode::Event::new(move |_t, s: &OVector<f64, D>| h0 + s[0])
-            .direction(ode::Direction::Falling)
-            .terminal(true)];
-        let sol = ode::solve(sys, a, y, b, opts.solver.method, o, &mut guard)
-            .map_err(|e| explain_ode_error(model, opts, e))?;
-        stats += &sol.stats;
-        if sol.terminated_by_event.is_some() {
-            return Err(left_the_model(model, sys, &sol));
-        }
-        Ok(sol)
+    let ode_opts = ode_options(&sys, opts, kinks)?;
+    // Stop where the lumped model ends: the pad gap h0 + y reaching zero puts the slider body
+    // into the disk (no pad contact is modelled; a power-law bearing is singular there).
+    let h0 = model.nominal_clearance;
+    let guard = ode::Event::new(move |_t, s: &OVector<f64, D>| h0 + s[0])
+        .direction(ode::Direction::Falling)
+        .terminal(true);
+    let end = initial_programme.end_time();
+    let it = Integrator::new(sys, t0, y0.clone(), end, opts.solver.method, &ode_opts)
+        .map_err(|e| explain_ode_error(model, opts, e))?
+        .events([guard]);
+    let mut run = Run {
+        it,
+        rec: Record::new(t0, &y0, opts.keep_series),
+        model,
+        opts,
     };
 
     let final_programme;
     let search_from;
     match triggered {
         None => {
-            let end = initial_programme.end_time();
-            let sol = solve(&sys, t0, y0, end, &ode_opts)?;
-            traj.segments.push(sol);
+            run.to_end()?;
             final_programme = initial_programme.clone();
             search_from = final_programme.end_of_hold();
         }
         Some((start_power, rate, overshoot)) => {
+            // Ramp up, watching the detector step by step.
             let chunk = overshoot / rate;
-            let end = initial_programme.end_time();
-            let (mut t, mut y) = (t0, y0);
+            let mut checked = t0;
             let t_td = loop {
-                let t1 = (t + chunk).min(end);
-                let sol = solve(&sys, t, y, t1, &ode_opts)?;
-                y = sol.y_final().clone();
-                traj.segments.push(sol);
+                let status = run.step()?;
+                let t = run.it.t();
                 let found = Detecting {
-                    traj: &traj,
+                    rec: &run.rec,
                     q,
                     detector: det,
                 }
-                .first_crossing(t, t1, true)?;
+                .first_crossing(checked, t, true)?;
                 if let Some(t_td) = found {
                     break t_td;
                 }
-                if t1 >= end {
+                if status == StepStatus::ReachedEnd {
                     return Err(Error::analysis(
                         "triggered cycle",
                         format!(
@@ -488,8 +552,10 @@ where
                         ),
                     ));
                 }
-                t = t1;
+                checked = t;
             };
+            // The programme turns `overshoot` after the detection: go on up the ramp to the
+            // turning point (or step back to it from a longer step), then ramp down.
             let t_peak = t_td + chunk;
             let p_peak = start_power + rate * (t_peak - t0);
             let t_end = t_peak + (p_peak - start_power) / rate;
@@ -498,17 +564,35 @@ where
                 (t_peak, p_peak),
                 (t_end, start_power),
             ])?;
-            sys = SliderSystem::new(model, final_programme.clone(), true);
-            let o = ode_options(&sys, opts, &final_programme)?;
-            let t_now = traj.segments.last().map_or(t0, |s| s.t_final());
-            let sol = solve(&sys, t_now, y, t_end, &o)?;
-            traj.segments.push(sol);
+            let ode_err = |e| explain_ode_error(model, opts, e);
+            if run.it.t() < t_peak {
+                if t_peak < run.it.tf() {
+                    run.it.set_tf(t_peak).map_err(ode_err)?;
+                }
+                run.to_end()?;
+            } else if run.it.t() > t_peak {
+                let mut y = y0.clone();
+                if !run.rec.dense.eval_into(t_peak, &mut y) {
+                    return Err(Error::analysis("triggered cycle", "turning point not covered"));
+                }
+                run.rec.truncate(t_peak);
+                if run.rec.times.last().is_some_and(|&t| t < t_peak) {
+                    run.rec.times.push(t_peak);
+                    if let Some(st) = run.rec.states.as_mut() {
+                        st.push(y.clone());
+                    }
+                }
+                run.it.reinit(t_peak, y).map_err(ode_err)?;
+            }
+            *run.it.system_mut() = SliderSystem::new(model, final_programme.clone(), true);
+            run.it.set_tf(t_end).map_err(ode_err)?;
+            run.to_end()?;
             search_from = t_peak;
         }
     }
 
     let detecting = Detecting {
-        traj: &traj,
+        rec: &run.rec,
         q,
         detector: det,
     };
@@ -528,13 +612,13 @@ where
         (Some(a), Some(b)) => Some(a.power - b.power),
         _ => None,
     };
-    let last = traj
-        .segments
-        .last()
-        .ok_or_else(|| Error::analysis("cycle", "nothing was integrated"))?;
     let duration = end - t0;
-    let mean_temperature_rise = last.y_final()[heat] / duration;
-    let series = opts.keep_series.then(|| series_of(&sys, &traj, &detecting));
+    let mean_temperature_rise = run.it.state()[heat] / duration;
+    let series = run
+        .rec
+        .states
+        .as_ref()
+        .map(|states| series_of(run.it.system(), &run.rec.times, states, &detecting));
     Ok(CycleResult {
         v_ac: model.voltage.ac_amplitude,
         touchdown,
@@ -543,13 +627,13 @@ where
         mean_temperature_rise,
         duration,
         programme: final_programme,
-        stats,
+        stats: run.it.stats(),
         wall_seconds: clock.elapsed().as_secs_f64(),
         series,
     })
 }
 
-fn ode_options(sys: &SliderSystem, opts: &CycleOptions, programme: &Programme) -> Result<Options> {
+fn ode_options(sys: &SliderSystem, opts: &CycleOptions, kinks: Vec<f64>) -> Result<Options> {
     let s = opts.solver;
     // The integrals only need the accuracy the detector and the mean temperature use.
     let atol = sys.tolerances(
@@ -563,8 +647,7 @@ fn ode_options(sys: &SliderSystem, opts: &CycleOptions, programme: &Programme) -
         .atol_per_component(atol)
         .h_max(sys.model().max_step(s.max_step))
         .max_steps(s.max_steps)
-        .t_stops(programme.knots().iter().map(|k| k.0).collect())
-        .save(SaveAt::Steps)
+        .t_stops(kinks)
         .dense(true);
     o.validate(n)
         .map_err(|e| Error::invalid("solver", e.to_string()))?;
@@ -573,11 +656,15 @@ fn ode_options(sys: &SliderSystem, opts: &CycleOptions, programme: &Programme) -
 
 /// The error for a trajectory that left the lumped model (the pad gap reached zero), with the
 /// likely cause when an interface lag makes the contact branch self-excited.
-fn left_the_model<D: DimName>(model: &SliderModel, sys: &SliderSystem, sol: &Solution<D>) -> Error
+fn left_the_model<D: DimName>(
+    model: &SliderModel,
+    sys: &SliderSystem,
+    t: f64,
+    s: &OVector<f64, D>,
+) -> Error
 where
     DefaultAllocator: Allocator<D>,
 {
-    let (t, s) = (sol.t_final(), sol.y_final());
     let g = sys.gaps(t, s);
     let mut reason = format!(
         "at t = {t:.6e} s the pad gap h0 + y fell to zero (bulge gap d = {:.4e} m, velocity {:.3e} \
@@ -618,38 +705,37 @@ fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError)
     }
 }
 
-fn series_of<D: DimName>(sys: &SliderSystem, traj: &Trajectory<D>, det: &Detecting<D>) -> TimeSeries
+fn series_of<D: DimName>(
+    sys: &SliderSystem,
+    times: &[f64],
+    states: &[OVector<f64, D>],
+    det: &Detecting<D>,
+) -> TimeSeries
 where
     DefaultAllocator: Allocator<D>,
 {
     let model = sys.model();
     let mut out = TimeSeries::default();
-    let mut last_t = f64::NEG_INFINITY;
-    for seg in &traj.segments {
-        for (t, s) in seg.t.iter().zip(&seg.y) {
-            if *t <= last_t {
-                continue; // segment boundaries repeat a time
-            }
-            last_t = *t;
-            let g = sys.gaps(*t, s);
-            let volt2 = model.voltage.squared(*t);
-            let b = model.breakdown(g, volt2);
-            let f_ab = sys.bearing_force(s);
-            out.t.push(*t);
-            out.power.push(sys.programme().power(*t));
-            out.d.push(g.bulge);
-            out.air_bearing.push(f_ab);
-            out.intermolecular.push(b.intermolecular);
-            out.electrostatic.push(b.electrostatic);
-            out.contact.push(b.contact);
-            out.total.push(f_ab + b.total);
-            out.temperature_rise.push(model.flash_temperature(g));
-            out.indicator.push(if *t >= det.detector.window {
-                det.indicator(*t)
-            } else {
-                f64::NAN
-            });
-        }
+    for (t, s) in times.iter().zip(states) {
+        let t = *t;
+        let g = sys.gaps(t, s);
+        let volt2 = model.voltage.squared(t);
+        let b = model.breakdown(g, volt2);
+        let f_ab = sys.bearing_force(s);
+        out.t.push(t);
+        out.power.push(sys.programme().power(t));
+        out.d.push(g.bulge);
+        out.air_bearing.push(f_ab);
+        out.intermolecular.push(b.intermolecular);
+        out.electrostatic.push(b.electrostatic);
+        out.contact.push(b.contact);
+        out.total.push(f_ab + b.total);
+        out.temperature_rise.push(model.flash_temperature(g));
+        out.indicator.push(if t >= det.detector.window {
+            det.indicator(t)
+        } else {
+            f64::NAN
+        });
     }
     out
 }
