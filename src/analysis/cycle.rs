@@ -13,7 +13,7 @@ use super::roots::brent;
 use crate::error::{check_positive, Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem, StateLayout};
-use crate::ode::{self, DenseOutput, Integrator, Method, Options, Stats, StepStatus};
+use crate::ode::{self, Integrator, Method, Options, Stats, StepStatus};
 use nalgebra::{
     allocator::Allocator, DefaultAllocator, DimName, OVector, U10, U4, U5, U6, U7, U8, U9,
 };
@@ -273,41 +273,69 @@ pub fn simulate_cycle(
     }
 }
 
-/// What the cycle keeps of its one integration: every step time, the step interpolants (the
-/// detector reads the contact impulse at `t` and `t − T_w` on them), and the states when a time
-/// series is asked for.
+/// What the cycle keeps of its one integration: every step time, the interpolant of the contact
+/// impulse `Q` over each step (the detector reads `Q` at `t` and `t − T_w`), and the states when a
+/// time series is asked for.
 struct Record<D: DimName>
 where
     DefaultAllocator: Allocator<D>,
 {
     times: Vec<f64>,
-    dense: DenseOutput,
+    /// Index of `Q` in the state.
+    q: usize,
+    /// Per step: start, length, and the offset of its monomial coefficients of `Q` in `coeffs`.
+    steps: Vec<(f64, f64, usize)>,
+    coeffs: Vec<f64>,
+    /// End of the covered range (the last step may have been cut).
+    end: f64,
     states: Option<Vec<OVector<f64, D>>>,
-    work: std::cell::RefCell<OVector<f64, D>>,
 }
 
 impl<D: DimName> Record<D>
 where
     DefaultAllocator: Allocator<D>,
 {
-    fn new(t0: f64, y0: &OVector<f64, D>, keep_states: bool) -> Self {
+    fn new(t0: f64, y0: &OVector<f64, D>, q: usize, keep_states: bool) -> Self {
         Record {
             times: vec![t0],
-            dense: DenseOutput::new(y0.len()),
+            q,
+            steps: Vec::new(),
+            coeffs: Vec::new(),
+            end: t0,
             states: keep_states.then(|| vec![y0.clone()]),
-            work: std::cell::RefCell::new(y0.clone()),
         }
     }
 
-    /// Component `i` at time `t` on the interpolants; `None` outside the integrated range.
-    fn sample(&self, t: f64, i: usize) -> Option<f64> {
-        let mut w = self.work.borrow_mut();
-        self.dense.eval_into(t, &mut w).then(|| w[i])
+    /// Keeps the `Q` part of the last step's interpolant, valid up to `t_end`.
+    /// (`coeffs[m·n + i]` is component `i` of the coefficient of `θ^m` on `[t0, t0 + h]`.)
+    fn push_step(&mut self, t0: f64, h: f64, n: usize, coeffs: &[f64], t_end: f64) {
+        self.steps.push((t0, h, self.coeffs.len()));
+        self.coeffs
+            .extend(coeffs.iter().skip(self.q).step_by(n.max(1)));
+        self.end = t_end;
     }
 
-    /// Drops everything after `t` (inside the last step).
+    /// `Q(t)` on the interpolants; `None` outside the integrated range.
+    fn impulse(&self, t: f64) -> Option<f64> {
+        let first = self.steps.first()?.0;
+        if !(t >= first && t <= self.end) {
+            return None;
+        }
+        let k = self.steps.partition_point(|s| s.0 <= t).saturating_sub(1);
+        let (t0, h, lo) = self.steps[k];
+        let hi = self.steps.get(k + 1).map_or(self.coeffs.len(), |s| s.2);
+        let theta = if h != 0.0 { (t - t0) / h } else { 0.0 };
+        Some(
+            self.coeffs[lo..hi]
+                .iter()
+                .rev()
+                .fold(0.0, |acc, &c| acc * theta + c),
+        )
+    }
+
+    /// Drops every step time after `t` (inside the last step).
     fn truncate(&mut self, t: f64) {
-        self.dense.truncate_last(t);
+        self.end = t;
         let keep = self.times.partition_point(|&s| s <= t);
         self.times.truncate(keep);
         if let Some(st) = self.states.as_mut() {
@@ -321,7 +349,6 @@ where
     DefaultAllocator: Allocator<D>,
 {
     rec: &'a Record<D>,
-    q: usize,
     detector: Detector,
 }
 
@@ -332,7 +359,7 @@ where
     /// Running mean of the contact force at `t ≥ T_w`.
     fn indicator(&self, t: f64) -> f64 {
         let w = self.detector.window;
-        match (self.rec.sample(t, self.q), self.rec.sample(t - w, self.q)) {
+        match (self.rec.impulse(t), self.rec.impulse(t - w)) {
             (Some(a), Some(b)) => (a - b) / w,
             _ => f64::NAN,
         }
@@ -409,9 +436,10 @@ where
             .it
             .step()
             .map_err(|e| explain_ode_error(model, opts, e))?;
-        self.rec.dense.push(&self.it.poly);
+        let p = &self.it.poly;
+        self.rec
+            .push_step(p.t0, p.h, p.n, &p.coeffs, self.it.t());
         if let StepStatus::Terminated(_) = status {
-            self.rec.dense.truncate_last(self.it.t());
             return Err(left_the_model(
                 model,
                 self.it.system(),
@@ -514,7 +542,7 @@ where
         .events([guard]);
     let mut run = Run {
         it,
-        rec: Record::new(t0, &y0, opts.keep_series),
+        rec: Record::new(t0, &y0, q, opts.keep_series),
         model,
         opts,
     };
@@ -536,7 +564,6 @@ where
                 let t = run.it.t();
                 let found = Detecting {
                     rec: &run.rec,
-                    q,
                     detector: det,
                 }
                 .first_crossing(checked, t, true)?;
@@ -571,10 +598,7 @@ where
                 }
                 run.to_end()?;
             } else if run.it.t() > t_peak {
-                let mut y = y0.clone();
-                if !run.rec.dense.eval_into(t_peak, &mut y) {
-                    return Err(Error::analysis("triggered cycle", "turning point not covered"));
-                }
+                let y = run.it.interpolate(t_peak).map_err(ode_err)?;
                 run.rec.truncate(t_peak);
                 if run.rec.times.last().is_some_and(|&t| t < t_peak) {
                     run.rec.times.push(t_peak);
@@ -593,7 +617,6 @@ where
 
     let detecting = Detecting {
         rec: &run.rec,
-        q,
         detector: det,
     };
     let end = final_programme.end_time();
