@@ -24,6 +24,13 @@ use std::time::Instant;
 /// long; the paper scene needs 200).
 const MAX_TRIGGERED_SEGMENTS: f64 = 1e5;
 
+/// `Auto` starts with the stiff method when the explicit method's stability limit alone would
+/// take more steps than this over the programme (the rigid paper scene needs about 1.3e3; a bulge
+/// ringing at hundreds of MHz, or a nanosecond interface lag, 1e6 and more). Auto would switch
+/// after its first stiffness checks anyway, but its explicit trial steps on the way throw the
+/// state out of the force tables, where every force is an exact quadrature.
+const EXPLICIT_STEPS_FOR_STIFF: f64 = 1e5;
+
 /// The heater programme of a cycle.
 #[derive(Clone, Debug, PartialEq)]
 pub enum HeaterProgramme {
@@ -62,7 +69,10 @@ pub struct SolverSettings {
     pub atol_displacement: f64,
     /// Largest step (s); `None`: a twentieth of the period of `V²` with AC, else unlimited.
     pub max_step: Option<f64>,
-    /// Step limit.
+    /// Step limit of the whole cycle (accepted and rejected steps). A cycle also stops early once
+    /// it runs at more than twice the pace that would spend the limit evenly over the programme
+    /// (after a tenth of the limit as a start allowance): a contact that bounces without bound
+    /// would otherwise use the whole limit on its first microseconds.
     pub max_steps: usize,
 }
 
@@ -423,6 +433,8 @@ where
     rec: Record<D>,
     model: &'m SliderModel,
     opts: &'m CycleOptions,
+    /// Start and length of the programme, for the step pace.
+    span: (f64, f64),
 }
 
 impl<D: DimName> Run<'_, D>
@@ -439,6 +451,13 @@ where
         let p = &self.it.poly;
         self.rec
             .push_step(p.t0, p.h, p.n, &p.coeffs, self.it.t());
+        let st = self.it.stats();
+        let (t0, span) = self.span;
+        let max = opts.solver.max_steps as f64;
+        let pace_limit = max * (0.1 + 2.0 * (self.it.t() - t0) / span);
+        if (st.accepted + st.rejected) as f64 > pace_limit && self.it.t() < t0 + span {
+            return Err(out_of_step_budget(opts, self.it.t(), st, span));
+        }
         if let StepStatus::Terminated(_) = status {
             return Err(left_the_model(
                 model,
@@ -537,7 +556,8 @@ where
         .direction(ode::Direction::Falling)
         .terminal(true);
     let end = initial_programme.end_time();
-    let it = Integrator::new(sys, t0, y0.clone(), end, opts.solver.method, &ode_opts)
+    let method = cycle_method(model, &opts.solver, end - t0);
+    let it = Integrator::new(sys, t0, y0.clone(), end, method, &ode_opts)
         .map_err(|e| explain_ode_error(model, opts, e))?
         .events([guard]);
     let mut run = Run {
@@ -545,6 +565,7 @@ where
         rec: Record::new(t0, &y0, q, opts.keep_series),
         model,
         opts,
+        span: (t0, end - t0),
     };
 
     let final_programme;
@@ -656,6 +677,23 @@ where
     })
 }
 
+/// The method of a cycle: as asked, except that `Auto` on a slider whose fastest rate no explicit
+/// step can follow over `span` is its stiff method from the start (Radau5 or Rodas5P by the
+/// tolerance, as `Auto` would choose).
+fn cycle_method(model: &SliderModel, s: &SolverSettings, span: f64) -> Method {
+    let explicit_steps = span * model.fastest_rate() / ode::EXPLICIT_STABILITY_BOUNDARY;
+    match s.method {
+        Method::Auto if explicit_steps > EXPLICIT_STEPS_FOR_STIFF => {
+            if s.rtol < ode::AUTO_RADAU_BELOW_RTOL {
+                Method::Radau5
+            } else {
+                Method::Rodas5P
+            }
+        }
+        m => m,
+    }
+}
+
 fn ode_options(sys: &SliderSystem, opts: &CycleOptions, kinks: Vec<f64>) -> Result<Options> {
     let s = opts.solver;
     // The integrals only need the accuracy the detector and the mean temperature use.
@@ -708,6 +746,20 @@ where
         }
     }
     Error::analysis("cycle", reason)
+}
+
+/// The error for a cycle that spends its steps too fast (see [`SolverSettings::max_steps`]).
+fn out_of_step_budget(opts: &CycleOptions, t: f64, st: Stats, span: f64) -> Error {
+    Error::analysis(
+        "cycle",
+        format!(
+            "{} steps by t = {t:.4e} s, more than twice the pace that spends solver.max_steps = {} \
+             evenly over the {span:.4e} s programme: the cycle would run out of steps (a contact \
+             that bounces without bound, or a tolerance too strict for the method)",
+            st.accepted + st.rejected,
+            opts.solver.max_steps
+        ),
+    )
 }
 
 /// ODE errors of an explicit method on a stiff cycle get the advice to use a stiff method.

@@ -48,6 +48,9 @@ pub use dense::DenseOutput;
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
 pub use integrator::{Integrator, StepStatus};
+/// What `Auto` is made of, for callers that know their problem is stiff from the start.
+pub(crate) use integrator::AUTO_RADAU_BELOW_RTOL;
+pub(crate) use tsit5::STABILITY_BOUNDARY as EXPLICIT_STABILITY_BOUNDARY;
 pub use options::{Method, Options, SaveAt, Tolerance};
 pub use problem::OdeProblem;
 pub use solution::{Solution, Stats};
