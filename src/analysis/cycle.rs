@@ -456,7 +456,7 @@ where
         let max = opts.solver.max_steps as f64;
         let pace_limit = max * (0.1 + 2.0 * (self.it.t() - t0) / span);
         if (st.accepted + st.rejected) as f64 > pace_limit && self.it.t() < t0 + span {
-            return Err(out_of_step_budget(opts, self.it.t(), st, span));
+            return Err(out_of_step_budget(model, opts, self.it.t(), st, span));
         }
         if let StepStatus::Terminated(_) = status {
             return Err(left_the_model(
@@ -748,35 +748,61 @@ where
     Error::analysis("cycle", reason)
 }
 
-/// The error for a cycle that spends its steps too fast (see [`SolverSettings::max_steps`]).
-fn out_of_step_budget(opts: &CycleOptions, t: f64, st: Stats, span: f64) -> Error {
-    Error::analysis(
-        "cycle",
-        format!(
-            "{} steps by t = {t:.4e} s, more than twice the pace that spends solver.max_steps = {} \
-             evenly over the {span:.4e} s programme: the cycle would run out of steps (a contact \
-             that bounces without bound, or a tolerance too strict for the method)",
-            st.accepted + st.rejected,
-            opts.solver.max_steps
+/// The error for a cycle that spends its steps too fast (see [`SolverSettings::max_steps`]);
+/// with an explicit method, the advice of [`explain_ode_error`].
+fn out_of_step_budget(
+    model: &SliderModel,
+    opts: &CycleOptions,
+    t: f64,
+    st: Stats,
+    span: f64,
+) -> Error {
+    let max_steps = opts.solver.max_steps;
+    let pace = format!(
+        "{} steps by t = {t:.4e} s, more than twice the pace that spends them evenly over the \
+         {span:.4e} s programme",
+        st.accepted + st.rejected
+    );
+    match stiff_advice(model, opts) {
+        Some(advice) => Error::analysis(
+            "cycle",
+            format!(
+                "the explicit method {} would use up its {max_steps} steps ({pace}): {advice}",
+                opts.solver.method
+            ),
         ),
-    )
+        None => Error::analysis(
+            "cycle",
+            format!(
+                "the cycle would use up solver.max_steps = {max_steps} ({pace}): a contact that \
+                 bounces without bound, or a tolerance too strict for the method"
+            ),
+        ),
+    }
+}
+
+/// Why an explicit method runs out of steps on the slider; `None` for the other methods.
+fn stiff_advice(model: &SliderModel, opts: &CycleOptions) -> Option<String> {
+    matches!(opts.solver.method, Method::Tsit5 | Method::Dop853).then(|| {
+        format!(
+            "the system is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact \
+             and lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
+            model.fastest_rate()
+        )
+    })
 }
 
 /// ODE errors of an explicit method on a stiff cycle get the advice to use a stiff method.
 fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError) -> Error {
-    let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
-    match e {
-        ode::OdeError::TooManySteps { t, max_steps } if explicit => Error::analysis(
+    match (e, stiff_advice(model, opts)) {
+        (ode::OdeError::TooManySteps { t, max_steps }, Some(advice)) => Error::analysis(
             "cycle",
             format!(
-                "the explicit method {} used up its {max_steps} steps at t = {t:e} s: the system \
-                 is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact and \
-                 lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
-                opts.solver.method,
-                model.fastest_rate()
+                "the explicit method {} used up its {max_steps} steps at t = {t:e} s: {advice}",
+                opts.solver.method
             ),
         ),
-        other => Error::Ode(other),
+        (other, _) => Error::Ode(other),
     }
 }
 
