@@ -5,9 +5,12 @@
 //! - `zeta`: V_ac × the bulge's damping ratio (`bulge`);
 //! - `lag_rigid`, `lag_bulge`: V_ac × the interface lag τ, on `rigid` and on `bulge`.
 //!
-//! Every point runs the scene's fixed programme twice, at the scene's tolerance and at one ten
-//! times tighter (`ac_sweep_refined` with two runs): a point counts as converged when touchdown
-//! and take-off move by at most 0.05 mW between the two. The heatmaps colour only converged
+//! Every point runs the scene's fixed programme at the scene's tolerance, and where that run
+//! gives touchdown and take-off, once more at a tolerance ten times tighter as a check: a point
+//! counts as converged when touchdown and take-off move by at most 0.05 mW between the two
+//! (`--full-check`: both runs at every point and the tighter one shown, `ac_sweep_refined` with
+//! two runs, as the maps in docs/analyses.md were made). The output gives each map's CPU time
+//! per status. The heatmaps colour only converged
 //! points with both detections (and, for `ΔP`, a non-negative value); the others are drawn in
 //! grey or black and named in the legend. A white dot marks a point whose contact force drops to
 //! zero during the hold at the highest power (the contact bounces). The outlined band is the
@@ -247,12 +250,7 @@ impl Setup {
             steps: 0,
             runs: 1,
         };
-        let power = |r: &CycleResult| {
-            (
-                r.touchdown.map(|d| d.power),
-                r.takeoff.map(|d| d.power),
-            )
-        };
+        let power = |r: &CycleResult| (r.touchdown.map(|d| d.power), r.takeoff.map(|d| d.power));
         let outcome = if full_check {
             let refine = Refinement {
                 power_tol: POWER_TOL,

@@ -449,8 +449,7 @@ where
             .step()
             .map_err(|e| explain_ode_error(model, opts, e))?;
         let p = &self.it.poly;
-        self.rec
-            .push_step(p.t0, p.h, p.n, &p.coeffs, self.it.t());
+        self.rec.push_step(p.t0, p.h, p.n, &p.coeffs, self.it.t());
         let st = self.it.stats();
         let (t0, span) = self.span;
         let max = opts.solver.max_steps as f64;

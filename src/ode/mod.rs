@@ -47,16 +47,16 @@ mod tsit5;
 pub use dense::DenseOutput;
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
-pub use integrator::{Integrator, StepStatus};
 /// What `Auto` is made of, for callers that know their problem is stiff from the start.
 pub(crate) use integrator::AUTO_RADAU_BELOW_RTOL;
-pub(crate) use tsit5::STABILITY_BOUNDARY as EXPLICIT_STABILITY_BOUNDARY;
+pub use integrator::{Integrator, StepStatus};
 pub use options::{Method, Options, SaveAt, Tolerance};
 pub use problem::OdeProblem;
 pub use solution::{Solution, Stats};
 pub use system::{
     complex_step_jacobian, finite_difference_jacobian, FnSystem, NoJacobian, OdeSystem,
 };
+pub(crate) use tsit5::STABILITY_BOUNDARY as EXPLICIT_STABILITY_BOUNDARY;
 
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
