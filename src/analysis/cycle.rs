@@ -473,7 +473,7 @@ where
     }
 
     /// Steps until the end time.
-    fn to_end(&mut self) -> Result<()> {
+    fn run_to_end(&mut self) -> Result<()> {
         while self.step()? != StepStatus::ReachedEnd {}
         Ok(())
     }
@@ -571,7 +571,7 @@ where
     let search_from;
     match triggered {
         None => {
-            run.to_end()?;
+            run.run_to_end()?;
             final_programme = initial_programme.clone();
             search_from = final_programme.end_of_hold();
         }
@@ -616,7 +616,7 @@ where
                 if t_peak < run.it.tf() {
                     run.it.set_tf(t_peak).map_err(ode_err)?;
                 }
-                run.to_end()?;
+                run.run_to_end()?;
             } else if run.it.t() > t_peak {
                 let y = run.it.interpolate(t_peak).map_err(ode_err)?;
                 run.rec.truncate(t_peak);
@@ -630,7 +630,7 @@ where
             }
             *run.it.system_mut() = SliderSystem::new(model, final_programme.clone(), true);
             run.it.set_tf(t_end).map_err(ode_err)?;
-            run.to_end()?;
+            run.run_to_end()?;
             search_from = t_peak;
         }
     }
