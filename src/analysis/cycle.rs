@@ -20,8 +20,8 @@ use nalgebra::{
 use serde::Serialize;
 use std::time::Instant;
 
-/// Largest number of segments of the touchdown-triggered search (each `overshoot / ramp_rate`
-/// long; the paper scene needs 200).
+/// Largest length of the touchdown-triggered search, in overshoots (`overshoot / ramp_rate` of
+/// time each; the paper scene's search spans 200).
 const MAX_TRIGGERED_SEGMENTS: f64 = 1e5;
 
 /// `Auto` starts with the stiff method when the explicit method's stability limit alone would
@@ -502,8 +502,8 @@ where
             crate::error::check_non_negative("programme.start_power", start_power)?;
             // Search up to the power whose protrusion is twice the nominal clearance.
             let span = 2.0 * model.nominal_clearance / model.efficiency;
-            // The search runs in segments of `overshoot`; bound their number so that a heater
-            // too weak to ever reach touchdown fails at once instead of running for ever.
+            // Bound the search, in overshoots, so that a heater too weak to ever reach touchdown
+            // fails at once instead of running for ever.
             let segments = span / overshoot;
             if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
                 return Err(Error::analysis(
