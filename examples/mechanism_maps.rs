@@ -5,9 +5,12 @@
 //! - `zeta`: V_ac × the bulge's damping ratio (`bulge`);
 //! - `lag_rigid`, `lag_bulge`: V_ac × the interface lag τ, on `rigid` and on `bulge`.
 //!
-//! Every point runs the scene's fixed programme twice, at the scene's tolerance and at one ten
-//! times tighter (`ac_sweep_refined` with two runs): a point counts as converged when touchdown
-//! and take-off move by at most 0.05 mW between the two. The heatmaps colour only converged
+//! Every point runs the scene's fixed programme at the scene's tolerance, and where that run
+//! gives touchdown and take-off, once more at a tolerance ten times tighter as a check: a point
+//! counts as converged when touchdown and take-off move by at most 0.05 mW between the two
+//! (`--full-check`: both runs at every point and the tighter one shown, `ac_sweep_refined` with
+//! two runs, as the maps in docs/analyses.md were made). The output gives each map's CPU time
+//! per status. The heatmaps colour only converged
 //! points with both detections (and, for `ΔP`, a non-negative value); the others are drawn in
 //! grey or black and named in the legend. A white dot marks a point whose contact force drops to
 //! zero during the hold at the highest power (the contact bounces). The outlined band is the
@@ -18,7 +21,7 @@
 //! Radau5 at a hundredfold tighter tolerance. Without `--grid` a 6 × 6 grid runs (a few minutes
 //! for all four maps on two cores; the test runs a 3 × 3 map in seconds).
 
-use hdi_tribology::analysis::cycle::{CycleOptions, HeaterProgramme};
+use hdi_tribology::analysis::cycle::{CycleOptions, CycleResult, HeaterProgramme};
 use hdi_tribology::analysis::{ac_sweep_refined, simulate_cycle, Refinement};
 use hdi_tribology::model::{SliderModel, Structure};
 use hdi_tribology::ode::Method;
@@ -146,6 +149,11 @@ struct Point {
     to: Option<f64>,
     status: Status,
     bounce: bool,
+    /// CPU time of the point's cycles (s) and their accepted steps.
+    cpu: f64,
+    steps: usize,
+    /// Cycles run for the point (1 without a check run, 2 with one).
+    runs: usize,
 }
 
 impl Point {
@@ -221,15 +229,16 @@ impl Setup {
         Ok(m)
     }
 
-    fn run(&self, axis: Axis, param: f64, v_ac: f64) -> Res<Point> {
+    /// One map point. The cycle at the scene's tolerance gives the values; a second cycle at a
+    /// tenfold tighter tolerance checks them (converged when touchdown and take-off move by at
+    /// most `POWER_TOL`). Where the first cycle already fails (the slider runs into the disk or
+    /// the stepper gives up) or misses touchdown or take-off, the point is marked as such
+    /// without the check run: no value is shown there, so there is nothing to check.
+    /// `full_check` runs the check everywhere and reports the tighter run instead (the earlier
+    /// scheme, for comparison).
+    fn run(&self, axis: Axis, param: f64, v_ac: f64, full_check: bool) -> Res<Point> {
         let m = self.model(axis, param, v_ac)?;
-        let refine = Refinement {
-            power_tol: POWER_TOL,
-            // The maps show powers only: the mean temperature rise is not checked.
-            temperature_tol: f64::MAX,
-            factor: 0.1,
-            max_runs: 2,
-        };
+        let cpu0 = thread_cpu_seconds();
         let mut p = Point {
             v_ac,
             param,
@@ -237,21 +246,61 @@ impl Setup {
             to: None,
             status: Status::Runaway,
             bounce: false,
+            cpu: 0.0,
+            steps: 0,
+            runs: 1,
         };
-        let r = match ac_sweep_refined(&m, &self.programme, &self.opts, &[v_ac], &refine) {
-            Ok(mut r) => r.remove(0),
-            // The slider entering the disk, or the stepper giving up, is a property of this
-            // point: mark it, do not stop the map.
-            Err(_) => return Ok(p),
+        let power = |r: &CycleResult| (r.touchdown.map(|d| d.power), r.takeoff.map(|d| d.power));
+        let outcome = if full_check {
+            let refine = Refinement {
+                power_tol: POWER_TOL,
+                // The maps show powers only: the mean temperature rise is not checked.
+                temperature_tol: f64::MAX,
+                factor: 0.1,
+                max_runs: 2,
+            };
+            ac_sweep_refined(&m, &self.programme, &self.opts, &[v_ac], &refine).map(|mut r| {
+                let r = r.remove(0);
+                p.runs = r.runs;
+                p.steps = r.stats.accepted;
+                (r.cycle, Some(r.converged))
+            })
+        } else {
+            simulate_cycle(&m, &self.programme, &self.opts).and_then(|first| {
+                p.steps = first.stats.accepted;
+                let (td, to) = power(&first);
+                if td.is_none() || to.is_none() {
+                    return Ok((first, None));
+                }
+                let mut o = self.opts;
+                o.keep_series = false;
+                o.solver.rtol *= 0.1;
+                o.solver.atol_displacement *= 0.1;
+                let check = simulate_cycle(&m, &self.programme, &o)?;
+                p.runs = 2;
+                p.steps += check.stats.accepted;
+                let (td2, to2) = power(&check);
+                let moved = |a: Option<f64>, b: Option<f64>| match (a, b) {
+                    (Some(a), Some(b)) => (a - b).abs(),
+                    _ => f64::INFINITY,
+                };
+                let converged = moved(td, td2).max(moved(to, to2)) <= POWER_TOL;
+                Ok((first, Some(converged)))
+            })
         };
-        p.td = r.cycle.touchdown.map(|d| d.power);
-        p.to = r.cycle.takeoff.map(|d| d.power);
-        p.status = match (p.td, p.to, r.converged) {
-            (Some(_), Some(_), true) => Status::Fine,
-            (Some(_), Some(_), false) => Status::Unconverged,
+        p.cpu = thread_cpu_seconds() - cpu0;
+        // The slider entering the disk, or the stepper giving up, is a property of this point:
+        // mark it, do not stop the map.
+        let Ok((r, converged)) = outcome else {
+            return Ok(p);
+        };
+        (p.td, p.to) = power(&r);
+        p.status = match (p.td, p.to, converged) {
+            (Some(_), Some(_), Some(true)) => Status::Fine,
+            (Some(_), Some(_), _) => Status::Unconverged,
             _ => Status::Undetected,
         };
-        if let Some(s) = &r.cycle.series {
+        if let Some(s) = &r.series {
             p.bounce = p.td.is_some()
                 && s.t
                     .iter()
@@ -262,13 +311,22 @@ impl Setup {
     }
 }
 
+/// CPU time of the calling thread (s), from `/proc/thread-self/schedstat` (0 where the kernel
+/// does not report it).
+fn thread_cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(0.0, |ns| ns * 1e-9)
+}
+
 fn log_grid((lo, hi): (f64, f64), n: usize) -> Vec<f64> {
     (0..n)
         .map(|j| lo + (hi - lo) * j as f64 / (n.max(2) - 1) as f64)
         .collect()
 }
 
-fn run_map(setup: &Setup, spec: &MapSpec, n: usize) -> Res<Vec<Point>> {
+fn run_map(setup: &Setup, spec: &MapSpec, n: usize, full_check: bool) -> Res<Vec<Point>> {
     let volts = log_grid((0.0, 1.0), n);
     let params = log_grid(spec.range, n);
     let cells: Vec<(f64, f64)> = params
@@ -277,7 +335,11 @@ fn run_map(setup: &Setup, spec: &MapSpec, n: usize) -> Res<Vec<Point>> {
         .collect();
     cells
         .par_iter()
-        .map(|&(v, p)| setup.run(spec.axis, p, v).map_err(|e| e.to_string()))
+        .map(|&(v, p)| {
+            setup
+                .run(spec.axis, p, v, full_check)
+                .map_err(|e| e.to_string())
+        })
         .collect::<Result<Vec<_>, String>>()
         .map_err(Into::into)
 }
@@ -470,6 +532,9 @@ fn write_points(path: &Path, points: &[Point]) -> Res<()> {
             "hysteresis_w",
             "status",
             "bounce",
+            "cpu_s",
+            "steps",
+            "runs",
         ],
         &[
             &col(&|p| p.v_ac),
@@ -479,9 +544,49 @@ fn write_points(path: &Path, points: &[Point]) -> Res<()> {
             &col(&|p| p.dp().unwrap_or(nan)),
             &col(&|p| p.status.code()),
             &col(&|p| p.bounce as u8 as f64),
+            &col(&|p| p.cpu),
+            &col(&|p| p.steps as f64),
+            &col(&|p| p.runs as f64),
         ],
     )?;
     Ok(())
+}
+
+/// Where a map's time goes: CPU time and steps per status, and the whole map's CPU time scaled
+/// to 100 × 100 points on two cores.
+fn cost(spec: &MapSpec, points: &[Point], wall: f64) {
+    let total: f64 = points.iter().map(|p| p.cpu).sum();
+    println!(
+        "{:<10} cost: {} points, wall {wall:.1} s, CPU {total:.1} s ({:.1} ms per point); \
+         100 × 100 at this CPU per point on 2 cores: {:.1} min",
+        spec.name,
+        points.len(),
+        1e3 * total / points.len() as f64,
+        total / points.len() as f64 * 1e4 / 2.0 / 60.0
+    );
+    for s in [
+        Status::Fine,
+        Status::Unconverged,
+        Status::Undetected,
+        Status::Runaway,
+    ] {
+        let these: Vec<&Point> = points.iter().filter(|p| p.status == s).collect();
+        if these.is_empty() {
+            continue;
+        }
+        let cpu: f64 = these.iter().map(|p| p.cpu).sum();
+        let steps: usize = these.iter().map(|p| p.steps).sum();
+        let runs: usize = these.iter().map(|p| p.runs).sum();
+        println!(
+            "{:<10}   {s:?}: {} points, CPU {cpu:.1} s ({:.0} % of the map), {:.0} steps per \
+             cycle, {:.2} cycles per point",
+            "",
+            these.len(),
+            100.0 * cpu / total.max(1e-300),
+            steps as f64 / runs.max(1) as f64,
+            runs as f64 / these.len() as f64
+        );
+    }
 }
 
 /// Per map: inside the plausible band, the largest shift of `P_TO` and `P_TD` from their value
@@ -526,7 +631,7 @@ fn summarise(spec: &MapSpec, points: &[Point]) {
 fn check(setup: &Setup, spec: &MapSpec, points: &[Point]) -> Res<()> {
     let mid = 10f64.powf(0.5 * (spec.plausible.0 + spec.plausible.1));
     for v in [0.0, 0.4, 0.8] {
-        let p = setup.run(spec.axis, mid, v)?;
+        let p = setup.run(spec.axis, mid, v, true)?;
         let m = setup.model(spec.axis, mid, v)?;
         let mut o = setup.opts;
         o.keep_series = false;
@@ -576,6 +681,7 @@ fn main() -> Res<()> {
         Scene::from_path(value("--scene").unwrap_or_else(|| "scenes/paper_bulge.toml".into()))?;
     let names = value("--maps").unwrap_or_else(|| "freq,zeta,lag_rigid,lag_bulge".into());
     let setup = Setup::from_scene(&scene)?;
+    let full_check = args.iter().any(|a| a == "--full-check");
     println!(
         "# {} ({} × {} grid, {} threads); scene bulge {:.3e} kg, {:.3e} N/m ({:.1} MHz), ζ = {}",
         scene.name,
@@ -592,8 +698,9 @@ fn main() -> Res<()> {
         .filter(|s| names.split(',').any(|x| x == s.name))
     {
         let clock = Instant::now();
-        let points = run_map(&setup, spec, n)?;
+        let points = run_map(&setup, spec, n, full_check)?;
         let wall = clock.elapsed().as_secs_f64();
+        cost(spec, &points, wall);
         draw_map(&out.join(format!("{}.svg", spec.name)), spec, &points, n)?;
         write_points(&out.join(format!("{}.csv", spec.name)), &points)?;
         println!(
@@ -624,7 +731,7 @@ mod tests {
         ))?;
         let setup = Setup::from_scene(&scene)?;
         let spec = MAPS[2];
-        let points = run_map(&setup, &spec, 3)?;
+        let points = run_map(&setup, &spec, 3, false)?;
         assert_eq!(points.len(), 9);
         let p = points[0];
         assert_eq!((p.v_ac, p.param), (0.0, 1e-10));

@@ -14,7 +14,8 @@
 //!
 //! Run with `cargo run --release --example work_precision`; `-- --quick` runs every second
 //! tolerance only, `-- --out DIR` writes into `DIR`; `-- --stepping` prints only the cost of
-//! stepping the `Integrator` by hand against `solve` (Van der Pol, interleaved runs, CPU time).
+//! stepping the `Integrator` by hand against `solve` (Van der Pol, interleaved runs, CPU time);
+//! `-- --slider` runs only the slider rows (no table file, no charts, no sweep report).
 //! Once a run has taken more than a few seconds, progress (problem and method done, time so far)
 //! goes to stderr; the table stays on stdout.
 
@@ -494,6 +495,13 @@ fn main() -> Res<()> {
     let mut rows = Vec::new();
     let progress = Progress(clock);
     print_header();
+    if args.iter().any(|a| a == "--slider") {
+        let slider = Slider::new()?;
+        for v_ac in [0.0, 0.6] {
+            run_slider(&slider, v_ac, &slider_rtols, &mut rows)?;
+        }
+        return Ok(());
+    }
     run_problem(&problems::exact(), &rtols, &mut rows, &progress);
     run_problem(&problems::van_der_pol(), &rtols, &mut rows, &progress);
     run_problem(&problems::robertson(), &rtols, &mut rows, &progress);

@@ -46,3 +46,63 @@ fn a_short_interface_lag_runs_through() {
     let h = r.hysteresis.unwrap();
     assert!(h > 0.0 && h.is_finite(), "{r:?}");
 }
+
+/// A bulge ringing at 142 MHz beside a 0.1 ns interface lag at 1 V AC: the few-peak contact
+/// bounces without bound. The cycle used its whole 3e5-step budget (7 s) on the first 73 µs of
+/// a 10 ms programme; it now stops once it spends steps at more than twice the even pace.
+#[test]
+fn a_cycle_spending_steps_too_fast_stops_early() {
+    let scene = Scene::from_path(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/paper_bulge.toml"
+    ))
+    .unwrap();
+    let mut model = SliderModel::from_scene(&scene).unwrap();
+    model.voltage.ac_amplitude = 1.0;
+    model.interface_lag = 1e-10;
+    let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
+    let mut opts = CycleOptions::from_scene(&scene).unwrap();
+    opts.solver.max_steps = 300_000;
+    match simulate_cycle(&model, &programme, &opts) {
+        Err(Error::Analysis { what, reason }) => {
+            assert_eq!(what, "cycle");
+            assert!(reason.contains("max_steps = 300000"), "{reason}");
+            // The steps spent are named: far fewer than the budget.
+            let spent: usize = reason
+                .split(" steps by t")
+                .next()
+                .and_then(|s| s.rsplit(' ').next())
+                .and_then(|s| s.trim_start_matches('(').parse().ok())
+                .unwrap();
+            assert!(spent < 100_000, "{reason}");
+        }
+        other => panic!("expected the step-pace error, got {other:?}"),
+    }
+}
+
+/// `auto` on a bulge at hundreds of MHz starts with its stiff method (its explicit steps would
+/// be limited to about a nanosecond), and gives the same hysteresis as Rodas5P asked for
+/// directly, bit for bit.
+#[test]
+fn auto_on_a_stiff_structure_starts_stiff() {
+    use hdi_tribology::model::Structure;
+    use hdi_tribology::ode::Method;
+    let scene = Scene::paper();
+    let mut model = SliderModel::from_scene(&scene).unwrap();
+    model.structure = Structure::bulge(scene.slider.mass_kg, 1e-13, 8e5, 0.05).unwrap();
+    let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
+    let mut opts = CycleOptions::from_scene(&scene).unwrap();
+    assert_eq!((opts.solver.method, opts.solver.rtol), (Method::Auto, 1e-6));
+    let auto = simulate_cycle(&model, &programme, &opts).unwrap();
+    assert_eq!(auto.stats.stiffness_switches, 0, "{:?}", auto.stats);
+    assert_eq!(auto.stats.stiff_steps, auto.stats.accepted);
+    opts.solver.method = Method::Rodas5P;
+    let rodas = simulate_cycle(&model, &programme, &opts).unwrap();
+    assert_eq!(auto.hysteresis, rodas.hysteresis);
+    assert!(auto.hysteresis.is_some_and(|h| h > 0.0));
+    // The rigid paper scene keeps Auto's switching (it starts explicit).
+    let rigid = SliderModel::from_scene(&scene).unwrap();
+    opts.solver.method = Method::Auto;
+    let r = simulate_cycle(&rigid, &programme, &opts).unwrap();
+    assert!(r.stats.stiff_steps < r.stats.accepted, "{:?}", r.stats);
+}

@@ -13,16 +13,23 @@ use super::roots::brent;
 use crate::error::{check_positive, Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem, StateLayout};
-use crate::ode::{self, Method, Options, SaveAt, Solution, Stats};
+use crate::ode::{self, Integrator, Method, Options, Stats, StepStatus};
 use nalgebra::{
     allocator::Allocator, DefaultAllocator, DimName, OVector, U10, U4, U5, U6, U7, U8, U9,
 };
 use serde::Serialize;
 use std::time::Instant;
 
-/// Largest number of segments of the touchdown-triggered search (each `overshoot / ramp_rate`
-/// long; the paper scene needs 200).
+/// Largest length of the touchdown-triggered search, in overshoots (`overshoot / ramp_rate` of
+/// time each; the paper scene's search spans 200).
 const MAX_TRIGGERED_SEGMENTS: f64 = 1e5;
+
+/// `Auto` starts with the stiff method when the explicit method's stability limit alone would
+/// take more steps than this over the programme (the rigid paper scene needs about 1.3e3; a bulge
+/// ringing at hundreds of MHz, or a nanosecond interface lag, 1e6 and more). Auto would switch
+/// after its first stiffness checks anyway, but its explicit trial steps on the way throw the
+/// state out of the force tables, where every force is an exact quadrature.
+const EXPLICIT_STEPS_FOR_STIFF: f64 = 1e5;
 
 /// The heater programme of a cycle.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,7 +69,10 @@ pub struct SolverSettings {
     pub atol_displacement: f64,
     /// Largest step (s); `None`: a twentieth of the period of `V²` with AC, else unlimited.
     pub max_step: Option<f64>,
-    /// Step limit.
+    /// Step limit of the whole cycle (accepted and rejected steps). A cycle also stops early once
+    /// it runs at more than twice the pace that would spend the limit evenly over the programme
+    /// (after a tenth of the limit as a start allowance): a contact that bounces without bound
+    /// would otherwise use the whole limit on its first microseconds.
     pub max_steps: usize,
 }
 
@@ -201,7 +211,7 @@ pub struct CycleResult {
     /// The programme actually run (for the triggered protocol: as fixed by the detection).
     #[serde(skip)]
     pub programme: Programme,
-    /// Solver statistics, summed over the segments.
+    /// Solver statistics of the cycle's integration.
     pub stats: Stats,
     /// Wall-clock time of the simulation (s).
     pub wall_seconds: f64,
@@ -273,29 +283,74 @@ pub fn simulate_cycle(
     }
 }
 
-/// Solutions of consecutive segments, sampled as one trajectory.
-struct Trajectory<D: DimName>
+/// What the cycle keeps of its one integration: every step time, the interpolant of the contact
+/// impulse `Q` over each step (the detector reads `Q` at `t` and `t − T_w`), and the states when a
+/// time series is asked for.
+struct Record<D: DimName>
 where
     DefaultAllocator: Allocator<D>,
 {
-    segments: Vec<Solution<D>>,
+    times: Vec<f64>,
+    /// Index of `Q` in the state.
+    q: usize,
+    /// Per step: start, length, and the offset of its monomial coefficients of `Q` in `coeffs`.
+    steps: Vec<(f64, f64, usize)>,
+    coeffs: Vec<f64>,
+    /// End of the covered range (the last step may have been cut).
+    end: f64,
+    states: Option<Vec<OVector<f64, D>>>,
 }
 
-impl<D: DimName> Trajectory<D>
+impl<D: DimName> Record<D>
 where
     DefaultAllocator: Allocator<D>,
 {
-    fn sample(&self, t: f64) -> Option<OVector<f64, D>> {
-        // The last segment that starts at or before t.
-        let i = self
-            .segments
-            .partition_point(|s| s.t.first().is_some_and(|&t0| t0 <= t));
-        let seg = self.segments.get(i.checked_sub(1)?)?;
-        seg.sample(t.min(seg.t_final()))
+    fn new(t0: f64, y0: &OVector<f64, D>, q: usize, keep_states: bool) -> Self {
+        Record {
+            times: vec![t0],
+            q,
+            steps: Vec::new(),
+            coeffs: Vec::new(),
+            end: t0,
+            states: keep_states.then(|| vec![y0.clone()]),
+        }
     }
 
-    fn step_times(&self) -> impl Iterator<Item = f64> + '_ {
-        self.segments.iter().flat_map(|s| s.t.iter().copied())
+    /// Keeps the `Q` part of the last step's interpolant, valid up to `t_end`.
+    /// (`coeffs[m·n + i]` is component `i` of the coefficient of `θ^m` on `[t0, t0 + h]`.)
+    fn push_step(&mut self, t0: f64, h: f64, n: usize, coeffs: &[f64], t_end: f64) {
+        self.steps.push((t0, h, self.coeffs.len()));
+        self.coeffs
+            .extend(coeffs.iter().skip(self.q).step_by(n.max(1)));
+        self.end = t_end;
+    }
+
+    /// `Q(t)` on the interpolants; `None` outside the integrated range.
+    fn impulse(&self, t: f64) -> Option<f64> {
+        let first = self.steps.first()?.0;
+        if !(t >= first && t <= self.end) {
+            return None;
+        }
+        let k = self.steps.partition_point(|s| s.0 <= t).saturating_sub(1);
+        let (t0, h, lo) = self.steps[k];
+        let hi = self.steps.get(k + 1).map_or(self.coeffs.len(), |s| s.2);
+        let theta = if h != 0.0 { (t - t0) / h } else { 0.0 };
+        Some(
+            self.coeffs[lo..hi]
+                .iter()
+                .rev()
+                .fold(0.0, |acc, &c| acc * theta + c),
+        )
+    }
+
+    /// Drops every step time after `t` (inside the last step).
+    fn truncate(&mut self, t: f64) {
+        self.end = t;
+        let keep = self.times.partition_point(|&s| s <= t);
+        self.times.truncate(keep);
+        if let Some(st) = self.states.as_mut() {
+            st.truncate(keep);
+        }
     }
 }
 
@@ -303,8 +358,7 @@ struct Detecting<'a, D: DimName>
 where
     DefaultAllocator: Allocator<D>,
 {
-    traj: &'a Trajectory<D>,
-    q: usize,
+    rec: &'a Record<D>,
     detector: Detector,
 }
 
@@ -315,8 +369,8 @@ where
     /// Running mean of the contact force at `t ≥ T_w`.
     fn indicator(&self, t: f64) -> f64 {
         let w = self.detector.window;
-        match (self.traj.sample(t), self.traj.sample(t - w)) {
-            (Some(a), Some(b)) => (a[self.q] - b[self.q]) / w,
+        match (self.rec.impulse(t), self.rec.impulse(t - w)) {
+            (Some(a), Some(b)) => (a - b) / w,
             _ => f64::NAN,
         }
     }
@@ -332,10 +386,17 @@ where
         if a > b {
             return Ok(None);
         }
-        let mut samples: Vec<f64> = self
-            .traj
-            .step_times()
-            .flat_map(|t| [t, t + w])
+        // Step times in (a, b) and in (a − T_w, b − T_w), the latter shifted by T_w.
+        let times = &self.rec.times;
+        let inside = |lo: f64, hi: f64| {
+            let i = times.partition_point(|&t| t <= lo);
+            let j = times.partition_point(|&t| t < hi);
+            &times[i..j.max(i)]
+        };
+        let mut samples: Vec<f64> = inside(a, b)
+            .iter()
+            .copied()
+            .chain(inside(a - w, b - w).iter().map(|&t| t + w))
             .filter(|&t| t > a && t < b)
             .collect();
         samples.push(a);
@@ -363,6 +424,61 @@ where
     }
 }
 
+/// The one integration of a cycle, with what the detector and the time series need.
+struct Run<'m, D: DimName>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    it: Integrator<'static, D, SliderSystem<'m>>,
+    rec: Record<D>,
+    model: &'m SliderModel,
+    opts: &'m CycleOptions,
+    /// Start and length of the programme, for the step pace.
+    span: (f64, f64),
+}
+
+impl<D: DimName> Run<'_, D>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    /// One accepted step, recorded; the pad-contact guard ends the cycle with an error.
+    fn step(&mut self) -> Result<StepStatus> {
+        let (model, opts) = (self.model, self.opts);
+        let status = self
+            .it
+            .step()
+            .map_err(|e| explain_ode_error(model, opts, e))?;
+        let p = &self.it.poly;
+        self.rec.push_step(p.t0, p.h, p.n, &p.coeffs, self.it.t());
+        let st = self.it.stats();
+        let (t0, span) = self.span;
+        let max = opts.solver.max_steps as f64;
+        let pace_limit = max * (0.1 + 2.0 * (self.it.t() - t0) / span);
+        if (st.accepted + st.rejected) as f64 > pace_limit && self.it.t() < t0 + span {
+            return Err(out_of_step_budget(model, opts, self.it.t(), st, span));
+        }
+        if let StepStatus::Terminated(_) = status {
+            return Err(left_the_model(
+                model,
+                self.it.system(),
+                self.it.t(),
+                self.it.state(),
+            ));
+        }
+        self.rec.times.push(self.it.t());
+        if let Some(st) = self.rec.states.as_mut() {
+            st.push(self.it.state().clone());
+        }
+        Ok(status)
+    }
+
+    /// Steps until the end time.
+    fn run_to_end(&mut self) -> Result<()> {
+        while self.step()? != StepStatus::ReachedEnd {}
+        Ok(())
+    }
+}
+
 fn run<D: DimName>(
     model: &SliderModel,
     programme: &HeaterProgramme,
@@ -386,8 +502,8 @@ where
             crate::error::check_non_negative("programme.start_power", start_power)?;
             // Search up to the power whose protrusion is twice the nominal clearance.
             let span = 2.0 * model.nominal_clearance / model.efficiency;
-            // The search runs in segments of `overshoot`; bound their number so that a heater
-            // too weak to ever reach touchdown fails at once instead of running for ever.
+            // Bound the search, in overshoots, so that a heater too weak to ever reach touchdown
+            // fails at once instead of running for ever.
             let segments = span / overshoot;
             if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
                 return Err(Error::analysis(
@@ -415,7 +531,7 @@ where
         volt2_0,
         &ScanGrid::default(),
     )?;
-    let mut sys = SliderSystem::new(model, initial_programme.clone(), true);
+    let sys = SliderSystem::new(model, initial_programme.clone(), true);
     let layout = sys.layout();
     let q = layout
         .contact_impulse
@@ -425,61 +541,56 @@ where
         .ok_or_else(|| Error::analysis("cycle", "no heat state"))?;
     let y0: OVector<f64, D> = sys.initial_state(D::name(), &eq.rest());
 
-    let ode_opts = ode_options(&sys, opts, &initial_programme)?;
-    let mut traj = Trajectory::<D> {
-        segments: Vec::new(),
+    // The fixed programme's knots are kinks of the right-hand side; the triggered programme's
+    // only interior knot, its turning point, is where the programme is replaced (a restart).
+    let kinks = match triggered {
+        None => initial_programme.knots().iter().map(|k| k.0).collect(),
+        Some(_) => Vec::new(),
     };
-    let mut stats = Stats::default();
-    let mut solve = |sys: &SliderSystem,
-                     a: f64,
-                     y: OVector<f64, D>,
-                     b: f64,
-                     o: &Options|
-     -> Result<Solution<D>> {
-        // Stop where the lumped model ends: the pad gap h0 + y reaching zero puts the slider body
-        // into the disk (no pad contact is modelled; a power-law bearing is singular there).
-        let h0 = model.nominal_clearance;
-        let mut guard = [ode::Event::new(move |_t, s: &OVector<f64, D>| h0 + s[0])
-            .direction(ode::Direction::Falling)
-            .terminal(true)];
-        let sol = ode::solve(sys, a, y, b, opts.solver.method, o, &mut guard)
-            .map_err(|e| explain_ode_error(model, opts, e))?;
-        stats += &sol.stats;
-        if sol.terminated_by_event.is_some() {
-            return Err(left_the_model(model, sys, &sol));
-        }
-        Ok(sol)
+    let ode_opts = ode_options(&sys, opts, kinks)?;
+    // Stop where the lumped model ends: the pad gap h0 + y reaching zero puts the slider body
+    // into the disk (no pad contact is modelled; a power-law bearing is singular there).
+    let h0 = model.nominal_clearance;
+    let guard = ode::Event::new(move |_t, s: &OVector<f64, D>| h0 + s[0])
+        .direction(ode::Direction::Falling)
+        .terminal(true);
+    let end = initial_programme.end_time();
+    let method = cycle_method(model, &opts.solver, end - t0);
+    let it = Integrator::new(sys, t0, y0.clone(), end, method, &ode_opts)
+        .map_err(|e| explain_ode_error(model, opts, e))?
+        .events([guard]);
+    let mut run = Run {
+        it,
+        rec: Record::new(t0, &y0, q, opts.keep_series),
+        model,
+        opts,
+        span: (t0, end - t0),
     };
 
     let final_programme;
     let search_from;
     match triggered {
         None => {
-            let end = initial_programme.end_time();
-            let sol = solve(&sys, t0, y0, end, &ode_opts)?;
-            traj.segments.push(sol);
+            run.run_to_end()?;
             final_programme = initial_programme.clone();
             search_from = final_programme.end_of_hold();
         }
         Some((start_power, rate, overshoot)) => {
+            // Ramp up, watching the detector step by step.
             let chunk = overshoot / rate;
-            let end = initial_programme.end_time();
-            let (mut t, mut y) = (t0, y0);
+            let mut checked = t0;
             let t_td = loop {
-                let t1 = (t + chunk).min(end);
-                let sol = solve(&sys, t, y, t1, &ode_opts)?;
-                y = sol.y_final().clone();
-                traj.segments.push(sol);
+                let status = run.step()?;
+                let t = run.it.t();
                 let found = Detecting {
-                    traj: &traj,
-                    q,
+                    rec: &run.rec,
                     detector: det,
                 }
-                .first_crossing(t, t1, true)?;
+                .first_crossing(checked, t, true)?;
                 if let Some(t_td) = found {
                     break t_td;
                 }
-                if t1 >= end {
+                if status == StepStatus::ReachedEnd {
                     return Err(Error::analysis(
                         "triggered cycle",
                         format!(
@@ -488,8 +599,10 @@ where
                         ),
                     ));
                 }
-                t = t1;
+                checked = t;
             };
+            // The programme turns `overshoot` after the detection: go on up the ramp to the
+            // turning point (or step back to it from a longer step), then ramp down.
             let t_peak = t_td + chunk;
             let p_peak = start_power + rate * (t_peak - t0);
             let t_end = t_peak + (p_peak - start_power) / rate;
@@ -498,18 +611,32 @@ where
                 (t_peak, p_peak),
                 (t_end, start_power),
             ])?;
-            sys = SliderSystem::new(model, final_programme.clone(), true);
-            let o = ode_options(&sys, opts, &final_programme)?;
-            let t_now = traj.segments.last().map_or(t0, |s| s.t_final());
-            let sol = solve(&sys, t_now, y, t_end, &o)?;
-            traj.segments.push(sol);
+            let ode_err = |e| explain_ode_error(model, opts, e);
+            if run.it.t() < t_peak {
+                if t_peak < run.it.tf() {
+                    run.it.set_tf(t_peak).map_err(ode_err)?;
+                }
+                run.run_to_end()?;
+            } else if run.it.t() > t_peak {
+                let y = run.it.interpolate(t_peak).map_err(ode_err)?;
+                run.rec.truncate(t_peak);
+                if run.rec.times.last().is_some_and(|&t| t < t_peak) {
+                    run.rec.times.push(t_peak);
+                    if let Some(st) = run.rec.states.as_mut() {
+                        st.push(y.clone());
+                    }
+                }
+                run.it.reinit(t_peak, y).map_err(ode_err)?;
+            }
+            *run.it.system_mut() = SliderSystem::new(model, final_programme.clone(), true);
+            run.it.set_tf(t_end).map_err(ode_err)?;
+            run.run_to_end()?;
             search_from = t_peak;
         }
     }
 
     let detecting = Detecting {
-        traj: &traj,
-        q,
+        rec: &run.rec,
         detector: det,
     };
     let end = final_programme.end_time();
@@ -528,13 +655,13 @@ where
         (Some(a), Some(b)) => Some(a.power - b.power),
         _ => None,
     };
-    let last = traj
-        .segments
-        .last()
-        .ok_or_else(|| Error::analysis("cycle", "nothing was integrated"))?;
     let duration = end - t0;
-    let mean_temperature_rise = last.y_final()[heat] / duration;
-    let series = opts.keep_series.then(|| series_of(&sys, &traj, &detecting));
+    let mean_temperature_rise = run.it.state()[heat] / duration;
+    let series = run
+        .rec
+        .states
+        .as_ref()
+        .map(|states| series_of(run.it.system(), &run.rec.times, states, &detecting));
     Ok(CycleResult {
         v_ac: model.voltage.ac_amplitude,
         touchdown,
@@ -543,13 +670,30 @@ where
         mean_temperature_rise,
         duration,
         programme: final_programme,
-        stats,
+        stats: run.it.stats(),
         wall_seconds: clock.elapsed().as_secs_f64(),
         series,
     })
 }
 
-fn ode_options(sys: &SliderSystem, opts: &CycleOptions, programme: &Programme) -> Result<Options> {
+/// The method of a cycle: as asked, except that `Auto` on a slider whose fastest rate no explicit
+/// step can follow over `span` is its stiff method from the start (Radau5 or Rodas5P by the
+/// tolerance, as `Auto` would choose).
+fn cycle_method(model: &SliderModel, s: &SolverSettings, span: f64) -> Method {
+    let explicit_steps = span * model.fastest_rate() / ode::EXPLICIT_STABILITY_BOUNDARY;
+    match s.method {
+        Method::Auto if explicit_steps > EXPLICIT_STEPS_FOR_STIFF => {
+            if s.rtol < ode::AUTO_RADAU_BELOW_RTOL {
+                Method::Radau5
+            } else {
+                Method::Rodas5P
+            }
+        }
+        m => m,
+    }
+}
+
+fn ode_options(sys: &SliderSystem, opts: &CycleOptions, kinks: Vec<f64>) -> Result<Options> {
     let s = opts.solver;
     // The integrals only need the accuracy the detector and the mean temperature use.
     let atol = sys.tolerances(
@@ -563,8 +707,7 @@ fn ode_options(sys: &SliderSystem, opts: &CycleOptions, programme: &Programme) -
         .atol_per_component(atol)
         .h_max(sys.model().max_step(s.max_step))
         .max_steps(s.max_steps)
-        .t_stops(programme.knots().iter().map(|k| k.0).collect())
-        .save(SaveAt::Steps)
+        .t_stops(kinks)
         .dense(true);
     o.validate(n)
         .map_err(|e| Error::invalid("solver", e.to_string()))?;
@@ -573,11 +716,15 @@ fn ode_options(sys: &SliderSystem, opts: &CycleOptions, programme: &Programme) -
 
 /// The error for a trajectory that left the lumped model (the pad gap reached zero), with the
 /// likely cause when an interface lag makes the contact branch self-excited.
-fn left_the_model<D: DimName>(model: &SliderModel, sys: &SliderSystem, sol: &Solution<D>) -> Error
+fn left_the_model<D: DimName>(
+    model: &SliderModel,
+    sys: &SliderSystem,
+    t: f64,
+    s: &OVector<f64, D>,
+) -> Error
 where
     DefaultAllocator: Allocator<D>,
 {
-    let (t, s) = (sol.t_final(), sol.y_final());
     let g = sys.gaps(t, s);
     let mut reason = format!(
         "at t = {t:.6e} s the pad gap h0 + y fell to zero (bulge gap d = {:.4e} m, velocity {:.3e} \
@@ -600,56 +747,95 @@ where
     Error::analysis("cycle", reason)
 }
 
-/// ODE errors of an explicit method on a stiff cycle get the advice to use a stiff method.
-fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError) -> Error {
-    let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
-    match e {
-        ode::OdeError::TooManySteps { t, max_steps } if explicit => Error::analysis(
+/// The error for a cycle that spends its steps too fast (see [`SolverSettings::max_steps`]);
+/// with an explicit method, the advice of [`explain_ode_error`].
+fn out_of_step_budget(
+    model: &SliderModel,
+    opts: &CycleOptions,
+    t: f64,
+    st: Stats,
+    span: f64,
+) -> Error {
+    let max_steps = opts.solver.max_steps;
+    let pace = format!(
+        "{} steps by t = {t:.4e} s, more than twice the pace that spends them evenly over the \
+         {span:.4e} s programme",
+        st.accepted + st.rejected
+    );
+    match stiff_advice(model, opts) {
+        Some(advice) => Error::analysis(
             "cycle",
             format!(
-                "the explicit method {} used up its {max_steps} steps at t = {t:e} s: the system \
-                 is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact and \
-                 lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
-                opts.solver.method,
-                model.fastest_rate()
+                "the explicit method {} would use up its {max_steps} steps ({pace}): {advice}",
+                opts.solver.method
             ),
         ),
-        other => Error::Ode(other),
+        None => Error::analysis(
+            "cycle",
+            format!(
+                "the cycle would use up solver.max_steps = {max_steps} ({pace}): a contact that \
+                 bounces without bound, or a tolerance too strict for the method"
+            ),
+        ),
     }
 }
 
-fn series_of<D: DimName>(sys: &SliderSystem, traj: &Trajectory<D>, det: &Detecting<D>) -> TimeSeries
+/// Why an explicit method runs out of steps on the slider; `None` for the other methods.
+fn stiff_advice(model: &SliderModel, opts: &CycleOptions) -> Option<String> {
+    matches!(opts.solver.method, Method::Tsit5 | Method::Dop853).then(|| {
+        format!(
+            "the system is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact \
+             and lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
+            model.fastest_rate()
+        )
+    })
+}
+
+/// ODE errors of an explicit method on a stiff cycle get the advice to use a stiff method.
+fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError) -> Error {
+    match (e, stiff_advice(model, opts)) {
+        (ode::OdeError::TooManySteps { t, max_steps }, Some(advice)) => Error::analysis(
+            "cycle",
+            format!(
+                "the explicit method {} used up its {max_steps} steps at t = {t:e} s: {advice}",
+                opts.solver.method
+            ),
+        ),
+        (other, _) => Error::Ode(other),
+    }
+}
+
+fn series_of<D: DimName>(
+    sys: &SliderSystem,
+    times: &[f64],
+    states: &[OVector<f64, D>],
+    det: &Detecting<D>,
+) -> TimeSeries
 where
     DefaultAllocator: Allocator<D>,
 {
     let model = sys.model();
     let mut out = TimeSeries::default();
-    let mut last_t = f64::NEG_INFINITY;
-    for seg in &traj.segments {
-        for (t, s) in seg.t.iter().zip(&seg.y) {
-            if *t <= last_t {
-                continue; // segment boundaries repeat a time
-            }
-            last_t = *t;
-            let g = sys.gaps(*t, s);
-            let volt2 = model.voltage.squared(*t);
-            let b = model.breakdown(g, volt2);
-            let f_ab = sys.bearing_force(s);
-            out.t.push(*t);
-            out.power.push(sys.programme().power(*t));
-            out.d.push(g.bulge);
-            out.air_bearing.push(f_ab);
-            out.intermolecular.push(b.intermolecular);
-            out.electrostatic.push(b.electrostatic);
-            out.contact.push(b.contact);
-            out.total.push(f_ab + b.total);
-            out.temperature_rise.push(model.flash_temperature(g));
-            out.indicator.push(if *t >= det.detector.window {
-                det.indicator(*t)
-            } else {
-                f64::NAN
-            });
-        }
+    for (t, s) in times.iter().zip(states) {
+        let t = *t;
+        let g = sys.gaps(t, s);
+        let volt2 = model.voltage.squared(t);
+        let b = model.breakdown(g, volt2);
+        let f_ab = sys.bearing_force(s);
+        out.t.push(t);
+        out.power.push(sys.programme().power(t));
+        out.d.push(g.bulge);
+        out.air_bearing.push(f_ab);
+        out.intermolecular.push(b.intermolecular);
+        out.electrostatic.push(b.electrostatic);
+        out.contact.push(b.contact);
+        out.total.push(f_ab + b.total);
+        out.temperature_rise.push(model.flash_temperature(g));
+        out.indicator.push(if t >= det.detector.window {
+            det.indicator(t)
+        } else {
+            f64::NAN
+        });
     }
     out
 }
