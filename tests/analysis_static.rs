@@ -4,27 +4,12 @@
 use hdi_tribology::analysis::*;
 use hdi_tribology::force::{Footprint, Gaps};
 use hdi_tribology::model::{SliderModel, Voltage};
-use hdi_tribology::scene::{ElectrostaticSpec, Scene};
+use hdi_tribology::scene::Scene;
 use hdi_tribology::units::EPSILON_0;
 
-/// A smooth surface with electrostatics only, on the given footprint.
-fn electrostatic_only(footprint: Footprint) -> Scene {
-    let mut s = Scene::paper();
-    s.name = "electrostatic only".into();
-    s.surface.height_sigma_m = 0.0;
-    s.intermolecular = None;
-    s.contact = None;
-    s.electrostatic = Some(ElectrostaticSpec {
-        contact_potential_v: 0.0,
-        dielectric_thickness_m: 0.0,
-        cutoff_m: Some(1e-10),
-        footprint,
-        gap: Default::default(),
-    });
-    // Keep the smooth kernel's cutoff (a step in the force) out of the table.
-    s.table.d_min_m = Some(1e-9);
-    s
-}
+#[path = "common/scenes.rs"]
+mod scenes;
+use scenes::electrostatic_only;
 
 #[test]
 fn pull_in_flat_plate_on_linear_spring_matches_closed_form() {

@@ -20,6 +20,7 @@ use hdi_tribology::scene::Scene;
 use hdi_tribology::surface::{
     Discrete, Empirical, Gaussian, GaussianHeights, PeakModel, RiceMaxima, Rician,
 };
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::Error;
 use std::sync::Arc;
 
@@ -529,7 +530,11 @@ fn analyses_in_power_need_a_working_heater() {
         overshoot: 1e-3,
     };
     match simulate_cycle(&weak, &triggered, &copts) {
-        Err(Error::Analysis { reason, .. }) => assert!(reason.contains("segments"), "{reason}"),
+        Err(Error::Analysis(AnalysisError::TooManySegments {
+            segments,
+            max_segments,
+            ..
+        })) => assert!(segments > max_segments, "{segments} {max_segments}"),
         other => panic!("expected the segment bound, got {other:?}"),
     }
 }

@@ -11,6 +11,7 @@ use hdi_tribology::heater::Programme;
 use hdi_tribology::model::{SliderModel, SliderSystem};
 use hdi_tribology::ode::{self, Method, OdeSystem, Options, SaveAt};
 use hdi_tribology::scene::Scene;
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::Error;
 use nalgebra::{DMatrix, DVector, Dyn};
 use std::path::Path;
@@ -147,12 +148,19 @@ fn explicit_method_on_a_stiff_scene_fails_with_a_clear_error() {
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
     opts.solver.method = Method::Tsit5;
     match simulate_cycle(&model, &programme, &opts) {
-        Err(Error::Analysis { reason, .. }) => {
-            assert!(
-                reason.contains("stiff") && reason.contains("20000 steps"),
-                "{reason}"
-            );
-            assert!(!reason.contains('\n'));
+        Err(Error::Analysis(
+            e @ AnalysisError::StepLimit {
+                method: Method::Tsit5,
+                max_steps: 20_000,
+                t_ms,
+                fastest_rate_per_s,
+            },
+        )) => {
+            assert!(t_ms > 0.0 && t_ms < 1.3, "{e}");
+            assert!(fastest_rate_per_s > 1e6, "{e}");
+            let text = e.to_string();
+            assert!(text.contains("stiff") && text.contains("20000 steps"), "{text}");
+            assert!(!text.contains('\n'));
         }
         other => panic!("expected a stiffness error, got {other:?}"),
     }

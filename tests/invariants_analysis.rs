@@ -16,6 +16,7 @@ use hdi_tribology::heater::Programme;
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::surface::PeakModel;
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::Error;
 use proptest::prelude::*;
 
@@ -149,8 +150,11 @@ proptest! {
                 prop_assert!((td - td2).abs() <= 1e-9 * td, "{td} vs {td2}");
                 prop_assert!((to - to2).abs() <= 1e-9 * td, "{to} vs {to2}");
             }
-            Err(Error::Analysis { reason, .. }) => {
-                prop_assert!(reason.contains("zero heater power"), "{reason}");
+            Err(Error::Analysis(
+                AnalysisError::InContactAtZeroPower { power_mw, .. }
+                | AnalysisError::NoTakeOff { power_mw, .. },
+            )) => {
+                prop_assert!(power_mw < 0.0, "{power_mw}");
             }
             Err(other) => prop_assert!(false, "{other}"),
         }

@@ -3,6 +3,7 @@
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
+use hdi_tribology::error::{AnalysisError, Stage};
 use hdi_tribology::Error;
 
 /// A 100 ns interface lag on the paper scene (c/K_contact ≈ 0.1 ns) makes the contact branch
@@ -20,11 +21,18 @@ fn self_excited_contact_stops_with_a_reason_instead_of_nan() {
         &programme,
         &CycleOptions::from_scene(&scene).unwrap(),
     ) {
-        Err(Error::Analysis { what, reason }) => {
-            assert_eq!(what, "cycle");
-            assert!(reason.contains("pad gap h0 + y fell to zero"), "{reason}");
-            assert!(reason.contains("self-excited"), "{reason}");
-            assert!(!reason.contains('\n'));
+        Err(Error::Analysis(
+            e @ AnalysisError::LeftTheModel {
+                self_excited: Some(x),
+                ..
+            },
+        )) => {
+            assert_eq!(e.stage(), Stage::Cycle);
+            assert!((x.interface_lag_ns - 100.0).abs() < 1e-9, "{e}");
+            assert!(x.limit_ns < x.interface_lag_ns, "{e}");
+            let text = e.to_string();
+            assert!(text.contains("pad gap h0 + y fell to zero"), "{text}");
+            assert!(!text.contains('\n'));
         }
         other => panic!("expected the self-excitation error, got {other:?}"),
     }

@@ -266,10 +266,11 @@ pub fn simulate_cycle(
         8 => run::<U8>(model, programme, opts),
         9 => run::<U9>(model, programme, opts),
         10 => run::<U10>(model, programme, opts),
-        n => Err(Error::analysis(
-            "cycle",
-            format!("unexpected state size {n}"),
-        )),
+        n => Err(crate::error::AnalysisError::Internal {
+            stage: crate::error::Stage::Cycle,
+            detail: format!("unexpected state size {n}"),
+        }
+        .into()),
     }
 }
 
@@ -390,14 +391,13 @@ where
             // too weak to ever reach touchdown fails at once instead of running for ever.
             let segments = span / overshoot;
             if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
-                return Err(Error::analysis(
-                    "triggered cycle",
-                    format!(
-                        "reaching a protrusion of 2 h0 takes {span:e} W, {segments:.3e} segments of \
-                         the overshoot {overshoot:e} W (at most {MAX_TRIGGERED_SEGMENTS:e}): raise the \
-                         overshoot or the heater efficiency"
-                    ),
-                ));
+                return Err(crate::error::AnalysisError::TooManySegments {
+                    span_mw: crate::units::to_mw(span),
+                    overshoot_mw: crate::units::to_mw(overshoot),
+                    segments,
+                    max_segments: MAX_TRIGGERED_SEGMENTS,
+                }
+                .into());
             }
             let ramp = Programme::new(vec![
                 (0.0, start_power),
@@ -419,10 +419,10 @@ where
     let layout = sys.layout();
     let q = layout
         .contact_impulse
-        .ok_or_else(|| Error::analysis("cycle", "no impulse state"))?;
+        .ok_or_else(|| internal("no impulse state"))?;
     let heat = layout
         .heat
-        .ok_or_else(|| Error::analysis("cycle", "no heat state"))?;
+        .ok_or_else(|| internal("no heat state"))?;
     let y0: OVector<f64, D> = sys.initial_state(D::name(), &eq.rest());
 
     let ode_opts = ode_options(&sys, opts, &initial_programme)?;
@@ -480,13 +480,12 @@ where
                     break t_td;
                 }
                 if t1 >= end {
-                    return Err(Error::analysis(
-                        "triggered cycle",
-                        format!(
-                            "no touchdown detected up to {} W",
-                            initial_programme.power(end)
-                        ),
-                    ));
+                    return Err(crate::error::AnalysisError::NoTouchdown {
+                        stage: crate::error::Stage::TriggeredCycle,
+                        max_power_mw: crate::units::to_mw(initial_programme.power(end)),
+                        detector: None,
+                    }
+                    .into());
                 }
                 t = t1;
             };
@@ -531,7 +530,7 @@ where
     let last = traj
         .segments
         .last()
-        .ok_or_else(|| Error::analysis("cycle", "nothing was integrated"))?;
+        .ok_or_else(|| internal("nothing was integrated"))?;
     let duration = end - t0;
     let mean_temperature_rise = last.y_final()[heat] / duration;
     let series = opts.keep_series.then(|| series_of(&sys, &traj, &detecting));
@@ -579,41 +578,46 @@ where
 {
     let (t, s) = (sol.t_final(), sol.y_final());
     let g = sys.gaps(t, s);
-    let mut reason = format!(
-        "at t = {t:.6e} s the pad gap h0 + y fell to zero (bulge gap d = {:.4e} m, velocity {:.3e} \
-         m/s): the slider body would enter the disk, outside the lumped model",
-        g.bulge,
-        s[sys.layout().velocity(0)]
-    );
+    let mut self_excited = None;
     if model.interface_lag > 0.0 {
         let k_contact = -model.forces().contact(g).d_bulge;
         let c = model.bearing().damping(s[0]);
         if k_contact > 0.0 && model.interface_lag > c / k_contact {
-            reason.push_str(&format!(
-                "; the interface lag {:e} s exceeds c/K_contact = {:.3e} s, so each contact feeds \
-                 energy into the bounce (self-excited contact branch)",
-                model.interface_lag,
-                c / k_contact
-            ));
+            self_excited = Some(crate::error::SelfExcitation {
+                interface_lag_ns: model.interface_lag * 1e9,
+                limit_ns: c / k_contact * 1e9,
+            });
         }
     }
-    Error::analysis("cycle", reason)
+    crate::error::AnalysisError::LeftTheModel {
+        t_ms: t * 1e3,
+        bulge_gap_nm: crate::units::to_nm(g.bulge),
+        velocity_m_per_s: s[sys.layout().velocity(0)],
+        self_excited,
+    }
+    .into()
+}
+
+/// An error of the cycle that no scene should cause.
+fn internal(detail: &str) -> Error {
+    crate::error::AnalysisError::Internal {
+        stage: crate::error::Stage::Cycle,
+        detail: detail.into(),
+    }
+    .into()
 }
 
 /// ODE errors of an explicit method on a stiff cycle get the advice to use a stiff method.
 fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError) -> Error {
     let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
     match e {
-        ode::OdeError::TooManySteps { t, max_steps } if explicit => Error::analysis(
-            "cycle",
-            format!(
-                "the explicit method {} used up its {max_steps} steps at t = {t:e} s: the system \
-                 is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact and \
-                 lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
-                opts.solver.method,
-                model.fastest_rate()
-            ),
-        ),
+        ode::OdeError::TooManySteps { t, max_steps } if explicit => crate::error::AnalysisError::StepLimit {
+            method: opts.solver.method,
+            max_steps,
+            t_ms: t * 1e3,
+            fastest_rate_per_s: model.fastest_rate(),
+        }
+        .into(),
         other => Error::Ode(other),
     }
 }

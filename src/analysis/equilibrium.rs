@@ -8,7 +8,8 @@
 //! `k_ab − ∂F_if/∂y` for the rigid slider) is positive; folds are where it vanishes.
 
 use super::roots::brent;
-use crate::error::{Error, Result};
+use crate::error::{AnalysisError, Error, Result, Stage};
+use crate::units::{to_mw, to_nm};
 use crate::force::ForceEval;
 use crate::model::{Dofs, Rest, SliderModel};
 use serde::Serialize;
@@ -317,8 +318,11 @@ pub fn flying_equilibrium(
             // The fold lies between this grid point and the last stable one: locate it, and if
             // the power asked for is reached before it, the equilibrium lies in that last
             // stretch (the power is nearly stationary there, so only direct forces decide).
+            // The fold's gap: refined when a stable point precedes it, else this grid point.
+            let mut fold_d = d;
             if let Some(p) = prev {
                 let fold = solver.refine_fold(e.d, p.d)?;
+                fold_d = fold.d;
                 if fold.protrusion >= target {
                     let tol = fold_tolerance(fold.d, p.d, model.nominal_clearance);
                     let d = brent(
@@ -334,19 +338,19 @@ pub fn flying_equilibrium(
                     return solver.at_gap_exact(d);
                 }
             }
-            return Err(Error::analysis(
-                "flying equilibrium",
-                format!(
-                    "the flying branch ends at a fold (d = {d:e} m) before the protrusion of {power} W is reached: the head is in contact there"
-                ),
-            ));
+            return Err(AnalysisError::FlyingBranchEnds {
+                power_mw: to_mw(power),
+                fold_gap_nm: to_nm(fold_d),
+            }
+            .into());
         }
         if e.protrusion >= target {
             let Some(p) = prev else {
-                return Err(Error::analysis(
-                    "flying equilibrium",
-                    "the largest tabulated gap is already below the equilibrium: widen the table range",
-                ));
+                return Err(AnalysisError::TableTooNarrow {
+                    stage: Stage::FlyingEquilibrium,
+                    gap_nm: to_nm(d),
+                }
+                .into());
             };
             let tol = fold_tolerance(e.d, p.d, model.nominal_clearance);
             let d = brent(
@@ -359,8 +363,8 @@ pub fn flying_equilibrium(
         }
         prev = Some(e);
     }
-    Err(Error::analysis(
-        "flying equilibrium",
-        format!("no flying equilibrium at {power} W inside the table range"),
-    ))
+    Err(AnalysisError::NoFlyingEquilibrium {
+        power_mw: to_mw(power),
+    }
+    .into())
 }

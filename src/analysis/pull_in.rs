@@ -10,7 +10,7 @@
 use super::equilibrium::EquilibriumSolver;
 use super::roots::brent;
 use super::touchdown::{touchdown_at, touchdown_signed, Cause, StaticOptions};
-use crate::error::{check_finite, Error, Result};
+use crate::error::{check_finite, AnalysisError, Error, Result};
 use crate::model::{SliderModel, Voltage};
 use serde::Serialize;
 
@@ -61,10 +61,7 @@ impl VoltageBalance<'_> {
 pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) -> Result<PullIn> {
     check_finite("power", power)?;
     if !model.forces().has_voltage_terms() {
-        return Err(Error::analysis(
-            "pull-in voltage",
-            "the scene has no electrostatic term",
-        ));
+        return Err(AnalysisError::NoElectrostatics.into());
     }
     // Past touchdown without voltage, pull-in is at zero volts. Without any touchdown in the
     // table range (e.g. electrostatics alone) the scan below decides.
@@ -76,7 +73,7 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
                 cause: td0.cause,
             });
         }
-        Ok(_) | Err(Error::Analysis { .. }) => {}
+        Ok(_) | Err(Error::Analysis(_)) => {}
         Err(e) => return Err(e),
     }
     let delta = model.protrusion(power);
@@ -127,10 +124,10 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
         }
         prev = Some((d, v2, k, fc));
     }
-    Err(Error::analysis(
-        "pull-in voltage",
-        "no pull-in inside the table range",
-    ))
+    Err(AnalysisError::NoPullIn {
+        power_mw: crate::units::to_mw(power),
+    }
+    .into())
 }
 
 /// One point of the clearance change against DC voltage.

@@ -288,27 +288,21 @@ pub fn calibrate(
         }
     }
     let Some(touchdown_power) = touchdown else {
-        return Err(Error::analysis(
-            "clearance calibration",
-            format!(
-                "{} saw no contact up to {} W",
-                detector.name(),
-                sc.max_power
-            ),
-        ));
+        return Err(crate::error::AnalysisError::NoTouchdown {
+            stage: crate::error::Stage::ClearanceCalibration,
+            max_power_mw: crate::units::to_mw(sc.max_power),
+            detector: Some(detector.name().to_string()),
+        }
+        .into());
     };
     if state.steps.len() == 1 {
         // Fired at the baseline level: the slider was in contact before the staircase began, so
         // there is no touchdown power to find and no contrast to measure.
-        return Err(Error::analysis(
-            "clearance calibration",
-            format!(
-                "{} fired at the start power {:?} W already, before the first heater step: \
-                 contact before the staircase began (start lower, or with less dither)",
-                detector.name(),
-                sc.start_power
-            ),
-        ));
+        return Err(crate::error::AnalysisError::ContactAtStart {
+            detector: detector.name().to_string(),
+            start_power_mw: crate::units::to_mw(sc.start_power),
+        }
+        .into());
     }
     let contrast = match state.steps.len() {
         0 | 1 => f64::INFINITY,

@@ -94,7 +94,12 @@ impl Discrete {
                 let q = rng.next_open01();
                 let z = parent
                     .inverse_survival(q)
-                    .ok_or_else(|| Error::analysis("peak sampling", "inverse survival failed"))?;
+                    .ok_or_else(|| {
+                        Error::from(crate::error::AnalysisError::Internal {
+                            stage: crate::error::Stage::PeakSampling,
+                            detail: "inverse survival failed".into(),
+                        })
+                    })?;
                 out.push(z);
             }
         } else {
