@@ -44,10 +44,16 @@ fn scenes() -> Vec<(&'static str, Scene)> {
     out
 }
 
+/// One analysis's result as a number (mW or V) or its error.
+type Outcome = Result<f64, String>;
+
 fn main() {
     let budget = Duration::from_secs(1);
-    println!("| scene | analysis | result | CPU ms/call | fastest wall ms |");
-    println!("|---|---|---|---|---|");
+    println!(
+        "| scene | analysis | result | direct refinement CPU ms | polished from tables CPU ms | \
+         ratio | relative difference |"
+    );
+    println!("|---|---|---|---|---|---|---|");
     for (name, scene) in scenes() {
         let model = match SliderModel::from_scene(&scene) {
             Ok(m) => m,
@@ -56,29 +62,56 @@ fn main() {
                 continue;
             }
         };
-        let opts = StaticOptions::new(scene.detector.contact_threshold_n);
-        let row = |what: &str, result: String, t: timing::Timing| {
-            println!(
-                "| {name} | {what} | {result} | {:.3} | {:.3} |",
-                t.cpu * 1e3,
-                t.wall * 1e3
-            );
+        let opts = |polish: bool| {
+            let mut o = StaticOptions::new(scene.detector.contact_threshold_n);
+            o.grid.polish_from_tables = polish;
+            o
         };
-        let (td, t) = timing::measure(3, 10_000, budget, || touchdown_power(&model, &opts));
-        let td = match td {
-            Ok(td) => td,
-            Err(e) => {
-                row("touchdown", e.to_string(), t);
-                continue;
+        // The take-off starts 30 mW above the touchdown of the default path.
+        let start = touchdown_power(&model, &opts(true))
+            .map(|t| t.power + opts(true).takeoff_start_excess)
+            .unwrap_or(0.1);
+        let analyses: [(&str, &str, &dyn Fn(&StaticOptions) -> Outcome); 3] = [
+            ("touchdown", "mW", &|o| {
+                touchdown_power(&model, o)
+                    .map(|t| t.power_mw())
+                    .map_err(|e| e.to_string())
+            }),
+            ("take-off", "mW", &|o| {
+                takeoff_power(&model, start, o)
+                    .map(|t| t.power_mw())
+                    .map_err(|e| e.to_string())
+            }),
+            ("pull-in at 0 mW", "V", &|o| {
+                pull_in_voltage(&model, 0.0, o)
+                    .map(|p| p.voltage)
+                    .map_err(|e| e.to_string())
+            }),
+        ];
+        for (what, unit, run) in analyses {
+            // Interleaved, so that both see the same load.
+            let (mut cpu_direct, mut cpu_polished) = (0.0, 0.0);
+            let (mut direct, mut polished) = (Err(String::new()), Err(String::new()));
+            for _ in 0..2 {
+                let (r, t) = timing::measure(3, 10_000, budget / 2, || run(&opts(false)));
+                (direct, cpu_direct) = (r, cpu_direct + 0.5 * t.cpu);
+                let (r, t) = timing::measure(3, 10_000, budget / 2, || run(&opts(true)));
+                (polished, cpu_polished) = (r, cpu_polished + 0.5 * t.cpu);
             }
-        };
-        row("touchdown", format!("{:.10} mW", td.power_mw()), t);
-        let start = td.power + opts.takeoff_start_excess;
-        let (to, t) = timing::measure(3, 10_000, budget, || takeoff_power(&model, start, &opts));
-        let text = to.map_or_else(|e| e.to_string(), |to| format!("{:.10} mW", to.power_mw()));
-        row("take-off", text, t);
-        let (pi, t) = timing::measure(3, 10_000, budget, || pull_in_voltage(&model, 0.0, &opts));
-        let text = pi.map_or_else(|e| e.to_string(), |p| format!("{:.10} V", p.voltage));
-        row("pull-in at 0 mW", text, t);
+            let (result, diff) = match (&direct, &polished) {
+                (Ok(a), Ok(b)) => (
+                    format!("{b:.10} {unit}"),
+                    format!("{:.1e}", (a - b).abs() / a.abs()),
+                ),
+                (Err(a), Err(b)) if a == b => (a.clone(), "same error".into()),
+                _ => (format!("{direct:?} vs {polished:?}"), "DIFFERENT".into()),
+            };
+            println!(
+                "| {name} | {what} | {result} | {:.3} | {:.3} | {:.2}× | {diff} |",
+                cpu_direct * 1e3,
+                cpu_polished * 1e3,
+                cpu_direct / cpu_polished
+            );
+        }
     }
 }

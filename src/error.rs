@@ -425,9 +425,7 @@ impl AnalysisError {
             | A::UnstableContactStart { .. } => Stage::TakeOff,
             A::NoPullIn { .. } | A::NoElectrostatics => Stage::PullIn,
             A::NoAcVoltage => Stage::SimulatedDither,
-            A::FlyingBranchEnds { .. } | A::NoFlyingEquilibrium { .. } => {
-                Stage::FlyingEquilibrium
-            }
+            A::FlyingBranchEnds { .. } | A::NoFlyingEquilibrium { .. } => Stage::FlyingEquilibrium,
             A::TooManySegments { .. } => Stage::TriggeredCycle,
             A::LeftTheModel { .. } | A::StepLimit { .. } => Stage::Cycle,
             A::NotFinished { .. } => Stage::DriveController,
@@ -522,10 +520,9 @@ impl AnalysisError {
                  range (down to {} mW): widen the table range",
                 num(*min_power_mw)
             ),
-            A::NoPullIn { power_mw } => format!(
-                "no pull-in inside the table range at {} mW",
-                num(*power_mw)
-            ),
+            A::NoPullIn { power_mw } => {
+                format!("no pull-in inside the table range at {} mW", num(*power_mw))
+            }
             A::NoElectrostatics => "the scene has no electrostatic term".into(),
             A::NoAcVoltage => "the voltage has no AC part".into(),
             A::TableTooNarrow {

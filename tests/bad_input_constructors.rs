@@ -7,6 +7,7 @@ use hdi_tribology::analysis::cycle::{
 use hdi_tribology::analysis::{
     flying_equilibrium, pull_in_voltage, s_curve, static_hysteresis, ScanGrid, StaticOptions,
 };
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::force::{
     composite_modulus, AirBearingModel, Coulomb, CubicBearing, Electrostatic, Footprint,
     GapReference, GreenwoodWilliamson, InterfaceForces, Intermolecular, LennardJones39,
@@ -20,7 +21,6 @@ use hdi_tribology::scene::Scene;
 use hdi_tribology::surface::{
     Discrete, Empirical, Gaussian, GaussianHeights, PeakModel, RiceMaxima, Rician,
 };
-use hdi_tribology::error::AnalysisError;
 use hdi_tribology::Error;
 use std::sync::Arc;
 
@@ -415,6 +415,7 @@ fn analyses_reject_bad_options_and_scan_grids() {
             fine_step: fine,
             coarse_step: coarse,
             fine_until: until,
+            ..ScanGrid::default()
         };
         let f = field(s_curve(&model, None, &grid));
         assert!(f.starts_with("grid."), "{f}");

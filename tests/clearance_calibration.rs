@@ -8,9 +8,9 @@ use hdi_tribology::analysis::{
 use hdi_tribology::clearance::{
     calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Zone,
 };
+use hdi_tribology::error::{AnalysisError, Stage};
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::scene::Scene;
-use hdi_tribology::error::{AnalysisError, Stage};
 use hdi_tribology::Error;
 
 const STEP: f64 = 0.5e-3;

@@ -5,10 +5,10 @@
 
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
 use hdi_tribology::analysis::{static_hysteresis, StaticHysteresis, StaticOptions};
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::force::Gaps;
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
-use hdi_tribology::error::AnalysisError;
 use hdi_tribology::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -56,11 +56,7 @@ use Expect::{Fails, Finite};
 
 /// (file, static analysis, dynamic cycle).
 const CASES: &[(&str, Expect, Expect)] = &[
-    (
-        "roughness_0p01nm.toml",
-        Fails(held_in_contact),
-        Finite,
-    ),
+    ("roughness_0p01nm.toml", Fails(held_in_contact), Finite),
     (
         "roughness_5nm.toml",
         Fails(in_contact_at_zero_power),
@@ -69,11 +65,7 @@ const CASES: &[(&str, Expect, Expect)] = &[
     ("smooth.toml", Finite, Finite),
     ("hard_contact.toml", Finite, Finite),
     ("adhesion_weak.toml", Finite, Finite),
-    (
-        "adhesion_strong.toml",
-        Fails(held_in_contact),
-        Finite,
-    ),
+    ("adhesion_strong.toml", Fails(held_in_contact), Finite),
     (
         "voltage_20v.toml",
         Fails(in_contact_at_zero_power),
@@ -94,11 +86,7 @@ const CASES: &[(&str, Expect, Expect)] = &[
         Fails(either_at_zero_power),
         Fails(flying_branch_ends),
     ),
-    (
-        "interface_lag_100ns.toml",
-        Finite,
-        Fails(self_excited),
-    ),
+    ("interface_lag_100ns.toml", Finite, Fails(self_excited)),
 ];
 
 fn dir() -> PathBuf {

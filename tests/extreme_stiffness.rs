@@ -7,11 +7,11 @@ use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgram
 use hdi_tribology::analysis::equilibrium::{
     flying_equilibrium, Equilibrium, EquilibriumSolver, ScanGrid,
 };
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::heater::Programme;
 use hdi_tribology::model::{SliderModel, SliderSystem};
 use hdi_tribology::ode::{self, Method, OdeSystem, Options, SaveAt};
 use hdi_tribology::scene::Scene;
-use hdi_tribology::error::AnalysisError;
 use hdi_tribology::Error;
 use nalgebra::{DMatrix, DVector, Dyn};
 use std::path::Path;
@@ -159,7 +159,10 @@ fn explicit_method_on_a_stiff_scene_fails_with_a_clear_error() {
             assert!(t_ms > 0.0 && t_ms < 1.3, "{e}");
             assert!(fastest_rate_per_s > 1e6, "{e}");
             let text = e.to_string();
-            assert!(text.contains("stiff") && text.contains("20000 steps"), "{text}");
+            assert!(
+                text.contains("stiff") && text.contains("20000 steps"),
+                "{text}"
+            );
             assert!(!text.contains('\n'));
         }
         other => panic!("expected a stiffness error, got {other:?}"),

@@ -11,12 +11,12 @@ use hdi_tribology::analysis::cycle::{CycleOptions, HeaterProgramme};
 use hdi_tribology::analysis::{
     ac_sweep, flying_equilibrium, static_hysteresis, ScanGrid, StaticOptions,
 };
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::force::{AirBearingModel, Footprint};
 use hdi_tribology::heater::Programme;
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::surface::PeakModel;
-use hdi_tribology::error::AnalysisError;
 use hdi_tribology::Error;
 use proptest::prelude::*;
 

@@ -1,9 +1,9 @@
 //! Dynamic-cycle cases that once failed, kept as regression tests.
 
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
+use hdi_tribology::error::{AnalysisError, Stage};
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
-use hdi_tribology::error::{AnalysisError, Stage};
 use hdi_tribology::Error;
 
 /// A 100 ns interface lag on the paper scene (c/K_contact ≈ 0.1 ns) makes the contact branch

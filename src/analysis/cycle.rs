@@ -420,9 +420,7 @@ where
     let q = layout
         .contact_impulse
         .ok_or_else(|| internal("no impulse state"))?;
-    let heat = layout
-        .heat
-        .ok_or_else(|| internal("no heat state"))?;
+    let heat = layout.heat.ok_or_else(|| internal("no heat state"))?;
     let y0: OVector<f64, D> = sys.initial_state(D::name(), &eq.rest());
 
     let ode_opts = ode_options(&sys, opts, &initial_programme)?;
@@ -611,13 +609,15 @@ fn internal(detail: &str) -> Error {
 fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError) -> Error {
     let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
     match e {
-        ode::OdeError::TooManySteps { t, max_steps } if explicit => crate::error::AnalysisError::StepLimit {
-            method: opts.solver.method,
-            max_steps,
-            t_ms: t * 1e3,
-            fastest_rate_per_s: model.fastest_rate(),
+        ode::OdeError::TooManySteps { t, max_steps } if explicit => {
+            crate::error::AnalysisError::StepLimit {
+                method: opts.solver.method,
+                max_steps,
+                t_ms: t * 1e3,
+                fastest_rate_per_s: model.fastest_rate(),
+            }
+            .into()
         }
-        .into(),
         other => Error::Ode(other),
     }
 }

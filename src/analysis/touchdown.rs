@@ -7,8 +7,8 @@
 
 use super::equilibrium::{Equilibrium, EquilibriumSolver, ScanGrid};
 use crate::error::{AnalysisError, Result, Stage};
-use crate::units::{to_mw, to_nm};
 use crate::model::SliderModel;
+use crate::units::{to_mw, to_nm};
 use serde::Serialize;
 
 /// Why a transition happened.
@@ -138,13 +138,13 @@ pub(crate) fn touchdown_signed(
     volt2: f64,
     opts: &StaticOptions,
 ) -> Result<Transition> {
-    let solver = EquilibriumSolver::new(model, volt2);
+    let solver = EquilibriumSolver::new(model, volt2).refining_as(&opts.grid);
     let (lo, hi) = model.forces().table_range();
     let th = opts.contact_threshold;
     let mut prev: Option<Equilibrium> = None;
     // A fold passed, not yet landed: (fold, its power).
     let mut jump: Option<Equilibrium> = None;
-    for d in opts.grid.descending(lo, hi)? {
+    for d in opts.grid.iter_descending(lo, hi)? {
         let e = solver.at_gap(d)?;
         if let Some(fold) = jump {
             // The contact side rises again through the fold's power on a stable part.
@@ -258,7 +258,7 @@ pub(crate) fn takeoff_at(
     start_power: f64,
     opts: &StaticOptions,
 ) -> Result<Transition> {
-    let solver = EquilibriumSolver::new(model, volt2);
+    let solver = EquilibriumSolver::new(model, volt2).refining_as(&opts.grid);
     let (mut lo, hi) = model.forces().table_range();
     let th = opts.contact_threshold;
     let target = model.protrusion(start_power);

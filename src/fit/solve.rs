@@ -563,14 +563,12 @@ fn analyse(
         }
     }
     let svd = js.clone().svd(false, true);
-    let v_t = svd
-        .v_t
-        .ok_or_else(|| {
-            Error::from(crate::error::AnalysisError::Internal {
-                stage: crate::error::Stage::Fit,
-                detail: "singular value decomposition failed".into(),
-            })
-        })?;
+    let v_t = svd.v_t.ok_or_else(|| {
+        Error::from(crate::error::AnalysisError::Internal {
+            stage: crate::error::Stage::Fit,
+            detail: "singular value decomposition failed".into(),
+        })
+    })?;
     let sv = svd.singular_values;
     let s_max = sv.iter().copied().fold(0.0, f64::max);
     // Singular values below this are treated as zero (their directions are not determined).

@@ -184,7 +184,10 @@ impl Structure {
                 Some((inertia, stiffness, damping, trailing_edge)) => {
                     Self::pitch(body_mass, inertia, stiffness, damping, trailing_edge)
                 }
-                None => Err(Error::invalid("structure.preset", "pitch without its values")),
+                None => Err(Error::invalid(
+                    "structure.preset",
+                    "pitch without its values",
+                )),
             },
             StructureSpec::General {
                 mass,
