@@ -177,3 +177,50 @@ fn a_rougher_disk_has_no_folds_and_no_static_hysteresis() {
     assert_eq!(h.takeoff.cause, Cause::Threshold);
     assert!(h.hysteresis.abs() < 1e-12, "{}", h.hysteresis);
 }
+
+/// Refining on the tables and polishing with direct forces finds the same folds and threshold
+/// crossings as Brent's method on the direct forces alone (both to 1e-12 relative in the gap),
+/// on the paper scene and on every extreme scene, or fails with the same error.
+#[test]
+fn polishing_from_the_tables_finds_the_direct_roots() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/extreme");
+    let mut scenes = vec![Scene::paper()];
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    for f in files {
+        scenes.push(Scene::from_path(&f).unwrap());
+    }
+    for scene in scenes {
+        let model = SliderModel::from_scene(&scene).unwrap();
+        let mut direct = StaticOptions::new(scene.detector.contact_threshold_n);
+        direct.grid.polish_from_tables = false;
+        let polished = StaticOptions::new(scene.detector.contact_threshold_n);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-10 * a.abs().max(1e-6);
+        match (
+            static_hysteresis(&model, &direct),
+            static_hysteresis(&model, &polished),
+        ) {
+            (Ok(a), Ok(b)) => {
+                assert!(close(a.touchdown.power, b.touchdown.power), "{}", scene.name);
+                assert!(close(a.takeoff.power, b.takeoff.power), "{}", scene.name);
+                assert!(close(a.touchdown.at.d, b.touchdown.at.d), "{}", scene.name);
+                assert_eq!(a.touchdown.cause, b.touchdown.cause);
+            }
+            (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{}", scene.name),
+            (a, b) => panic!("{}: {a:?} vs {b:?}", scene.name),
+        }
+        if model.forces().has_voltage_terms() {
+            match (
+                pull_in_voltage(&model, 0.0, &direct),
+                pull_in_voltage(&model, 0.0, &polished),
+            ) {
+                (Ok(a), Ok(b)) => assert!(close(a.voltage, b.voltage), "{}", scene.name),
+                (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{}", scene.name),
+                (a, b) => panic!("{}: {a:?} vs {b:?}", scene.name),
+            }
+        }
+    }
+}
