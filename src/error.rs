@@ -1,7 +1,5 @@
 //! The crate's error type: every variant says what went wrong and where.
 
-use crate::analysis::touchdown::Cause;
-use crate::ode::Method;
 use std::fmt;
 use thiserror::Error;
 
@@ -250,8 +248,8 @@ pub enum AnalysisError {
     /// Touchdown: the head is in contact already at zero heater power (the transition lies at
     /// negative power).
     InContactAtZeroPower {
-        /// Fold or threshold crossing.
-        cause: Cause,
+        /// `true` at a fold, `false` at a threshold crossing.
+        at_fold: bool,
         /// Bulge gap at the transition (nm).
         gap_nm: f64,
         /// Heater power of the transition (mW), negative.
@@ -346,8 +344,8 @@ pub enum AnalysisError {
     },
     /// Cycle: an explicit method used up its steps where the system is stiff.
     StepLimit {
-        /// The method.
-        method: Method,
+        /// The method's name, e.g. `tsit5`.
+        method: &'static str,
         /// Its step budget.
         max_steps: usize,
         /// Time reached (ms).
@@ -479,15 +477,16 @@ impl AnalysisError {
         use AnalysisError as A;
         match self {
             A::InContactAtZeroPower {
-                cause,
+                at_fold,
                 gap_nm,
                 power_mw,
             } => format!(
                 "the head is in contact already at zero heater power (the {} at d = {} nm lies at \
                  {} mW < 0)",
-                match cause {
-                    Cause::Fold => "fold",
-                    Cause::Threshold => "threshold crossing",
+                if *at_fold {
+                    "fold"
+                } else {
+                    "threshold crossing"
                 },
                 num(*gap_nm),
                 num(*power_mw)

@@ -204,7 +204,11 @@ fn polishing_from_the_tables_finds_the_direct_roots() {
             static_hysteresis(&model, &polished),
         ) {
             (Ok(a), Ok(b)) => {
-                assert!(close(a.touchdown.power, b.touchdown.power), "{}", scene.name);
+                assert!(
+                    close(a.touchdown.power, b.touchdown.power),
+                    "{}",
+                    scene.name
+                );
                 assert!(close(a.takeoff.power, b.takeoff.power), "{}", scene.name);
                 assert!(close(a.touchdown.at.d, b.touchdown.at.d), "{}", scene.name);
                 assert_eq!(a.touchdown.cause, b.touchdown.cause);

@@ -150,7 +150,7 @@ fn explicit_method_on_a_stiff_scene_fails_with_a_clear_error() {
     match simulate_cycle(&model, &programme, &opts) {
         Err(Error::Analysis(
             e @ AnalysisError::StepLimit {
-                method: Method::Tsit5,
+                method: "tsit5",
                 max_steps: 20_000,
                 t_ms,
                 fastest_rate_per_s,

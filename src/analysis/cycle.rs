@@ -611,7 +611,7 @@ fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError)
     match e {
         ode::OdeError::TooManySteps { t, max_steps } if explicit => {
             crate::error::AnalysisError::StepLimit {
-                method: opts.solver.method,
+                method: opts.solver.method.name(),
                 max_steps,
                 t_ms: t * 1e3,
                 fastest_rate_per_s: model.fastest_rate(),

@@ -215,7 +215,7 @@ fn transition(at: Equilibrium, cause: Cause, touchdown: bool) -> Result<Transiti
         let (gap_nm, power_mw) = (to_nm(at.d), to_mw(at.power));
         return Err(if touchdown {
             AnalysisError::InContactAtZeroPower {
-                cause,
+                at_fold: cause == Cause::Fold,
                 gap_nm,
                 power_mw,
             }
