@@ -47,6 +47,9 @@ fn scenes() -> Vec<(&'static str, Scene)> {
 /// One analysis's result as a number (mW or V) or its error.
 type Outcome = Result<f64, String>;
 
+/// An analysis under given options.
+type Analysis<'a> = &'a dyn Fn(&StaticOptions) -> Outcome;
+
 fn main() {
     let budget = Duration::from_secs(1);
     println!(
@@ -71,7 +74,7 @@ fn main() {
         let start = touchdown_power(&model, &opts(true))
             .map(|t| t.power + opts(true).takeoff_start_excess)
             .unwrap_or(0.1);
-        let analyses: [(&str, &str, &dyn Fn(&StaticOptions) -> Outcome); 3] = [
+        let analyses: [(&str, &str, Analysis); 3] = [
             ("touchdown", "mW", &|o| {
                 touchdown_power(&model, o)
                     .map(|t| t.power_mw())
