@@ -84,6 +84,11 @@ impl Error {
     }
 
     /// Shorthand for [`Error::Output`].
+    ///
+    /// ```
+    /// let e = hdi_tribology::Error::output("CSV", "a row of 3 cells, the header has 2");
+    /// assert_eq!(e.to_string(), "cannot write CSV: a row of 3 cells, the header has 2");
+    /// ```
     pub fn output(what: impl Into<String>, reason: impl Into<String>) -> Self {
         Error::Output {
             what: what.into(),

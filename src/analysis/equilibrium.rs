@@ -144,6 +144,14 @@ impl ScanGrid {
 
     /// The gaps of [`ScanGrid::descending`], made one at a time (a scan that stops early makes
     /// only the points it reads).
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::equilibrium::ScanGrid;
+    /// let g = ScanGrid::default();
+    /// let lazy: Vec<f64> = g.iter_descending(-4e-9, 3e-8)?.collect();
+    /// assert_eq!(lazy, g.descending(-4e-9, 3e-8)?);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     pub fn iter_descending(&self, lo: f64, hi: f64) -> Result<impl Iterator<Item = f64>> {
         self.validate(lo, hi)?;
         let (fine, coarse, until) = (self.fine_step, self.coarse_step, self.fine_until);
@@ -192,6 +200,16 @@ impl<'a> EquilibriumSolver<'a> {
     }
 
     /// The same solver refining as `grid` says ([`ScanGrid::polish_from_tables`]).
+    ///
+    /// ```no_run
+    /// use hdi_tribology::analysis::equilibrium::{EquilibriumSolver, ScanGrid};
+    /// use hdi_tribology::{model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let direct = ScanGrid { polish_from_tables: false, ..ScanGrid::default() };
+    /// let solver = EquilibriumSolver::new(&model, 0.0).refining_as(&direct);
+    /// let fold = solver.refine_fold(1.0e-9, 1.5e-9);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     pub fn refining_as(self, grid: &ScanGrid) -> Self {
         EquilibriumSolver {
             polish: grid.polish_from_tables,
