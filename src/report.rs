@@ -138,7 +138,7 @@ impl CsvTable {
     pub fn to_csv_string(&self) -> Result<String> {
         let rows = self.rows()?;
         let mut w = csv::Writer::from_writer(Vec::new());
-        let err = |e: csv::Error| Error::analysis("csv", e.to_string());
+        let err = |e: csv::Error| Error::output("CSV", e.to_string());
         w.write_record(&self.headers).map_err(err)?;
         for r in 0..rows {
             w.write_record(self.columns.iter().map(|c| c.cell(r)))
@@ -146,8 +146,8 @@ impl CsvTable {
         }
         let bytes = w
             .into_inner()
-            .map_err(|e| Error::analysis("csv", e.to_string()))?;
-        String::from_utf8(bytes).map_err(|e| Error::analysis("csv", e.to_string()))
+            .map_err(|e| Error::output("CSV", e.to_string()))?;
+        String::from_utf8(bytes).map_err(|e| Error::output("CSV", e.to_string()))
     }
 
     /// Writes the table to `path` whole (see [`write_file`]).
@@ -609,7 +609,7 @@ impl Chart<'_> {
     pub fn to_svg(&self, path: &Path, width: u32, height: u32) -> Result<()> {
         let mut svg = String::new();
         self.draw(&mut svg, width, height)
-            .map_err(|e| Error::analysis("chart", format!("{}: {e}", self.title)))?;
+            .map_err(|e| Error::output(format!("chart {:?}", self.title), e))?;
         write_file(path, &svg)
     }
 

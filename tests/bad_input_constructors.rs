@@ -7,6 +7,7 @@ use hdi_tribology::analysis::cycle::{
 use hdi_tribology::analysis::{
     flying_equilibrium, pull_in_voltage, s_curve, static_hysteresis, ScanGrid, StaticOptions,
 };
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::force::{
     composite_modulus, AirBearingModel, Coulomb, CubicBearing, Electrostatic, Footprint,
     GapReference, GreenwoodWilliamson, InterfaceForces, Intermolecular, LennardJones39,
@@ -414,6 +415,7 @@ fn analyses_reject_bad_options_and_scan_grids() {
             fine_step: fine,
             coarse_step: coarse,
             fine_until: until,
+            ..ScanGrid::default()
         };
         let f = field(s_curve(&model, None, &grid));
         assert!(f.starts_with("grid."), "{f}");
@@ -529,7 +531,11 @@ fn analyses_in_power_need_a_working_heater() {
         overshoot: 1e-3,
     };
     match simulate_cycle(&weak, &triggered, &copts) {
-        Err(Error::Analysis { reason, .. }) => assert!(reason.contains("segments"), "{reason}"),
+        Err(Error::Analysis(AnalysisError::TooManySegments {
+            segments,
+            max_segments,
+            ..
+        })) => assert!(segments > max_segments, "{segments} {max_segments}"),
         other => panic!("expected the segment bound, got {other:?}"),
     }
 }

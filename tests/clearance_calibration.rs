@@ -8,6 +8,7 @@ use hdi_tribology::analysis::{
 use hdi_tribology::clearance::{
     calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Zone,
 };
+use hdi_tribology::error::{AnalysisError, Stage};
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
@@ -260,7 +261,11 @@ fn bad_options_are_typed_errors_naming_the_field() {
     // No contact below max_power: an analysis error, not a panic or an endless search.
     o = CalibrationOptions::new(0.0, 5e-3, 0.01, 0.0);
     match calibrate(&model, &mut det, &o).unwrap_err() {
-        Error::Analysis { .. } => {}
+        Error::Analysis(AnalysisError::NoTouchdown {
+            stage: Stage::ClearanceCalibration,
+            max_power_mw,
+            detector: Some(_),
+        }) => assert_eq!(max_power_mw, 10.0),
         other => panic!("unexpected {other}"),
     }
 }

@@ -7,6 +7,7 @@ use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgram
 use hdi_tribology::analysis::equilibrium::{
     flying_equilibrium, Equilibrium, EquilibriumSolver, ScanGrid,
 };
+use hdi_tribology::error::AnalysisError;
 use hdi_tribology::heater::Programme;
 use hdi_tribology::model::{SliderModel, SliderSystem};
 use hdi_tribology::ode::{self, Method, OdeSystem, Options, SaveAt};
@@ -147,12 +148,22 @@ fn explicit_method_on_a_stiff_scene_fails_with_a_clear_error() {
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
     opts.solver.method = Method::Tsit5;
     match simulate_cycle(&model, &programme, &opts) {
-        Err(Error::Analysis { reason, .. }) => {
+        Err(Error::Analysis(
+            e @ AnalysisError::StepLimit {
+                method: "tsit5",
+                max_steps: 20_000,
+                t_ms,
+                fastest_rate_per_s,
+            },
+        )) => {
+            assert!(t_ms > 0.0 && t_ms < 1.3, "{e}");
+            assert!(fastest_rate_per_s > 1e6, "{e}");
+            let text = e.to_string();
             assert!(
-                reason.contains("stiff") && reason.contains("20000 steps"),
-                "{reason}"
+                text.contains("stiff") && text.contains("20000 steps"),
+                "{text}"
             );
-            assert!(!reason.contains('\n'));
+            assert!(!text.contains('\n'));
         }
         other => panic!("expected a stiffness error, got {other:?}"),
     }

@@ -1,6 +1,7 @@
 //! Dynamic-cycle cases that once failed, kept as regression tests.
 
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
+use hdi_tribology::error::{AnalysisError, Stage};
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
@@ -20,11 +21,18 @@ fn self_excited_contact_stops_with_a_reason_instead_of_nan() {
         &programme,
         &CycleOptions::from_scene(&scene).unwrap(),
     ) {
-        Err(Error::Analysis { what, reason }) => {
-            assert_eq!(what, "cycle");
-            assert!(reason.contains("pad gap h0 + y fell to zero"), "{reason}");
-            assert!(reason.contains("self-excited"), "{reason}");
-            assert!(!reason.contains('\n'));
+        Err(Error::Analysis(
+            e @ AnalysisError::LeftTheModel {
+                self_excited: Some(x),
+                ..
+            },
+        )) => {
+            assert_eq!(e.stage(), Stage::Cycle);
+            assert!((x.interface_lag_ns - 100.0).abs() < 1e-9, "{e}");
+            assert!(x.limit_ns < x.interface_lag_ns, "{e}");
+            let text = e.to_string();
+            assert!(text.contains("pad gap h0 + y fell to zero"), "{text}");
+            assert!(!text.contains('\n'));
         }
         other => panic!("expected the self-excitation error, got {other:?}"),
     }
@@ -64,17 +72,12 @@ fn a_cycle_spending_steps_too_fast_stops_early() {
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
     opts.solver.max_steps = 300_000;
     match simulate_cycle(&model, &programme, &opts) {
-        Err(Error::Analysis { what, reason }) => {
-            assert_eq!(what, "cycle");
-            assert!(reason.contains("max_steps = 300000"), "{reason}");
+        Err(Error::Analysis(AnalysisError::StepPace {
+            steps, max_steps, ..
+        })) => {
+            assert_eq!(max_steps, 300_000);
             // The steps spent are named: far fewer than the budget.
-            let spent: usize = reason
-                .split(" steps by t")
-                .next()
-                .and_then(|s| s.rsplit(' ').next())
-                .and_then(|s| s.trim_start_matches('(').parse().ok())
-                .unwrap();
-            assert!(spent < 100_000, "{reason}");
+            assert!(steps < 100_000, "{steps}");
         }
         other => panic!("expected the step-pace error, got {other:?}"),
     }

@@ -8,12 +8,15 @@ use hdi_tribology::force::{AirBearingModel, Footprint};
 use hdi_tribology::heater::Programme;
 use hdi_tribology::model::{SliderModel, SliderSystem, Structure};
 use hdi_tribology::ode::{self, Method, Options, SaveAt};
-use hdi_tribology::scene::{ElectrostaticSpec, Scene, StructureSpec};
+use hdi_tribology::scene::{Scene, StructureSpec};
 use hdi_tribology::units::EPSILON_0;
 use hdi_tribology::Error;
 use nalgebra::U4;
 use proptest::prelude::*;
 use std::f64::consts::PI;
+
+#[path = "common/scenes.rs"]
+mod scenes;
 
 const K_AB: f64 = 3e5;
 const M: f64 = 1e-6;
@@ -151,18 +154,7 @@ fn static_deflection_of_the_presets_matches_closed_forms() {
 fn pull_in_uses_the_stiffness_condensed_onto_the_bulge() {
     // A flat plate on the bulge: the bulge spring and the bearing in series hold it.
     let area = 1e-11;
-    let mut s = Scene::paper();
-    s.surface.height_sigma_m = 0.0;
-    s.intermolecular = None;
-    s.contact = None;
-    s.electrostatic = Some(ElectrostaticSpec {
-        contact_potential_v: 0.0,
-        dielectric_thickness_m: 0.0,
-        cutoff_m: Some(1e-10),
-        footprint: Footprint::Flat { area_m2: area },
-        gap: Default::default(),
-    });
-    s.table.d_min_m = Some(1e-9);
+    let mut s = scenes::electrostatic_only(Footprint::Flat { area_m2: area });
     let kb = 2e5;
     s.structure = StructureSpec::Bulge {
         mass_kg: 1e-12,
@@ -307,13 +299,13 @@ proptest! {
                 prop_assert!(h.hysteresis.is_finite());
             }
             Err(e) => prop_assert!(
-                matches!(e, Error::Analysis { .. } | Error::NoConvergence { .. }),
+                matches!(e, Error::Analysis(_) | Error::NoConvergence { .. }),
                 "{e:?}"
             ),
         }
         match linear_response(&model, 0.03) {
             Ok(r) => prop_assert!(r.modes.iter().all(|m| m.frequency.is_finite())),
-            Err(e) => prop_assert!(matches!(e, Error::Analysis { .. } | Error::NoConvergence { .. }), "{e:?}"),
+            Err(e) => prop_assert!(matches!(e, Error::Analysis(_) | Error::NoConvergence { .. }), "{e:?}"),
         }
     }
 }

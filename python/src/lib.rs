@@ -46,7 +46,15 @@ fn to_py_err(e: hdi_tribology::Error) -> PyErr {
             "NoConvergenceError",
             vec![("what", what), ("reason", reason)],
         ),
-        E::Analysis { what, reason } => ("AnalysisError", vec![("what", what), ("reason", reason)]),
+        E::Analysis(a) => (
+            "AnalysisError",
+            vec![
+                ("what", a.stage().to_string()),
+                ("reason", a.reason()),
+                ("kind", a.kind().to_string()),
+            ],
+        ),
+        E::Output { what, reason } => ("HdiError", vec![("what", what), ("reason", reason)]),
         E::Ode(o) => ("SolverError", vec![("reason", o.to_string())]),
         E::Io { path, source } => (
             "FileError",

@@ -276,10 +276,11 @@ pub fn simulate_cycle(
         8 => run::<U8>(model, programme, opts),
         9 => run::<U9>(model, programme, opts),
         10 => run::<U10>(model, programme, opts),
-        n => Err(Error::analysis(
-            "cycle",
-            format!("unexpected state size {n}"),
-        )),
+        n => Err(crate::error::AnalysisError::Internal {
+            stage: crate::error::Stage::Cycle,
+            detail: format!("unexpected state size {n}"),
+        }
+        .into()),
     }
 }
 
@@ -506,14 +507,13 @@ where
             // fails at once instead of running for ever.
             let segments = span / overshoot;
             if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
-                return Err(Error::analysis(
-                    "triggered cycle",
-                    format!(
-                        "reaching a protrusion of 2 h0 takes {span:e} W, {segments:.3e} segments of \
-                         the overshoot {overshoot:e} W (at most {MAX_TRIGGERED_SEGMENTS:e}): raise the \
-                         overshoot or the heater efficiency"
-                    ),
-                ));
+                return Err(crate::error::AnalysisError::TooManySegments {
+                    span_mw: crate::units::to_mw(span),
+                    overshoot_mw: crate::units::to_mw(overshoot),
+                    segments,
+                    max_segments: MAX_TRIGGERED_SEGMENTS,
+                }
+                .into());
             }
             let ramp = Programme::new(vec![
                 (0.0, start_power),
@@ -535,10 +535,8 @@ where
     let layout = sys.layout();
     let q = layout
         .contact_impulse
-        .ok_or_else(|| Error::analysis("cycle", "no impulse state"))?;
-    let heat = layout
-        .heat
-        .ok_or_else(|| Error::analysis("cycle", "no heat state"))?;
+        .ok_or_else(|| internal("no impulse state"))?;
+    let heat = layout.heat.ok_or_else(|| internal("no heat state"))?;
     let y0: OVector<f64, D> = sys.initial_state(D::name(), &eq.rest());
 
     // The fixed programme's knots are kinks of the right-hand side; the triggered programme's
@@ -591,13 +589,12 @@ where
                     break t_td;
                 }
                 if status == StepStatus::ReachedEnd {
-                    return Err(Error::analysis(
-                        "triggered cycle",
-                        format!(
-                            "no touchdown detected up to {} W",
-                            initial_programme.power(end)
-                        ),
-                    ));
+                    return Err(crate::error::AnalysisError::NoTouchdown {
+                        stage: crate::error::Stage::TriggeredCycle,
+                        max_power_mw: crate::units::to_mw(initial_programme.power(end)),
+                        detector: None,
+                    }
+                    .into());
                 }
                 checked = t;
             };
@@ -726,29 +723,37 @@ where
     DefaultAllocator: Allocator<D>,
 {
     let g = sys.gaps(t, s);
-    let mut reason = format!(
-        "at t = {t:.6e} s the pad gap h0 + y fell to zero (bulge gap d = {:.4e} m, velocity {:.3e} \
-         m/s): the slider body would enter the disk, outside the lumped model",
-        g.bulge,
-        s[sys.layout().velocity(0)]
-    );
+    let mut self_excited = None;
     if model.interface_lag > 0.0 {
         let k_contact = -model.forces().contact(g).d_bulge;
         let c = model.bearing().damping(s[0]);
         if k_contact > 0.0 && model.interface_lag > c / k_contact {
-            reason.push_str(&format!(
-                "; the interface lag {:e} s exceeds c/K_contact = {:.3e} s, so each contact feeds \
-                 energy into the bounce (self-excited contact branch)",
-                model.interface_lag,
-                c / k_contact
-            ));
+            self_excited = Some(crate::error::SelfExcitation {
+                interface_lag_ns: model.interface_lag * 1e9,
+                limit_ns: c / k_contact * 1e9,
+            });
         }
     }
-    Error::analysis("cycle", reason)
+    crate::error::AnalysisError::LeftTheModel {
+        t_ms: t * 1e3,
+        bulge_gap_nm: crate::units::to_nm(g.bulge),
+        velocity_m_per_s: s[sys.layout().velocity(0)],
+        self_excited,
+    }
+    .into()
+}
+
+/// An error of the cycle that no scene should cause.
+fn internal(detail: &str) -> Error {
+    crate::error::AnalysisError::Internal {
+        stage: crate::error::Stage::Cycle,
+        detail: detail.into(),
+    }
+    .into()
 }
 
 /// The error for a cycle that spends its steps too fast (see [`SolverSettings::max_steps`]);
-/// with an explicit method, the advice of [`explain_ode_error`].
+/// with an explicit method, the stiffness of the model as the likely cause.
 fn out_of_step_budget(
     model: &SliderModel,
     opts: &CycleOptions,
@@ -756,52 +761,32 @@ fn out_of_step_budget(
     st: Stats,
     span: f64,
 ) -> Error {
-    let max_steps = opts.solver.max_steps;
-    let pace = format!(
-        "{} steps by t = {t:.4e} s, more than twice the pace that spends them evenly over the \
-         {span:.4e} s programme",
-        st.accepted + st.rejected
-    );
-    match stiff_advice(model, opts) {
-        Some(advice) => Error::analysis(
-            "cycle",
-            format!(
-                "the explicit method {} would use up its {max_steps} steps ({pace}): {advice}",
-                opts.solver.method
-            ),
-        ),
-        None => Error::analysis(
-            "cycle",
-            format!(
-                "the cycle would use up solver.max_steps = {max_steps} ({pace}): a contact that \
-                 bounces without bound, or a tolerance too strict for the method"
-            ),
-        ),
+    let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
+    crate::error::AnalysisError::StepPace {
+        method: opts.solver.method.name(),
+        steps: st.accepted + st.rejected,
+        t_ms: t * 1e3,
+        span_ms: span * 1e3,
+        max_steps: opts.solver.max_steps,
+        stiff_rate_per_s: explicit.then(|| model.fastest_rate()),
     }
-}
-
-/// Why an explicit method runs out of steps on the slider; `None` for the other methods.
-fn stiff_advice(model: &SliderModel, opts: &CycleOptions) -> Option<String> {
-    matches!(opts.solver.method, Method::Tsit5 | Method::Dop853).then(|| {
-        format!(
-            "the system is stiff there (fastest mode about {:.3e} 1/s from the bearing, contact \
-             and lags), so stability, not accuracy, limits its step; use auto, rodas5p or radau5",
-            model.fastest_rate()
-        )
-    })
+    .into()
 }
 
 /// ODE errors of an explicit method on a stiff cycle get the advice to use a stiff method.
 fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError) -> Error {
-    match (e, stiff_advice(model, opts)) {
-        (ode::OdeError::TooManySteps { t, max_steps }, Some(advice)) => Error::analysis(
-            "cycle",
-            format!(
-                "the explicit method {} used up its {max_steps} steps at t = {t:e} s: {advice}",
-                opts.solver.method
-            ),
-        ),
-        (other, _) => Error::Ode(other),
+    let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
+    match e {
+        ode::OdeError::TooManySteps { t, max_steps } if explicit => {
+            crate::error::AnalysisError::StepLimit {
+                method: opts.solver.method.name(),
+                max_steps,
+                t_ms: t * 1e3,
+                fastest_rate_per_s: model.fastest_rate(),
+            }
+            .into()
+        }
+        other => Error::Ode(other),
     }
 }
 

@@ -7,10 +7,11 @@
 //! where the total stiffness condensed onto the bulge ([`SliderModel::total_stiffness`];
 //! `k_ab − ∂F_if/∂y` for the rigid slider) is positive; folds are where it vanishes.
 
-use super::roots::brent;
-use crate::error::{Error, Result};
+use super::roots::{brent, brent_polished};
+use crate::error::{AnalysisError, Error, Result, Stage};
 use crate::force::ForceEval;
 use crate::model::{Dofs, Rest, SliderModel};
+use crate::units::{to_mw, to_nm};
 use serde::Serialize;
 
 /// One equilibrium of the slider.
@@ -62,7 +63,7 @@ pub struct Fold {
     pub jump_in: bool,
 }
 
-/// The gap grid of a scan.
+/// The gap grid of a scan, and how the brackets it finds are refined.
 ///
 /// ```
 /// use hdi_tribology::analysis::equilibrium::ScanGrid;
@@ -77,6 +78,11 @@ pub struct ScanGrid {
     pub coarse_step: f64,
     /// Gap (m) below which the fine spacing is used.
     pub fine_until: f64,
+    /// Refine folds, threshold crossings and equilibria first on the force tables, then polish
+    /// the root with direct forces from a small bracket around it (the default: about half as
+    /// many direct evaluations). `false` runs Brent's method on the direct forces over the whole
+    /// grid interval. Both give the root to the same tolerance (1e-12 relative).
+    pub polish_from_tables: bool,
 }
 
 impl Default for ScanGrid {
@@ -85,6 +91,7 @@ impl Default for ScanGrid {
             fine_step: 2e-12,
             coarse_step: 5e-11,
             fine_until: 5e-9,
+            polish_from_tables: true,
         }
     }
 }
@@ -132,20 +139,39 @@ impl ScanGrid {
 
     /// Gaps from `hi` down to `lo`, decreasing; fails when [`ScanGrid::validate`] does.
     pub fn descending(&self, lo: f64, hi: f64) -> Result<Vec<f64>> {
+        Ok(self.iter_descending(lo, hi)?.collect())
+    }
+
+    /// The gaps of [`ScanGrid::descending`], made one at a time (a scan that stops early makes
+    /// only the points it reads).
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::equilibrium::ScanGrid;
+    /// let g = ScanGrid::default();
+    /// let lazy: Vec<f64> = g.iter_descending(-4e-9, 3e-8)?.collect();
+    /// assert_eq!(lazy, g.descending(-4e-9, 3e-8)?);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn iter_descending(&self, lo: f64, hi: f64) -> Result<impl Iterator<Item = f64>> {
         self.validate(lo, hi)?;
-        let mut out = Vec::new();
+        let (fine, coarse, until) = (self.fine_step, self.coarse_step, self.fine_until);
         let mut d = hi;
+        let mut n = 0;
+        let mut done = false;
         // Bounded: validate() capped the number of points.
-        while d > lo && out.len() < MAX_SCAN_POINTS {
-            out.push(d);
-            d -= if d > self.fine_until {
-                self.coarse_step
-            } else {
-                self.fine_step
-            };
-        }
-        out.push(lo);
-        Ok(out)
+        Ok(std::iter::from_fn(move || {
+            if done {
+                return None;
+            }
+            if d > lo && n < MAX_SCAN_POINTS {
+                let out = d;
+                d -= if d > until { coarse } else { fine };
+                n += 1;
+                return Some(out);
+            }
+            done = true;
+            Some(lo)
+        }))
     }
 }
 
@@ -160,12 +186,64 @@ pub(crate) fn check_heater(model: &SliderModel) -> Result<()> {
 pub struct EquilibriumSolver<'a> {
     model: &'a SliderModel,
     volt2: f64,
+    polish: bool,
 }
 
 impl<'a> EquilibriumSolver<'a> {
     /// A solver for `V² = volt2` (use `(V_dc − φ)²` for the DC equilibria).
     pub fn new(model: &'a SliderModel, volt2: f64) -> Self {
-        EquilibriumSolver { model, volt2 }
+        EquilibriumSolver {
+            model,
+            volt2,
+            polish: true,
+        }
+    }
+
+    /// The same solver refining as `grid` says ([`ScanGrid::polish_from_tables`]).
+    ///
+    /// ```no_run
+    /// use hdi_tribology::analysis::equilibrium::{EquilibriumSolver, ScanGrid};
+    /// use hdi_tribology::{model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let direct = ScanGrid { polish_from_tables: false, ..ScanGrid::default() };
+    /// let solver = EquilibriumSolver::new(&model, 0.0).refining_as(&direct);
+    /// let fold = solver.refine_fold(1.0e-9, 1.5e-9);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn refining_as(self, grid: &ScanGrid) -> Self {
+        EquilibriumSolver {
+            polish: grid.polish_from_tables,
+            ..self
+        }
+    }
+
+    /// The direct equilibrium where `quantity` of the equilibria changes sign in `[a, b]`, to
+    /// 1e-12 relative in the gap: the last direct evaluation is reused, not repeated.
+    fn refine(
+        &self,
+        a: f64,
+        b: f64,
+        quantity: impl Fn(&Equilibrium) -> f64,
+    ) -> Result<Equilibrium> {
+        let tol = fold_tolerance(a, b, self.model.nominal_clearance);
+        let mut seen: Vec<Equilibrium> = Vec::new();
+        let exact = |d| match self.at_gap_exact(d) {
+            Ok(e) => {
+                seen.push(e);
+                quantity(&e)
+            }
+            Err(_) => f64::NAN,
+        };
+        let d = if self.polish {
+            let approx = |d| self.at_gap(d).map_or(f64::NAN, |e| quantity(&e));
+            brent_polished(approx, exact, a, b, tol)?
+        } else {
+            brent(exact, a, b, tol)?
+        };
+        match seen.iter().rev().find(|e| e.d == d) {
+            Some(e) => Ok(*e),
+            None => self.at_gap_exact(d),
+        }
     }
 
     /// The equilibrium whose bulge gap is `d`, through the tables.
@@ -198,29 +276,12 @@ impl<'a> EquilibriumSolver<'a> {
 
     /// Locates the gap in `[a, b]` where the stiffness changes sign, to `1e-12` relative.
     pub fn refine_fold(&self, a: f64, b: f64) -> Result<Equilibrium> {
-        let tol = fold_tolerance(a, b, self.model.nominal_clearance);
-        let d = brent(
-            |d| self.at_gap_exact(d).map_or(f64::NAN, |e| e.stiffness),
-            a,
-            b,
-            tol,
-        )?;
-        self.at_gap_exact(d)
+        self.refine(a, b, |e| e.stiffness)
     }
 
     /// Locates the gap in `[a, b]` where the contact force equals `threshold`.
     pub fn refine_threshold(&self, a: f64, b: f64, threshold: f64) -> Result<Equilibrium> {
-        let tol = fold_tolerance(a, b, self.model.nominal_clearance);
-        let d = brent(
-            |d| {
-                self.at_gap_exact(d)
-                    .map_or(f64::NAN, |e| e.contact_force - threshold)
-            },
-            a,
-            b,
-            tol,
-        )?;
-        self.at_gap_exact(d)
+        self.refine(a, b, |e| e.contact_force - threshold)
     }
 }
 
@@ -262,7 +323,7 @@ pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) 
             format!("need d_lo < d_hi, got [{lo:e}, {hi:e}]"),
         ));
     }
-    let solver = EquilibriumSolver::new(model, volt2);
+    let solver = EquilibriumSolver::new(model, volt2).refining_as(grid);
     let mut points = Vec::new();
     for d in grid.descending(lo, hi)? {
         points.push(solver.at_gap(d)?);
@@ -307,46 +368,38 @@ pub fn flying_equilibrium(
 ) -> Result<Equilibrium> {
     crate::error::check_finite("power", power)?;
     crate::error::check_non_negative("volt2", volt2)?;
-    let solver = EquilibriumSolver::new(model, volt2);
+    let solver = EquilibriumSolver::new(model, volt2).refining_as(grid);
     let target = model.protrusion(power);
     let (lo, hi) = model.forces().table_range();
     let mut prev: Option<Equilibrium> = None;
-    for d in grid.descending(lo, hi)? {
+    for d in grid.iter_descending(lo, hi)? {
         let e = solver.at_gap(d)?;
         if !e.is_stable() {
             // The fold lies between this grid point and the last stable one: locate it, and if
             // the power asked for is reached before it, the equilibrium lies in that last
             // stretch (the power is nearly stationary there, so only direct forces decide).
+            // The fold's gap: refined when a stable point precedes it, else this grid point.
+            let mut fold_d = d;
             if let Some(p) = prev {
                 let fold = solver.refine_fold(e.d, p.d)?;
+                fold_d = fold.d;
                 if fold.protrusion >= target {
-                    let tol = fold_tolerance(fold.d, p.d, model.nominal_clearance);
-                    let d = brent(
-                        |x| {
-                            solver
-                                .at_gap_exact(x)
-                                .map_or(f64::NAN, |q| q.protrusion - target)
-                        },
-                        fold.d,
-                        p.d,
-                        tol,
-                    )?;
-                    return solver.at_gap_exact(d);
+                    return solver.refine(fold.d, p.d, |q| q.protrusion - target);
                 }
             }
-            return Err(Error::analysis(
-                "flying equilibrium",
-                format!(
-                    "the flying branch ends at a fold (d = {d:e} m) before the protrusion of {power} W is reached: the head is in contact there"
-                ),
-            ));
+            return Err(AnalysisError::FlyingBranchEnds {
+                power_mw: to_mw(power),
+                fold_gap_nm: to_nm(fold_d),
+            }
+            .into());
         }
         if e.protrusion >= target {
             let Some(p) = prev else {
-                return Err(Error::analysis(
-                    "flying equilibrium",
-                    "the largest tabulated gap is already below the equilibrium: widen the table range",
-                ));
+                return Err(AnalysisError::TableTooNarrow {
+                    stage: Stage::FlyingEquilibrium,
+                    gap_nm: to_nm(d),
+                }
+                .into());
             };
             let tol = fold_tolerance(e.d, p.d, model.nominal_clearance);
             let d = brent(
@@ -359,8 +412,8 @@ pub fn flying_equilibrium(
         }
         prev = Some(e);
     }
-    Err(Error::analysis(
-        "flying equilibrium",
-        format!("no flying equilibrium at {power} W inside the table range"),
-    ))
+    Err(AnalysisError::NoFlyingEquilibrium {
+        power_mw: to_mw(power),
+    }
+    .into())
 }

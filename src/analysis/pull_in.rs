@@ -8,9 +8,9 @@
 //! down from the zero-voltage equilibrium.
 
 use super::equilibrium::EquilibriumSolver;
-use super::roots::brent;
+use super::roots::{brent, brent_polished};
 use super::touchdown::{touchdown_at, touchdown_signed, Cause, StaticOptions};
-use crate::error::{check_finite, Error, Result};
+use crate::error::{check_finite, AnalysisError, Error, Result};
 use crate::model::{SliderModel, Voltage};
 use serde::Serialize;
 
@@ -31,6 +31,36 @@ struct VoltageBalance<'a> {
 }
 
 impl VoltageBalance<'_> {
+    /// The gap in `[a, b]` where `quantity` of [`VoltageBalance::at`] changes sign, to `tol`,
+    /// and the direct values there (the last direct evaluation reused, not repeated).
+    fn refine(
+        &self,
+        a: f64,
+        b: f64,
+        tol: f64,
+        polish: bool,
+        quantity: impl Fn(&(f64, f64, f64)) -> f64,
+    ) -> Result<(f64, (f64, f64, f64))> {
+        let mut seen: Vec<(f64, (f64, f64, f64))> = Vec::new();
+        let exact = |x| match self.at(x, true) {
+            Ok(r) => {
+                seen.push((x, r));
+                quantity(&r)
+            }
+            Err(_) => f64::NAN,
+        };
+        let d = if polish {
+            let approx = |x| self.at(x, false).map_or(f64::NAN, |r| quantity(&r));
+            brent_polished(approx, exact, a, b, tol)?
+        } else {
+            brent(exact, a, b, tol)?
+        };
+        match seen.iter().rev().find(|r| r.0 == d) {
+            Some(&r) => Ok(r),
+            None => Ok((d, self.at(d, true)?)),
+        }
+    }
+
     /// `(V², total stiffness, contact force)` at gap `d`, tabulated or exact.
     fn at(&self, d: f64, exact: bool) -> Result<(f64, f64, f64)> {
         let m = self.model;
@@ -61,10 +91,7 @@ impl VoltageBalance<'_> {
 pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) -> Result<PullIn> {
     check_finite("power", power)?;
     if !model.forces().has_voltage_terms() {
-        return Err(Error::analysis(
-            "pull-in voltage",
-            "the scene has no electrostatic term",
-        ));
+        return Err(AnalysisError::NoElectrostatics.into());
     }
     // Past touchdown without voltage, pull-in is at zero volts. Without any touchdown in the
     // table range (e.g. electrostatics alone) the scan below decides.
@@ -76,7 +103,7 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
                 cause: td0.cause,
             });
         }
-        Ok(_) | Err(Error::Analysis { .. }) => {}
+        Ok(_) | Err(Error::Analysis(_)) => {}
         Err(e) => return Err(e),
     }
     let delta = model.protrusion(power);
@@ -84,7 +111,7 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
     // Zero-voltage equilibrium at this power: the flying one, on the tables.
     let d0 = EquilibriumSolver::new(model, 0.0);
     let (lo, hi) = model.forces().table_range();
-    let grid = opts.grid.descending(lo, hi)?;
+    let grid = opts.grid.iter_descending(lo, hi)?;
     let mut started = false;
     let mut prev: Option<(f64, f64, f64, f64)> = None; // (d, V², k, F_c)
     for d in grid {
@@ -98,9 +125,9 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
         let (v2, k, fc) = vb.at(d, false)?;
         if let Some((pd, _pv2, _pk, _)) = prev {
             let tol = 1e-12 * d.abs().max(1e-3 * model.nominal_clearance);
+            let polish = opts.grid.polish_from_tables;
             if k <= 0.0 {
-                let df = brent(|x| vb.at(x, true).map_or(f64::NAN, |r| r.1), d, pd, tol)?;
-                let (v2f, _, _) = vb.at(df, true)?;
+                let (df, (v2f, _, _)) = vb.refine(d, pd, tol, polish, |r| r.1)?;
                 return Ok(PullIn {
                     voltage: v2f.max(0.0).sqrt(),
                     d: df,
@@ -108,16 +135,8 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
                 });
             }
             if fc >= opts.contact_threshold {
-                let dt = brent(
-                    |x| {
-                        vb.at(x, true)
-                            .map_or(f64::NAN, |r| r.2 - opts.contact_threshold)
-                    },
-                    d,
-                    pd,
-                    tol,
-                )?;
-                let (v2t, _, _) = vb.at(dt, true)?;
+                let th = opts.contact_threshold;
+                let (dt, (v2t, _, _)) = vb.refine(d, pd, tol, polish, |r| r.2 - th)?;
                 return Ok(PullIn {
                     voltage: v2t.max(0.0).sqrt(),
                     d: dt,
@@ -127,10 +146,10 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
         }
         prev = Some((d, v2, k, fc));
     }
-    Err(Error::analysis(
-        "pull-in voltage",
-        "no pull-in inside the table range",
-    ))
+    Err(AnalysisError::NoPullIn {
+        power_mw: crate::units::to_mw(power),
+    }
+    .into())
 }
 
 /// One point of the clearance change against DC voltage.

@@ -7,7 +7,7 @@
 //! bulge displacement.
 
 use super::equilibrium::{flying_equilibrium, Equilibrium, ScanGrid};
-use crate::error::{Error, Result};
+use crate::error::{AnalysisError, Error, Result, Stage};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem, Voltage};
 use crate::ode::OdeSystem;
@@ -226,7 +226,11 @@ pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse
             .then(q.re.total_cmp(&p.re))
     });
     if modes.iter().any(|m| !m.re.is_finite()) {
-        return Err(Error::analysis("linear response", "non-finite eigenvalue"));
+        return Err(AnalysisError::NotFinite {
+            stage: Stage::LinearResponse,
+            quantity: "eigenvalue",
+        }
+        .into());
     }
     let stable = modes.iter().all(|m| m.re < 0.0);
     let g = model.gaps(&eq.q, eq.protrusion);
@@ -276,10 +280,7 @@ pub fn simulated_dither(
     use crate::ode::{solve, Options, SaveAt};
     let v = model.voltage;
     if !v.is_time_dependent() {
-        return Err(Error::analysis(
-            "simulated dither",
-            "the voltage has no AC part",
-        ));
+        return Err(AnalysisError::NoAcVoltage.into());
     }
     if periods == 0 {
         return Err(Error::invalid("periods", "must be at least 1"));

@@ -42,10 +42,10 @@ fn contact_force_exact(model: &SliderModel, q: &Dofs, delta: f64) -> Result<f64>
 fn stepped(changed: &SliderModel, d: f64, q: &Dofs) -> Result<(Dofs, f64)> {
     let (step, _) = changed.exact_balance_step(d, changed.voltage.dc_squared(), q)?;
     let step = step.ok_or_else(|| {
-        Error::analysis(
-            "transition sensitivity",
-            format!("the balance's tangent is singular at d = {d:e} m"),
-        )
+        Error::from(crate::error::AnalysisError::NoSensitivity {
+            gap_nm: d * 1e9,
+            why: "the balance's tangent is singular",
+        })
     })?;
     let q1 = q + step;
     // d = h0 + bᵀq − δ
@@ -91,10 +91,11 @@ pub fn transition_shift(model: &SliderModel, changed: &SliderModel, t: &Transiti
             let dfc_dd = (fc(model, &hi)? - fc(model, &lo)?) / (2.0 * h);
             let dfc = contact_force_exact(changed, &q1, delta1)? - fc(model, e0)?;
             if dfc_dd == 0.0 || !dfc_dd.is_finite() {
-                return Err(Error::analysis(
-                    "transition sensitivity",
-                    format!("the contact force does not change with the gap at d = {d:e} m"),
-                ));
+                return Err(crate::error::AnalysisError::NoSensitivity {
+                    gap_nm: d * 1e9,
+                    why: "the contact force does not change with the gap",
+                }
+                .into());
             }
             Ok(dp_fixed_gap - dp_dd * dfc / dfc_dd)
         }

@@ -6,8 +6,9 @@
 //! falling) until the contact force drops below `F_th` or that branch ends at a fold.
 
 use super::equilibrium::{Equilibrium, EquilibriumSolver, ScanGrid};
-use crate::error::{Error, Result};
+use crate::error::{AnalysisError, Result, Stage};
 use crate::model::SliderModel;
+use crate::units::{to_mw, to_nm};
 use serde::Serialize;
 
 /// Why a transition happened.
@@ -127,7 +128,7 @@ pub(crate) fn touchdown_at(
     opts: &StaticOptions,
 ) -> Result<Transition> {
     let t = touchdown_signed(model, volt2, opts)?;
-    transition("touchdown", t.at, t.cause, true)
+    transition(t.at, t.cause, true)
 }
 
 /// As [`touchdown_at`], but a transition at negative power is returned as it is (the pull-in
@@ -137,13 +138,13 @@ pub(crate) fn touchdown_signed(
     volt2: f64,
     opts: &StaticOptions,
 ) -> Result<Transition> {
-    let solver = EquilibriumSolver::new(model, volt2);
+    let solver = EquilibriumSolver::new(model, volt2).refining_as(&opts.grid);
     let (lo, hi) = model.forces().table_range();
     let th = opts.contact_threshold;
     let mut prev: Option<Equilibrium> = None;
     // A fold passed, not yet landed: (fold, its power).
     let mut jump: Option<Equilibrium> = None;
-    for d in opts.grid.descending(lo, hi)? {
+    for d in opts.grid.iter_descending(lo, hi)? {
         let e = solver.at_gap(d)?;
         if let Some(fold) = jump {
             // The contact side rises again through the fold's power on a stable part.
@@ -183,10 +184,11 @@ pub(crate) fn touchdown_signed(
                 });
             }
         } else if !e.is_stable() || e.contact_force >= th {
-            return Err(Error::analysis(
-                "touchdown",
-                format!("the equilibrium at the largest tabulated gap ({d:e} m) is already unstable or in contact: widen the table range"),
-            ));
+            return Err(AnalysisError::TableTooNarrow {
+                stage: Stage::Touchdown,
+                gap_nm: to_nm(d),
+            }
+            .into());
         }
         prev = Some(e);
     }
@@ -198,32 +200,29 @@ pub(crate) fn touchdown_signed(
             cause: Cause::Fold,
         });
     }
-    Err(Error::analysis(
-        "touchdown",
-        "the flying branch neither reaches the contact threshold nor folds inside the table range",
-    ))
+    Err(AnalysisError::NoTouchdown {
+        stage: Stage::Touchdown,
+        max_power_mw: prev.map_or(f64::NAN, |p| to_mw(p.power)),
+        detector: None,
+    }
+    .into())
 }
 
 /// A transition, or the error that says the head never leaves (or is already in) contact at
 /// non-negative heater power.
-fn transition(what: &str, at: Equilibrium, cause: Cause, touchdown: bool) -> Result<Transition> {
+fn transition(at: Equilibrium, cause: Cause, touchdown: bool) -> Result<Transition> {
     if at.power < 0.0 {
-        let reason = if touchdown {
-            format!(
-                "the head is in contact already at zero heater power (the {} at d = {:e} m lies at \
-                 {:e} W < 0)",
-                if cause == Cause::Fold { "fold" } else { "threshold crossing" },
-                at.d,
-                at.power
-            )
+        let (gap_nm, power_mw) = (to_nm(at.d), to_mw(at.power));
+        return Err(if touchdown {
+            AnalysisError::InContactAtZeroPower {
+                at_fold: cause == Cause::Fold,
+                gap_nm,
+                power_mw,
+            }
         } else {
-            format!(
-                "the head stays in contact down to zero heater power (the contact branch ends at \
-                 d = {:e} m, {:e} W < 0): adhesion holds it",
-                at.d, at.power
-            )
-        };
-        return Err(Error::analysis(what, reason));
+            AnalysisError::NoTakeOff { gap_nm, power_mw }
+        }
+        .into());
     }
     Ok(Transition {
         power: at.power,
@@ -259,7 +258,7 @@ pub(crate) fn takeoff_at(
     start_power: f64,
     opts: &StaticOptions,
 ) -> Result<Transition> {
-    let solver = EquilibriumSolver::new(model, volt2);
+    let solver = EquilibriumSolver::new(model, volt2).refining_as(&opts.grid);
     let (mut lo, hi) = model.forces().table_range();
     let th = opts.contact_threshold;
     let target = model.protrusion(start_power);
@@ -271,13 +270,11 @@ pub(crate) fn takeoff_at(
         lo -= step;
         extended += 1;
         if extended > 50 {
-            return Err(Error::analysis(
-                "take-off",
-                format!(
-                    "no contact equilibrium at {start_power} W within {} m of interpenetration",
-                    -lo
-                ),
-            ));
+            return Err(AnalysisError::NoContactEquilibrium {
+                power_mw: to_mw(start_power),
+                depth_nm: to_nm(-lo),
+            }
+            .into());
         }
     }
     let mut ascending = opts.grid.descending(lo, hi)?;
@@ -290,12 +287,10 @@ pub(crate) fn takeoff_at(
         if !started {
             if e.protrusion <= target {
                 if !e.is_stable() {
-                    return Err(Error::analysis(
-                        "take-off",
-                        format!(
-                            "the equilibrium at {start_power} W on the contact side is unstable"
-                        ),
-                    ));
+                    return Err(AnalysisError::UnstableContactStart {
+                        power_mw: to_mw(start_power),
+                    }
+                    .into());
                 }
                 started = true;
             } else {
@@ -307,7 +302,7 @@ pub(crate) fn takeoff_at(
             // The flying side falls again through the fold's power on a stable part.
             if e.is_stable() && e.power <= fold.power {
                 if e.contact_force < th {
-                    return transition("take-off", fold, Cause::Fold, false);
+                    return transition(fold, Cause::Fold, false);
                 }
                 jump = None;
             }
@@ -318,7 +313,7 @@ pub(crate) fn takeoff_at(
             if !e.is_stable() {
                 let at = solver.refine_fold(p.d, e.d)?;
                 if at.power < 0.0 {
-                    return transition("take-off", at, Cause::Fold, false);
+                    return transition(at, Cause::Fold, false);
                 }
                 jump = Some(at);
                 prev = Some(e);
@@ -326,21 +321,21 @@ pub(crate) fn takeoff_at(
             }
             if e.contact_force < th {
                 let at = solver.refine_threshold(p.d, e.d, th)?;
-                return transition("take-off", at, Cause::Threshold, false);
+                return transition(at, Cause::Threshold, false);
             }
             if e.power < 0.0 {
-                return transition("take-off", e, Cause::Fold, false);
+                return transition(e, Cause::Fold, false);
             }
         }
         prev = Some(e);
     }
     if let Some(fold) = jump {
-        return transition("take-off", fold, Cause::Fold, false);
+        return transition(fold, Cause::Fold, false);
     }
-    Err(Error::analysis(
-        "take-off",
-        "the contact branch neither falls below the threshold nor folds inside the table range",
-    ))
+    Err(AnalysisError::NoTakeOffInTable {
+        min_power_mw: prev.map_or(f64::NAN, |p| to_mw(p.power)),
+    }
+    .into())
 }
 
 /// Touchdown, take-off (from `takeoff_start_excess` above touchdown) and their difference at the

@@ -311,23 +311,22 @@ pub fn calibrate(
     let name = staircase.detector().inner.name().to_string();
 
     let Some(touchdown_power) = outcome.touchdown_power else {
-        return Err(Error::analysis(
-            "clearance calibration",
-            format!("{name} saw no contact up to {} W", sc.max_power),
-        ));
+        return Err(crate::error::AnalysisError::NoTouchdown {
+            stage: crate::error::Stage::ClearanceCalibration,
+            max_power_mw: crate::units::to_mw(sc.max_power),
+            detector: Some(name),
+        }
+        .into());
     };
     let up = steps.iter().take_while(|s| !s.descending).count();
     if up == 1 {
         // Fired at the baseline level: the slider was in contact before the staircase began, so
         // there is no touchdown power to find and no contrast to measure.
-        return Err(Error::analysis(
-            "clearance calibration",
-            format!(
-                "{name} fired at the start power {:?} W already, before the first heater step: \
-                 contact before the staircase began (start lower, or with less dither)",
-                sc.start_power
-            ),
-        ));
+        return Err(crate::error::AnalysisError::ContactAtStart {
+            detector: name,
+            start_power_mw: crate::units::to_mw(sc.start_power),
+        }
+        .into());
     }
     let contrast = {
         let (a, b) = (steps[up - 1].peak_level, steps[up - 2].peak_level);

@@ -607,10 +607,11 @@ impl Drive {
             9 => start!(S9, U9),
             10 => start!(S10, U10),
             n => {
-                return Err(Error::analysis(
-                    "drive",
-                    format!("no fixed-size state of {n} components"),
-                ))
+                return Err(crate::error::AnalysisError::Internal {
+                    stage: crate::error::Stage::Drive,
+                    detail: format!("no fixed-size state of {n} components"),
+                }
+                .into())
             }
         };
         Ok(Drive {

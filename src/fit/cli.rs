@@ -59,7 +59,7 @@ pub fn run_cli(args: &CliArgs) -> Result<String, FitError> {
         write_plots(&result, dir)?;
     }
     serde_json::to_string_pretty(&result)
-        .map_err(|e| Error::analysis("fit", format!("cannot write the result as JSON: {e}")).into())
+        .map_err(|e| Error::output("the fit result as JSON", e.to_string()).into())
 }
 
 /// Writes, per measured column, `<file>_<column>.svg` (data and fit) and

@@ -431,15 +431,12 @@ fn predict_indicator(m: &SliderModel, ds: &DataSet) -> Result<Vec<Vec<Predicted>
             (Some(&(p0, f0)), Some(&(p1, f1))) => f0 + (f1 - f0) * (p - p0) / (p1 - p0),
             (None, Some(&(_, f1))) => f1,
             _ => {
-                return Err(crate::Error::analysis(
-                    "contact indicator",
-                    format!(
-                        "{}: the heater power {p} W lies beyond the equilibria of the table range \
-                         (up to {} W)",
-                        ds.origin,
-                        path.last().map_or(f64::NAN, |l| l.0)
-                    ),
-                ))
+                return Err(crate::error::AnalysisError::BeyondEquilibria {
+                    origin: ds.origin.clone(),
+                    heater_power_mw: crate::units::to_mw(p),
+                    last_power_mw: path.last().map_or(f64::NAN, |l| crate::units::to_mw(l.0)),
+                }
+                .into())
             }
         };
         values.push(Predicted {

@@ -613,14 +613,12 @@ pub fn fit(
                 .collect();
             let included = ev.excluded.iter().filter(|e| !**e).count();
             if included <= params.len() {
-                return Err(Error::analysis(
-                    "fit",
-                    format!(
-                        "only {included} of {points} values remain once the dynamic points whose                          detected powers do not settle within {} mW under tighter tolerances are                          left out: too few for {} free parameters (raise dynamic_power_tol_mw or                          tighten solver.rtol)",
-                        opts.dynamic_power_tol_mw,
-                        params.len()
-                    ),
-                )
+                return Err(Error::from(crate::error::AnalysisError::TooFewSettled {
+                    included,
+                    points,
+                    tol_mw: opts.dynamic_power_tol_mw,
+                    free: params.len(),
+                })
                 .into());
             }
         }
@@ -642,13 +640,9 @@ pub fn fit(
         }
     }
     let Some((_, mut x, mut converged, mut termination)) = best.filter(|b| b.0.is_finite()) else {
-        return Err(Error::analysis(
-            "fit",
-            format!(
-                "the model could not be evaluated at any start: {}",
-                first_error.unwrap_or_default()
-            ),
-        )
+        return Err(Error::from(crate::error::AnalysisError::NoModelStart {
+            first_error: first_error.unwrap_or_default(),
+        })
         .into());
     };
     let best_start = outcomes
@@ -773,9 +767,12 @@ fn analyse(
         }
     }
     let svd = js.clone().svd(false, true);
-    let v_t = svd
-        .v_t
-        .ok_or_else(|| Error::analysis("fit", "singular value decomposition failed"))?;
+    let v_t = svd.v_t.ok_or_else(|| {
+        Error::from(crate::error::AnalysisError::Internal {
+            stage: crate::error::Stage::Fit,
+            detail: "singular value decomposition failed".into(),
+        })
+    })?;
     let sv = svd.singular_values;
     let s_max = sv.iter().copied().fold(0.0, f64::max);
     // Singular values below this are treated as zero (their directions are not determined).
@@ -1133,15 +1130,11 @@ pub fn model_curves(scene: &Scene, data: &[DataSet]) -> Result<Vec<DataSet>, Fit
     for (ds, p) in out.iter_mut().zip(&pred) {
         for (o, pc) in ds.observed.iter_mut().zip(p) {
             if let Some(i) = pc.iter().position(|q| q.clipped) {
-                return Err(Error::analysis(
-                    "model curves",
-                    format!(
-                        "{}: the model detects no {} at x = {} inside the heater programme",
-                        ds.origin,
-                        o.quantity.stem(),
-                        ds.x[i]
-                    ),
-                )
+                return Err(Error::from(crate::error::AnalysisError::NotDetected {
+                    origin: ds.origin.clone(),
+                    quantity: o.quantity.stem().to_string(),
+                    x: ds.x[i],
+                })
                 .into());
             }
             o.values = pc.iter().map(|q| q.value).collect();

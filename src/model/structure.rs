@@ -194,20 +194,15 @@ impl Structure {
                 stiffness_n_per_m,
                 damping_ratio,
             } => Self::bulge(body_mass, mass_kg, stiffness_n_per_m, damping_ratio),
-            &StructureSpec::Pitch {
-                inertia_kg_m2,
-                stiffness_n_m_per_rad,
-                coupling_stiffness_n_per_rad,
-                damping_n_m_s_per_rad,
-                coupling_damping_n_s_per_rad,
-                trailing_edge_m,
-            } => Self::pitch(
-                body_mass,
-                inertia_kg_m2,
-                [stiffness_n_m_per_rad, coupling_stiffness_n_per_rad],
-                [damping_n_m_s_per_rad, coupling_damping_n_s_per_rad],
-                trailing_edge_m,
-            ),
+            StructureSpec::Pitch { .. } => match spec.pitch_values() {
+                Some((inertia, stiffness, damping, trailing_edge)) => {
+                    Self::pitch(body_mass, inertia, stiffness, damping, trailing_edge)
+                }
+                None => Err(Error::invalid(
+                    "structure.preset",
+                    "pitch without its values",
+                )),
+            },
             StructureSpec::General {
                 mass,
                 damping,

@@ -95,6 +95,32 @@ impl StructureSpec {
         }
     }
 
+    /// The pitch preset's values in the order [`Structure::pitch`](crate::model::Structure::pitch)
+    /// takes them: `(I, [k_θθ, k_yθ], [c_θθ, c_yθ], L)`; `None` for the other presets.
+    ///
+    /// ```
+    /// use hdi_tribology::scene::StructureSpec;
+    /// assert_eq!(StructureSpec::Rigid.pitch_values(), None);
+    /// ```
+    pub fn pitch_values(&self) -> Option<(f64, [f64; 2], [f64; 2], f64)> {
+        match *self {
+            StructureSpec::Pitch {
+                inertia_kg_m2,
+                stiffness_n_m_per_rad,
+                coupling_stiffness_n_per_rad,
+                damping_n_m_s_per_rad,
+                coupling_damping_n_s_per_rad,
+                trailing_edge_m,
+            } => Some((
+                inertia_kg_m2,
+                [stiffness_n_m_per_rad, coupling_stiffness_n_per_rad],
+                [damping_n_m_s_per_rad, coupling_damping_n_s_per_rad],
+                trailing_edge_m,
+            )),
+            _ => None,
+        }
+    }
+
     /// Field-by-field checks; errors name `structure.<field>`. The matrix properties of the
     /// general form (symmetry, definiteness) are checked when the model is built.
     pub fn validate(&self) -> Result<()> {
@@ -109,26 +135,15 @@ impl StructureSpec {
                 check_positive("structure.stiffness_n_per_m", *stiffness_n_per_m)?;
                 check_non_negative("structure.damping_ratio", *damping_ratio)?;
             }
-            StructureSpec::Pitch {
-                inertia_kg_m2,
-                stiffness_n_m_per_rad,
-                coupling_stiffness_n_per_rad,
-                damping_n_m_s_per_rad,
-                coupling_damping_n_s_per_rad,
-                trailing_edge_m,
-            } => {
-                check_positive("structure.inertia_kg_m2", *inertia_kg_m2)?;
-                check_positive("structure.stiffness_n_m_per_rad", *stiffness_n_m_per_rad)?;
-                check_finite(
-                    "structure.coupling_stiffness_n_per_rad",
-                    *coupling_stiffness_n_per_rad,
-                )?;
-                check_non_negative("structure.damping_n_m_s_per_rad", *damping_n_m_s_per_rad)?;
-                check_finite(
-                    "structure.coupling_damping_n_s_per_rad",
-                    *coupling_damping_n_s_per_rad,
-                )?;
-                check_finite("structure.trailing_edge_m", *trailing_edge_m)?;
+            StructureSpec::Pitch { .. } => {
+                if let Some((inertia, [k, k_c], [c, c_c], l)) = self.pitch_values() {
+                    check_positive("structure.inertia_kg_m2", inertia)?;
+                    check_positive("structure.stiffness_n_m_per_rad", k)?;
+                    check_finite("structure.coupling_stiffness_n_per_rad", k_c)?;
+                    check_non_negative("structure.damping_n_m_s_per_rad", c)?;
+                    check_finite("structure.coupling_damping_n_s_per_rad", c_c)?;
+                    check_finite("structure.trailing_edge_m", l)?;
+                }
             }
             StructureSpec::General {
                 mass,

@@ -92,9 +92,12 @@ impl Discrete {
         } else if parent.inverse_survival(0.5).is_some() {
             for _ in 0..n {
                 let q = rng.next_open01();
-                let z = parent
-                    .inverse_survival(q)
-                    .ok_or_else(|| Error::analysis("peak sampling", "inverse survival failed"))?;
+                let z = parent.inverse_survival(q).ok_or_else(|| {
+                    Error::from(crate::error::AnalysisError::Internal {
+                        stage: crate::error::Stage::PeakSampling,
+                        detail: "inverse survival failed".into(),
+                    })
+                })?;
                 out.push(z);
             }
         } else {
