@@ -172,11 +172,11 @@ def main():
     out.parent.mkdir(parents=True, exist_ok=True)
     exe = None if args.no_rust else rust_binary(args.rust_bin)
 
-    serial_s = None
+    serial_s = serial_cpu = None
     if not args.skip_serial:
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         serial = flat(run_serial(groups, amplitudes))
-        serial_s = time.perf_counter() - t
+        serial_s, serial_cpu = time.perf_counter() - t, time.process_time() - c
 
     t = time.perf_counter()
     if args.scheduler:
@@ -188,8 +188,12 @@ def main():
                                dashboard_address=None)
         client = Client(cluster)
         where = f"Dask LocalCluster, {args.workers} workers x 1 thread"
-    client.wait_for_workers(1)
+    client.wait_for_workers(args.workers if cluster is not None else 1)
     startup = time.perf_counter() - t
+    # what the idle workers burn (event loop, heartbeats, profiler), per second of wall time
+    c, t = workers_cpu(client), time.perf_counter()
+    time.sleep(5)
+    idle = (workers_cpu(client) - c) / (time.perf_counter() - t)
 
     rust_s, dask_s, rust_cpu, dask_cpu, rust_rows, rows = [], [], [], [], None, None
     for _ in range(args.rounds):
@@ -229,7 +233,7 @@ def main():
     print(f"\n{'run':<52} {'wall s':>8} {'scenes/s':>9} {'vs Rust':>8} {'CPU ms/scene':>13}")
     table = []
     if serial_s is not None:
-        table.append(("Python serial, 1 core", serial_s, None))
+        table.append(("Python serial, 1 core", serial_s, serial_cpu))
     for i in range(len(dask_s)):
         if rust_s:
             table.append((f"Rust doe_baseline, {args.workers} threads (round {i + 1})",
@@ -247,7 +251,8 @@ def main():
         print(f"Dask CPU per scene over Rust's, per round: "
               f"{', '.join(f'{x:.3f}' for x in cpu_ratios)} "
               f"(median {statistics.median(cpu_ratios):.3f})")
-    print(f"(Dask start-up, not counted above: {startup:.1f} s)")
+    print(f"(Dask start-up, not counted above: {startup:.1f} s; idle workers use "
+          f"{idle:.3f} s of CPU per second of wall time, together)")
     if failed:
         raise SystemExit("results differ between the runs")
 
