@@ -48,8 +48,11 @@ fn grid(start: f64, stop: f64, n: usize) -> Res<Vec<f64>> {
         .collect()
 }
 
-/// The design: (roughness in nm, Hamaker constant in J) pairs, and the AC amplitudes (V).
-fn design(n_sigma: usize, n_hamaker: usize, n_ac: usize) -> Res<(Vec<(f64, f64)>, Vec<f64>)> {
+/// (roughness in nm, Hamaker constant in J) pairs, and the AC amplitudes (V).
+type Design = (Vec<(f64, f64)>, Vec<f64>);
+
+/// The design of `n_sigma × n_hamaker` pairs and `n_ac` amplitudes.
+fn design(n_sigma: usize, n_hamaker: usize, n_ac: usize) -> Res<Design> {
     let sigmas = grid(0.5, 0.9, n_sigma)?;
     let hamakers = grid(0.6, 1.5, n_hamaker)?
         .into_iter()
