@@ -6,7 +6,7 @@ Each call's wall time seen from Python is compared with `Cycle.wall_seconds`, th
 simulation measured for itself inside the same call, so both come from the same run on the same
 machine. The overhead is everything else: arguments, options, releasing the GIL, building the
 result objects and copying the time series into numpy arrays. Also times `ac_sweep` on one
-shared model (cycles per second on every core), the Rust baseline of the DoE in doe_dask.py.
+shared model (cycles per second on every core; the DoE baseline is examples/doe_baseline.rs).
 """
 
 import statistics

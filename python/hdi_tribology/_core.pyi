@@ -60,6 +60,12 @@ class Model:
     @property
     def scene(self) -> Scene:
         """A copy of the scene the model was built from."""
+    @property
+    def structure(self) -> str:
+        """The structure's preset as the scene names it: "rigid", "bulge", "pitch", "general"."""
+    @property
+    def dofs(self) -> int:
+        """Degrees of freedom of the structure: the length of ``Equilibrium.q``, ``Mode.shape``."""
 
 class Equilibrium:
     """A static equilibrium of the slider."""
@@ -80,6 +86,9 @@ class Equilibrium:
     """Contact force (N)."""
     stable: bool
     """Whether the equilibrium is stable."""
+    q: List[float]
+    """Every coordinate of the structure, one per degree of freedom (m; rad for a pitch):
+    ``[y]`` rigid, ``[y, z]`` bulge (body heave, bulge), ``[y, θ]`` pitch."""
     @property
     def d_nm(self) -> float:
         """Bulge gap (nm)."""
@@ -187,11 +196,29 @@ class RefinedCycle:
     wall_seconds: float
     """Wall time over all runs (s)."""
 
+class Mode:
+    """One mode of the linearised slider."""
+
+    eigenvalue: complex
+    """Eigenvalue λ (1/s)."""
+    frequency_hz: float
+    """|Im λ| / 2π (Hz)."""
+    damping_ratio: float
+    """−Re λ / |λ|."""
+    shape: List[float]
+    """Displacement part of the eigenvector over the structure's coordinates (as
+    ``Equilibrium.q``), largest entry 1 and real there; all zero for a mode of the lags alone."""
+
 class LinearResponse:
     """The linearised slider about its flying equilibrium."""
 
     @property
-    def equilibrium(self) -> Equilibrium: ...
+    def equilibrium(self) -> Equilibrium:
+        """The equilibrium linearised about (under the time-mean V²)."""
+    @property
+    def modes(self) -> List[Mode]:
+        """Every mode by ascending frequency: eigenvalue, frequency, damping ratio, shape. A
+        vibrating degree of freedom gives a complex pair; lags and overdamped motions real ones."""
     @property
     def eigenvalues(self) -> List[complex]:
         """Eigenvalues (1/s)."""
@@ -326,7 +353,23 @@ def ac_sweep_refined(
     by at most ``temperature_tol_k`` (K)."""
 
 def linear_response(target: Target, power_mw: float) -> LinearResponse:
-    """The linearised slider about its flying equilibrium at ``power_mw`` (mW)."""
+    """The linearised slider about its flying equilibrium at ``power_mw`` (mW): modes,
+    transfer function H(iω) and the predicted dither at twice the AC frequency."""
+
+def flying_equilibrium(target: Target, power_mw: float, *,
+                       v_ac: Optional[float] = None) -> Equilibrium:
+    """The stable flying equilibrium at heater power ``power_mw`` (mW), under the time-mean V²
+    of the scene's voltage (AC amplitude ``v_ac`` in V when given): the one ``linear_response``
+    linearises about. Raises when the flying branch ends below that power (head in contact)."""
+
+def simulated_dither(target: Target, power_mw: float, v_ac: Optional[float] = None, *,
+                     settle: int = 40, periods: int = 10, method: Optional[str] = None,
+                     rtol: Optional[float] = None, atol_nm: Optional[float] = None) -> float:
+    """Dither amplitude of the bulge at 2f (m) simulated at constant heater power ``power_mw``
+    (mW) and AC amplitude ``v_ac`` (V; default the scene's): half the peak-to-peak bulge
+    displacement over the last ``periods`` periods of V² after ``settle`` periods. The
+    simulated counterpart of ``LinearResponse.dither_amplitude_m``; raises ``AnalysisError``
+    without an AC voltage."""
 
 def calibrate(
     target: Target,

@@ -305,6 +305,19 @@ impl Model {
         })
     }
 
+    /// The structure's preset, as the scene file names it: `"rigid"`, `"bulge"`, `"pitch"` or
+    /// `"general"`.
+    #[getter]
+    fn structure(&self) -> &'static str {
+        self.scene.structure.preset()
+    }
+
+    /// Degrees of freedom of the structure: the length of `Equilibrium.q` and `Mode.shape`.
+    #[getter]
+    fn dofs(&self) -> usize {
+        self.model.structure.dofs()
+    }
+
     /// The scene the model was built from (a copy).
     #[getter]
     fn scene(&self) -> Scene {
@@ -314,7 +327,11 @@ impl Model {
     }
 
     fn __repr__(&self) -> String {
-        format!("Model(scene={:?})", self.scene.name)
+        format!(
+            "Model(scene={:?}, structure={:?})",
+            self.scene.name,
+            self.structure()
+        )
     }
 }
 
@@ -431,11 +448,16 @@ struct Equilibrium {
     contact_force_n: f64,
     /// Whether the equilibrium is stable.
     stable: bool,
+    /// Every coordinate of the structure (m for displacements, rad for the pitch; one per degree
+    /// of freedom: `[y]` for the rigid slider, `[y, z]` for `bulge`, `[y, θ]` for `pitch`).
+    q: Vec<f64>,
 }
 
-impl From<&analysis::Equilibrium> for Equilibrium {
-    fn from(e: &analysis::Equilibrium) -> Self {
+impl Equilibrium {
+    /// The equilibrium `e` of a structure of `dofs` coordinates.
+    fn of(e: &analysis::Equilibrium, dofs: usize) -> Self {
         Equilibrium {
+            q: e.q.iter().take(dofs).copied().collect(),
             d_m: e.d,
             y_m: e.y,
             protrusion_m: e.protrusion,
@@ -490,12 +512,12 @@ fn cause_name(c: analysis::Cause) -> String {
     }
 }
 
-impl From<&analysis::Transition> for Transition {
-    fn from(t: &analysis::Transition) -> Self {
+impl Transition {
+    fn of(t: &analysis::Transition, dofs: usize) -> Self {
         Transition {
             power_w: t.power,
             cause: cause_name(t.cause),
-            at: Equilibrium::from(&t.at),
+            at: Equilibrium::of(&t.at, dofs),
         }
     }
 }
@@ -573,9 +595,10 @@ fn static_hysteresis(
     let h = py
         .detach(|| analysis::static_hysteresis(&model, &opts))
         .py()?;
+    let dofs = model.structure.dofs();
     Ok(StaticHysteresis {
-        touchdown: (&h.touchdown).into(),
-        takeoff: (&h.takeoff).into(),
+        touchdown: Transition::of(&h.touchdown, dofs),
+        takeoff: Transition::of(&h.takeoff, dofs),
         hysteresis_w: h.hysteresis,
     })
 }
@@ -1067,10 +1090,38 @@ fn ac_sweep_refined(
 // ---------------------------------------------------------------------------------------------
 // Linear response
 
+/// One mode of the linearised slider.
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+#[derive(Clone)]
+struct Mode {
+    /// Eigenvalue λ (1/s), complex.
+    eigenvalue: numpy::Complex64,
+    /// `|Im λ| / 2π` (Hz).
+    frequency_hz: f64,
+    /// Damping ratio `−Re λ / |λ|`.
+    damping_ratio: f64,
+    /// Mode shape over the structure's coordinates (one per degree of freedom, as
+    /// `Equilibrium.q`): the eigenvector's displacement part scaled so that its largest entry is
+    /// 1 and rotated to be real there. All zero for a mode of the lags alone (thermal or
+    /// interface lag), which moves no coordinate.
+    shape: Vec<f64>,
+}
+
+#[pymethods]
+impl Mode {
+    fn __repr__(&self) -> String {
+        format!(
+            "Mode(frequency_hz={:.6e}, damping_ratio={:.4e}, shape={:?})",
+            self.frequency_hz, self.damping_ratio, self.shape
+        )
+    }
+}
+
 /// The linear response about the flying equilibrium at one heater power.
 #[pyclass(module = "hdi_tribology", frozen)]
 struct LinearResponse {
     inner: analysis::LinearResponse,
+    dofs: usize,
 }
 
 #[pymethods]
@@ -1078,7 +1129,23 @@ impl LinearResponse {
     /// The equilibrium (under the mean V²).
     #[getter]
     fn equilibrium(&self) -> Equilibrium {
-        (&self.inner.equilibrium).into()
+        Equilibrium::of(&self.inner.equilibrium, self.dofs)
+    }
+    /// Every mode (`Mode`: eigenvalue, frequency, damping ratio, shape), by ascending
+    /// frequency: one pair of complex eigenvalues per vibrating degree of freedom, plus real ones
+    /// for overdamped motions and lags.
+    #[getter]
+    fn modes(&self) -> Vec<Mode> {
+        self.inner
+            .modes
+            .iter()
+            .map(|m| Mode {
+                eigenvalue: numpy::Complex64::new(m.re, m.im),
+                frequency_hz: m.frequency,
+                damping_ratio: m.damping_ratio,
+                shape: m.shape.iter().take(self.dofs).copied().collect(),
+            })
+            .collect()
     }
     /// Eigenvalues as complex numbers (1/s).
     #[getter]
@@ -1156,7 +1223,78 @@ fn linear_response(
     let inner = py
         .detach(|| analysis::linear_response(&model, units::mw(power_mw)))
         .py()?;
-    Ok(LinearResponse { inner })
+    Ok(LinearResponse {
+        inner,
+        dofs: model.structure.dofs(),
+    })
+}
+
+/// The model at AC amplitude `v_ac` (V), or the model itself when `None`.
+fn at_amplitude(model: &SliderModel, v_ac: Option<f64>) -> PyResult<Option<SliderModel>> {
+    match v_ac {
+        None => Ok(None),
+        Some(a) if !a.is_finite() => Err(invalid("v_ac", format!("must be finite, got {a:?} V"))),
+        Some(a) => Ok(Some(model.with_voltage(Voltage {
+            ac_amplitude: a,
+            ..model.voltage
+        }))),
+    }
+}
+
+/// The stable flying equilibrium at heater power `power_mw` (mW), reached scanning down from the
+/// largest tabulated gap, under the time-mean V² of the voltage (the scene's, with AC amplitude
+/// `v_ac` in V when given): the equilibrium `linear_response` linearises about. Raises
+/// `NoConvergenceError`/`AnalysisError` when the flying branch ends (fold) below that power:
+/// the head is then in contact.
+#[pyfunction]
+#[pyo3(signature = (target, power_mw, *, v_ac = None))]
+fn flying_equilibrium(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    power_mw: f64,
+    v_ac: Option<f64>,
+) -> PyResult<Equilibrium> {
+    let (_, model) = model_of(py, target)?;
+    let changed = at_amplitude(&model, v_ac)?;
+    let m: &SliderModel = changed.as_ref().unwrap_or(&model);
+    let e = py
+        .detach(|| {
+            analysis::flying_equilibrium(
+                m,
+                units::mw(power_mw),
+                m.voltage.mean_squared(),
+                &ScanGrid::default(),
+            )
+        })
+        .py()?;
+    Ok(Equilibrium::of(&e, model.structure.dofs()))
+}
+
+/// The dither of the bulge at twice the AC frequency from a simulation at constant heater power
+/// `power_mw` (mW) and AC amplitude `v_ac` (V; default the scene's): half the peak-to-peak
+/// bulge displacement over the last `periods` periods of V², after `settle` periods for the
+/// start-up transient, in m. The simulated counterpart of `LinearResponse.dither_amplitude_m`.
+/// Raises `AnalysisError` when the voltage has no AC part.
+#[pyfunction]
+#[pyo3(signature = (target, power_mw, v_ac = None, *, settle = 40, periods = 10, method = None, rtol = None, atol_nm = None))]
+fn simulated_dither(
+    py: Python<'_>,
+    target: &Bound<'_, PyAny>,
+    power_mw: f64,
+    v_ac: Option<f64>,
+    settle: usize,
+    periods: usize,
+    method: Option<&str>,
+    rtol: Option<f64>,
+    atol_nm: Option<f64>,
+) -> PyResult<f64> {
+    let setup = cycle_setup(py, target, false, method, rtol, atol_nm)?;
+    let changed = at_amplitude(&setup.model, v_ac)?;
+    let m: &SliderModel = changed.as_ref().unwrap_or(&setup.model);
+    py.detach(|| {
+        analysis::response::simulated_dither(m, units::mw(power_mw), &setup.opts, settle, periods)
+    })
+    .py()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1376,6 +1514,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Detection>()?;
     m.add_class::<Cycle>()?;
     m.add_class::<RefinedCycle>()?;
+    m.add_class::<Mode>()?;
     m.add_class::<LinearResponse>()?;
     m.add_class::<Calibration>()?;
     m.add_function(wrap_pyfunction!(forces, m)?)?;
@@ -1387,6 +1526,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ac_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(ac_sweep_refined, m)?)?;
     m.add_function(wrap_pyfunction!(linear_response, m)?)?;
+    m.add_function(wrap_pyfunction!(flying_equilibrium, m)?)?;
+    m.add_function(wrap_pyfunction!(simulated_dither, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -93,6 +93,6 @@ def test_parse_errors_name_the_origin_and_field(tmp_path, paper_scene):
 
 def test_scene_and_model_repr(paper_scene, paper_model):
     assert repr(paper_scene) == 'Scene(name="paper")'
-    assert repr(paper_model) == 'Model(scene="paper")'
+    assert repr(paper_model) == 'Model(scene="paper", structure="rigid")'
     assert paper_model.scene == paper_scene
     assert json.loads(paper_scene.to_json())["name"] == "paper"
