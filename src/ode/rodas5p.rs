@@ -233,12 +233,13 @@ where
         ctx: &Ctx<D>,
     ) -> Option<(usize, f64)> {
         let n = y.len();
-        for i in 0..n {
-            let mut s = 0.0;
-            for j in 0..n {
-                s += self.jac[(i, j)].abs() * (y_new[j] - y[j]).abs();
+        self.fu.fill(0.0);
+        // Column by column (J is stored by columns).
+        for (j, col) in self.jac.column_iter().enumerate() {
+            let d = f64::EPSILON * (y_new[j] - y[j]).abs();
+            for (v, a) in self.fu.iter_mut().zip(col.iter()) {
+                *v += a.abs() * d;
             }
-            self.fu[i] = f64::EPSILON * s;
         }
         self.lu.solve_mut(&mut self.fu);
         (0..n)
