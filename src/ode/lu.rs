@@ -89,9 +89,6 @@ where
         // by rows.
         for j in 0..n {
             let bj = b[j].clone();
-            if bj == T::zero() {
-                continue;
-            }
             for i in j + 1..n {
                 b[i] -= self.m[(i, j)].clone() * bj.clone();
             }
