@@ -80,10 +80,7 @@ fn e5_every_method_is_right_or_reports_failure() {
                         "{m} rtol {rtol}: invariant {}",
                         y[1] - y[2] - y[3]
                     );
-                    assert!(
-                        matches!(m, Method::Radau5 | Method::Auto),
-                        "{m} completed"
-                    );
+                    assert!(matches!(m, Method::Radau5 | Method::Auto), "{m} completed");
                 }
                 Err(e) => {
                     println!("e5 {m} rtol {rtol:e}: {e}");
