@@ -954,8 +954,12 @@ where
                 self.needs_restart = true;
                 Ok(())
             }
-            Steppers::Rodas5P(m) => {
-                let (component, floor) = m.floor_hit().unwrap_or((0, f64::NAN));
+            steppers => {
+                // Only Rodas5P reports a rounding floor.
+                let (component, floor) = match steppers {
+                    Steppers::Rodas5P(m) => m.floor_hit().unwrap_or((0, f64::NAN)),
+                    _ => (0, f64::NAN),
+                };
                 Err(OdeError::RoundingFloor {
                     t,
                     h,
@@ -964,7 +968,6 @@ where
                     significant: self.ctx.atol[component] / self.ctx.rtol,
                 })
             }
-            _ => unreachable!("only Rodas5P reports a rounding floor"),
         }
     }
 
@@ -1068,7 +1071,11 @@ fn register_failure(
             reason: format!("{MAX_CONSECUTIVE_FAILURES} consecutive failures while halving h"),
         },
         FailKind::Singular => OdeError::SingularMatrix { t, h },
-        FailKind::RoundingFloor => unreachable!("handled before"),
+        // Handled before `register_failure` (the method is changed or the run ends).
+        FailKind::RoundingFloor => OdeError::NonFinite {
+            t,
+            what: "rounding floor of the linear solves".into(),
+        },
     })
 }
 
