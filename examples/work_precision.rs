@@ -85,6 +85,10 @@ fn explicit(m: Method) -> bool {
 fn failure_status(method: Method, stiff: bool, e: &OdeError) -> String {
     match e {
         OdeError::TooManySteps { .. } if stiff && explicit(method) => "failed (stiff)".into(),
+        // Rodas5P on E5: its linear algebra cannot resolve the tolerance asked for.
+        OdeError::RoundingFloor { t, component, .. } => {
+            format!("refused (rounding floor, y[{component}] at t = {t:.3e})")
+        }
         OdeError::InvalidInput { .. } if e.to_string().contains("not available") => {
             "unavailable".into()
         }

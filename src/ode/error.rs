@@ -56,6 +56,26 @@ pub enum OdeError {
         /// Details.
         reason: String,
     },
+    /// Rodas5P cannot resolve a component to the tolerance asked for: the rounding of its
+    /// stage solves (`ε·|J|·|Δy|`, multiplied by up to `hγ` in slow and conserved directions and
+    /// invisible to its error estimate) exceeds `atol_i / rtol`, the smallest size of that
+    /// component the tolerance declares significant. Radau5 (whose result is defined by a
+    /// residual in `f` alone) has no such floor; `Method::Auto` switches to it by itself.
+    #[error(
+        "Rodas5P cannot resolve component {component} at t = {t} (h = {h:e}): the rounding of its linear solves reaches {floor:e}, above atol/rtol = {significant:e}; use Radau5 or Auto"
+    )]
+    RoundingFloor {
+        /// Time reached.
+        t: f64,
+        /// Step size tried.
+        h: f64,
+        /// Index of the component.
+        component: usize,
+        /// Estimated rounding error of the step in that component.
+        floor: f64,
+        /// `atol / rtol` of that component.
+        significant: f64,
+    },
     /// The iteration matrix of a stiff method stayed singular as the step shrank.
     #[error("singular iteration matrix at t = {t} (h = {h:e})")]
     SingularMatrix {

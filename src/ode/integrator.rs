@@ -735,6 +735,14 @@ where
                     self.last_rejected = true;
                     continue;
                 }
+                Trial::Failed {
+                    kind: FailKind::RoundingFloor,
+                    ..
+                } => {
+                    self.ctx.stats.rejected += 1;
+                    self.rounding_floor_fallback(t, h)?;
+                    return self.step_with(events);
+                }
                 Trial::Failed { factor, kind } => {
                     if kind == FailKind::NonFinite {
                         self.recent_nonfinite += 1;
@@ -931,6 +939,38 @@ where
         Ok(StepStatus::Accepted)
     }
 
+    /// Rodas5P refused a step of size `h` at `t` for its rounding floor (see
+    /// [`OdeError::RoundingFloor`]): `Auto` takes Radau5 as its stiff method from here on and
+    /// retries the same step; Rodas5P chosen by the user fails.
+    fn rounding_floor_fallback(&mut self, t: f64, h: f64) -> Result<(), OdeError> {
+        match &self.steppers {
+            Steppers::Auto(..) => {
+                self.steppers = Steppers::AutoRadau(
+                    Tsit5::new(&self.y),
+                    Box::new(Radau5::new(&self.y, self.ctx.rtol)),
+                );
+                self.h = h;
+                self.err_prev = 1.0;
+                self.needs_restart = true;
+                Ok(())
+            }
+            steppers => {
+                // Only Rodas5P reports a rounding floor.
+                let (component, floor) = match steppers {
+                    Steppers::Rodas5P(m) => m.floor_hit().unwrap_or((0, f64::NAN)),
+                    _ => (0, f64::NAN),
+                };
+                Err(OdeError::RoundingFloor {
+                    t,
+                    h,
+                    component,
+                    floor,
+                    significant: self.ctx.atol[component] / self.ctx.rtol,
+                })
+            }
+        }
+    }
+
     fn switch_check(&mut self, stiff: bool, h_acc: f64) {
         let sys = &self.sys;
         let switch = if !stiff {
@@ -1031,6 +1071,11 @@ fn register_failure(
             reason: format!("{MAX_CONSECUTIVE_FAILURES} consecutive failures while halving h"),
         },
         FailKind::Singular => OdeError::SingularMatrix { t, h },
+        // Handled before `register_failure` (the method is changed or the run ends).
+        FailKind::RoundingFloor => OdeError::NonFinite {
+            t,
+            what: "rounding floor of the linear solves".into(),
+        },
     })
 }
 

@@ -38,10 +38,12 @@ where
         let n = self.m.nrows();
         self.valid = false;
         for k in 0..n {
+            // Pivot on |re| + |im| (the modulus needs a hypot per entry and picks the same
+            // magnitude up to a factor √2, which is all partial pivoting needs).
             let mut p = k;
-            let mut best = self.m[(k, k)].clone().abs();
+            let mut best = self.m[(k, k)].clone().norm1();
             for i in k + 1..n {
-                let v = self.m[(i, k)].clone().abs();
+                let v = self.m[(i, k)].clone().norm1();
                 if v > best {
                     best = v;
                     p = i;
@@ -54,13 +56,19 @@ where
             if p != k {
                 self.m.swap_rows(p, k);
             }
-            let pivot = self.m[(k, k)].clone();
+            let inv_pivot = T::one() / self.m[(k, k)].clone();
             for i in k + 1..n {
-                let l = self.m[(i, k)].clone() / pivot.clone();
-                self.m[(i, k)] = l.clone();
-                for j in k + 1..n {
-                    let ukj = self.m[(k, j)].clone();
-                    self.m[(i, j)] -= l.clone() * ukj;
+                self.m[(i, k)] *= inv_pivot.clone();
+            }
+            // Column by column (the storage order).
+            for j in k + 1..n {
+                let ukj = self.m[(k, j)].clone();
+                if ukj == T::zero() {
+                    continue;
+                }
+                for i in k + 1..n {
+                    let lik = self.m[(i, k)].clone();
+                    self.m[(i, j)] -= lik * ukj.clone();
                 }
             }
         }
@@ -77,12 +85,13 @@ where
                 b.swap_rows(p, k);
             }
         }
-        for i in 1..n {
-            let mut s = b[i].clone();
-            for j in 0..i {
-                s -= self.m[(i, j)].clone() * b[j].clone();
+        // Forward substitution by columns: each b[i] receives its terms in the same order as
+        // by rows.
+        for j in 0..n {
+            let bj = b[j].clone();
+            for i in j + 1..n {
+                b[i] -= self.m[(i, j)].clone() * bj.clone();
             }
-            b[i] = s;
         }
         for i in (0..n).rev() {
             let mut s = b[i].clone();

@@ -23,12 +23,15 @@ pub enum Method {
     /// tolerances on non-stiff problems.
     Dop853,
     /// Rosenbrock method Rodas5P (Steinebach), order 5, L-stable, 4th-order dense output.
+    /// Refuses with [`OdeError::RoundingFloor`](super::OdeError::RoundingFloor) a problem whose
+    /// absolute tolerance lies below the rounding of its linear solves (E5 of the Test Set).
     Rodas5P,
     /// Radau IIA, 3 stages, order 5, L-stable, with simplified Newton iterations.
     Radau5,
     /// Tsit5 while the problem is non-stiff, a stiff method while it is stiff, switching both
     /// ways. The stiff method is Radau5 for `rtol` below 1e-6 and Rodas5P from 1e-6 on (by
-    /// the measured work–precision of both; the tolerance at the start decides).
+    /// the measured work–precision of both; the tolerance at the start decides). When
+    /// Rodas5P refuses a step for its rounding floor, Auto goes on with Radau5.
     Auto,
 }
 

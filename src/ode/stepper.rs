@@ -56,6 +56,8 @@ pub(crate) enum FailKind {
     NonFinite,
     Newton,
     Singular,
+    /// The rounding of the linear algebra exceeds what the tolerance asks for (Rodas5P).
+    RoundingFloor,
 }
 
 /// One integration method.
