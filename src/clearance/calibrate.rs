@@ -230,8 +230,8 @@ impl Calibration {
 /// Runs the firmware's touchdown calibration on the simulated drive.
 ///
 /// The slider starts at rest in its flying equilibrium at `start_power` (with `V(0)²`). The heater
-/// climbs the staircase; every level is integrated with the crate's ODE stepper through
-/// [`SliderSystem`] (the model's voltage, dither included, acts throughout) and sampled every
+/// climbs the staircase; every level runs on the simulated drive ([`Drive`](crate::drive::Drive):
+/// the model's voltage, dither included, acts throughout) and is sampled every
 /// `sample_interval` for the detector. The first level where the detector fires in its
 /// measurement window is the touchdown power. With `find_takeoff`, the heater then steps down
 /// until a level passes without contact. The operating power is the touchdown power minus the
