@@ -150,21 +150,23 @@ fn explicit_method_on_a_stiff_scene_fails_with_a_clear_error() {
     match simulate_cycle(&model, &programme, &opts) {
         // The cycle stops on the step budget itself, or earlier on the pace of its steps;
         // either way it names the stiffness.
-        Err(Error::Analysis(
-            e @ (AnalysisError::StepLimit {
-                method: "tsit5",
-                max_steps: 20_000,
-                t_ms,
-                fastest_rate_per_s: rate,
-            }
-            | AnalysisError::StepPace {
-                method: "tsit5",
-                max_steps: 20_000,
-                t_ms,
-                stiff_rate_per_s: Some(rate),
-                ..
-            }),
-        )) => {
+        Err(Error::Analysis(e)) => {
+            let (t_ms, rate) = match &e {
+                AnalysisError::StepLimit {
+                    method: "tsit5",
+                    max_steps: 20_000,
+                    t_ms,
+                    fastest_rate_per_s,
+                } => (*t_ms, *fastest_rate_per_s),
+                AnalysisError::StepPace {
+                    method: "tsit5",
+                    max_steps: 20_000,
+                    t_ms,
+                    stiff_rate_per_s: Some(rate),
+                    ..
+                } => (*t_ms, *rate),
+                other => panic!("expected a stiffness error, got {other:?}"),
+            };
             assert!(t_ms > 0.0 && t_ms < 1.3, "{e}");
             assert!(rate > 1e6, "{e}");
             let text = e.to_string();
