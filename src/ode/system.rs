@@ -55,52 +55,49 @@ where
     }
 }
 
-/// A shared reference to a system is a system: [`Integrator::new(&sys, ..)`](crate::ode::Integrator::new)
-/// borrows it, `Integrator::new(sys, ..)` owns it.
-impl<D: Dim, S: OdeSystem<D> + ?Sized> OdeSystem<D> for &S
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    #[inline]
-    fn rhs(&self, t: f64, y: &OVector<f64, D>, dydt: &mut OVector<f64, D>) {
-        (**self).rhs(t, y, dydt)
-    }
-    #[inline]
-    fn jacobian(&self, t: f64, y: &OVector<f64, D>, jac: &mut OMatrix<f64, D, D>) -> bool {
-        (**self).jacobian(t, y, jac)
-    }
-    #[inline]
-    fn time_derivative(&self, t: f64, y: &OVector<f64, D>, dfdt: &mut OVector<f64, D>) -> bool {
-        (**self).time_derivative(t, y, dfdt)
-    }
-    #[inline]
-    fn is_autonomous(&self) -> bool {
-        (**self).is_autonomous()
-    }
+/// Forwards every method of [`OdeSystem`] through a pointer type.
+macro_rules! forward_system {
+    ($(#[$doc:meta])* $ptr:ty) => {
+        $(#[$doc])*
+        impl<D: Dim, S: OdeSystem<D> + ?Sized> OdeSystem<D> for $ptr
+        where
+            DefaultAllocator: Allocator<D> + Allocator<D, D>,
+        {
+            #[inline]
+            fn rhs(&self, t: f64, y: &OVector<f64, D>, dydt: &mut OVector<f64, D>) {
+                (**self).rhs(t, y, dydt)
+            }
+            #[inline]
+            fn jacobian(&self, t: f64, y: &OVector<f64, D>, jac: &mut OMatrix<f64, D, D>) -> bool {
+                (**self).jacobian(t, y, jac)
+            }
+            #[inline]
+            fn time_derivative(
+                &self,
+                t: f64,
+                y: &OVector<f64, D>,
+                dfdt: &mut OVector<f64, D>,
+            ) -> bool {
+                (**self).time_derivative(t, y, dfdt)
+            }
+            #[inline]
+            fn is_autonomous(&self) -> bool {
+                (**self).is_autonomous()
+            }
+        }
+    };
 }
 
-/// A boxed system (for example a `Box<dyn OdeSystem<D>>` chosen at run time) is a system.
-impl<D: Dim, S: OdeSystem<D> + ?Sized> OdeSystem<D> for Box<S>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    #[inline]
-    fn rhs(&self, t: f64, y: &OVector<f64, D>, dydt: &mut OVector<f64, D>) {
-        (**self).rhs(t, y, dydt)
-    }
-    #[inline]
-    fn jacobian(&self, t: f64, y: &OVector<f64, D>, jac: &mut OMatrix<f64, D, D>) -> bool {
-        (**self).jacobian(t, y, jac)
-    }
-    #[inline]
-    fn time_derivative(&self, t: f64, y: &OVector<f64, D>, dfdt: &mut OVector<f64, D>) -> bool {
-        (**self).time_derivative(t, y, dfdt)
-    }
-    #[inline]
-    fn is_autonomous(&self) -> bool {
-        (**self).is_autonomous()
-    }
-}
+forward_system!(
+    /// A shared reference to a system is a system:
+    /// [`Integrator::new(&sys, ..)`](crate::ode::Integrator::new) borrows it,
+    /// `Integrator::new(sys, ..)` owns it.
+    &S
+);
+forward_system!(
+    /// A boxed system (for example a `Box<dyn OdeSystem<D>>` chosen at run time) is a system.
+    Box<S>
+);
 
 /// Adapter turning closures into an [`OdeSystem`]: the right-hand side `|t, y, dydt|`, and
 /// optionally the Jacobian `|t, y, jac|` (finite differences otherwise) and a declaration that
