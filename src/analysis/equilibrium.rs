@@ -258,10 +258,23 @@ impl<'a> EquilibriumSolver<'a> {
         Ok(self.assemble(d, q, &f))
     }
 
+    /// The protrusion (m) of the equilibrium whose bulge gap is `d`, through the tables: the
+    /// [`EquilibriumSolver::at_gap`] equilibrium's `protrusion`, without the rest of it.
+    pub fn protrusion_at(&self, d: f64) -> Result<f64> {
+        let (q, _) = self.model.balance(d, self.volt2, false)?;
+        Ok(self.protrusion(d, &q))
+    }
+
+    /// `δ = h0 + bᵀq − d`: the gap geometry solved for the protrusion.
+    fn protrusion(&self, d: f64, q: &Dofs) -> f64 {
+        let m = self.model;
+        m.nominal_clearance + m.structure.bulge_displacement(q) - d
+    }
+
     fn assemble(&self, d: f64, q: Dofs, f: &ForceEval) -> Equilibrium {
         let m = self.model;
-        let protrusion = m.nominal_clearance + m.structure.bulge_displacement(&q) - d;
-        let g = m.gaps(&q, protrusion);
+        let protrusion = self.protrusion(d, &q);
+        let g = m.gaps_at(d, q[0]);
         Equilibrium {
             d,
             y: q[0],

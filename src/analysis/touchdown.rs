@@ -266,7 +266,7 @@ pub(crate) fn takeoff_at(
     // extend the scan downwards (the forces fall back to direct evaluation outside the table).
     let step = (hi - lo).max(1e-9) * 0.1;
     let mut extended = 0;
-    while solver.at_gap(lo)?.protrusion < target {
+    while solver.protrusion_at(lo)? < target {
         lo -= step;
         extended += 1;
         if extended > 50 {
@@ -279,24 +279,27 @@ pub(crate) fn takeoff_at(
     }
     let mut ascending = opts.grid.descending(lo, hi)?;
     ascending.reverse();
+    // Up to the start only the protrusion is needed: the equilibria before it are assembled
+    // for the last one alone (the first step's `prev`).
+    let mut before: Option<f64> = None;
     let mut started = false;
     let mut prev: Option<Equilibrium> = None;
     let mut jump: Option<Equilibrium> = None;
     for d in ascending {
+        if !started && solver.protrusion_at(d)? > target {
+            before = Some(d);
+            continue;
+        }
         let e = solver.at_gap(d)?;
         if !started {
-            if e.protrusion <= target {
-                if !e.is_stable() {
-                    return Err(AnalysisError::UnstableContactStart {
-                        power_mw: to_mw(start_power),
-                    }
-                    .into());
+            if !e.is_stable() {
+                return Err(AnalysisError::UnstableContactStart {
+                    power_mw: to_mw(start_power),
                 }
-                started = true;
-            } else {
-                prev = Some(e);
-                continue;
+                .into());
             }
+            started = true;
+            prev = before.map(|b| solver.at_gap(b)).transpose()?;
         }
         if let Some(fold) = jump {
             // The flying side falls again through the fold's power on a stable part.

@@ -470,6 +470,23 @@ impl InterfaceForces {
     /// the same tolerance), so this costs one look-up instead of three.
     #[inline]
     pub fn evaluate(&self, g: Gaps) -> HotForces {
+        self.evaluate_with(g, true, true)
+    }
+
+    /// The static and per-V² sums of [`InterfaceForces::evaluate`] alone: where there is no
+    /// fused table, the contact force's look-up is left out (the interface force needs the two
+    /// sums only; the contact force is part of the static one), and so is the per-V² look-up
+    /// when `voltage` is false (it is then zero).
+    #[inline]
+    pub fn coupled_sums(&self, g: Gaps, voltage: bool) -> (ForceEval, ForceEval) {
+        let h = self.evaluate_with(g, false, voltage);
+        (h.static_part, h.per_volt2)
+    }
+
+    /// [`InterfaceForces::evaluate`], the separate contact and per-V² look-ups only when
+    /// asked for.
+    #[inline]
+    fn evaluate_with(&self, g: Gaps, contact: bool, voltage: bool) -> HotForces {
         if let Some(f) = &self.fused {
             if let Some([s, v, c]) = f.eval(g.bulge) {
                 let e = |(value, d_bulge): (f64, f64)| ForceEval {
@@ -486,8 +503,16 @@ impl InterfaceForces {
         }
         HotForces {
             static_part: self.static_part(g),
-            per_volt2: self.per_volt2_part(g),
-            contact: self.contact(g),
+            per_volt2: if voltage {
+                self.per_volt2_part(g)
+            } else {
+                ForceEval::default()
+            },
+            contact: if contact {
+                self.contact(g)
+            } else {
+                ForceEval::default()
+            },
         }
     }
 

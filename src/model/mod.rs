@@ -249,15 +249,26 @@ impl SliderModel {
     /// is `h0 + bᵀq − δ` and the pad gap `h0 + q₀` (for the rigid slider: `h0 + y − δ`, `h0 + y`).
     #[inline]
     pub fn gaps(&self, q: &Dofs, delta: f64) -> Gaps {
+        self.gaps_at(
+            self.nominal_clearance + self.structure.bulge_displacement(q) - delta,
+            q[0],
+        )
+    }
+
+    /// The gaps when the bulge gap is held at `d` and the body heaves by `y` (m): the pad gap
+    /// `h0 + y`. The static balance, parametrised by `d`, uses this form of
+    /// [`SliderModel::gaps`] (`d` itself, not recomputed from `q` and `δ` with rounding).
+    pub fn gaps_at(&self, d: f64, y: f64) -> Gaps {
         Gaps {
-            bulge: self.nominal_clearance + self.structure.bulge_displacement(q) - delta,
-            pad: self.nominal_clearance + q[0],
+            bulge: d,
+            pad: self.nominal_clearance + y,
         }
     }
 
     /// Interface force `F_if = F_static + V² G_e` and its partial derivatives.
     pub fn interface_force(&self, g: Gaps, volt2: f64) -> ForceEval {
-        self.hot_forces(g, volt2).0
+        let (s, e) = self.forces.coupled_sums(g, volt2 != 0.0);
+        add_scaled(s, e, volt2)
     }
 
     /// `F_if` and the three tabulated sums it is made of (static, per V², contact), from one
@@ -332,11 +343,11 @@ impl SliderModel {
     pub fn balance(&self, d: f64, volt2: f64, exact: bool) -> Result<(Dofs, ForceEval)> {
         let h0 = self.nominal_clearance;
         let st = &self.structure;
-        let at = |q0: f64| Gaps {
-            bulge: d,
-            pad: h0 + q0,
-        };
+        let at = |q0: f64| self.gaps_at(d, q0);
         let residual = |q: &Dofs, f: &ForceEval| self.balance_residual(q, f);
+        // With no pad-gap term the interface force depends on `d` alone, which is held: one
+        // evaluation serves every Newton step (the same numbers, fewer look-ups).
+        let pad_free = !self.forces.uses_pad_gap();
         // Start from the linearised bearing.
         let f0 = self.interface_force(at(0.0), volt2);
         let j0 = st.tangent(self.bearing.stiffness(0.0), 0.0, 0.0);
@@ -350,7 +361,11 @@ impl SliderModel {
         }
         let mut found = None;
         for _ in 0..200 {
-            let f = self.interface_force(at(q[0]), volt2);
+            let f = if pad_free {
+                f0
+            } else {
+                self.interface_force(at(q[0]), volt2)
+            };
             let (r, j) = residual(&q, &f);
             if !r.iter().all(|x| x.is_finite()) || !j.iter().all(|x| x.is_finite()) {
                 // Say which term failed rather than that no balance exists.
@@ -384,8 +399,15 @@ impl SliderModel {
         };
         if exact {
             // Newton on the balance with direct forces, from the tabulated solution.
+            let mut direct = None;
             for _ in 0..50 {
-                let (step, fe) = self.exact_balance_step(d, volt2, &q)?;
+                let (step, fe) = match direct {
+                    Some(fe) => (self.balance_step(&q, &fe), fe),
+                    None => self.exact_balance_step(d, volt2, &q)?,
+                };
+                if pad_free {
+                    direct = Some(fe);
+                }
                 f = fe;
                 let Some(step) = step else { break };
                 q += step;
@@ -407,14 +429,15 @@ impl SliderModel {
         volt2: f64,
         q: &Dofs,
     ) -> Result<(Option<Dofs>, ForceEval)> {
-        let st = &self.structure;
-        let g = Gaps {
-            bulge: d,
-            pad: self.nominal_clearance + q[0],
-        };
-        let f = self.interface_force_exact(g, volt2)?;
-        let (r, j) = self.balance_residual(q, &f);
-        Ok((st.solve(&j, &r), f))
+        let f = self.interface_force_exact(self.gaps_at(d, q[0]), volt2)?;
+        Ok((self.balance_step(q, &f), f))
+    }
+
+    /// The Newton step of the static balance at coordinates `q` under interface force `f`
+    /// (`None` where the tangent is singular).
+    fn balance_step(&self, q: &Dofs, f: &ForceEval) -> Option<Dofs> {
+        let (r, j) = self.balance_residual(q, f);
+        self.structure.solve(&j, &r)
     }
 
     /// The static balance's residual and tangent at coordinates `q` under interface force `f`.
