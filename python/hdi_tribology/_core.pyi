@@ -271,6 +271,75 @@ class Calibration:
     def clearance_nm(self) -> float:
         """Clearance at the set power (nm)."""
 
+SENSOR_COLUMNS: List[str]
+"""The columns of a sensor stream (``replay``, ``hdi drive``), units in their names."""
+
+class Sensors:
+    """One controller period's sensors and the true values behind them (the columns of
+    ``hdi drive``, in the units their names carry)."""
+
+    time_s: float
+    """Time at the end of the period (s)."""
+    heater_mw: float
+    """Heater power held over the period (mW)."""
+    contact_resistance_ohm: float
+    """Embedded contact sensor's resistance (Ω)."""
+    acoustic_v: float
+    """Acoustic-emission RMS (V)."""
+    readback_fundamental_v: float
+    """Read-back amplitude, fundamental (V)."""
+    readback_third_v: float
+    """Read-back amplitude, third harmonic (V)."""
+    hr_clearance_change_nm: float
+    """Harmonic-ratio clearance change since the drive's first period (nm)."""
+    true_gap_nm: float
+    """True bulge gap at the end of the period (nm)."""
+    true_contact_force_un: float
+    """True contact force, mean over the period (µN)."""
+    true_sensor_temperature_k: float
+    """True contact-sensor temperature (K above its reference)."""
+    true_disk_height_nm: float
+    """Disk surface height under the head (nm)."""
+    true_ambient_k: float
+    """Ambient temperature change since the start (K)."""
+    true_protrusion_nm: float
+    """True protrusion at the end of the period (nm)."""
+    true_friction_power_mw: float
+    """True frictional power over the period (mW)."""
+
+class Drive:
+    """A simulated drive for firmware prototyping: the scene's slider over a disk with run-out
+    and waviness (or a flat one), with a heater, a head–disk voltage and the sensors firmware
+    reads, stepped at the controller's rate. Starts at rest in the flying equilibrium at
+    ``initial_power_mw``. The same seed gives the same stream, bit for bit. A ``Drive``
+    belongs to the thread that made it."""
+
+    def __init__(self, scene: Scene, *, seed: int = 1, radius_mm: float = 25.0,
+                 flat_disk: bool = False, initial_power_mw: float = 60.0) -> None: ...
+    def step(self, heater_mw: float, *, dc_v: float = 0.0, ac_v: float = 0.0,
+             ac_khz: float = 0.0, dt_us: float = 50.0) -> Sensors:
+        """Holds the heater at ``heater_mw`` (mW) and the voltage at ``dc_v`` (V) plus an AC
+        dither of ``ac_v`` (V) at ``ac_khz`` (kHz) for one period of ``dt_us`` (µs); returns
+        the sensors at its end."""
+    @property
+    def time_s(self) -> float:
+        """Simulated time so far (s)."""
+    @property
+    def stats(self) -> Dict[str, int]:
+        """Integrator work so far: accepted, rejected, rhs_evals, jac_evals, lu_decomps."""
+    @property
+    def seed(self) -> int:
+        """Seed of the disk's random waviness and of the sensor noise."""
+
+def replay(scene: Scene, time_s: Sequence[float], heater_mw: Sequence[float],
+           voltage_dc_v: Sequence[float], voltage_ac_v: Optional[Sequence[float]] = None,
+           ac_frequency_khz: Optional[Sequence[float]] = None, *, rate_khz: float = 20.0,
+           seed: int = 1, radius_mm: float = 25.0, flat_disk: bool = False) -> Dict[str, F64Array]:
+    """Replays commands (each holds from its ``time_s`` until the next; the last time ends the
+    run) through a new drive, as ``hdi drive SCENE --commands FILE`` does: the sensor columns
+    of ``SENSOR_COLUMNS`` as float64 arrays, one value per period, bit for bit the CLI's.
+    The GIL is released while the drive runs."""
+
 class Forces(TypedDict):
     d_m: F64Array
     intermolecular_n: F64Array

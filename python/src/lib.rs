@@ -18,6 +18,10 @@ use hdi_tribology::clearance::{
     self, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
     VibrationRms,
 };
+use hdi_tribology::drive::{
+    check_commands, replay_each, scene_zone, sensor_row, Command, CommandRow, DiskSpec, Drive,
+    DriveOptions, Plant, SENSOR_COLUMNS,
+};
 use hdi_tribology::fit::{DataSet, FitError, FitOptions, FreeParameter};
 use hdi_tribology::force::Gaps;
 use hdi_tribology::model::{SliderModel, Voltage};
@@ -1407,6 +1411,318 @@ fn calibrate(
 }
 
 // ---------------------------------------------------------------------------------------------
+// Drive
+
+/// The plant of a `Drive` or a replay: the scene in the zone at `radius_mm`, the disk and the
+/// seed, with the drive's default sensors, heater lag and solver.
+fn plant_of(
+    py: Python<'_>,
+    scene: &Scene,
+    seed: u64,
+    radius_mm: f64,
+    flat_disk: bool,
+    initial_power_mw: f64,
+) -> PyResult<Plant> {
+    if !(radius_mm.is_finite() && radius_mm > 0.0) {
+        return Err(invalid(
+            "radius_mm",
+            format!("must be a positive number of mm, got {radius_mm}"),
+        ));
+    }
+    if !(initial_power_mw.is_finite() && initial_power_mw >= 0.0) {
+        return Err(invalid(
+            "initial_power_mw",
+            format!("must be ≥ 0 mW, got {initial_power_mw} mW"),
+        ));
+    }
+    let opts = DriveOptions {
+        initial_power: units::mw(initial_power_mw),
+        disk: if flat_disk {
+            DiskSpec::flat()
+        } else {
+            DiskSpec::default()
+        },
+        ..DriveOptions::default()
+    };
+    let scene = &scene.inner;
+    py.detach(|| Plant::new(scene, &scene_zone(scene, radius_mm * 1e-3)?, seed, opts))
+        .py()
+}
+
+/// One controller period's sensors, as the firmware reads them, and the true values behind
+/// them, in the units their names carry (the columns of `hdi drive`, `docs/clearance.md`).
+#[pyclass(module = "hdi_tribology", frozen, get_all)]
+struct Sensors {
+    /// Time at the end of the period (s).
+    time_s: f64,
+    /// Heater power held over the period (mW).
+    heater_mw: f64,
+    /// Embedded contact sensor's resistance (Ω).
+    contact_resistance_ohm: f64,
+    /// Acoustic-emission RMS (V).
+    acoustic_v: f64,
+    /// Read-back amplitude, fundamental (V).
+    readback_fundamental_v: f64,
+    /// Read-back amplitude, third harmonic (V).
+    readback_third_v: f64,
+    /// Harmonic-ratio clearance change since the drive's first period (nm; Wallace).
+    hr_clearance_change_nm: f64,
+    /// True bulge gap at the end of the period (nm).
+    true_gap_nm: f64,
+    /// True contact force, mean over the period (µN).
+    true_contact_force_un: f64,
+    /// True contact-sensor temperature (K above its reference).
+    true_sensor_temperature_k: f64,
+    /// Disk surface height under the head (nm).
+    true_disk_height_nm: f64,
+    /// Ambient temperature change since the start (K).
+    true_ambient_k: f64,
+    /// True protrusion at the end of the period (nm).
+    true_protrusion_nm: f64,
+    /// True frictional power over the period (mW).
+    true_friction_power_mw: f64,
+}
+
+impl Sensors {
+    /// From one row of `replay_each` (the columns of `SENSOR_COLUMNS`, in order) and the
+    /// true values the row leaves out.
+    fn of(row: &[f64; 12], truth: &hdi_tribology::drive::Truth) -> Self {
+        Sensors {
+            time_s: row[0],
+            heater_mw: row[1],
+            contact_resistance_ohm: row[2],
+            acoustic_v: row[3],
+            readback_fundamental_v: row[4],
+            readback_third_v: row[5],
+            hr_clearance_change_nm: row[6],
+            true_gap_nm: row[7],
+            true_contact_force_un: row[8],
+            true_sensor_temperature_k: row[9],
+            true_disk_height_nm: row[10],
+            true_ambient_k: row[11],
+            true_protrusion_nm: units::to_nm(truth.protrusion),
+            true_friction_power_mw: units::to_mw(truth.friction_power),
+        }
+    }
+}
+
+#[pymethods]
+impl Sensors {
+    fn __repr__(&self) -> String {
+        format!(
+            "Sensors(time_s={:.6e}, heater_mw={:.4}, contact_resistance_ohm={:.6}, acoustic_v={:.4e}, \
+             hr_clearance_change_nm={:.4}, true_gap_nm={:.4}, true_contact_force_un={:.4})",
+            self.time_s,
+            self.heater_mw,
+            self.contact_resistance_ohm,
+            self.acoustic_v,
+            self.hr_clearance_change_nm,
+            self.true_gap_nm,
+            self.true_contact_force_un
+        )
+    }
+}
+
+/// A simulated drive for firmware prototyping: the scene's slider flying over a disk with
+/// run-out and waviness (or a flat one), with a heater, a head–disk voltage and the sensors
+/// firmware reads, stepped at the controller's rate (`docs/clearance.md`).
+///
+/// `Drive(scene, *, seed=1, radius_mm=25, flat_disk=False, initial_power_mw=60)` starts at rest
+/// in the flying equilibrium at `initial_power_mw`. The same seed gives the same disk and the
+/// same sensor noise, bit for bit; stepping it with the commands of a command file gives the
+/// rows `replay` (and `hdi drive`) gives. A `Drive` belongs to the thread that made it.
+#[pyclass(module = "hdi_tribology", name = "Drive", unsendable)]
+struct PyDrive {
+    inner: Drive,
+    wavelength: f64,
+    /// The first period's read-back log ratio: the reference of the harmonic-ratio change.
+    reference: Option<f64>,
+}
+
+#[pymethods]
+impl PyDrive {
+    #[new]
+    #[pyo3(signature = (scene, *, seed = 1, radius_mm = 25.0, flat_disk = false, initial_power_mw = 60.0))]
+    fn new(
+        py: Python<'_>,
+        scene: &Scene,
+        seed: u64,
+        radius_mm: f64,
+        flat_disk: bool,
+        initial_power_mw: f64,
+    ) -> PyResult<Self> {
+        let plant = plant_of(py, scene, seed, radius_mm, flat_disk, initial_power_mw)?;
+        let wavelength = plant.sensor_spec().readback.wavelength;
+        Ok(PyDrive {
+            inner: plant.into_drive().py()?,
+            wavelength,
+            reference: None,
+        })
+    }
+
+    /// Holds the heater at `heater_mw` (mW) and the voltage at `dc_v` (V) plus an AC dither of
+    /// amplitude `ac_v` (V) at `ac_khz` (kHz) for one controller period of `dt_us` (µs), and
+    /// returns the `Sensors` at its end.
+    #[pyo3(signature = (heater_mw, *, dc_v = 0.0, ac_v = 0.0, ac_khz = 0.0, dt_us = 50.0))]
+    fn step(
+        &mut self,
+        heater_mw: f64,
+        dc_v: f64,
+        ac_v: f64,
+        ac_khz: f64,
+        dt_us: f64,
+    ) -> PyResult<Sensors> {
+        let row = CommandRow {
+            time_s: 0.0,
+            heater_mw,
+            voltage_dc_v: dc_v,
+            voltage_ac_v: ac_v,
+            ac_frequency_khz: ac_khz,
+        };
+        let arg = |name: &str| {
+            match name {
+                "heater_mw" => "heater_mw",
+                "voltage_dc_v" => "dc_v",
+                "voltage_ac_v" => "ac_v",
+                "ac_frequency_khz" => "ac_khz",
+                other => other,
+            }
+            .to_string()
+        };
+        check_commands(&[row, CommandRow { time_s: 1.0, ..row }], "step", |_, n| {
+            arg(n)
+        })
+        .py()?;
+        if !(dt_us.is_finite() && dt_us > 0.0 && dt_us <= 1e6) {
+            return Err(invalid(
+                "dt_us",
+                format!("must be a period in (0, 1e6] µs, got {dt_us} µs"),
+            ));
+        }
+        let command = Command {
+            heater_power: units::mw(heater_mw),
+            dc_voltage: dc_v,
+            ac_amplitude: ac_v,
+            ac_frequency: ac_khz * 1e3,
+        };
+        let s = self.inner.step(&command, dt_us / 1e6).py()?;
+        let lr = s.readback.log_ratio();
+        let lr0 = *self.reference.get_or_insert(lr);
+        let row = sensor_row(&s, lr0, self.wavelength);
+        Ok(Sensors::of(&row, &s.truth))
+    }
+
+    /// Simulated time so far (s).
+    #[getter]
+    fn time_s(&self) -> f64 {
+        self.inner.time()
+    }
+
+    /// The integrator's work so far: a dict of `accepted`, `rejected`, `rhs_evals`,
+    /// `jac_evals` and `lu_decomps`.
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let st = self.inner.stats();
+        let d = PyDict::new(py);
+        d.set_item("accepted", st.accepted)?;
+        d.set_item("rejected", st.rejected)?;
+        d.set_item("rhs_evals", st.rhs_evals)?;
+        d.set_item("jac_evals", st.jac_evals)?;
+        d.set_item("lu_decomps", st.lu_decomps)?;
+        Ok(d)
+    }
+
+    /// The seed of the disk's random waviness and of the sensor noise.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.inner.plant().seed()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Drive(scene={:?}, seed={}, radius_mm={}, time_s={:.6e})",
+            self.inner.plant().zone().name,
+            self.inner.plant().seed(),
+            self.inner.plant().zone().radius * 1e3,
+            self.inner.time()
+        )
+    }
+}
+
+/// Replays commands through a new drive, as `hdi drive SCENE --commands FILE` does, and returns
+/// the sensor columns as float64 arrays (the CSV's columns, `SENSOR_COLUMNS`; units in their
+/// names), bit for bit the CLI's. Each command holds from its `time_s` until the next; the last
+/// time ends the run. `voltage_ac_v` and `ac_frequency_khz` default to zeros. The GIL is released
+/// while the drive runs.
+#[pyfunction]
+#[pyo3(signature = (scene, time_s, heater_mw, voltage_dc_v, voltage_ac_v = None, ac_frequency_khz = None, *, rate_khz = 20.0, seed = 1, radius_mm = 25.0, flat_disk = false))]
+fn replay<'py>(
+    py: Python<'py>,
+    scene: &Scene,
+    time_s: Vec<f64>,
+    heater_mw: Vec<f64>,
+    voltage_dc_v: Vec<f64>,
+    voltage_ac_v: Option<Vec<f64>>,
+    ac_frequency_khz: Option<Vec<f64>>,
+    rate_khz: f64,
+    seed: u64,
+    radius_mm: f64,
+    flat_disk: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let n = time_s.len();
+    let ac = voltage_ac_v.unwrap_or_else(|| vec![0.0; n]);
+    let f = ac_frequency_khz.unwrap_or_else(|| vec![0.0; n]);
+    for (name, len) in [
+        ("heater_mw", heater_mw.len()),
+        ("voltage_dc_v", voltage_dc_v.len()),
+        ("voltage_ac_v", ac.len()),
+        ("ac_frequency_khz", f.len()),
+    ] {
+        if len != n {
+            return Err(invalid(
+                name,
+                format!("has {len} values, time_s has {n}: one per command"),
+            ));
+        }
+    }
+    if !(rate_khz.is_finite() && rate_khz > 0.0) {
+        return Err(invalid(
+            "rate_khz",
+            format!("must be a positive rate in kHz, got {rate_khz}"),
+        ));
+    }
+    let rows: Vec<CommandRow> = (0..n)
+        .map(|i| CommandRow {
+            time_s: time_s[i],
+            heater_mw: heater_mw[i],
+            voltage_dc_v: voltage_dc_v[i],
+            voltage_ac_v: ac[i],
+            ac_frequency_khz: f[i],
+        })
+        .collect();
+    check_commands(&rows, "time_s", |i, name| format!("{name}[{i}]")).py()?;
+    let plant = plant_of(py, scene, seed, radius_mm, flat_disk, 60.0)?;
+    let dt = 1e-3 / rate_khz;
+    let columns = py
+        .detach(|| {
+            let mut cols: Vec<Vec<f64>> = vec![Vec::new(); SENSOR_COLUMNS.len()];
+            replay_each(&plant, &rows, dt, |row| {
+                for (c, v) in cols.iter_mut().zip(row) {
+                    c.push(*v);
+                }
+                Ok(())
+            })?;
+            Ok::<_, hdi_tribology::Error>(cols)
+        })
+        .py()?;
+    let out = PyDict::new(py);
+    for (name, col) in SENSOR_COLUMNS.iter().zip(columns) {
+        out.set_item(name, array(py, col))?;
+    }
+    Ok(out)
+}
+
+// ---------------------------------------------------------------------------------------------
 // Fit
 
 fn fit_error(e: FitError) -> PyErr {
@@ -1517,6 +1833,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Mode>()?;
     m.add_class::<LinearResponse>()?;
     m.add_class::<Calibration>()?;
+    m.add_class::<Sensors>()?;
+    m.add_class::<PyDrive>()?;
     m.add_function(wrap_pyfunction!(forces, m)?)?;
     m.add_function(wrap_pyfunction!(static_hysteresis, m)?)?;
     m.add_function(wrap_pyfunction!(pull_in_voltage, m)?)?;
@@ -1530,6 +1848,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulated_dither, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(replay, m)?)?;
+    m.add("SENSOR_COLUMNS", SENSOR_COLUMNS.to_vec())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! Replaying a command file through a drive: the way in for tools that are not Rust.
 
 use super::plant::{Command, Plant};
-use super::sensors::Readback;
+use super::sensors::{Readback, Sensors};
 use crate::error::{Error, Result};
 use std::io::{Read, Write};
 
@@ -68,54 +68,91 @@ pub fn read_commands<R: Read>(input: R, origin: &str) -> Result<Vec<CommandRow>>
         let line = i + 2;
         let row =
             rec.map_err(|e| Error::invalid(format!("{origin} line {line}"), e.to_string()))?;
-        let field = |name: &str| format!("{origin} line {line}, {name}");
-        let check = |name: &str, v: f64, ok: bool, want: &str| -> Result<()> {
-            if v.is_finite() && ok {
-                Ok(())
-            } else {
-                Err(Error::invalid(
-                    field(name),
-                    format!("must be {want}, got {v}"),
-                ))
-            }
-        };
-        check("time_s", row.time_s, row.time_s >= 0.0, "≥ 0 s")?;
-        check("heater_mw", row.heater_mw, row.heater_mw >= 0.0, "≥ 0 mW")?;
-        check("voltage_dc_v", row.voltage_dc_v, true, "finite (V)")?;
-        check("voltage_ac_v", row.voltage_ac_v, true, "finite (V)")?;
-        check(
-            "ac_frequency_khz",
-            row.ac_frequency_khz,
-            row.ac_frequency_khz >= 0.0,
-            "≥ 0 kHz",
-        )?;
-        match rows.last() {
-            None if row.time_s != 0.0 => {
-                return Err(Error::invalid(
-                    field("time_s"),
-                    format!("the first row must be at 0 s, got {} s", row.time_s),
-                ))
-            }
-            Some(prev) if row.time_s <= prev.time_s => {
-                return Err(Error::invalid(
-                    field("time_s"),
-                    format!(
-                        "times must increase strictly, got {} s after {} s",
-                        row.time_s, prev.time_s
-                    ),
-                ))
-            }
-            _ => {}
-        }
+        check_row(&row, rows.last(), |name| {
+            format!("{origin} line {line}, {name}")
+        })?;
         rows.push(row);
     }
+    check_count(&rows, origin)?;
+    Ok(rows)
+}
+
+/// Checks command rows given as columns rather than read from a file (for bindings and
+/// programs that hold the commands in memory), with the rules of [`read_commands`]; `field`
+/// names a value in errors from its row index and column name.
+///
+/// ```
+/// use hdi_tribology::drive::{check_commands, CommandRow};
+/// let row = |t: f64, p: f64| CommandRow { time_s: t, heater_mw: p, voltage_dc_v: 0.0,
+///     voltage_ac_v: 0.0, ac_frequency_khz: 0.0 };
+/// let field = |i: usize, name: &str| format!("{name}[{i}]");
+/// assert!(check_commands(&[row(0.0, 60.0), row(1e-3, 65.0)], "commands", field).is_ok());
+/// let e = check_commands(&[row(0.0, 60.0), row(0.0, 65.0)], "commands", field).unwrap_err();
+/// assert!(e.to_string().contains("time_s[1]"), "{e}");
+/// ```
+pub fn check_commands(
+    rows: &[CommandRow],
+    origin: &str,
+    field: impl Fn(usize, &str) -> String,
+) -> Result<()> {
+    for (i, row) in rows.iter().enumerate() {
+        let prev = i.checked_sub(1).map(|j| &rows[j]);
+        check_row(row, prev, |name| field(i, name))?;
+    }
+    check_count(rows, origin)
+}
+
+/// One row's values and its time against the row before.
+fn check_row(
+    row: &CommandRow,
+    prev: Option<&CommandRow>,
+    field: impl Fn(&str) -> String,
+) -> Result<()> {
+    let check = |name: &str, v: f64, ok: bool, want: &str| -> Result<()> {
+        if v.is_finite() && ok {
+            Ok(())
+        } else {
+            Err(Error::invalid(
+                field(name),
+                format!("must be {want}, got {v}"),
+            ))
+        }
+    };
+    check("time_s", row.time_s, row.time_s >= 0.0, "≥ 0 s")?;
+    check("heater_mw", row.heater_mw, row.heater_mw >= 0.0, "≥ 0 mW")?;
+    check("voltage_dc_v", row.voltage_dc_v, true, "finite (V)")?;
+    check("voltage_ac_v", row.voltage_ac_v, true, "finite (V)")?;
+    check(
+        "ac_frequency_khz",
+        row.ac_frequency_khz,
+        row.ac_frequency_khz >= 0.0,
+        "≥ 0 kHz",
+    )?;
+    match prev {
+        None if row.time_s != 0.0 => Err(Error::invalid(
+            field("time_s"),
+            format!("the first row must be at 0 s, got {} s", row.time_s),
+        )),
+        Some(p) if row.time_s <= p.time_s => Err(Error::invalid(
+            field("time_s"),
+            format!(
+                "times must increase strictly, got {} s after {} s",
+                row.time_s, p.time_s
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// A command list needs the first command and the end time.
+fn check_count(rows: &[CommandRow], origin: &str) -> Result<()> {
     if rows.len() < 2 {
         return Err(Error::invalid(
             origin,
             "needs at least two rows: the first command and the end time",
         ));
     }
-    Ok(rows)
+    Ok(())
 }
 
 /// What a replay did.
@@ -159,6 +196,50 @@ pub fn replay<W: Write>(
     dt: f64,
     out: W,
 ) -> Result<ReplaySummary> {
+    let io = |e: csv::Error| Error::invalid("output", e.to_string());
+    let mut w = csv::Writer::from_writer(out);
+    // The header goes out with the first row, so that nothing is written when the checks of
+    // `replay_each` fail.
+    let mut header = false;
+    let summary = replay_each(plant, rows, dt, |row| {
+        if !header {
+            w.write_record(SENSOR_COLUMNS).map_err(io)?;
+            header = true;
+        }
+        w.serialize(row).map_err(io)
+    })?;
+    if !header {
+        w.write_record(SENSOR_COLUMNS).map_err(io)?;
+    }
+    w.flush()
+        .map_err(|e| Error::invalid("output", e.to_string()))?;
+    Ok(summary)
+}
+
+/// [`replay`] without the file: `each` receives every period's row of sensors, in the columns
+/// and units of [`SENSOR_COLUMNS`], as it is made (for bindings that collect the columns).
+///
+/// ```
+/// use hdi_tribology::drive::{read_commands, replay_each, scene_zone, DriveOptions, Plant};
+/// use hdi_tribology::scene::Scene;
+/// let scene = Scene::paper();
+/// let plant = Plant::new(&scene, &scene_zone(&scene, 0.025)?, 1, DriveOptions::default())?;
+/// let rows = read_commands("time_s,heater_mw,voltage_dc_v\n0,60,0\n0.0005,60,0\n".as_bytes(), "c.csv")?;
+/// let mut gaps = Vec::new();
+/// replay_each(&plant, &rows, 50e-6, |row| Ok(gaps.push(row[7])))?;
+/// assert_eq!(gaps.len(), 10);
+/// assert!(gaps.iter().all(|&g| g > 0.0)); // flying: the true gap in nm
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+///
+/// # Errors
+/// As [`replay`]; an error `each` returns stops the replay and is passed on.
+pub fn replay_each(
+    plant: &Plant,
+    rows: &[CommandRow],
+    dt: f64,
+    mut each: impl FnMut(&[f64; 12]) -> Result<()>,
+) -> Result<ReplaySummary> {
     crate::error::check_positive("dt", dt)?;
     let end = rows.last().map_or(0.0, |r| r.time_s);
     let periods = (end / dt * (1.0 + 1e-12)).floor();
@@ -173,9 +254,6 @@ pub fn replay<W: Write>(
     }
     let periods = periods as usize;
     let wavelength = plant.sensor_spec().readback.wavelength;
-    let io = |e: csv::Error| Error::invalid("output", e.to_string());
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(SENSOR_COLUMNS).map_err(io)?;
     let mut drive = plant.drive()?;
     let mut k = 0usize;
     let mut reference = None;
@@ -192,29 +270,46 @@ pub fn replay<W: Write>(
             ac_frequency: r.ac_frequency_khz * 1e3,
         };
         let s = drive.step(&cmd, dt)?;
-        let lr = s.readback.log_ratio();
-        let lr0 = *reference.get_or_insert(lr);
-        let tr = &s.truth;
-        w.serialize([
-            s.t,
-            s.heater_power * 1e3,
-            s.contact_resistance,
-            s.acoustic,
-            s.readback.fundamental,
-            s.readback.third,
-            Readback::clearance_change(lr0, lr, wavelength) * 1e9,
-            tr.gap * 1e9,
-            tr.mean_contact_force * 1e6,
-            tr.sensor_temperature,
-            tr.disk_height * 1e9,
-            tr.ambient,
-        ])
-        .map_err(io)?;
+        let lr0 = *reference.get_or_insert(s.readback.log_ratio());
+        each(&sensor_row(&s, lr0, wavelength))?;
     }
-    w.flush()
-        .map_err(|e| Error::invalid("output", e.to_string()))?;
     Ok(ReplaySummary {
         periods,
         simulated_time: drive.time(),
     })
+}
+
+/// One period's [`Sensors`] as a row of the sensor file, in the columns and units of
+/// [`SENSOR_COLUMNS`]. The harmonic-ratio clearance change is taken against
+/// `reference_log_ratio`, the read-back `ln(A_1/A_3)` of the first period (with `wavelength`
+/// the read-back's bit wavelength, m).
+///
+/// ```
+/// use hdi_tribology::drive::{scene_zone, sensor_row, Command, DriveOptions, Plant};
+/// use hdi_tribology::scene::Scene;
+/// let scene = Scene::paper();
+/// let plant = Plant::new(&scene, &scene_zone(&scene, 0.025)?, 1, DriveOptions::default())?;
+/// let mut drive = plant.drive()?;
+/// let s = drive.step(&Command::heater_mw(60.0), 50e-6)?;
+/// let row = sensor_row(&s, s.readback.log_ratio(), plant.sensor_spec().readback.wavelength);
+/// assert_eq!(row[1], 60.0); // heater, mW
+/// assert_eq!(row[6], 0.0); // no clearance change against itself
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn sensor_row(s: &Sensors, reference_log_ratio: f64, wavelength: f64) -> [f64; 12] {
+    let tr = &s.truth;
+    [
+        s.t,
+        s.heater_power * 1e3,
+        s.contact_resistance,
+        s.acoustic,
+        s.readback.fundamental,
+        s.readback.third,
+        Readback::clearance_change(reference_log_ratio, s.readback.log_ratio(), wavelength) * 1e9,
+        tr.gap * 1e9,
+        tr.mean_contact_force * 1e6,
+        tr.sensor_temperature,
+        tr.disk_height * 1e9,
+        tr.ambient,
+    ]
 }

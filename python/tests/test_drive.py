@@ -1,0 +1,137 @@
+"""The simulated drive from Python: one period at a time (`Drive.step`), a whole command list
+(`replay`, bit for bit the `hdi drive` program's CSV), a firmware loop written in Python, and
+errors naming the argument."""
+
+import threading
+
+import numpy as np
+import pytest
+
+import hdi_tribology as hdi
+
+# Two commands on a flat disk: 60 mW, then 66 mW from 1 ms on, to 2 ms (40 periods at 20 kHz).
+TIMES = [0.0, 1e-3, 2e-3]
+HEATER = [60.0, 66.0, 66.0]
+DC = [0.0, 0.0, 0.0]
+
+
+def test_replay_columns_shape_and_dtype(paper_scene):
+    out = hdi.replay(paper_scene, TIMES, HEATER, DC, flat_disk=True)
+    assert list(out) == list(hdi.SENSOR_COLUMNS)
+    for name, col in out.items():
+        assert isinstance(col, np.ndarray) and col.dtype == np.float64 and col.shape == (40,), name
+    assert np.all(np.isfinite(np.column_stack(list(out.values()))))
+    assert out["heater_mw"][:20].tolist() == [60.0] * 20
+    assert out["heater_mw"][20:].tolist() == [66.0] * 20
+    # 6 mW more heater brings the bulge closer: the true gap falls, and the harmonic ratio
+    # sees it (first period is its reference)
+    assert out["hr_clearance_change_nm"][0] == 0.0
+    assert out["true_gap_nm"][-1] < out["true_gap_nm"][19] - 0.1
+
+
+def test_same_seed_same_stream_other_seed_other_noise(paper_scene):
+    a = hdi.replay(paper_scene, TIMES, HEATER, DC, seed=7)
+    b = hdi.replay(paper_scene, TIMES, HEATER, DC, seed=7)
+    c = hdi.replay(paper_scene, TIMES, HEATER, DC, seed=8)
+    for name in hdi.SENSOR_COLUMNS:
+        assert a[name].tobytes() == b[name].tobytes(), name
+    assert a["contact_resistance_ohm"].tobytes() != c["contact_resistance_ohm"].tobytes()
+
+
+def test_stepping_equals_replay(paper_scene):
+    """`Drive.step` with the commands of a command list gives `replay`'s rows, bit for bit."""
+    ref = hdi.replay(paper_scene, TIMES, HEATER, DC, seed=3)
+    drive = hdi.Drive(paper_scene, seed=3)
+    rows = [drive.step(60.0 if k < 20 else 66.0) for k in range(40)]
+    for name in hdi.SENSOR_COLUMNS:
+        assert [getattr(s, name) for s in rows] == ref[name].tolist(), name
+    assert drive.time_s == rows[-1].time_s
+    assert drive.stats["accepted"] > 0
+    assert "Drive(" in repr(drive) and "Sensors(" in repr(rows[0])
+
+
+def test_replay_matches_the_cli_bit_for_bit(tmp_path, paper_scene, hdi_cli):
+    commands = tmp_path / "commands.csv"
+    commands.write_text(
+        "time_s,heater_mw,voltage_dc_v,voltage_ac_v,ac_frequency_khz\n"
+        "0,60,0,0,0\n0.0005,70,0.2,0.3,10.5\n0.001,70,0,0,0\n"
+    )
+    csv = tmp_path / "sensors.csv"
+    summary = hdi_cli("drive", "--paper", "--commands", str(commands), "--out", str(csv),
+                      "--seed", "5")
+    assert summary["periods"] == 20
+    table = np.genfromtxt(csv, delimiter=",", names=True)
+    py = hdi.replay(paper_scene, [0.0, 0.0005, 0.001], [60.0, 70.0, 70.0], [0.0, 0.2, 0.0],
+                    [0.0, 0.3, 0.0], [0.0, 10.5, 0.0], seed=5)
+    assert list(table.dtype.names) == list(hdi.SENSOR_COLUMNS)
+    for name in hdi.SENSOR_COLUMNS:
+        assert table[name].tolist() == py[name].tolist(), name
+
+
+def test_a_firmware_loop_in_python_finds_touchdown(paper_scene):
+    """A staircase with an acoustic-emission detector, written in Python against `Drive.step`:
+    touchdown within 1 mW of the static touchdown power (74.324 mW)."""
+    static_td = hdi.static_hysteresis(paper_scene).touchdown.power_mw
+    drive = hdi.Drive(paper_scene, seed=11, flat_disk=True, initial_power_mw=71.0)
+    levels = np.arange(71.0, 78.0, 0.5)
+    hold, read = 30, 20  # periods per level; the last `read` are averaged
+    means, errors, touchdown = [], [], None
+    for p in levels:
+        ae = [drive.step(p).acoustic_v for _ in range(hold)][-read:]
+        means.append(np.mean(ae))
+        errors.append(np.std(ae, ddof=1) / np.sqrt(read))
+        if len(means) > 3:
+            base = np.mean(means[:3])
+            se = np.hypot(np.mean(errors[:3]), errors[-1])
+            if means[-1] - base > 8.0 * se:
+                touchdown = p
+                break
+    assert touchdown is not None, "no touchdown up to 78 mW"
+    assert abs(touchdown - static_td) <= 1.0, (touchdown, static_td)
+
+
+def test_replay_releases_the_gil(paper_scene):
+    times = [0.0, 0.02]
+    done = threading.Event()
+    ticks = []
+
+    def work():
+        hdi.replay(paper_scene, times, [60.0, 60.0], [0.0, 0.0])
+        done.set()
+
+    t = threading.Thread(target=work)
+    t.start()
+    while not done.is_set():
+        ticks.append(1)
+        done.wait(0.001)
+    t.join()
+    assert len(ticks) > 3
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(heater_mw=-1.0), "heater_mw"),
+    (dict(heater_mw=float("nan")), "heater_mw"),
+    (dict(heater_mw=60.0, dc_v=float("inf")), "dc_v"),
+    (dict(heater_mw=60.0, ac_khz=-2.0), "ac_khz"),
+    (dict(heater_mw=60.0, dt_us=0.0), "dt_us"),
+])
+def test_step_errors_name_the_argument(paper_scene, kwargs, field):
+    drive = hdi.Drive(paper_scene)
+    with pytest.raises(hdi.InvalidInputError) as e:
+        drive.step(**kwargs)
+    assert e.value.field == field
+    assert drive.time_s == 0.0  # nothing was stepped
+
+
+@pytest.mark.parametrize("args, kwargs, field", [
+    (([0.0, 1e-3], [60.0], [0.0, 0.0]), {}, "heater_mw"),
+    (([0.0, 1e-3], [60.0, -5.0], [0.0, 0.0]), {}, "heater_mw[1]"),
+    (([0.0, 0.0], [60.0, 60.0], [0.0, 0.0]), {}, "time_s[1]"),
+    (([0.0], [60.0], [0.0]), {}, "time_s"),
+    (([0.0, 1e-3], [60.0, 60.0], [0.0, 0.0]), dict(rate_khz=0.0), "rate_khz"),
+    (([0.0, 1e-3], [60.0, 60.0], [0.0, 0.0]), dict(radius_mm=-1.0), "radius_mm"),
+])
+def test_replay_errors_name_the_argument(paper_scene, args, kwargs, field):
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.replay(paper_scene, *args, **kwargs)
+    assert e.value.field == field
