@@ -6,7 +6,7 @@
 //! the identifiability report, and the wall time against the time of one model evaluation
 //! measured in the same run.
 //!
-//!     cargo run --release --example fit_synthetic [-- static|static-fd|dynamic|dynamic-tight]
+//!     cargo run --release --example fit_synthetic [-- static|static-fd|dynamic|dynamic-direct|dynamic-starts|dynamic-tight|dynamic-from-truth]
 //!
 //! `static-fd` runs the four-parameter static fit twice, with the Jacobian from the transitions'
 //! sensitivities (the default) and by finite differences of the whole model, for the ratio.
@@ -34,6 +34,9 @@ fn measure(truth: &Scene, grid: &str, origin: &str, sd_mw: f64, seed: u64) -> Da
         for v in &mut o.values {
             *v += gauss(&mut rng, sd_mw * 1e-3);
         }
+        // The noise is the measurement's stated uncertainty, as a data file's `_err_` column
+        // gives it: the fit then tests its χ² against it.
+        o.errors = Some(vec![sd_mw * 1e-3; o.values.len()]);
     }
     d
 }
@@ -108,14 +111,37 @@ fn report(title: &str, r: &FitResult, truth: &[f64], secs: f64, one_eval: f64) {
         "  {} points, χ² {:.3}, s {:.3}, converged {}, trusted {}, {} model evaluations",
         r.points, r.chi2, r.residual_scale, r.converged, r.trusted, r.evaluations
     );
-    println!(
-        "  wall time {secs:.3} s; one model evaluation {one_eval:.4} s; ratio {:.1}",
-        secs / one_eval
-    );
+    let lin: Vec<String> = r
+        .parameters
+        .iter()
+        .filter_map(|p| p.linearity.map(|l| format!("{} {l:.2}", p.name)))
+        .collect();
+    if !lin.is_empty() {
+        println!(
+            "  χ² rise over one error bar / the linearisation's: {}",
+            lin.join(", ")
+        );
+    }
+    if let Some(g) = &r.goodness.chi2 {
+        println!(
+            "  χ² against the stated uncertainties {:.1} for {} degrees of freedom, p = {:.2e}",
+            g.chi2, g.dof, g.p_value
+        );
+    }
+    if secs.is_finite() {
+        println!(
+            "  wall time {secs:.3} s; one model evaluation {one_eval:.4} s; ratio {:.1}",
+            secs / one_eval
+        );
+    }
 }
 
 /// Times one model evaluation of `baseline` and the fit from `start` (with `opts`), then
 /// reports both, wall and CPU time.
+///
+/// With `static_first`, the fit is made in two stages, both timed: the first `static_first` data
+/// sets alone (static curves: cheap), then every set from that fit's result.
+#[allow(clippy::too_many_arguments)]
 fn timed_fit(
     title: &str,
     baseline: &Scene,
@@ -124,10 +150,21 @@ fn timed_fit(
     free: &[FreeParameter],
     truth: &[f64],
     opts: &FitOptions,
+    static_first: Option<usize>,
 ) -> Result<(), hdi_tribology::fit::FitError> {
     let (one, one_wall, one_cpu) = timed(|| model_curves(baseline, data));
     one?;
-    let (r, wall, cpu) = timed(|| fit(start, data, free, opts));
+    let (r, wall, cpu) = timed(|| match static_first {
+        Some(k) => {
+            let first = fit(start, &data[..k], free, opts)?;
+            println!(
+                "  (stage 1, the static curve alone: {} evaluations, trusted {})",
+                first.evaluations, first.trusted
+            );
+            fit(&first.scene, data, free, opts)
+        }
+        None => fit(start, data, free, opts),
+    });
     let r = r?;
     report(title, &r, truth, wall, one_wall);
     println!(
@@ -184,6 +221,7 @@ fn main() -> Result<(), hdi_tribology::fit::FitError> {
             &free,
             &true_values,
             &opts,
+            None,
         )?;
     }
     if which == "static-fd" {
@@ -200,6 +238,7 @@ fn main() -> Result<(), hdi_tribology::fit::FitError> {
                 finite_difference_jacobian: true,
                 ..opts
             },
+            None,
         )?;
     }
     if which == "static" || which == "both" {
@@ -250,6 +289,7 @@ fn main() -> Result<(), hdi_tribology::fit::FitError> {
             &free4,
             &[0.2, 0.1, 10.0, 3e5],
             &opts,
+            None,
         )?;
     }
     if which.starts_with("dynamic") || which == "both" {
@@ -261,6 +301,11 @@ fn main() -> Result<(), hdi_tribology::fit::FitError> {
         let mut start = start.clone();
         if let Some(e) = start.electrostatic.as_mut() {
             e.contact_potential_v = 0.0;
+        }
+        // `dynamic-from-truth`: the same fit started at the truth (is a misfit the optimiser's
+        // or the model's?).
+        if which == "dynamic-from-truth" {
+            start = truth.clone();
         }
         // `dynamic-tight`: cycles at rtol 1e-8 (the scene's is 1e-6).
         if which == "dynamic-tight" {
@@ -277,6 +322,16 @@ fn main() -> Result<(), hdi_tribology::fit::FitError> {
         let dc_grid = grid("dc_voltage_v", &dc);
         let static_data = measure(&truth, &dc_grid, "static_vs_vdc.csv", 0.05, 7);
         let data = [static_data, ac_data];
+        // The static curve first, then both from there (`dynamic-direct`: both at once from the
+        // start, which ends in a false minimum the goodness-of-fit tests reject).
+        let staged = (which != "dynamic-direct").then_some(1);
+        // `dynamic-starts`: three seeded starts in each stage (other minima as good as the best
+        // mark the parameters that differ between them as not determined).
+        let opts = if which == "dynamic-starts" {
+            FitOptions { starts: 3, ..opts }
+        } else {
+            opts
+        };
         timed_fit(
             "static curve plus a 6-amplitude AC hysteresis curve (32 points), σ, A, η",
             // At the start the cycle detects no take-off at zero amplitude (clipped, fitted
@@ -287,6 +342,7 @@ fn main() -> Result<(), hdi_tribology::fit::FitError> {
             &free,
             &true_values,
             &opts,
+            staged,
         )?;
     }
     Ok(())

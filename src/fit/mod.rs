@@ -23,6 +23,7 @@
 
 mod cli;
 mod data;
+pub mod goodness;
 mod model;
 mod params;
 mod solve;

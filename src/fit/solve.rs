@@ -9,6 +9,7 @@ use nalgebra_lm::{storage::Owned, DMatrix as LmMatrix, DVector as LmVector, Dyn}
 use serde::Serialize;
 
 use super::data::{DataError, DataSet};
+use super::goodness::{self, Goodness};
 use super::model::{weighted, weights, Evaluator, Predicted, Sets};
 use super::params::{resolve, FreeParameter, Resolved};
 use super::FitError;
@@ -135,6 +136,10 @@ pub struct FittedParameter {
     pub upper: Option<f64>,
     /// The fit ended on a bound (its error bar then means little).
     pub at_bound: bool,
+    /// Curves with cycles only: the rise of χ² when the parameter moves by its error bar (both
+    /// ways, mean) over the rise the linearisation predicts. About 1 where the error bar is
+    /// right; below 0.25 the error bar is at least twice too small, and the fit is not trusted.
+    pub linearity: Option<f64>,
 }
 
 /// A direction in parameter space (relative to each parameter's scale) and how well the data fix it.
@@ -307,7 +312,11 @@ pub struct FitResult {
     pub starts: Vec<StartOutcome>,
     /// Integration-noise check (curves with cycles only).
     pub integration: Option<IntegrationCheck>,
-    /// Converged, no clipped transition, integration noise small.
+    /// Whether the residuals look like noise: χ² against stated uncertainties, the scale of
+    /// each curve against the others, runs of residual signs ([`super::goodness`]).
+    pub goodness: Goodness,
+    /// Converged, no clipped transition, integration noise small, and every goodness-of-fit
+    /// test passed.
     pub trusted: bool,
     /// What keeps the fit from being trusted, in words.
     pub warnings: Vec<String>,
@@ -849,6 +858,7 @@ fn analyse(
                 lower: p.lower,
                 upper: p.upper,
                 at_bound,
+                linearity: None,
             }
         })
         .collect();
@@ -918,6 +928,37 @@ fn analyse(
         ));
     }
     let integration = if data.iter().any(DataSet::is_dynamic) {
+        // Detected transitions of cycles are not smooth in the parameters at the scale of the
+        // integration tolerance: check that χ² rises over an error bar as the Jacobian says.
+        for (j, p) in parameters.iter_mut().enumerate() {
+            let Some(se) = p.standard_error else { continue };
+            let rel = se / params[j].scale;
+            let predicted: f64 = (0..r0.len()).map(|i| (js[(i, j)] * rel).powi(2)).sum();
+            let mut rise = 0.0;
+            for sign in [1.0, -1.0] {
+                let mut xs = x.clone();
+                xs[j] += sign * se;
+                let inside = params[j].lower.is_none_or(|lo| xs[j] >= lo)
+                    && params[j].upper.is_none_or(|hi| xs[j] <= hi);
+                if !inside {
+                    xs[j] -= 2.0 * sign * se;
+                }
+                let r = weighted(data, &ev.predict(&xs)?, &ev.excluded);
+                rise += 0.5 * (r.iter().map(|v| v * v).sum::<f64>() - chi2);
+            }
+            let ratio = rise / predicted.max(f64::MIN_POSITIVE);
+            p.linearity = Some(ratio);
+            if ratio < 0.25 {
+                warnings.push(format!(
+                    "the error bar of {} is not reliable: moving it by one error bar raises χ² \
+                     by {:.2} of what the linearisation predicts (the error bar is about {:.1} \
+                     times too small)",
+                    p.name,
+                    ratio,
+                    ratio.max(f64::MIN_POSITIVE).sqrt().recip()
+                ));
+            }
+        }
         let check = integration_check(data, &pred, &ev.excluded, s, opts);
         let left_out: Vec<String> = residuals
             .iter()
@@ -953,7 +994,20 @@ fn analyse(
     } else {
         None
     };
-    let trusted = converged && clipped == 0 && integration.as_ref().is_none_or(|i| i.ok);
+    let stated: Vec<bool> = data
+        .iter()
+        .flat_map(|d| d.observed.iter().map(|o| o.errors.is_some()))
+        .collect();
+    let goodness = goodness::assess(&residuals, &stated, n);
+    warnings.extend(goodness.failures.iter().cloned());
+    let linear = parameters
+        .iter()
+        .all(|p| p.linearity.is_none_or(|r| r >= 0.25));
+    let trusted = converged
+        && linear
+        && clipped == 0
+        && integration.as_ref().is_none_or(|i| i.ok)
+        && goodness.passed();
     Ok(FitResult {
         scene: ev.scene(&x)?,
         parameters,
@@ -972,6 +1026,7 @@ fn analyse(
         evaluations: ev.evaluations.load(Ordering::Relaxed),
         starts,
         integration,
+        goodness,
         trusted,
         warnings,
     })
