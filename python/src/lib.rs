@@ -1701,7 +1701,14 @@ fn replay<'py>(
         })
         .collect();
     check_commands(&rows, "time_s", |i, name| format!("{name}[{i}]")).py()?;
-    let plant = plant_of(py, scene, seed, radius_mm, flat_disk, 60.0)?;
+    let plant = plant_of(
+        py,
+        scene,
+        seed,
+        radius_mm,
+        flat_disk,
+        units::to_mw(DriveOptions::default().initial_power),
+    )?;
     let dt = 1e-3 / rate_khz;
     let columns = py
         .detach(|| {
