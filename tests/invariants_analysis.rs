@@ -7,12 +7,14 @@
 #[path = "common/seeded.rs"]
 mod seeded;
 
+#[cfg(feature = "parallel")]
+use hdi_tribology::analysis::ac_sweep;
+#[cfg(feature = "parallel")]
 use hdi_tribology::analysis::cycle::{CycleOptions, HeaterProgramme};
-use hdi_tribology::analysis::{
-    ac_sweep, flying_equilibrium, static_hysteresis, ScanGrid, StaticOptions,
-};
+use hdi_tribology::analysis::{flying_equilibrium, static_hysteresis, ScanGrid, StaticOptions};
 use hdi_tribology::error::AnalysisError;
 use hdi_tribology::force::{AirBearingModel, Footprint};
+#[cfg(feature = "parallel")]
 use hdi_tribology::heater::Programme;
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
