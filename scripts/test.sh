@@ -9,6 +9,19 @@ root=$PWD
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
 
 cargo test --all-features
+# The `hdi` program that run built (the integration tests run it): the Python tests compare
+# against that same binary, so nothing is built again for them.
+if [ -z "${HDI_BIN:-}" ]; then
+  HDI_BIN=$(cargo test --all-features --no-run --message-format=json 2>/dev/null | "${PYTHON:-python3}" -c '
+import json, sys
+for line in sys.stdin:
+    m = json.loads(line)
+    if m.get("reason") == "compiler-artifact" and m["target"]["name"] == "hdi" \
+            and "bin" in m["target"]["kind"] and not m["profile"]["test"] and m.get("executable"):
+        print(m["executable"])
+')
+  export HDI_BIN
+fi
 
 venv="$root/python/.venv"
 py="${PYTHON:-python3}"

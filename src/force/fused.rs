@@ -1,7 +1,6 @@
-//! One table holding the three hot-path sums on a shared grid, so that a full evaluation costs a
-//! single index computation and two node reads.
-
-use crate::quadrature::TableOptions;
+//! One table holding several hot-path sums on a shared grid (the static, per-V² and contact
+//! forces; or the real contact area), so that an evaluation costs a single index computation and
+//! two node reads, and the values alone (an ODE's right-hand side) skip the slopes.
 
 /// Panels of equal width; each holds a uniform grid refined until every function agrees with its
 /// source at every interval midpoint.
@@ -19,50 +18,63 @@ struct Panel {
     n: usize,
 }
 
-/// Values and slopes of three functions at each node.
+/// Values and slopes of `N` functions at each node.
 #[derive(Clone, Debug)]
-pub(crate) struct Fused {
+pub(crate) struct Fused<const N: usize> {
     lo: f64,
     hi: f64,
     inv_panel: f64,
     panels: Vec<Panel>,
-    nodes: Vec<[f64; 6]>,
+    nodes: Vec<[(f64, f64); N]>,
 }
 
+/// An interval's two end nodes, the local coordinate `t ∈ [0, 1]` in it and its width.
+type Interval<'a, const N: usize> = (&'a [(f64, f64); N], &'a [(f64, f64); N], f64, f64);
+
+/// The cubic Hermite weights of the two values and two slopes at `t` in an interval of width `h`.
 #[inline]
-fn basis(t: f64, h: f64) -> ([f64; 4], [f64; 4]) {
+fn weights(t: f64, h: f64) -> [f64; 4] {
     let t2 = t * t;
     let t3 = t2 * t;
-    (
-        [
-            2.0 * t3 - 3.0 * t2 + 1.0,
-            (t3 - 2.0 * t2 + t) * h,
-            3.0 * t2 - 2.0 * t3,
-            (t3 - t2) * h,
-        ],
-        [
-            (6.0 * t2 - 6.0 * t) / h,
-            3.0 * t2 - 4.0 * t + 1.0,
-            (6.0 * t - 6.0 * t2) / h,
-            3.0 * t2 - 2.0 * t,
-        ],
-    )
+    [
+        2.0 * t3 - 3.0 * t2 + 1.0,
+        (t3 - 2.0 * t2 + t) * h,
+        3.0 * t2 - 2.0 * t3,
+        (t3 - t2) * h,
+    ]
 }
 
-impl Fused {
-    /// Tabulates `f` (three (value, slope) pairs) on `[lo, hi]` against `f` itself, which is meant
-    /// to be cheap (the separate tables). `None` when the node budget is exceeded or `f` is not
-    /// finite.
+/// The weights of the same cubic's derivative.
+#[inline]
+fn slope_weights(t: f64, h: f64) -> [f64; 4] {
+    let t2 = t * t;
+    [
+        (6.0 * t2 - 6.0 * t) / h,
+        3.0 * t2 - 4.0 * t + 1.0,
+        (6.0 * t - 6.0 * t2) / h,
+        3.0 * t2 - 2.0 * t,
+    ]
+}
+
+/// `w · (y0, m0, y1, m1)`.
+#[inline]
+fn combine(w: &[f64; 4], (y0, m0): (f64, f64), (y1, m1): (f64, f64)) -> f64 {
+    w[0] * y0 + w[1] * m0 + w[2] * y1 + w[3] * m1
+}
+
+impl<const N: usize> Fused<N> {
+    /// Tabulates `f` (`N` (value, slope) pairs) on `[lo, hi]` against `f` itself, which is meant
+    /// to be cheap (the separate tables), to the tolerance `(rel, abs)` of each function. `None`
+    /// when the node budget is exceeded or `f` is not finite.
     pub(crate) fn build(
-        f: impl Fn(f64) -> [(f64, f64); 3],
+        f: impl Fn(f64) -> [(f64, f64); N],
         lo: f64,
         hi: f64,
-        opts: &TableOptions,
-    ) -> Option<Fused> {
+        tols: [(f64, f64); N],
+    ) -> Option<Self> {
         let width = (hi - lo) / PANELS as f64;
         let mut panels = Vec::with_capacity(PANELS);
-        let mut nodes: Vec<[f64; 6]> = Vec::new();
-        let pack = |v: [(f64, f64); 3]| [v[0].0, v[0].1, v[1].0, v[1].1, v[2].0, v[2].1];
+        let mut nodes: Vec<[(f64, f64); N]> = Vec::new();
         for p in 0..PANELS {
             let a = lo + p as f64 * width;
             let b = if p + 1 == PANELS { hi } else { a + width };
@@ -72,23 +84,21 @@ impl Fused {
                 let xs: Vec<f64> = (0..=n)
                     .map(|i| if i == n { b } else { a + i as f64 * h })
                     .collect();
-                let vals: Vec<[f64; 6]> = xs.iter().map(|&x| pack(f(x))).collect();
-                if vals.iter().flatten().any(|v| !v.is_finite()) {
+                let vals: Vec<[(f64, f64); N]> = xs.iter().map(|&x| f(x)).collect();
+                if vals
+                    .iter()
+                    .flatten()
+                    .any(|&(v, m)| !(v.is_finite() && m.is_finite()))
+                {
                     return None;
                 }
                 let ok = (0..n).all(|i| {
-                    let exact = pack(f(0.5 * (xs[i] + xs[i + 1])));
-                    let (w, _) = basis(0.5, xs[i + 1] - xs[i]);
-                    (0..3).all(|k| {
-                        let (y0, m0, y1, m1) = (
-                            vals[i][2 * k],
-                            vals[i][2 * k + 1],
-                            vals[i + 1][2 * k],
-                            vals[i + 1][2 * k + 1],
-                        );
-                        let v = w[0] * y0 + w[1] * m0 + w[2] * y1 + w[3] * m1;
-                        (v - exact[2 * k]).abs()
-                            <= (opts.rel_tol * exact[2 * k].abs()).max(opts.abs_tol)
+                    let exact = f(0.5 * (xs[i] + xs[i + 1]));
+                    let w = weights(0.5, xs[i + 1] - xs[i]);
+                    (0..N).all(|k| {
+                        let v = combine(&w, vals[i][k], vals[i + 1][k]);
+                        let (rel, abs) = tols[k];
+                        (v - exact[k].0).abs() <= (rel * exact[k].0.abs()).max(abs)
                     })
                 });
                 if ok {
@@ -117,26 +127,40 @@ impl Fused {
         })
     }
 
-    /// The three (value, slope) pairs at `d`, or `None` outside the range.
+    /// The interval holding `d`: its two end nodes, the local coordinate in it and its width;
+    /// `None` outside the range.
     #[inline]
-    pub(crate) fn eval(&self, d: f64) -> Option<[(f64, f64); 3]> {
+    fn locate(&self, d: f64) -> Option<Interval<'_, N>> {
         if !(d >= self.lo && d <= self.hi) {
             return None;
         }
-        let p = (((d - self.lo) * self.inv_panel) as usize).min(PANELS - 1);
+        // `d` is inside the range, so both indices are small and non-negative up to rounding:
+        // clamped in floating point, the conversions are single instructions.
+        let p = ((d - self.lo) * self.inv_panel).min((PANELS - 1) as f64) as u32 as usize;
         let pan = &self.panels[p];
         let s = (d - pan.a) * pan.inv_h;
-        let j = (s as usize).min(pan.n - 1);
-        let (w, dw) = basis(s - j as f64, pan.h);
-        let (n0, n1) = (&self.nodes[pan.start + j], &self.nodes[pan.start + j + 1]);
-        let pair = |k: usize| {
-            let (y0, m0, y1, m1) = (n0[2 * k], n0[2 * k + 1], n1[2 * k], n1[2 * k + 1]);
-            (
-                w[0] * y0 + w[1] * m0 + w[2] * y1 + w[3] * m1,
-                dw[0] * y0 + dw[1] * m0 + dw[2] * y1 + dw[3] * m1,
-            )
-        };
-        Some([pair(0), pair(1), pair(2)])
+        let j = s.clamp(0.0, (pan.n - 1) as f64) as u32 as usize;
+        let k = pan.start + j;
+        Some((&self.nodes[k], &self.nodes[k + 1], s - j as f64, pan.h))
+    }
+
+    /// The `N` (value, slope) pairs at `d`, or `None` outside the range.
+    #[inline]
+    pub(crate) fn eval(&self, d: f64) -> Option<[(f64, f64); N]> {
+        let (n0, n1, t, h) = self.locate(d)?;
+        let (w, dw) = (weights(t, h), slope_weights(t, h));
+        Some(std::array::from_fn(|k| {
+            (combine(&w, n0[k], n1[k]), combine(&dw, n0[k], n1[k]))
+        }))
+    }
+
+    /// The `N` values alone at `d` (the same numbers as [`Fused::eval`]'s), or `None` outside
+    /// the range: the right-hand side of an ODE needs no slope.
+    #[inline]
+    pub(crate) fn values(&self, d: f64) -> Option<[f64; N]> {
+        let (n0, n1, t, h) = self.locate(d)?;
+        let w = weights(t, h);
+        Some(std::array::from_fn(|k| combine(&w, n0[k], n1[k])))
     }
 
     /// Number of nodes.
@@ -148,6 +172,7 @@ impl Fused {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::quadrature::TableOptions;
 
     #[test]
     fn fused_table_meets_its_tolerance_for_each_function() {
@@ -159,7 +184,8 @@ mod tests {
             ]
         };
         let opts = TableOptions::default();
-        let t = Fused::build(f, 0.0, 3.0, &opts).unwrap();
+        let tol = (opts.rel_tol, opts.abs_tol);
+        let t = Fused::build(f, 0.0, 3.0, [tol; 3]).unwrap();
         for i in 0..1000 {
             let x = 3.0 * ((0.5 + i as f64 * 0.618_033_988_749_895) % 1.0);
             let got = t.eval(x).unwrap();
@@ -175,5 +201,11 @@ mod tests {
         let (v, s) = t.eval(1.234).unwrap()[2];
         assert!((v - 1.234f64.powi(3)).abs() < 1e-14 && (s - 3.0 * 1.234 * 1.234).abs() < 1e-13);
         assert!(t.eval(3.1).is_none() && t.eval(f64::NAN).is_none());
+        // the values alone are the same numbers, to the bit
+        for x in [0.0, 0.37, 1.234, 2.999, 3.0] {
+            let (all, values) = (t.eval(x).unwrap(), t.values(x).unwrap());
+            assert_eq!(all.map(|p| p.0), values);
+        }
+        assert!(t.values(-0.1).is_none());
     }
 }

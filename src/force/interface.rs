@@ -48,6 +48,23 @@ pub struct HotForces {
     pub contact: ForceEval,
 }
 
+/// The values of [`InterfaceForces::values`]: what an ODE's right-hand side reads at one point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HotValues {
+    /// Interface force `F_static + V² G_e` (N).
+    pub interface: f64,
+    /// Contact force (N), never negative.
+    pub contact: f64,
+    /// Real contact area (m²), never negative.
+    pub area: f64,
+}
+
+/// The one home of summing by coupling: a static part plus `V²` times the per-V² part.
+#[inline]
+pub(crate) fn by_coupling(static_part: f64, per_volt2: f64, volt2: f64) -> f64 {
+    static_part + volt2 * per_volt2
+}
+
 /// Every force by kind at one point, SI (N, m²), positive = away from the disk.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Breakdown {
@@ -278,7 +295,11 @@ pub struct InterfaceForces {
     contact: PerGap,
     area: PerGap,
     by_kind: Vec<(TermKind, Coupling, GapReference, Arc<Tabulated>)>,
-    fused: Option<Arc<Fused>>,
+    /// Static, per-V² and contact sums and the real contact area on one grid.
+    fused: Option<Arc<Fused<4>>>,
+    /// Whether the fused table's fourth function is the real contact area (else it is zero and
+    /// the area comes from its own table).
+    fused_area: bool,
 }
 
 impl InterfaceForces {
@@ -405,24 +426,39 @@ impl InterfaceForces {
             area: hot(area),
             by_kind,
             fused: None,
+            fused_area: false,
         };
-        // Fuse the three hot sums when everything sits on the bulge gap in one smooth piece.
+        // Fuse the three hot sums when everything sits on the bulge gap in one smooth piece, and
+        // the real contact area with them (to its own tolerance) when it does too: a
+        // right-hand side with frictional heating then reads everything from one interval.
         let smooth = |p: &PerGap| p[0].as_ref().is_none_or(|s| s.single.is_some());
         if !me.uses_pad_gap()
             && smooth(&me.static_part)
             && smooth(&me.per_volt2)
             && smooth(&me.contact)
         {
+            let with_area = me.area[0].as_ref().is_some_and(|s| s.single.is_some());
             let fused = Fused::build(
                 |d| {
                     let g = Gaps::same(d);
-                    let e = [me.static_part(g), me.per_volt2_part(g), me.contact(g)];
+                    let area = if with_area {
+                        me.sum(&me.area, g)
+                    } else {
+                        ForceEval::default()
+                    };
+                    let e = [me.static_part(g), me.per_volt2_part(g), me.contact(g), area];
                     e.map(|x| (x.value, x.d_bulge))
                 },
                 lo,
                 hi,
-                opts,
+                [
+                    (opts.rel_tol, opts.abs_tol),
+                    (opts.rel_tol, opts.abs_tol),
+                    (opts.rel_tol, opts.abs_tol),
+                    (area_opts.rel_tol, area_opts.abs_tol),
+                ],
             );
+            me.fused_area = with_area && fused.is_some();
             me.fused = fused.map(Arc::new);
         }
         Ok(me)
@@ -488,7 +524,7 @@ impl InterfaceForces {
     #[inline]
     fn evaluate_with(&self, g: Gaps, contact: bool, voltage: bool) -> HotForces {
         if let Some(f) = &self.fused {
-            if let Some([s, v, c]) = f.eval(g.bulge) {
+            if let Some([s, v, c, _]) = f.eval(g.bulge) {
                 let e = |(value, d_bulge): (f64, f64)| ForceEval {
                     value,
                     d_bulge,
@@ -521,7 +557,53 @@ impl InterfaceForces {
     /// (the flash temperature takes its square root).
     #[inline]
     pub fn real_contact_area(&self, g: Gaps) -> f64 {
-        self.sum(&self.area, g).value.max(0.0)
+        let fused = match &self.fused {
+            Some(f) if self.fused_area => f.values(g.bulge),
+            _ => None,
+        };
+        match fused {
+            Some([_, _, _, a]) => a,
+            None => self.sum(&self.area, g).value,
+        }
+        .max(0.0)
+    }
+
+    /// The values alone of the interface force `F_static + V² G_e` at the squared voltage
+    /// `volt2` (V²), of the contact force and of the real contact area: what a right-hand side
+    /// needs, without the slopes. The same numbers as [`InterfaceForces::evaluate`] and
+    /// [`InterfaceForces::real_contact_area`] give.
+    ///
+    /// ```no_run
+    /// # fn main() -> hdi_tribology::Result<()> {
+    /// use hdi_tribology::{force::Gaps, scene::Scene};
+    /// let forces = Scene::paper().build_interface()?;
+    /// let g = Gaps::same(2e-9);
+    /// let v = forces.values(g, 0.25);
+    /// let hot = forces.evaluate(g);
+    /// assert_eq!(v.interface, hot.static_part.value + 0.25 * hot.per_volt2.value);
+    /// assert_eq!(v.contact, hot.contact.value);
+    /// assert_eq!(v.area, forces.real_contact_area(g));
+    /// # Ok(()) }
+    /// ```
+    #[inline]
+    pub fn values(&self, g: Gaps, volt2: f64) -> HotValues {
+        if let Some([s, v, c, a]) = self.fused.as_ref().and_then(|f| f.values(g.bulge)) {
+            return HotValues {
+                interface: by_coupling(s, v, volt2),
+                contact: if c < 0.0 { 0.0 } else { c },
+                area: if self.fused_area {
+                    a.max(0.0)
+                } else {
+                    self.real_contact_area(g)
+                },
+            };
+        }
+        let h = self.evaluate_with(g, true, volt2 != 0.0);
+        HotValues {
+            interface: by_coupling(h.static_part.value, h.per_volt2.value, volt2),
+            contact: h.contact.value,
+            area: self.real_contact_area(g),
+        }
     }
 
     /// Every force by kind at the gaps `g` and squared voltage `volt2` (V²), through the tables.

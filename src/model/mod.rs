@@ -11,7 +11,9 @@ pub use structure::{Dofs, Structure};
 pub use system::{Rest, SliderSystem, StateLayout};
 
 use crate::error::{Error, Result};
-use crate::force::{AirBearing, Breakdown, ForceEval, Gaps, HotForces, InterfaceForces};
+use crate::force::{
+    by_coupling, AirBearing, Breakdown, ForceEval, Gaps, HotForces, HotValues, InterfaceForces,
+};
 use crate::heater::Programme;
 use crate::scene::Scene;
 use std::f64::consts::PI;
@@ -39,8 +41,14 @@ pub struct Voltage {
 
 impl Voltage {
     /// `V(t)` (V).
+    #[inline]
     pub fn at(&self, t: f64) -> f64 {
-        self.dc - self.contact_potential + self.ac_amplitude * (2.0 * PI * self.frequency * t).sin()
+        let dc = self.dc - self.contact_potential;
+        if self.ac_amplitude == 0.0 {
+            // No sine to evaluate: the same number as `dc + 0 · sin(…)`.
+            return dc;
+        }
+        dc + self.ac_amplitude * (2.0 * PI * self.frequency * t).sin()
     }
 
     /// `V(t)²` (V²).
@@ -278,6 +286,13 @@ impl SliderModel {
         (add_scaled(h.static_part, h.per_volt2, volt2), h)
     }
 
+    /// The values alone of `F_if`, the contact force and the real contact area at `g` and `V²`,
+    /// from the same tables as [`SliderModel::hot_forces`]: what the right-hand side reads.
+    #[inline]
+    pub fn hot_values(&self, g: Gaps, volt2: f64) -> HotValues {
+        self.forces.values(g, volt2)
+    }
+
     /// The static part and the per-V² part of the interface force from direct (untabulated)
     /// evaluation of every term: slow, for refinement and checks.
     pub fn interface_parts_exact(&self, g: Gaps) -> Result<(ForceEval, ForceEval)> {
@@ -327,9 +342,8 @@ impl SliderModel {
         if !self.forces.has_contact() {
             return 0.0;
         }
-        let fc = self.forces.contact(g).value;
-        let area = self.forces.real_contact_area(g);
-        self.friction.flash_temperature(fc, area)
+        let v = self.forces.values(g, 0.0);
+        self.friction.flash_temperature(v.contact, v.area)
     }
 
     /// The static balance with the bulge gap held at `d` (the protrusion then follows from
@@ -479,8 +493,8 @@ impl SliderModel {
 /// `a + scale·b`, component by component.
 fn add_scaled(a: ForceEval, b: ForceEval, scale: f64) -> ForceEval {
     ForceEval {
-        value: a.value + scale * b.value,
-        d_bulge: a.d_bulge + scale * b.d_bulge,
-        d_pad: a.d_pad + scale * b.d_pad,
+        value: by_coupling(a.value, b.value, scale),
+        d_bulge: by_coupling(a.d_bulge, b.d_bulge, scale),
+        d_pad: by_coupling(a.d_pad, b.d_pad, scale),
     }
 }

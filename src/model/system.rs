@@ -105,7 +105,6 @@ pub struct SliderSystem<'a> {
 /// Forces and their derivatives at one state.
 struct Local {
     g: Gaps,
-    delta: f64,
     /// `F_if` and partials.
     f: crate::force::ForceEval,
     /// The tabulated sums behind `f`, with the contact force.
@@ -228,7 +227,7 @@ impl<'a> SliderSystem<'a> {
         let g = self.model.gaps(&self.coordinates(s), delta);
         let volt2 = self.model.voltage.squared(t);
         let (f, hot) = self.model.hot_forces(g, volt2);
-        Local { g, delta, f, hot }
+        Local { g, f, hot }
     }
 
     /// Flash temperature and its derivative with respect to the bulge gap (central difference:
@@ -256,12 +255,14 @@ where
         let m = self.model;
         let st = &m.structure;
         let lay = self.layout;
-        let l = self.local(t, s);
+        // The values alone: no slope is needed here.
+        let (q, v) = (self.coordinates(s), self.velocities(s));
+        let delta = self.protrusion(t, s);
+        let hot = m.hot_values(m.gaps(&q, delta), m.voltage.squared(t));
         let drive = match lay.lagged_force {
             Some(i) => s[i],
-            None => l.f.value,
+            None => hot.interface,
         };
-        let (q, v) = (self.coordinates(s), self.velocities(s));
         let f_ab = m.bearing().force(q[0], v[0]);
         let a = st.mass_solve(&st.generalised_force(&q, &v, f_ab, drive));
         for i in 0..lay.dofs {
@@ -269,17 +270,16 @@ where
             ds[lay.velocity(i)] = a[i];
         }
         if let Some(i) = lay.delta {
-            ds[i] = (m.protrusion(self.programme.power(t)) - l.delta) / m.thermal_lag;
+            ds[i] = (m.protrusion(self.programme.power(t)) - delta) / m.thermal_lag;
         }
         if let Some(i) = lay.lagged_force {
-            ds[i] = (l.f.value - s[i]) / m.interface_lag;
+            ds[i] = (hot.interface - s[i]) / m.interface_lag;
         }
         if let Some(i) = lay.contact_impulse {
-            ds[i] = l.hot.contact.value;
+            ds[i] = hot.contact;
         }
         if let Some(i) = lay.heat {
-            let area = m.forces().real_contact_area(l.g);
-            ds[i] = m.friction.flash_temperature(l.hot.contact.value, area);
+            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
         }
     }
 

@@ -405,6 +405,10 @@ const DENSE: [[f64; 16]; 4] = [
     ],
 ];
 
+/// Where DOP853's stability region meets the negative real axis (`h·ρ`, about 6.0; Hairer's
+/// code flags stiffness above 6.1).
+const STABILITY_BOUNDARY: f64 = 6.0;
+
 pub(crate) struct Dop853<D: Dim>
 where
     DefaultAllocator: Allocator<D>,
@@ -413,6 +417,8 @@ where
     stage: OVector<f64, D>,
     e3: OVector<f64, D>,
     e5: OVector<f64, D>,
+    /// `h·ρ` of the last step (Hairer's indicator: the two evaluations at `t + h`).
+    h_rho: Option<f64>,
 }
 
 impl<D: Dim> Dop853<D>
@@ -426,6 +432,7 @@ where
             stage: z.clone(),
             e3: z.clone(),
             e5: z,
+            h_rho: None,
         }
     }
 
@@ -511,6 +518,16 @@ where
             s5 += (self.e5[i] / sc).powi(2);
             s3 += (self.e3[i] / sc).powi(2);
         }
+        // Stiffness indicator: stages 11 and 12 are both at `t + h` (C[11] = 1), at the inputs
+        // `stage` and `y_new`; their difference quotient estimates the spectral radius.
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..n {
+            let dk = self.k[12][i] - self.k[11][i];
+            let dy = y_new[i] - self.stage[i];
+            num += dk * dk;
+            den += dy * dy;
+        }
+        self.h_rho = (den > 0.0).then(|| h.abs() * (num / den).sqrt());
         let mut deno = s5 + 0.01 * s3;
         if deno.is_nan() || deno <= 0.0 {
             deno = 1.0;
@@ -590,6 +607,10 @@ where
     }
 
     fn stiffness(&self) -> Option<f64> {
-        None
+        self.h_rho
+    }
+
+    fn stability_boundary(&self) -> f64 {
+        STABILITY_BOUNDARY
     }
 }

@@ -13,7 +13,7 @@ use super::rodas5p::Rodas5P;
 use super::solution::Stats;
 use super::stepper::{all_finite, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
-use super::tsit5::{Tsit5, STABILITY_BOUNDARY};
+use super::tsit5::Tsit5;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 
 /// Controller constants: PI control `fac = SAFETY · err^(−α) · err_prev^β` with
@@ -66,6 +66,7 @@ where
     Radau5(Box<Radau5<D>>),
     Auto(Tsit5<D>, Box<Rodas5P<D>>),
     AutoRadau(Tsit5<D>, Box<Radau5<D>>),
+    AutoDop853(Box<Dop853<D>>, Box<Radau5<D>>),
 }
 
 /// `Auto` takes Radau5 as its stiff method below this relative tolerance, Rodas5P from it on.
@@ -74,6 +75,12 @@ where
 /// OREGO), and it alone is right on E5; at rtol ≥ 1e-6 Rodas5P is up to 1.5× faster on Van der
 /// Pol, HIRES and the slider without AC.
 pub(crate) const AUTO_RADAU_BELOW_RTOL: f64 = 1e-6;
+
+/// `Auto` takes DOP853 as its explicit method below this relative tolerance, Tsit5 from it on.
+/// Measured (docs/benchmarks.md, "Auto's explicit method"): at rtol 1e-9 the 8th-order method
+/// needs 2.6–3× fewer steps than Tsit5 on the slider cycle and on Pleiades for an error as
+/// small or smaller; at rtol ≥ 1e-8 Tsit5's cheaper steps win on the slider without AC.
+pub(crate) const AUTO_DOP853_BELOW_RTOL: f64 = 1e-8;
 
 impl<D: Dim> Steppers<D>
 where
@@ -85,6 +92,9 @@ where
             Method::Dop853 => Steppers::Dop853(Box::new(Dop853::new(y0))),
             Method::Rodas5P => Steppers::Rodas5P(Box::new(Rodas5P::new(y0))),
             Method::Radau5 => Steppers::Radau5(Box::new(Radau5::new(y0, rtol))),
+            Method::Auto if rtol < AUTO_DOP853_BELOW_RTOL => {
+                Steppers::AutoDop853(Box::new(Dop853::new(y0)), Box::new(Radau5::new(y0, rtol)))
+            }
             Method::Auto if rtol < AUTO_RADAU_BELOW_RTOL => {
                 Steppers::AutoRadau(Tsit5::new(y0), Box::new(Radau5::new(y0, rtol)))
             }
@@ -94,7 +104,7 @@ where
 
     fn count(&self) -> usize {
         match self {
-            Steppers::Auto(..) | Steppers::AutoRadau(..) => 2,
+            Steppers::Auto(..) | Steppers::AutoRadau(..) | Steppers::AutoDop853(..) => 2,
             _ => 1,
         }
     }
@@ -119,12 +129,21 @@ where
                     s.as_mut()
                 }
             }
+            Steppers::AutoDop853(e, s) => {
+                if active == 0 {
+                    e.as_mut()
+                } else {
+                    s.as_mut()
+                }
+            }
         }
     }
 
     fn set_rtol(&mut self, rtol: f64) {
         match self {
-            Steppers::Radau5(m) | Steppers::AutoRadau(_, m) => m.set_rtol(rtol),
+            Steppers::Radau5(m) | Steppers::AutoRadau(_, m) | Steppers::AutoDop853(_, m) => {
+                m.set_rtol(rtol)
+            }
             _ => {}
         }
     }
@@ -478,7 +497,9 @@ where
         match &self.steppers {
             Steppers::Tsit5(_) | Steppers::Dop853(_) => false,
             Steppers::Rodas5P(_) | Steppers::Radau5(_) => true,
-            Steppers::Auto(..) | Steppers::AutoRadau(..) => self.active == 1,
+            Steppers::Auto(..) | Steppers::AutoRadau(..) | Steppers::AutoDop853(..) => {
+                self.active == 1
+            }
         }
     }
 
@@ -973,6 +994,8 @@ where
 
     fn switch_check(&mut self, stiff: bool, h_acc: f64) {
         let sys = &self.sys;
+        // The explicit method (the first of the two) sets the stability boundary.
+        let boundary = self.steppers.get::<S>(0).stability_boundary();
         let switch = if !stiff {
             self.since_check += 1;
             // The cheap indicator of the explicit method flags growing stiff components;
@@ -982,7 +1005,7 @@ where
                 .steppers
                 .get::<S>(self.active)
                 .stiffness()
-                .is_some_and(|h_rho| h_rho > STABILITY_BOUNDARY);
+                .is_some_and(|h_rho| h_rho > boundary);
             if flagged || self.since_check >= CHECK_INTERVAL {
                 self.since_check = 0;
                 let f0 = self.steppers.get::<S>(self.active).f0();
@@ -995,7 +1018,7 @@ where
                     &mut self.work,
                     &mut self.ctx,
                 );
-                if h_acc * rho > STIFF_FRACTION * STABILITY_BOUNDARY {
+                if h_acc * rho > STIFF_FRACTION * boundary {
                     self.stiff_count += 1;
                 } else {
                     self.stiff_count = 0;
@@ -1004,7 +1027,7 @@ where
             self.stiff_count >= STIFF_CHECKS_TO_SWITCH
         } else {
             match self.steppers.get::<S>(self.active).stiffness() {
-                Some(rho) if h_acc * rho < RETURN_FRACTION * STABILITY_BOUNDARY => {
+                Some(rho) if h_acc * rho < RETURN_FRACTION * boundary => {
                     self.return_count += 1;
                 }
                 _ => self.return_count = 0,

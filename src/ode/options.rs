@@ -28,9 +28,10 @@ pub enum Method {
     Rodas5P,
     /// Radau IIA, 3 stages, order 5, L-stable, with simplified Newton iterations.
     Radau5,
-    /// Tsit5 while the problem is non-stiff, a stiff method while it is stiff, switching both
-    /// ways. The stiff method is Radau5 for `rtol` below 1e-6 and Rodas5P from 1e-6 on (by
-    /// the measured work–precision of both; the tolerance at the start decides). When
+    /// An explicit method while the problem is non-stiff, a stiff method while it is stiff,
+    /// switching both ways. The explicit method is DOP853 for `rtol` below 1e-8 and Tsit5 from
+    /// 1e-8 on; the stiff method is Radau5 for `rtol` below 1e-6 and Rodas5P from 1e-6 on (by
+    /// the measured work–precision of each pair; the tolerance at the start decides). When
     /// Rodas5P refuses a step for its rounding floor, Auto goes on with Radau5.
     Auto,
 }

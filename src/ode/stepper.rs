@@ -107,6 +107,12 @@ where
     /// spectral radius), for stiff methods `ρ`; `None` when not available.
     fn stiffness(&self) -> Option<f64>;
 
+    /// Where the method's stability region meets the negative real axis, as `h·ρ`: the limit of
+    /// an explicit step on a stiff problem (infinite for the stiff methods).
+    fn stability_boundary(&self) -> f64 {
+        f64::INFINITY
+    }
+
     /// Step size multiplier suggested after a Newton or linear-algebra difficulty, if any.
     fn step_hint(&self) -> Option<f64> {
         None

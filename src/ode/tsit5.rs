@@ -243,4 +243,8 @@ where
     fn stiffness(&self) -> Option<f64> {
         self.h_rho
     }
+
+    fn stability_boundary(&self) -> f64 {
+        STABILITY_BOUNDARY
+    }
 }
