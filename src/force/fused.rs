@@ -1,7 +1,7 @@
 //! One table holding the three hot-path sums on a shared grid, so that a full evaluation costs a
 //! single index computation and two node reads.
 
-use crate::quadrature::TableOptions;
+use crate::quadrature::{hermite_bounds, Span, TableOptions};
 
 /// Panels of equal width; each holds a uniform grid refined until every function agrees with its
 /// source at every interval midpoint.
@@ -139,6 +139,53 @@ impl Fused {
         Some([pair(0), pair(1), pair(2)])
     }
 
+    /// Bounds of the first `K` (at most 3) of [`Fused::eval`]'s (value, slope) pairs at every `d`
+    /// in `[a, b]`, or `None` unless `lo ≤ a ≤ b ≤ hi`: the hull of the bounds of every interval
+    /// a point of `[a, b]` can be given (as [`crate::quadrature::Table`]'s bounds).
+    pub(crate) fn bounds<const K: usize>(&self, a: f64, b: f64) -> Option<[(Span, Span); K]> {
+        if !(a >= self.lo && b <= self.hi && a <= b) {
+            return None;
+        }
+        let panel = |d: f64| (((d - self.lo) * self.inv_panel) as usize).min(PANELS - 1);
+        let interval = |p: &Panel, d: f64| (((d - p.a) * p.inv_h) as usize).min(p.n - 1);
+        let (first, last) = (panel(a), panel(b));
+        let mut out: Option<[(Span, Span); K]> = None;
+        for (i, p) in self.panels[first..=last].iter().enumerate() {
+            let j0 = if i == 0 { interval(p, a) } else { 0 };
+            let j1 = if first + i == last {
+                interval(p, b)
+            } else {
+                p.n - 1
+            };
+            let ext = 1e-12 * (p.n + 1) as f64;
+            for j in j0..=j1 {
+                let (n0, n1) = (&self.nodes[p.start + j], &self.nodes[p.start + j + 1]);
+                let each = |k: usize| {
+                    let (v, s) = hermite_bounds(
+                        n0[2 * k],
+                        p.h * n0[2 * k + 1],
+                        n1[2 * k],
+                        p.h * n1[2 * k + 1],
+                        ext,
+                    );
+                    let s = Span {
+                        lo: s.lo * p.inv_h,
+                        hi: s.hi * p.inv_h,
+                    };
+                    (v, s.widen(1e-12 * s.magnitude()))
+                };
+                let here: [(Span, Span); K] = std::array::from_fn(each);
+                out = Some(match out {
+                    Some(o) => {
+                        std::array::from_fn(|k| (o[k].0.hull(here[k].0), o[k].1.hull(here[k].1)))
+                    }
+                    None => here,
+                });
+            }
+        }
+        out
+    }
+
     /// Number of nodes.
     pub(crate) fn len(&self) -> usize {
         self.nodes.len()
@@ -175,5 +222,39 @@ mod tests {
         let (v, s) = t.eval(1.234).unwrap()[2];
         assert!((v - 1.234f64.powi(3)).abs() < 1e-14 && (s - 3.0 * 1.234 * 1.234).abs() < 1e-13);
         assert!(t.eval(3.1).is_none() && t.eval(f64::NAN).is_none());
+    }
+
+    #[test]
+    fn bounds_hold_every_look_up_of_the_stretch() {
+        let f = |x: f64| {
+            [
+                ((3.0 * x).sin(), 3.0 * (3.0 * x).cos()),
+                ((-x).exp(), -(-x).exp()),
+                (x.powi(3), 3.0 * x * x),
+            ]
+        };
+        let t = Fused::build(f, 0.0, 3.0, &TableOptions::default()).unwrap();
+        let mut x = 0.123_f64;
+        for _ in 0..200 {
+            // stretches of every width, edges included
+            let a = 3.0 * ((x * 7.77) % 1.0);
+            let b = (a + 3.0 * (x % 1.0).powi(3)).min(3.0);
+            x = (x + 0.618_033_988_749_895) % 1.0 + 0.01;
+            let bounds: [(Span, Span); 3] = t.bounds(a, b).unwrap();
+            for i in 0..=50 {
+                let d = if i == 50 {
+                    b
+                } else {
+                    a + (b - a) * i as f64 / 50.0
+                };
+                let got = t.eval(d).unwrap();
+                for k in 0..3 {
+                    let (v, s) = bounds[k];
+                    assert!(v.lo <= got[k].0 && got[k].0 <= v.hi, "{k} value at {d}");
+                    assert!(s.lo <= got[k].1 && got[k].1 <= s.hi, "{k} slope at {d}");
+                }
+            }
+        }
+        assert!(t.bounds::<3>(-0.1, 1.0).is_none() && t.bounds::<3>(1.0, 0.5).is_none());
     }
 }
