@@ -10,7 +10,7 @@
 use super::roots::{brent, brent_polished};
 use crate::error::{AnalysisError, Error, Result, Stage};
 use crate::force::ForceEval;
-use crate::model::{Dofs, Rest, SliderModel};
+use crate::model::{Dofs, LinearBalance, Rest, SliderModel, StaticBounds};
 use crate::units::{to_mw, to_nm};
 use serde::Serialize;
 
@@ -68,7 +68,7 @@ pub struct Fold {
 /// ```
 /// use hdi_tribology::analysis::equilibrium::ScanGrid;
 /// let g = ScanGrid::default();
-/// assert!(g.fine_step < g.coarse_step);
+/// assert!(g.fine_step < g.coarse_step && g.skip_proven);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ScanGrid {
@@ -83,6 +83,14 @@ pub struct ScanGrid {
     /// many direct evaluations). `false` runs Brent's method on the direct forces over the whole
     /// grid interval. Both give the root to the same tolerance (1e-12 relative).
     pub polish_from_tables: bool,
+    /// Let the touchdown and take-off scans pass over stretches of the grid without computing
+    /// their equilibria where bounds on the force tables prove that none of them would change
+    /// the scan (every one stable with the contact force on the same side of the threshold, or
+    /// every one unstable, or every power on the same side of the one sought). The results are
+    /// those of the full scan, to the bit; `false` computes every grid point. The bounds need a
+    /// static balance linear in the interface force (a linear air bearing and no pad-gap term);
+    /// other models compute every point either way.
+    pub skip_proven: bool,
 }
 
 impl Default for ScanGrid {
@@ -92,6 +100,7 @@ impl Default for ScanGrid {
             coarse_step: 5e-11,
             fine_until: 5e-9,
             polish_from_tables: true,
+            skip_proven: true,
         }
     }
 }
@@ -172,6 +181,64 @@ impl ScanGrid {
             done = true;
             Some(lo)
         }))
+    }
+}
+
+/// Passes over stretches of a scan's grid that bounds on the force tables prove uneventful
+/// ([`ScanGrid::skip_proven`]): the stride grows while the proofs hold and shrinks, down to one
+/// point, where they fail (near a fold, a threshold or the power sought, whose grid points are
+/// then computed one by one).
+pub(crate) struct Skipper<'a> {
+    model: &'a SliderModel,
+    linear: Option<LinearBalance>,
+    stride: usize,
+}
+
+/// Largest stride of a [`Skipper`] (grid points).
+const MAX_STRIDE: usize = 1024;
+
+impl<'a> Skipper<'a> {
+    /// A skipper for the equilibria of `model` at `V² = volt2`; it never skips unless
+    /// `grid.skip_proven` is set and the model's balance is linear in the interface force.
+    pub(crate) fn new(model: &'a SliderModel, volt2: f64, grid: &ScanGrid) -> Self {
+        Skipper {
+            model,
+            linear: grid
+                .skip_proven
+                .then(|| model.linear_balance(volt2))
+                .flatten(),
+            stride: 16,
+        }
+    }
+
+    /// How many grid points from `gaps[i]` on `quiet` proves uneventful from the bounds of
+    /// their equilibria ([`SliderModel::static_bounds`]); 0 when none (compute `gaps[i]`).
+    pub(crate) fn skip(
+        &mut self,
+        gaps: &[f64],
+        i: usize,
+        quiet: impl Fn(&StaticBounds) -> bool,
+    ) -> usize {
+        let Some(lin) = &self.linear else { return 0 };
+        loop {
+            let m = self.stride.min(gaps.len().saturating_sub(i));
+            if m == 0 {
+                return 0;
+            }
+            let (x, y) = (gaps[i], gaps[i + m - 1]);
+            let proven = self
+                .model
+                .static_bounds(lin, x.min(y), x.max(y))
+                .is_some_and(|b| quiet(&b));
+            if proven {
+                self.stride = (2 * self.stride).min(MAX_STRIDE);
+                return m;
+            }
+            if self.stride == 1 {
+                return 0;
+            }
+            self.stride /= 2;
+        }
     }
 }
 

@@ -5,7 +5,7 @@
 //! start on the contact branch `excess` above the touchdown power and follow it back (power
 //! falling) until the contact force drops below `F_th` or that branch ends at a fold.
 
-use super::equilibrium::{Equilibrium, EquilibriumSolver, ScanGrid};
+use super::equilibrium::{Equilibrium, EquilibriumSolver, ScanGrid, Skipper};
 use crate::error::{AnalysisError, Result, Stage};
 use crate::model::SliderModel;
 use crate::units::{to_mw, to_nm};
@@ -141,10 +141,29 @@ pub(crate) fn touchdown_signed(
     let solver = EquilibriumSolver::new(model, volt2).refining_as(&opts.grid);
     let (lo, hi) = model.forces().table_range();
     let th = opts.contact_threshold;
-    let mut prev: Option<Equilibrium> = None;
+    let gaps = opts.grid.descending(lo, hi)?;
+    let mut skip = Skipper::new(model, volt2, &opts.grid);
+    // The gap of the last grid point passed (its equilibrium is needed only for an error).
+    let mut prev: Option<f64> = None;
     // A fold passed, not yet landed: (fold, its power).
     let mut jump: Option<Equilibrium> = None;
-    for d in opts.grid.iter_descending(lo, hi)? {
+    let mut i = 0;
+    while i < gaps.len() {
+        // Pass over grid points proven not to change the scan below.
+        let passed = match (jump, prev) {
+            (Some(fold), _) => skip.skip(&gaps, i, |b| {
+                b.stable == Some(false) || model.power_for(b.protrusion.hi) < fold.power
+            }),
+            (None, Some(_)) => skip.skip(&gaps, i, |b| b.stable == Some(true) && b.contact.hi < th),
+            (None, None) => 0,
+        };
+        if passed > 0 {
+            i += passed;
+            prev = Some(gaps[i - 1]);
+            continue;
+        }
+        let d = gaps[i];
+        i += 1;
         let e = solver.at_gap(d)?;
         if let Some(fold) = jump {
             // The contact side rises again through the fold's power on a stable part.
@@ -158,12 +177,12 @@ pub(crate) fn touchdown_signed(
                 }
                 jump = None;
             }
-            prev = Some(e);
+            prev = Some(d);
             continue;
         }
         if let Some(p) = prev {
             if !e.is_stable() {
-                let at = solver.refine_fold(e.d, p.d)?;
+                let at = solver.refine_fold(e.d, p)?;
                 if at.power < 0.0 {
                     return Ok(Transition {
                         power: at.power,
@@ -172,11 +191,11 @@ pub(crate) fn touchdown_signed(
                     });
                 }
                 jump = Some(at);
-                prev = Some(e);
+                prev = Some(d);
                 continue;
             }
             if e.contact_force >= th {
-                let at = solver.refine_threshold(e.d, p.d, th)?;
+                let at = solver.refine_threshold(e.d, p, th)?;
                 return Ok(Transition {
                     power: at.power,
                     at,
@@ -190,7 +209,7 @@ pub(crate) fn touchdown_signed(
             }
             .into());
         }
-        prev = Some(e);
+        prev = Some(d);
     }
     if let Some(fold) = jump {
         // The landing lies beyond the table range: the jump goes deep into contact.
@@ -200,9 +219,13 @@ pub(crate) fn touchdown_signed(
             cause: Cause::Fold,
         });
     }
+    let max_power = match prev {
+        Some(p) => to_mw(solver.at_gap(p)?.power),
+        None => f64::NAN,
+    };
     Err(AnalysisError::NoTouchdown {
         stage: Stage::Touchdown,
-        max_power_mw: prev.map_or(f64::NAN, |p| to_mw(p.power)),
+        max_power_mw: max_power,
         detector: None,
     }
     .into())
@@ -279,13 +302,37 @@ pub(crate) fn takeoff_at(
     }
     let mut ascending = opts.grid.descending(lo, hi)?;
     ascending.reverse();
-    // Up to the start only the protrusion is needed: the equilibria before it are assembled
-    // for the last one alone (the first step's `prev`).
+    let mut skip = Skipper::new(model, volt2, &opts.grid);
+    // Up to the start only the protrusion is needed: the gap of the last point before it is the
+    // first step's `prev`.
     let mut before: Option<f64> = None;
     let mut started = false;
-    let mut prev: Option<Equilibrium> = None;
+    // The gap of the last grid point passed (its equilibrium is needed only for an error).
+    let mut prev: Option<f64> = None;
     let mut jump: Option<Equilibrium> = None;
-    for d in ascending {
+    let mut i = 0;
+    while i < ascending.len() {
+        // Pass over grid points proven not to change the scan below.
+        let passed = match (started, jump) {
+            (false, _) => skip.skip(&ascending, i, |b| b.protrusion.lo > target),
+            (true, Some(fold)) => skip.skip(&ascending, i, |b| {
+                b.stable == Some(false) || model.power_for(b.protrusion.lo) > fold.power
+            }),
+            (true, None) => skip.skip(&ascending, i, |b| {
+                b.stable == Some(true) && b.contact.lo >= th && b.protrusion.lo >= 0.0
+            }),
+        };
+        if passed > 0 {
+            i += passed;
+            if started {
+                prev = Some(ascending[i - 1]);
+            } else {
+                before = Some(ascending[i - 1]);
+            }
+            continue;
+        }
+        let d = ascending[i];
+        i += 1;
         if !started && solver.protrusion_at(d)? > target {
             before = Some(d);
             continue;
@@ -299,7 +346,7 @@ pub(crate) fn takeoff_at(
                 .into());
             }
             started = true;
-            prev = before.map(|b| solver.at_gap(b)).transpose()?;
+            prev = before;
         }
         if let Some(fold) = jump {
             // The flying side falls again through the fold's power on a stable part.
@@ -309,34 +356,38 @@ pub(crate) fn takeoff_at(
                 }
                 jump = None;
             }
-            prev = Some(e);
+            prev = Some(d);
             continue;
         }
         if let Some(p) = prev {
             if !e.is_stable() {
-                let at = solver.refine_fold(p.d, e.d)?;
+                let at = solver.refine_fold(p, e.d)?;
                 if at.power < 0.0 {
                     return transition(at, Cause::Fold, false);
                 }
                 jump = Some(at);
-                prev = Some(e);
+                prev = Some(d);
                 continue;
             }
             if e.contact_force < th {
-                let at = solver.refine_threshold(p.d, e.d, th)?;
+                let at = solver.refine_threshold(p, e.d, th)?;
                 return transition(at, Cause::Threshold, false);
             }
             if e.power < 0.0 {
                 return transition(e, Cause::Fold, false);
             }
         }
-        prev = Some(e);
+        prev = Some(d);
     }
     if let Some(fold) = jump {
         return transition(fold, Cause::Fold, false);
     }
+    let min_power = match prev {
+        Some(p) => to_mw(solver.at_gap(p)?.power),
+        None => f64::NAN,
+    };
     Err(AnalysisError::NoTakeOffInTable {
-        min_power_mw: prev.map_or(f64::NAN, |p| to_mw(p.power)),
+        min_power_mw: min_power,
     }
     .into())
 }

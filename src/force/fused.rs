@@ -1,6 +1,8 @@
-//! One table holding several hot-path sums on a shared grid (the static, per-V² and contact
-//! forces; or the real contact area), so that an evaluation costs a single index computation and
-//! two node reads, and the values alone (an ODE's right-hand side) skip the slopes.
+//! One table holding the hot-path sums on a shared grid (the static, per-V² and contact forces,
+//! and the real contact area), so that an evaluation costs a single index computation and two
+//! node reads, and the values alone (an ODE's right-hand side) skip the slopes.
+
+use crate::quadrature::{hermite_bounds, Span};
 
 /// Panels of equal width; each holds a uniform grid refined until every function agrees with its
 /// source at every interval midpoint.
@@ -26,6 +28,13 @@ pub(crate) struct Fused<const N: usize> {
     inv_panel: f64,
     panels: Vec<Panel>,
     nodes: Vec<[(f64, f64); N]>,
+}
+
+/// The interval of a panel holding the local coordinate `s` (in interval widths from the panel's
+/// start), clamped to the panel.
+#[inline]
+fn interval_index(p: &Panel, s: f64) -> usize {
+    s.clamp(0.0, (p.n - 1) as f64) as u32 as usize
 }
 
 /// An interval's two end nodes, the local coordinate `t ∈ [0, 1]` in it and its width.
@@ -134,14 +143,18 @@ impl<const N: usize> Fused<N> {
         if !(d >= self.lo && d <= self.hi) {
             return None;
         }
-        // `d` is inside the range, so both indices are small and non-negative up to rounding:
-        // clamped in floating point, the conversions are single instructions.
-        let p = ((d - self.lo) * self.inv_panel).min((PANELS - 1) as f64) as u32 as usize;
-        let pan = &self.panels[p];
+        let pan = &self.panels[self.panel_index(d)];
         let s = (d - pan.a) * pan.inv_h;
-        let j = s.clamp(0.0, (pan.n - 1) as f64) as u32 as usize;
+        let j = interval_index(pan, s);
         let k = pan.start + j;
         Some((&self.nodes[k], &self.nodes[k + 1], s - j as f64, pan.h))
+    }
+
+    /// The panel of `d` (inside the range). `d` is inside the range, so the index is small and
+    /// non-negative up to rounding: clamped in floating point, the conversion is one instruction.
+    #[inline]
+    fn panel_index(&self, d: f64) -> usize {
+        ((d - self.lo) * self.inv_panel).min((PANELS - 1) as f64) as u32 as usize
     }
 
     /// The `N` (value, slope) pairs at `d`, or `None` outside the range.
@@ -161,6 +174,48 @@ impl<const N: usize> Fused<N> {
         let (n0, n1, t, h) = self.locate(d)?;
         let w = weights(t, h);
         Some(std::array::from_fn(|k| combine(&w, n0[k], n1[k])))
+    }
+
+    /// Bounds of the first `K` (at most `N`) of [`Fused::eval`]'s (value, slope) pairs at every `d`
+    /// in `[a, b]`, or `None` unless `lo ≤ a ≤ b ≤ hi`: the hull of the bounds of every interval
+    /// a point of `[a, b]` can be given (as [`crate::quadrature::Table`]'s bounds).
+    pub(crate) fn bounds<const K: usize>(&self, a: f64, b: f64) -> Option<[(Span, Span); K]> {
+        if !(a >= self.lo && b <= self.hi && a <= b) {
+            return None;
+        }
+        // The same intervals as `locate` gives the points of [a, b].
+        let interval = |p: &Panel, d: f64| interval_index(p, (d - p.a) * p.inv_h);
+        let (first, last) = (self.panel_index(a), self.panel_index(b));
+        let mut out: Option<[(Span, Span); K]> = None;
+        for (i, p) in self.panels[first..=last].iter().enumerate() {
+            let j0 = if i == 0 { interval(p, a) } else { 0 };
+            let j1 = if first + i == last {
+                interval(p, b)
+            } else {
+                p.n - 1
+            };
+            let ext = 1e-12 * (p.n + 1) as f64;
+            for j in j0..=j1 {
+                let (n0, n1) = (&self.nodes[p.start + j], &self.nodes[p.start + j + 1]);
+                let each = |k: usize| {
+                    let (v, s) =
+                        hermite_bounds(n0[k].0, p.h * n0[k].1, n1[k].0, p.h * n1[k].1, ext);
+                    let s = Span {
+                        lo: s.lo * p.inv_h,
+                        hi: s.hi * p.inv_h,
+                    };
+                    (v, s.widen(1e-12 * s.magnitude()))
+                };
+                let here: [(Span, Span); K] = std::array::from_fn(each);
+                out = Some(match out {
+                    Some(o) => {
+                        std::array::from_fn(|k| (o[k].0.hull(here[k].0), o[k].1.hull(here[k].1)))
+                    }
+                    None => here,
+                });
+            }
+        }
+        out
     }
 
     /// Number of nodes.
@@ -207,5 +262,40 @@ mod tests {
             assert_eq!(all.map(|p| p.0), values);
         }
         assert!(t.values(-0.1).is_none());
+    }
+
+    #[test]
+    fn bounds_hold_every_look_up_of_the_stretch() {
+        let f = |x: f64| {
+            [
+                ((3.0 * x).sin(), 3.0 * (3.0 * x).cos()),
+                ((-x).exp(), -(-x).exp()),
+                (x.powi(3), 3.0 * x * x),
+            ]
+        };
+        let opts = TableOptions::default();
+        let t = Fused::build(f, 0.0, 3.0, [(opts.rel_tol, opts.abs_tol); 3]).unwrap();
+        let mut x = 0.123_f64;
+        for _ in 0..200 {
+            // stretches of every width, edges included
+            let a = 3.0 * ((x * 7.77) % 1.0);
+            let b = (a + 3.0 * (x % 1.0).powi(3)).min(3.0);
+            x = (x + 0.618_033_988_749_895) % 1.0 + 0.01;
+            let bounds: [(Span, Span); 3] = t.bounds(a, b).unwrap();
+            for i in 0..=50 {
+                let d = if i == 50 {
+                    b
+                } else {
+                    a + (b - a) * i as f64 / 50.0
+                };
+                let got = t.eval(d).unwrap();
+                for k in 0..3 {
+                    let (v, s) = bounds[k];
+                    assert!(v.lo <= got[k].0 && got[k].0 <= v.hi, "{k} value at {d}");
+                    assert!(s.lo <= got[k].1 && got[k].1 <= s.hi, "{k} slope at {d}");
+                }
+            }
+        }
+        assert!(t.bounds::<3>(-0.1, 1.0).is_none() && t.bounds::<3>(1.0, 0.5).is_none());
     }
 }

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::fused::Fused;
 use super::{Coupling, GapReference, InterfaceTerm, TermKind};
-use crate::quadrature::{Table, TableOptions};
+use crate::quadrature::{Span, Table, TableOptions};
 use crate::{Error, Result};
 
 /// The two gaps a term may see: at the bulge (`d`) and at the pad (`d + δ`), both in m.
@@ -185,6 +185,30 @@ impl Tabulated {
         self.segments[k].eval(d)
     }
 
+    /// Bounds of [`Tabulated::lookup`]'s value and slope at every `d` in `[a, b]`, or `None`
+    /// where a point of `[a, b]` lies outside the tables: the hull over the segments that the
+    /// points of `[a, b]` can be given.
+    fn bounds(&self, a: f64, b: f64) -> Option<(Span, Span)> {
+        if self.segments.len() == 1 {
+            return self.segments[0].bounds(a, b);
+        }
+        let segment = |d: f64| self.cuts.partition_point(|&c| c <= d);
+        let mut out: Option<(Span, Span)> = None;
+        for t in &self.segments[segment(a)..=segment(b)] {
+            let (lo, hi) = t.range();
+            let (x, y) = (a.max(lo), b.min(hi));
+            if x > y {
+                continue;
+            }
+            let (v, s) = t.bounds(x, y)?;
+            out = Some(match out {
+                Some((ov, os)) => (ov.hull(v), os.hull(s)),
+                None => (v, s),
+            });
+        }
+        out
+    }
+
     /// Table look-up; outside the range the exact sum; NaN if that fails.
     #[inline]
     fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
@@ -230,6 +254,29 @@ impl Slot {
             None => fallback(&self.tab, terms, d),
         }
     }
+}
+
+impl Slot {
+    /// Bounds of [`Slot::eval`] over `[a, b]` where it reads the tables alone.
+    fn bounds(&self, a: f64, b: f64) -> Option<(Span, Span)> {
+        match &self.single {
+            Some(t) => t.bounds(a, b),
+            None => self.tab.bounds(a, b),
+        }
+    }
+}
+
+/// Bounds of the interface force of [`crate::model::SliderModel::interface_force`] and of the
+/// contact force of [`InterfaceForces::contact`] over a stretch of bulge gaps (no term on the
+/// pad gap), each as the tables give them, rounding included.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct BulgeBounds {
+    /// `F_static + V² G_e` (N).
+    pub force: Span,
+    /// Its slope `∂F/∂d` (N/m).
+    pub slope: Span,
+    /// The contact force (N).
+    pub contact: Span,
 }
 
 /// A contact force (and area) is never negative: an interpolation undershoot below zero, of the
@@ -550,6 +597,40 @@ impl InterfaceForces {
                 ForceEval::default()
             },
         }
+    }
+
+    /// Bounds of the interface force at `V² = volt2` (as `SliderModel::interface_force` sums it
+    /// from [`InterfaceForces::coupled_sums`]), of its slope and of the contact force at every
+    /// bulge gap in `[a, b]`; `None` where some term sees the pad gap, a point lies outside the
+    /// tables (the exact fallback is not bounded) or a bound is not finite.
+    pub(crate) fn bulge_bounds(&self, a: f64, b: f64, volt2: f64) -> Option<BulgeBounds> {
+        if self.uses_pad_gap() {
+            return None;
+        }
+        let zero = (Span::point(0.0), Span::point(0.0));
+        let slot = |s: &PerGap| s[0].as_ref().map_or(Some(zero), |t| t.bounds(a, b));
+        let (stat, per_v2) = match &self.fused {
+            Some(f) => {
+                let [s, v] = f.bounds(a, b)?;
+                (s, v)
+            }
+            None if volt2 != 0.0 => (slot(&self.static_part)?, slot(&self.per_volt2)?),
+            None => (slot(&self.static_part)?, zero),
+        };
+        let (c, _) = slot(&self.contact)?;
+        let out = BulgeBounds {
+            force: stat.0.add(per_v2.0.scale(volt2)),
+            slope: stat.1.add(per_v2.1.scale(volt2)),
+            // A contact force is never negative (`non_negative`).
+            contact: Span {
+                lo: c.lo.max(0.0),
+                hi: c.hi.max(0.0),
+            },
+        };
+        [out.force, out.slope, out.contact]
+            .iter()
+            .all(|s| s.is_finite())
+            .then_some(out)
     }
 
     /// Real contact area, m², never negative: where the area is below the table's absolute

@@ -12,9 +12,11 @@ pub use system::{Rest, SliderSystem, StateLayout};
 
 use crate::error::{Error, Result};
 use crate::force::{
-    by_coupling, AirBearing, Breakdown, ForceEval, Gaps, HotForces, HotValues, InterfaceForces,
+    by_coupling, AirBearing, AirBearingModel, Breakdown, ForceEval, Gaps, HotForces, HotValues,
+    InterfaceForces,
 };
 use crate::heater::Programme;
+use crate::quadrature::Span;
 use crate::scene::Scene;
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -153,6 +155,8 @@ pub struct SliderModel {
     pub voltage: Voltage,
     /// Friction and flash temperature.
     pub friction: Friction,
+    /// Whether the bearing is the linear spring (its stiffness does not depend on `y`).
+    linear_bearing: bool,
 }
 
 impl SliderModel {
@@ -205,6 +209,7 @@ impl SliderModel {
                 disk_speed: scene.friction.disk_speed_m_per_s,
                 conductivity: scene.friction.head_conductivity_w_per_m_k,
             },
+            linear_bearing: matches!(scene.air_bearing, AirBearingModel::Linear { .. }),
         })
     }
 
@@ -433,6 +438,106 @@ impl SliderModel {
         Ok((q, f))
     }
 
+    /// The static balance of [`SliderModel::balance`] in closed form, where it is linear in the
+    /// interface force: with a linear bearing and no term on the pad gap the tangent
+    /// `J₀ = K + e₀e₀ᵀk_ab` is constant and the interface force depends on `d` alone, so the
+    /// balance is `q = J₀⁻¹ b F_if(d)` and the bulge displacement `bᵀq = s F_if(d)` with the
+    /// compliance `s = bᵀJ₀⁻¹b`; the total stiffness ([`SliderModel::total_stiffness`]) is
+    /// `1/s − ∂F_if/∂d` (Sherman–Morrison). `None` for other models, or where `J₀` is not positive
+    /// (the balance then fails at every gap).
+    pub(crate) fn linear_balance(&self, volt2: f64) -> Option<LinearBalance> {
+        if !self.linear_bearing || self.forces.uses_pad_gap() {
+            return None;
+        }
+        let st = &self.structure;
+        let n = st.dofs();
+        let j0 = st.tangent(self.bearing.stiffness(0.0), 0.0, 0.0);
+        if !st.is_positive(&j0) {
+            return None;
+        }
+        let b = st.bulge_vector();
+        let w = st.solve(&j0, &b)?;
+        let compliance = b.dot(&w);
+        let u = w / compliance;
+        // |J₀⁻¹|, column by column, for the rounding allowances.
+        let mut inverse = [[0.0; crate::scene::MAX_DOF]; crate::scene::MAX_DOF];
+        for (c, col) in inverse.iter_mut().enumerate().take(n) {
+            let mut e = Dofs::zeros();
+            e[c] = 1.0;
+            let x = st.solve(&j0, &e)?;
+            for (r, v) in col.iter_mut().enumerate().take(n) {
+                *v = x[r].abs();
+            }
+        }
+        let through = |r: usize| (0..n).map(|c| inverse[c][r] * b[c].abs()).sum::<f64>();
+        let lin = LinearBalance {
+            volt2,
+            stiffness: 1.0 / compliance,
+            compliance,
+            heave: w[0],
+            stiffness_scale: [
+                (0..n)
+                    .flat_map(|r| (0..n).map(move |c| (r, c)))
+                    .map(|(r, c)| u[r].abs() * j0[(r, c)].abs() * u[c].abs())
+                    .sum(),
+                (0..n).map(|r| b[r].abs() * u[r].abs()).sum::<f64>().powi(2),
+            ],
+            compliance_scale: (0..n).map(|r| b[r].abs() * through(r)).sum(),
+            heave_scale: through(0),
+        };
+        let all = [
+            lin.stiffness,
+            lin.heave,
+            lin.stiffness_scale[0],
+            lin.stiffness_scale[1],
+            lin.compliance_scale,
+        ];
+        all.iter().all(|x| x.is_finite()).then_some(lin)
+    }
+
+    /// What every tabulated equilibrium ([`SliderModel::balance`] with the tables, then
+    /// [`SliderModel::total_stiffness`], the contact force and the protrusion `h0 + bᵀq − d`) at
+    /// a bulge gap in `[a, b]` is known to be, from bounds on the tables: `None` where the tables
+    /// do not bound them, or where the balance could meet the pad-gap floor. Each bound allows
+    /// [`PROOF_MARGIN`] times the magnitudes the computation goes through (absolute values of
+    /// `J₀`, `J₀⁻¹`, `b` and the forces), far above their rounding.
+    pub(crate) fn static_bounds(
+        &self,
+        lin: &LinearBalance,
+        a: f64,
+        b: f64,
+    ) -> Option<StaticBounds> {
+        let f = self.forces.bulge_bounds(a, b, lin.volt2)?;
+        let h0 = self.nominal_clearance;
+        let m = PROOF_MARGIN;
+        let force = f.force.magnitude();
+        // The balance keeps the pad gap positive by moving a heave below this floor.
+        let heave = f.force.scale(lin.heave);
+        if heave.lo - m * (h0 + lin.heave_scale * force) <= -h0 * (1.0 - 1e-9) {
+            return None;
+        }
+        let [c0, c1] = lin.stiffness_scale;
+        let tol = m * (c0 + c1 * f.slope.magnitude());
+        let stable = if lin.stiffness - f.slope.hi > tol {
+            Some(true)
+        } else if f.slope.lo - lin.stiffness > tol {
+            Some(false)
+        } else {
+            None
+        };
+        let lift = f.force.scale(lin.compliance);
+        let protrusion = Span {
+            lo: h0 + lift.lo - b,
+            hi: h0 + lift.hi - a,
+        }
+        .widen(m * (h0 + a.abs().max(b.abs()) + lin.compliance_scale * force));
+        Some(StaticBounds {
+            stable,
+            contact: f.contact,
+            protrusion,
+        })
+    }
+
     /// One Newton step of the static balance of [`SliderModel::balance`] at bulge gap `d` from
     /// coordinates `q`, with direct (untabulated) forces: the step (`None` where the tangent is
     /// singular) and the interface force at `q`. From the balance of a slightly different model
@@ -488,6 +593,43 @@ impl SliderModel {
     pub fn programme_from_knots(knots: &[[f64; 2]]) -> Result<Programme> {
         Programme::new(knots.iter().map(|k| (k[0], k[1])).collect())
     }
+}
+
+/// Relative allowance of the bounds of [`SliderModel::static_bounds`] for the rounding of the
+/// computations they bound (some 10⁷ times the unit roundoff).
+const PROOF_MARGIN: f64 = 1e-9;
+
+/// The constants of [`SliderModel::linear_balance`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct LinearBalance {
+    /// `V²` of the balance (V²).
+    volt2: f64,
+    /// `1/s` (N/m): the total stiffness where the interface force has no slope.
+    stiffness: f64,
+    /// `s = bᵀJ₀⁻¹b` (m/N).
+    compliance: f64,
+    /// `e₀ᵀJ₀⁻¹b` (m/N): the heave per unit of interface force.
+    heave: f64,
+    /// `|u|ᵀ|J₀||u|` and `(|b|ᵀ|u|)²` with `u = J₀⁻¹b/s`: the size of the rounding of the total
+    /// stiffness is their sum weighted by 1 and by `|∂F_if/∂d|`.
+    stiffness_scale: [f64; 2],
+    /// `|b|ᵀ|J₀⁻¹||b|` (m/N): the size of the rounding of `bᵀq` per unit of force.
+    compliance_scale: f64,
+    /// `e₀ᵀ|J₀⁻¹||b|` (m/N): the same for the heave.
+    heave_scale: f64,
+}
+
+/// What every tabulated equilibrium over a stretch of bulge gaps is known to be
+/// ([`SliderModel::static_bounds`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StaticBounds {
+    /// `Some(true)`: every one is stable (total stiffness > 0); `Some(false)`: every one is
+    /// unstable (≤ 0); `None`: not known.
+    pub stable: Option<bool>,
+    /// Bounds of the contact force (N).
+    pub contact: Span,
+    /// Bounds of the protrusion (m).
+    pub protrusion: Span,
 }
 
 /// `a + scale·b`, component by component.

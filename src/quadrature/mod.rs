@@ -17,6 +17,7 @@ mod tanh_sinh;
 
 pub(crate) use gauss_kronrod::integrate_best_effort;
 pub use gauss_kronrod::{integrate, integrate_with_breaks};
+pub(crate) use table::{hermite_bounds, Span};
 pub use table::{Table, TableOptions};
 pub use tanh_sinh::integrate_tanh_sinh;
 

@@ -18,6 +18,96 @@ pub const MAX_NODES: usize = 10_000_000;
 /// Intervals per panel before any doubling (even, so panels split on nodes).
 const INITIAL_INTERVALS: usize = 4;
 
+/// A closed interval `[lo, hi]` of real numbers: bounds of a table's values or slopes over a
+/// stretch of its argument.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Span {
+    /// Lower bound.
+    pub lo: f64,
+    /// Upper bound.
+    pub hi: f64,
+}
+
+impl Span {
+    /// The one point `x`.
+    pub(crate) fn point(x: f64) -> Self {
+        Span { lo: x, hi: x }
+    }
+
+    /// The smallest span holding both.
+    pub(crate) fn hull(self, o: Span) -> Self {
+        Span {
+            lo: self.lo.min(o.lo),
+            hi: self.hi.max(o.hi),
+        }
+    }
+
+    /// Widened by `m ≥ 0` on both sides.
+    pub(crate) fn widen(self, m: f64) -> Self {
+        Span {
+            lo: self.lo - m,
+            hi: self.hi + m,
+        }
+    }
+
+    /// `{x + y}`, widened by the rounding of the sum.
+    pub(crate) fn add(self, o: Span) -> Self {
+        Span {
+            lo: self.lo + o.lo,
+            hi: self.hi + o.hi,
+        }
+        .widen(ROUNDING * (self.magnitude() + o.magnitude()))
+    }
+
+    /// `{c x}` for a constant `c`, widened by the rounding of the product.
+    pub(crate) fn scale(self, c: f64) -> Self {
+        let (a, b) = (c * self.lo, c * self.hi);
+        Span {
+            lo: a.min(b),
+            hi: a.max(b),
+        }
+        .widen(ROUNDING * a.abs().max(b.abs()))
+    }
+
+    /// The largest magnitude in the span.
+    pub(crate) fn magnitude(self) -> f64 {
+        self.lo.abs().max(self.hi.abs())
+    }
+
+    /// Whether both ends are finite.
+    pub(crate) fn is_finite(self) -> bool {
+        self.lo.is_finite() && self.hi.is_finite()
+    }
+}
+
+/// Relative allowance for the rounding of a table look-up (a few operations of relative error
+/// 1.1e-16 each on numbers no larger than the magnitudes involved), with a wide safety factor.
+const ROUNDING: f64 = 1e-12;
+
+/// Bounds of the cubic Hermite interpolant of one interval (values `y0`, `y1`, slopes times the
+/// spacing `hm0`, `hm1`) for `t` in `[−ext, 1 + ext]`: the value and the `t`-derivative (divide by
+/// the spacing for the slope), each widened by the rounding of an evaluation. On `[0, 1]` both
+/// lie within their Bernstein coefficients: `y0, y0 + hm0/3, y1 − hm1/3, y1` for the value and
+/// `hm0, 3(y1 − y0) − hm0 − hm1, hm1` for the derivative; `ext` adds the largest derivative (of
+/// the value, and of the derivative) times `ext`.
+pub(crate) fn hermite_bounds(y0: f64, hm0: f64, y1: f64, hm1: f64, ext: f64) -> (Span, Span) {
+    let c = [y0, y0 + hm0 / 3.0, y1 - hm1 / 3.0, y1];
+    let g = [hm0, 3.0 * (y1 - y0) - hm0 - hm1, hm1];
+    let hull = |x: &[f64]| {
+        x.iter().fold(Span::point(x[0]), |s, &v| Span {
+            lo: s.lo.min(v),
+            hi: s.hi.max(v),
+        })
+    };
+    let (value, slope) = (hull(&c), hull(&g));
+    let curvature = 2.0 * (g[1] - g[0]).abs().max((g[2] - g[1]).abs());
+    let size = y0.abs() + y1.abs() + hm0.abs() + hm1.abs();
+    (
+        value.widen(ext * slope.magnitude() + ROUNDING * size),
+        slope.widen(ext * curvature + 4.0 * ROUNDING * size),
+    )
+}
+
 /// Accuracy and size limits of [`Table::build`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TableOptions {
@@ -364,6 +454,50 @@ impl Table {
         Some((v, dt * p.inv_h))
     }
 
+    /// Bounds of [`Table::eval`]'s value and derivative at every `d` in `[a, b]`, or `None`
+    /// unless `lo ≤ a ≤ b ≤ hi`. Follows the look-up: every panel and interval that a point of
+    /// `[a, b]` can be given (the index computations are monotone in `d`), the intervals at a
+    /// panel's ends a little beyond `[0, 1]` in `t` (a point within rounding of a panel edge may
+    /// be given the neighbouring panel).
+    pub(crate) fn bounds(&self, a: f64, b: f64) -> Option<(Span, Span)> {
+        if !(a >= self.lo && b <= self.hi && a <= b) {
+            return None;
+        }
+        let cell =
+            |d: f64| (((d - self.lo) * self.inv_cell) as i32 as usize).min(self.cells.len() - 1);
+        let interval =
+            |p: &Panel, d: f64| ((d - p.a) * p.inv_h).clamp(0.0, f64::from(p.last)) as i32 as u32;
+        let (first, last) = (cell(a), cell(b));
+        let mut out: Option<(Span, Span)> = None;
+        let mut c = first;
+        while c <= last {
+            let p = &self.cells[c];
+            let mut end = c;
+            while end < last && self.cells[end + 1].start == p.start {
+                end += 1;
+            }
+            let j0 = if c == first { interval(p, a) } else { 0 };
+            let j1 = if end == last { interval(p, b) } else { p.last };
+            let ext = 1e-12 * f64::from(p.last + 2);
+            for j in j0..=j1 {
+                let k = (p.start + j) as usize;
+                let ([y0, hm0], [y1, hm1]) = (self.nodes[k], self.nodes[k + 1]);
+                let (v, s) = hermite_bounds(y0, hm0, y1, hm1, ext);
+                let s = Span {
+                    lo: s.lo * p.inv_h,
+                    hi: s.hi * p.inv_h,
+                }
+                .widen(ROUNDING * s.magnitude() * p.inv_h);
+                out = Some(match out {
+                    Some((ov, os)) => (ov.hull(v), os.hull(s)),
+                    None => (v, s),
+                });
+            }
+            c = end + 1;
+        }
+        out
+    }
+
     /// The panel covering `d` (which must be inside the range).
     #[inline(always)]
     fn panel(&self, d: f64) -> &Panel {
@@ -398,5 +532,50 @@ impl Table {
     /// Number of panels of uniform spacing.
     pub fn panels(&self) -> usize {
         self.panel_count
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_hold_every_look_up_of_the_stretch() {
+        // A function with a narrow feature, so that the panels differ in spacing.
+        let f = |x: f64| {
+            Ok(((5.0 * x).sin() + (-(x - 1.0).powi(2) * 400.0).exp(), {
+                5.0 * (5.0 * x).cos() - 800.0 * (x - 1.0) * (-(x - 1.0).powi(2) * 400.0).exp()
+            }))
+        };
+        let t = Table::build(f, 0.0, 3.0, &TableOptions::default()).unwrap();
+        assert!(t.panels() > 1);
+        let mut x = 0.123_f64;
+        for _ in 0..300 {
+            let a = 3.0 * ((x * 7.77) % 1.0);
+            let b = (a + 3.0 * (x % 1.0).powi(3)).min(3.0);
+            x = (x + 0.618_033_988_749_895) % 1.0 + 0.01;
+            let (v, s) = t.bounds(a, b).unwrap();
+            for i in 0..=50 {
+                let d = if i == 50 {
+                    b
+                } else {
+                    a + (b - a) * i as f64 / 50.0
+                };
+                let (y, dy) = t.eval(d).unwrap();
+                assert!(v.lo <= y && y <= v.hi, "value at {d} in [{a}, {b}]");
+                assert!(s.lo <= dy && dy <= s.hi, "slope at {d} in [{a}, {b}]");
+            }
+        }
+        // Tight where the function is simple: a cubic is its own interpolant.
+        let c = Table::build(
+            |x| Ok((x * x * x, 3.0 * x * x)),
+            0.0,
+            1.0,
+            &TableOptions::default(),
+        )
+        .unwrap();
+        let (v, _) = c.bounds(0.5, 0.5).unwrap();
+        assert!(v.lo <= 0.125 && v.hi >= 0.125 && v.hi - v.lo < 0.1);
+        assert!(t.bounds(-0.1, 1.0).is_none() && t.bounds(1.0, 3.5).is_none());
     }
 }
