@@ -27,8 +27,9 @@ fn vdp_jac(_t: f64, y: &Vector2<f64>, j: &mut Matrix2<f64>) {
 fn jacobian_closure_gives_the_trait_implementations_steps() {
     // The problem table's Van der Pol implements `OdeSystem::jacobian` by hand; the closure
     // form must give the same floating-point operations, hence the same result to the bit.
+    // Both declare the system autonomous (the problem table does).
     let by_trait = problems::van_der_pol();
-    let by_closure = FnSystem::new(vdp_rhs).with_jacobian(vdp_jac);
+    let by_closure = FnSystem::new(vdp_rhs).with_jacobian(vdp_jac).autonomous();
     let opts = Options::default()
         .rtol(1e-6)
         .atol(1e-6)
@@ -58,7 +59,7 @@ fn jacobian_closure_gives_the_trait_implementations_steps() {
         assert_eq!(a.y_final(), b.y_final(), "{m}");
         assert_eq!(a.stats, b.stats, "{m}");
         // Without the Jacobian, differences cost 2 right-hand sides per Jacobian.
-        let fd = FnSystem::new(vdp_rhs);
+        let fd = FnSystem::new(vdp_rhs).autonomous();
         let c = solve(&fd, 0.0, by_trait.y0_vector(), 100.0, m, &opts, &mut []).unwrap();
         assert!(c.stats.rhs_evals > b.stats.rhs_evals, "{m}");
     }

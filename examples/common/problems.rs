@@ -17,6 +17,9 @@ pub struct Problem<const N: usize> {
     pub name: &'static str,
     /// Whether explicit methods are expected to fail on it.
     pub stiff: bool,
+    /// Whether `f` does not depend on `t` (declared to the solvers, as a user would: Rodas5P
+    /// then needs no difference quotient for ∂f/∂t).
+    pub autonomous: bool,
     /// `dy = f(t, y)`.
     pub rhs: fn(f64, &[f64], &mut [f64]),
     /// Row-major Jacobian `j[i·N + k] = ∂f_i/∂y_k`.
@@ -81,6 +84,9 @@ impl<const N: usize> OdeSystem<Const<N>> for Problem<N> {
         }
         true
     }
+    fn is_autonomous(&self) -> bool {
+        self.autonomous
+    }
 }
 
 /// End time of the non-stiff problem.
@@ -91,6 +97,7 @@ const EXACT_T_END: f64 = 10.0;
 pub fn exact() -> Problem<3> {
     Problem {
         name: "exact",
+        autonomous: false,
         stiff: false,
         rhs: |t, y, dy| {
             dy[0] = -2.0 * t * y[0] * y[0];
@@ -122,6 +129,7 @@ const MU: f64 = 1000.0;
 pub fn van_der_pol() -> Problem<2> {
     Problem {
         name: "vdp",
+        autonomous: true,
         stiff: true,
         rhs: |_, y, dy| {
             dy[0] = y[1];
@@ -146,6 +154,7 @@ pub fn van_der_pol() -> Problem<2> {
 pub fn robertson() -> Problem<3> {
     Problem {
         name: "robertson",
+        autonomous: true,
         stiff: true,
         rhs: |_, y, dy| {
             let r1 = 0.04 * y[0];
@@ -184,6 +193,7 @@ pub fn robertson() -> Problem<3> {
 pub fn hires() -> Problem<8> {
     Problem {
         name: "hires",
+        autonomous: true,
         stiff: true,
         rhs: |_, y, f| {
             f[0] = -1.71 * y[0] + 0.43 * y[1] + 8.32 * y[2] + 0.0007;
@@ -248,6 +258,7 @@ pub fn orego() -> Problem<3> {
     const Q: f64 = 8.375e-6;
     Problem {
         name: "orego",
+        autonomous: true,
         stiff: true,
         rhs: |_, y, f| {
             f[0] = S * (y[1] + y[0] * (1.0 - Q * y[0] - y[1]));
@@ -298,6 +309,7 @@ const E5_M: f64 = 1e6;
 pub fn e5() -> Problem<4> {
     Problem {
         name: "e5",
+        autonomous: true,
         stiff: true,
         rhs: |_, y, f| {
             let (a, b, mc) = (E5_A * y[0], E5_B * y[0] * y[2], E5_M * E5_C * y[1] * y[2]);
@@ -347,6 +359,7 @@ pub fn e5() -> Problem<4> {
 pub fn pleiades() -> Problem<28> {
     Problem {
         name: "pleiades",
+        autonomous: true,
         stiff: false,
         rhs: |_, y, f| {
             for i in 0..7 {

@@ -22,7 +22,7 @@ where
     if !sys.jacobian(t, y, jac) {
         ctx.stats.rhs_evals += finite_difference_jacobian(sys, t, y, f0, &ctx.atol, jac, work);
     }
-    jac.iter().all(|v| v.is_finite())
+    jac.as_slice().iter().all(|v| v.is_finite())
 }
 
 /// Fills `dfdt` with ∂f/∂t at `(t, y)`, by a forward difference when the system does not

@@ -220,18 +220,20 @@ where
     fn factor(&mut self, h: f64, ctx: &mut Ctx<D>) -> bool {
         let k = consts();
         let n = self.jac.nrows();
-        self.lu_re.m.copy_from(&self.jac);
-        self.lu_re.m.neg_mut();
         let g = k.gamma / h;
-        for i in 0..n {
-            self.lu_re.m[(i, i)] += g;
-        }
         let lam = Complex64::new(k.alpha / h, k.beta / h);
-        for j in 0..n {
-            for i in 0..n {
-                self.lu_cx.m[(i, j)] = Complex64::new(-self.jac[(i, j)], 0.0);
-            }
-            self.lu_cx.m[(j, j)] += lam;
+        let jac = self.jac.as_slice();
+        let re = self.lu_re.m.as_mut_slice();
+        for (r, j) in re.iter_mut().zip(jac) {
+            *r = -j;
+        }
+        let cx = self.lu_cx.m.as_mut_slice();
+        for (c, j) in cx.iter_mut().zip(jac) {
+            *c = Complex64::new(-j, 0.0);
+        }
+        for i in 0..n {
+            re[i * n + i] += g;
+            cx[i * n + i] += lam;
         }
         ctx.stats.lu_decomps += 2;
         let ok = self.lu_re.factor() && self.lu_cx.factor();

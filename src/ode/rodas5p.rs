@@ -5,7 +5,7 @@
 use super::dense::StepPoly;
 use super::jacobian::{eval_jacobian, eval_time_derivative, spectral_radius};
 use super::lu::Lu;
-use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
+use super::stepper::{add_scaled, all_finite, sum_into, zeros_like, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 
@@ -171,6 +171,8 @@ where
     f0_valid: bool,
     jac: OMatrix<f64, D, D>,
     dfdt: OVector<f64, D>,
+    /// ∂f/∂t is zero (autonomous systems): its stage terms are skipped.
+    dfdt_zero: bool,
     /// J and ∂f/∂t belong to the current point (they survive rejected attempts).
     jac_valid: bool,
     lu: Lu<f64, D>,
@@ -195,6 +197,7 @@ where
             f0_valid: false,
             jac: OMatrix::zeros_generic(r, r),
             dfdt: z.clone(),
+            dfdt_zero: false,
             jac_valid: false,
             lu: Lu::new(r),
             lu_h: f64::NAN,
@@ -235,9 +238,10 @@ where
         let n = y.len();
         self.fu.fill(0.0);
         // Column by column (J is stored by columns).
-        for (j, col) in self.jac.column_iter().enumerate() {
+        let fu = self.fu.as_mut_slice();
+        for (j, col) in self.jac.as_slice().chunks_exact(n.max(1)).enumerate() {
             let d = f64::EPSILON * (y_new[j] - y[j]).abs();
-            for (v, a) in self.fu.iter_mut().zip(col.iter()) {
+            for (v, a) in fu.iter_mut().zip(col) {
                 *v += a.abs() * d;
             }
         }
@@ -303,6 +307,7 @@ where
             if !all_finite(&self.dfdt) {
                 return fail(FailKind::NonFinite);
             }
+            self.dfdt_zero = self.dfdt.as_slice().iter().all(|&v| v == 0.0);
             self.jac_valid = true;
             self.lu.invalidate();
             if ctx.want_stiffness {
@@ -311,11 +316,14 @@ where
         }
         if !self.lu.is_valid() || self.lu_h != h {
             // W = I/(hγ) − J.
-            self.lu.m.copy_from(&self.jac);
-            self.lu.m.neg_mut();
+            let n = y.len();
             let d = 1.0 / (h * GAMMA);
-            for i in 0..y.len() {
-                self.lu.m[(i, i)] += d;
+            let w = self.lu.m.as_mut_slice();
+            for (wi, ji) in w.iter_mut().zip(self.jac.as_slice()) {
+                *wi = -ji;
+            }
+            for i in 0..n {
+                w[i * n + i] += d;
             }
             ctx.stats.lu_decomps += 1;
             if !self.lu.factor() {
@@ -339,26 +347,25 @@ where
                     for (j, kj) in done.iter().enumerate().take(5) {
                         let a = A[s][j];
                         if a != 0.0 {
-                            self.u.axpy(a, kj, 1.0);
+                            add_scaled(&mut self.u, a, kj);
                         }
                     }
                 } else {
-                    self.u += &done[s - 1];
+                    add_scaled(&mut self.u, 1.0, &done[s - 1]);
                 }
                 sys.rhs(t + C[s] * h, &self.u, ks);
                 ctx.stats.rhs_evals += 1;
             }
             for (j, kj) in done.iter().enumerate() {
-                ks.axpy(CC[s][j] * inv_h, kj, 1.0);
+                add_scaled(ks, CC[s][j] * inv_h, kj);
             }
-            if D_T[s] != 0.0 {
-                ks.axpy(h * D_T[s], &self.dfdt, 1.0);
+            if D_T[s] != 0.0 && !self.dfdt_zero {
+                add_scaled(ks, h * D_T[s], &self.dfdt);
             }
             lu.solve_mut(ks);
             ctx.stats.lin_solves += 1;
         }
-        y_new.copy_from(&self.u);
-        *y_new += &self.k[7];
+        sum_into(y_new, &self.u, &self.k[7]);
         if !all_finite(y_new) {
             return fail(FailKind::NonFinite);
         }

@@ -130,7 +130,7 @@ pub(crate) fn all_finite<D: Dim>(v: &OVector<f64, D>) -> bool
 where
     DefaultAllocator: Allocator<D>,
 {
-    v.iter().all(|x| x.is_finite())
+    v.as_slice().iter().all(|x| x.is_finite())
 }
 
 /// Zero vector shaped like `y`.
@@ -140,4 +140,32 @@ where
 {
     let (r, c) = y.shape_generic();
     OVector::zeros_generic(r, c)
+}
+
+/// `y += a·x`, on the contiguous storage (the same result as nalgebra's `y.axpy(a, x, 1.0)`,
+/// without its strided indexing).
+#[inline]
+pub(crate) fn add_scaled<D: Dim>(y: &mut OVector<f64, D>, a: f64, x: &OVector<f64, D>)
+where
+    DefaultAllocator: Allocator<D>,
+{
+    for (yi, xi) in y.as_mut_slice().iter_mut().zip(x.as_slice()) {
+        *yi += a * xi;
+    }
+}
+
+/// `out = a + b`, on the contiguous storage.
+#[inline]
+pub(crate) fn sum_into<D: Dim>(out: &mut OVector<f64, D>, a: &OVector<f64, D>, b: &OVector<f64, D>)
+where
+    DefaultAllocator: Allocator<D>,
+{
+    for ((o, ai), bi) in out
+        .as_mut_slice()
+        .iter_mut()
+        .zip(a.as_slice())
+        .zip(b.as_slice())
+    {
+        *o = ai + bi;
+    }
 }
