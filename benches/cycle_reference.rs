@@ -6,8 +6,12 @@
 //!
 //! `cargo bench --bench cycle_reference`; `-- --quick` times each row for 0.3 s.
 
+#[path = "../examples/common/slider_reference.rs"]
+mod slider_reference;
 #[path = "../examples/common/timing.rs"]
 mod timing;
+
+use slider_reference::{SLIDER_ATOL_PER_RTOL as ATOL_PER_RTOL, SLIDER_REF_RTOL as REF_RTOL};
 
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
 use hdi_tribology::model::{SliderModel, Voltage};
@@ -15,10 +19,6 @@ use hdi_tribology::ode::Method;
 use hdi_tribology::scene::Scene;
 use std::time::Duration;
 
-/// Tolerance of the reference cycles.
-const REF_RTOL: f64 = 1e-11;
-/// The displacement tolerance goes with rtol as in the work–precision example (m per unit rtol).
-const ATOL_PER_RTOL: f64 = 1e-8;
 /// The accuracy asked for: ΔP within 1e-8 mW.
 const TARGET_W: f64 = 1e-11;
 

@@ -6,36 +6,26 @@
 //! processes waiting for the cores) and the fastest wall-clock call, with the results, so that a
 //! faster path can be checked to give the same numbers.
 
+#[path = "../tests/common/scenes.rs"]
+mod scenes;
 #[path = "../examples/common/timing.rs"]
 mod timing;
 
 use hdi_tribology::analysis::pull_in::pull_in_voltage;
 use hdi_tribology::analysis::touchdown::{takeoff_power, touchdown_power, StaticOptions};
 use hdi_tribology::model::SliderModel;
-use hdi_tribology::scene::{Scene, StructureSpec};
+use hdi_tribology::scene::Scene;
 use std::time::Duration;
 
 fn scenes() -> Vec<(&'static str, Scene)> {
-    let paper = Scene::paper();
-    let mut bulge = paper.clone();
-    bulge.structure = StructureSpec::Bulge {
-        mass_kg: 5e-13,
-        stiffness_n_per_m: 4e5,
-        damping_ratio: 0.05,
-    };
-    // Pitch: a 1 mg slider, 1 mm long, pivot at its middle (L = 0.5 mm), pitch stiffness of the
-    // bearing's heave stiffness over the pads (k L²/3) and a small heave–pitch coupling.
-    let (k_ab, l) = (3e5, 0.5e-3);
-    let mut pitch = paper.clone();
-    pitch.structure = StructureSpec::Pitch {
-        inertia_kg_m2: paper.slider.mass_kg * l * l / 3.0,
-        stiffness_n_m_per_rad: k_ab * l * l / 3.0,
-        coupling_stiffness_n_per_rad: 10.0,
-        damping_n_m_s_per_rad: 1e-9,
-        coupling_damping_n_s_per_rad: 0.0,
-        trailing_edge_m: l,
-    };
-    let mut out = vec![("rigid", paper), ("bulge", bulge), ("pitch", pitch)];
+    let mut out: Vec<(&'static str, Scene)> = scenes::bench_structures()
+        .into_iter()
+        .map(|(name, structure)| {
+            let mut s = Scene::paper();
+            s.structure = structure;
+            (name, s)
+        })
+        .collect();
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper_bulge.toml");
     match Scene::from_path(file) {
         Ok(s) => out.push(("paper_bulge.toml", s)),

@@ -23,8 +23,12 @@
 mod output;
 #[path = "common/problems.rs"]
 mod problems;
+#[path = "common/slider_reference.rs"]
+mod slider_reference;
 #[path = "common/timing.rs"]
 mod timing;
+
+use slider_reference::{SLIDER_ATOL_PER_RTOL, SLIDER_REF_RTOL};
 
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
 use hdi_tribology::analysis::sweep::ac_sweep;
@@ -47,13 +51,6 @@ const EXPLICIT_STEP_CAP: usize = 200_000;
 const TIMING_BUDGET: Duration = Duration::from_millis(100);
 const MIN_REPEATS: usize = 3;
 const MAX_REPEATS: usize = 100_000;
-
-/// Relative tolerance of the slider reference.
-const SLIDER_REF_RTOL: f64 = 1e-11;
-
-/// Absolute tolerance on the displacement per unit relative tolerance (m): the scene's
-/// 1e-14 m at rtol 1e-6, i.e. rtol × 10 nm, the size of the spacing.
-const SLIDER_ATOL_PER_RTOL: f64 = 1e-8;
 
 /// One row of the table.
 struct Row {

@@ -5,8 +5,12 @@
 
 use hdi_tribology::analysis::*;
 use hdi_tribology::model::{SliderModel, Structure, Voltage};
-use hdi_tribology::scene::{Scene, StructureSpec};
+use hdi_tribology::scene::Scene;
 use proptest::prelude::*;
+
+#[path = "common/scenes.rs"]
+mod scenes;
+use scenes::bench_structures;
 
 /// The options with and without skipping.
 fn both(threshold: f64) -> (StaticOptions, StaticOptions) {
@@ -52,34 +56,6 @@ fn check(name: &str, model: &SliderModel, threshold: f64, excess: f64) {
             _ => panic!("{name}: pull-in {a:?} vs {b:?}"),
         }
     }
-}
-
-/// The paper scene on the benchmark's `bulge` and `pitch` structures.
-fn bench_structures() -> Vec<(&'static str, StructureSpec)> {
-    let paper = Scene::paper();
-    let (k_ab, l) = (3e5, 0.5e-3);
-    vec![
-        ("rigid", StructureSpec::Rigid),
-        (
-            "bulge",
-            StructureSpec::Bulge {
-                mass_kg: 5e-13,
-                stiffness_n_per_m: 4e5,
-                damping_ratio: 0.05,
-            },
-        ),
-        (
-            "pitch",
-            StructureSpec::Pitch {
-                inertia_kg_m2: paper.slider.mass_kg * l * l / 3.0,
-                stiffness_n_m_per_rad: k_ab * l * l / 3.0,
-                coupling_stiffness_n_per_rad: 10.0,
-                damping_n_m_s_per_rad: 1e-9,
-                coupling_damping_n_s_per_rad: 0.0,
-                trailing_edge_m: l,
-            },
-        ),
-    ]
 }
 
 #[test]
