@@ -1,7 +1,9 @@
 //! Events located on the dense output: zero crossings of sin t, direction filters, a terminal
 //! event (falling ball) and a bouncing ball restarted at each impact, for several methods.
 
-use hdi_tribology::ode::{solve, Direction, Event, FnSystem, Method, Options, SaveAt};
+use hdi_tribology::ode::{
+    solve, solve_observed, Direction, Event, FnSystem, Method, Options, SaveAt,
+};
 use nalgebra::Vector2;
 use std::f64::consts::PI;
 
@@ -161,5 +163,51 @@ fn bouncing_ball_restarts_match_closed_form() {
             (ti - expected).abs() < 1e-9,
             "impact {k}: {ti} vs {expected}"
         );
+    }
+}
+
+#[test]
+fn observer_sees_every_saved_step_bit_for_bit() {
+    // A ball bouncing with restitution 0.8 (an acting event): the observer of a run that saves
+    // nothing must see the same times and states, bit for bit, as a run that saves every step
+    // (after an action, the state after it), for every method.
+    for m in METHODS {
+        let bounce = || {
+            [Event::new(|_t, y: &Vector2<f64>| y[0])
+                .direction(Direction::Falling)
+                .affect(|_t, y| y[1] = -0.8 * y[1])]
+        };
+        let y0 = Vector2::new(1.0, 0.0);
+        let opts = Options::default().rtol(1e-9).atol(1e-12);
+        let saved = solve(&ball(), 0.0, y0, 2.0, m, &opts, &mut bounce()).unwrap();
+        let mut seen = Vec::new();
+        let streamed = solve_observed(
+            &ball(),
+            0.0,
+            y0,
+            2.0,
+            m,
+            &opts.clone().save(SaveAt::Final),
+            &mut bounce(),
+            |t, y| seen.push((t, *y)),
+        )
+        .unwrap();
+        assert!(saved.events.len() >= 2, "{m}: the ball bounces");
+        assert_eq!(seen.len(), streamed.stats.accepted + 1, "{m}");
+        // Saved steps hold the state before each action too; the observer sees it after.
+        let after_actions: Vec<(f64, Vector2<f64>)> = saved
+            .t
+            .iter()
+            .zip(&saved.y)
+            .enumerate()
+            .filter(|&(i, (t, _))| saved.t.get(i + 1) != Some(t))
+            .map(|(_, (t, y))| (*t, *y))
+            .collect();
+        assert_eq!(seen.len(), after_actions.len(), "{m}");
+        for ((ta, ya), (tb, yb)) in seen.iter().zip(&after_actions) {
+            assert_eq!(ta.to_bits(), tb.to_bits(), "{m}");
+            assert_eq!(ya, yb, "{m} at t = {ta}");
+        }
+        assert_eq!(streamed.y_final(), saved.y_final(), "{m}");
     }
 }

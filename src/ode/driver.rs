@@ -10,7 +10,9 @@ use super::solution::{Solution, Stats};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
-/// Integrates from `t0` to `tf` (or a terminal event) and collects the output.
+/// Integrates from `t0` to `tf` (or a terminal event) and collects the output; `observe` sees
+/// the start and every accepted step.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn run<D: Dim, S: OdeSystem<D> + ?Sized>(
     sys: &S,
     t0: f64,
@@ -19,6 +21,7 @@ pub(crate) fn run<D: Dim, S: OdeSystem<D> + ?Sized>(
     method: Method,
     opts: &Options,
     events: &mut [Event<'_, D>],
+    observe: &mut dyn FnMut(f64, &OVector<f64, D>),
 ) -> Result<Solution<D>, OdeError>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
@@ -67,6 +70,7 @@ where
 
     let mut it = Integrator::build(sys, t0, y0, tf, method, opts, need_poly)?;
     it.init_events(events);
+    observe(t0, it.state());
     let mut work = sol.y_end.clone();
     loop {
         it.hits.clear();
@@ -106,6 +110,7 @@ where
             }
             SaveAt::Final => {}
         }
+        observe(t, it.state());
         sol.events.append(&mut it.hits);
         match status {
             StepStatus::Terminated(i) => {
