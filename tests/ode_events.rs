@@ -175,7 +175,7 @@ fn observer_sees_every_saved_step_bit_for_bit() {
         let bounce = || {
             [Event::new(|_t, y: &Vector2<f64>| y[0])
                 .direction(Direction::Falling)
-                .affect(|_t, y| y[1] = -0.8 * y[1])]
+                .affect(|_t, y| y[1] *= -0.8)]
         };
         let y0 = Vector2::new(1.0, 0.0);
         let opts = Options::default().rtol(1e-9).atol(1e-12);
