@@ -49,6 +49,15 @@ pub struct HotForces {
 }
 
 /// The values of [`InterfaceForces::values`]: what an ODE's right-hand side reads at one point.
+///
+/// ```no_run
+/// # fn main() -> hdi_tribology::Result<()> {
+/// use hdi_tribology::{force::{Gaps, HotValues}, scene::Scene};
+/// let forces = Scene::paper().build_interface()?;
+/// let HotValues { interface, contact, area } = forces.values(Gaps::same(5e-9), 0.0);
+/// assert!(interface < 0.0 && contact >= 0.0 && area >= 0.0); // attraction, little contact
+/// # Ok(()) }
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct HotValues {
     /// Interface force `F_static + V² G_e` (N).

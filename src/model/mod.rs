@@ -293,6 +293,16 @@ impl SliderModel {
 
     /// The values alone of `F_if`, the contact force and the real contact area at `g` and `V²`,
     /// from the same tables as [`SliderModel::hot_forces`]: what the right-hand side reads.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{force::Gaps, model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let g = Gaps::same(1e-9);
+    /// let v = model.hot_values(g, 0.36);
+    /// assert_eq!(v.interface, model.hot_forces(g, 0.36).0.value);
+    /// assert!(v.contact > 0.0 && v.area > 0.0);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     #[inline]
     pub fn hot_values(&self, g: Gaps, volt2: f64) -> HotValues {
         self.forces.values(g, volt2)
