@@ -493,28 +493,35 @@ impl InterfaceForces {
             && smooth(&me.per_volt2)
             && smooth(&me.contact)
         {
-            let with_area = me.area[0].as_ref().is_some_and(|s| s.single.is_some());
-            let fused = Fused::build(
-                |d| {
-                    let g = Gaps::same(d);
-                    let area = if with_area {
-                        me.sum(&me.area, g)
-                    } else {
-                        ForceEval::default()
-                    };
-                    let e = [me.static_part(g), me.per_volt2_part(g), me.contact(g), area];
-                    e.map(|x| (x.value, x.d_bulge))
-                },
-                lo,
-                hi,
-                [
-                    (opts.rel_tol, opts.abs_tol),
-                    (opts.rel_tol, opts.abs_tol),
-                    (opts.rel_tol, opts.abs_tol),
-                    (area_opts.rel_tol, area_opts.abs_tol),
-                ],
-            );
-            me.fused_area = with_area && fused.is_some();
+            let area_fusable = me.area[0].as_ref().is_some_and(|s| s.single.is_some());
+            let build = |with_area: bool| {
+                Fused::build(
+                    |d| {
+                        let g = Gaps::same(d);
+                        let area = if with_area {
+                            me.sum(&me.area, g)
+                        } else {
+                            ForceEval::default()
+                        };
+                        let e = [me.static_part(g), me.per_volt2_part(g), me.contact(g), area];
+                        e.map(|x| (x.value, x.d_bulge))
+                    },
+                    lo,
+                    hi,
+                    [
+                        (opts.rel_tol, opts.abs_tol),
+                        (opts.rel_tol, opts.abs_tol),
+                        (opts.rel_tol, opts.abs_tol),
+                        (area_opts.rel_tol, area_opts.abs_tol),
+                    ],
+                )
+            };
+            // Should the area need more nodes than the budget, the forces are fused alone.
+            let (fused, with_area) = match area_fusable.then(|| build(true)).flatten() {
+                Some(f) => (Some(f), true),
+                None => (build(false), false),
+            };
+            me.fused_area = with_area;
             me.fused = fused.map(Arc::new);
         }
         Ok(me)
