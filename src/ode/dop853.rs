@@ -520,14 +520,17 @@ where
         }
         // Stiffness indicator: stages 11 and 12 are both at `t + h` (C[11] = 1), at the inputs
         // `stage` and `y_new`; their difference quotient estimates the spectral radius.
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..n {
-            let dk = self.k[12][i] - self.k[11][i];
-            let dy = y_new[i] - self.stage[i];
-            num += dk * dk;
-            den += dy * dy;
+        // Only `Auto` asks for it.
+        if ctx.want_stiffness {
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in 0..n {
+                let dk = self.k[12][i] - self.k[11][i];
+                let dy = y_new[i] - self.stage[i];
+                num += dk * dk;
+                den += dy * dy;
+            }
+            self.h_rho = (den > 0.0).then(|| h.abs() * (num / den).sqrt());
         }
-        self.h_rho = (den > 0.0).then(|| h.abs() * (num / den).sqrt());
         let mut deno = s5 + 0.01 * s3;
         if deno.is_nan() || deno <= 0.0 {
             deno = 1.0;

@@ -102,7 +102,7 @@ pub fn solve<D: Dim, S: OdeSystem<D> + ?Sized>(
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    driver::run(sys, t0, y0, tf, method, opts, events, &mut |_, _| {})
+    solve_observed(sys, t0, y0, tf, method, opts, events, |_, _| {})
 }
 
 /// [`solve`], calling `observe(t, y)` at the start and after every accepted step (after an
