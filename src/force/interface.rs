@@ -665,6 +665,26 @@ impl InterfaceForces {
         .max(0.0)
     }
 
+    /// [`InterfaceForces::real_contact_area`] and its slope along the bulge gap (m²/m), from the
+    /// same table: the derivative of the interpolant that the value comes from.
+    #[inline]
+    pub(crate) fn real_contact_area_with_slope(&self, g: Gaps) -> (f64, f64) {
+        let fused = match &self.fused {
+            Some(f) if self.fused_area => f.eval(g.bulge).map(|[_, _, _, a]| a),
+            _ => None,
+        };
+        let (a, slope) = fused.unwrap_or_else(|| {
+            let e = self.sum(&self.area, g);
+            (e.value, e.d_bulge)
+        });
+        // Clamped as the value alone is.
+        if a > 0.0 {
+            (a, slope)
+        } else {
+            (0.0, 0.0)
+        }
+    }
+
     /// The values alone of the interface force `F_static + V² G_e` at the squared voltage
     /// `volt2` (V²), of the contact force and of the real contact area: what a right-hand side
     /// needs, without the slopes. The same numbers as [`InterfaceForces::evaluate`] and

@@ -124,6 +124,35 @@ impl Friction {
         let a = (real_area / PI).sqrt();
         self.coefficient * contact_force * self.disk_speed / (4.0 * a * self.conductivity)
     }
+
+    /// The derivative of [`Friction::flash_temperature`] along a coordinate that changes the
+    /// contact force and the real area at the rates `force_rate` and `area_rate`:
+    /// `ΔT (F_c′/F_c − A_r′/(2 A_r))`, zero where the flash temperature is.
+    ///
+    /// ```
+    /// use hdi_tribology::model::Friction;
+    /// let fr = Friction { coefficient: 0.2, disk_speed: 10.0, conductivity: 20.0 };
+    /// // Along the gap d with F_c = 1e-4 (1 − d/1e-9) N and A_r = 1e-14 (1 − d/1e-9) m²:
+    /// let t = |d: f64| fr.flash_temperature(1e-4 * (1.0 - d / 1e-9), 1e-14 * (1.0 - d / 1e-9));
+    /// let slope = fr.flash_temperature_slope(1e-4, -1e5, 1e-14, -1e-5);
+    /// let h = 1e-15;
+    /// let fd = (t(h) - t(-h)) / (2.0 * h);
+    /// assert!((slope - fd).abs() < 1e-6 * fd.abs());
+    /// assert_eq!(fr.flash_temperature_slope(0.0, 1.0, 1e-14, 1.0), 0.0);
+    /// ```
+    pub fn flash_temperature_slope(
+        &self,
+        contact_force: f64,
+        force_rate: f64,
+        real_area: f64,
+        area_rate: f64,
+    ) -> f64 {
+        let t = self.flash_temperature(contact_force, real_area);
+        if t == 0.0 {
+            return 0.0;
+        }
+        t * (force_rate / contact_force - 0.5 * area_rate / real_area)
+    }
 }
 
 /// The slider with a heater-driven bulge (MODEL.md section 2) on its [`Structure`]: one rigid

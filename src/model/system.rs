@@ -230,20 +230,14 @@ impl<'a> SliderSystem<'a> {
         Local { g, f, hot }
     }
 
-    /// Flash temperature and its derivative with respect to the bulge gap (central difference:
-    /// the real contact area is tabulated without its derivative).
-    fn heat_rate(&self, g: Gaps) -> (f64, f64) {
+    /// The derivative of the flash temperature (the heat state's rate) along the bulge gap at
+    /// the point of `l`: the derivative of the interpolants the right-hand side reads.
+    fn heat_slope(&self, l: &Local) -> f64 {
         let m = self.model;
-        let h = 1e-6 * g.bulge.abs().max(1e-10);
-        let up = m.flash_temperature(Gaps {
-            bulge: g.bulge + h,
-            ..g
-        });
-        let down = m.flash_temperature(Gaps {
-            bulge: g.bulge - h,
-            ..g
-        });
-        (m.flash_temperature(g), (up - down) / (2.0 * h))
+        let (area, area_rate) = m.forces().real_contact_area_with_slope(l.g);
+        let c = &l.hot.contact;
+        m.friction
+            .flash_temperature_slope(c.value, c.d_bulge, area, area_rate)
     }
 }
 
@@ -360,7 +354,7 @@ where
             }
         }
         if let Some(i) = lay.heat {
-            let (_, dd) = self.heat_rate(l.g);
+            let dd = self.heat_slope(&l);
             for col in 0..n {
                 j[(i, col)] = dd * b[col];
             }
@@ -399,7 +393,7 @@ where
             dfdt[i] = -l.hot.contact.d_bulge * delta_rate;
         }
         if let Some(i) = self.layout.heat {
-            let (_, dd) = self.heat_rate(l.g);
+            let dd = self.heat_slope(&l);
             dfdt[i] = -dd * delta_rate;
         }
         true

@@ -8,7 +8,8 @@
 //! table prints the CPU time of each solver there and the ratio to the fastest diffsol solver.
 //! Both sides get the same right-hand side and the same analytic Jacobian.
 //!
-//! Run from this folder with `cargo run --release`.
+//! Run from this folder with `cargo run --release`; `cargo run --release -- hires orego` runs the
+//! named problems only (`vdp`, `robertson`, `hires`, `orego`, `e5`, `pleiades`).
 
 #[path = "../../../examples/common/problems.rs"]
 mod problems;
@@ -240,14 +241,29 @@ fn main() {
     let clock = Instant::now();
     let rtols: Vec<f64> = (3..=12).map(|k| 10f64.powi(-k)).collect();
     let targets = [1e-4, 1e-6, 1e-8];
+    // Problems named on the command line (`vdp robertson hires orego e5 pleiades`), else all.
+    let picked: Vec<String> = std::env::args().skip(1).collect();
+    let want = |name: &str| picked.is_empty() || picked.iter().any(|p| p == name);
     println!("hdi-tribology (this tree) against diffsol 0.18 (nalgebra dense LU)");
-    compare(&problems::van_der_pol(), &rtols, &targets);
-    compare(&problems::robertson(), &rtols, &targets);
-    compare(&problems::hires(), &rtols, &targets);
-    compare(&problems::orego(), &rtols, &targets);
+    if want("vdp") {
+        compare(&problems::van_der_pol(), &rtols, &targets);
+    }
+    if want("robertson") {
+        compare(&problems::robertson(), &rtols, &targets);
+    }
+    if want("hires") {
+        compare(&problems::hires(), &rtols, &targets);
+    }
+    if want("orego") {
+        compare(&problems::orego(), &rtols, &targets);
+    }
     // E5: the error is relative with floor 1e-24; about three digits is the double-precision
     // limit (see tests/ode_testset.rs), so only 1e-2 … 1e-3 are compared.
-    compare(&problems::e5(), &rtols[..6], &[1e-2, 1e-3]);
-    compare(&problems::pleiades(), &rtols, &targets);
+    if want("e5") {
+        compare(&problems::e5(), &rtols[..6], &[1e-2, 1e-3]);
+    }
+    if want("pleiades") {
+        compare(&problems::pleiades(), &rtols, &targets);
+    }
     println!("\ntotal {:.1} s", clock.elapsed().as_secs_f64());
 }
