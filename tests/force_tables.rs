@@ -279,3 +279,42 @@ fn shipped_scenes_tables_match_direct_quadrature() {
         check_all(&forces, 150);
     }
 }
+
+/// The values alone (`values`, what a right-hand side reads) are the values of `evaluate` and
+/// `real_contact_area`, bit for bit, with or without the fused table, inside the tables and in
+/// the exact fallback outside them: the few-peak scene has kinked tables (no fused table), the
+/// paper scene a fused one, the mixed scene terms on the pad gap.
+#[test]
+fn values_alone_equal_the_values_of_the_full_evaluation() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes");
+    for name in ["paper.toml", "paper_bulge.toml", "finite_radius.toml"] {
+        let scene = Scene::from_path(format!("{dir}/{name}")).unwrap();
+        let forces = scene.build_interface().unwrap();
+        let (lo, hi) = forces.table_range();
+        for d in points(lo - 0.2 * (hi - lo), hi + 0.2 * (hi - lo), 400) {
+            for volt2 in [0.0, 0.36] {
+                let g = Gaps {
+                    bulge: d,
+                    pad: d + 2e-9,
+                };
+                let v = forces.values(g, volt2);
+                let h = forces.evaluate(g);
+                assert_eq!(
+                    v.interface.to_bits(),
+                    (h.static_part.value + volt2 * h.per_volt2.value).to_bits(),
+                    "{name}: interface at {d:e}, V² = {volt2}"
+                );
+                assert_eq!(
+                    v.contact.to_bits(),
+                    h.contact.value.to_bits(),
+                    "{name}: contact at {d:e}"
+                );
+                assert_eq!(
+                    v.area.to_bits(),
+                    forces.real_contact_area(g).to_bits(),
+                    "{name}: area at {d:e}"
+                );
+            }
+        }
+    }
+}

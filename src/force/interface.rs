@@ -186,12 +186,23 @@ impl Tabulated {
 
     #[inline]
     fn lookup(&self, d: f64) -> Option<(f64, f64)> {
+        self.segment(d).eval(d)
+    }
+
+    /// The value of [`Tabulated::lookup`] alone.
+    #[inline]
+    fn lookup_value(&self, d: f64) -> Option<f64> {
+        self.segment(d).value(d)
+    }
+
+    /// The segment holding `d`.
+    #[inline]
+    fn segment(&self, d: f64) -> &Table {
         if self.segments.len() == 1 {
-            return self.segments[0].eval(d);
+            return &self.segments[0];
         }
         // Right-continuous at the cuts, like the terms themselves (d ≥ h_c counts as non-contact).
-        let k = self.cuts.partition_point(|&c| c <= d);
-        self.segments[k].eval(d)
+        &self.segments[self.cuts.partition_point(|&c| c <= d)]
     }
 
     /// Bounds of [`Tabulated::lookup`]'s value and slope at every `d` in `[a, b]`, or `None`
@@ -261,6 +272,19 @@ impl Slot {
         match hit {
             Some(v) => v,
             None => fallback(&self.tab, terms, d),
+        }
+    }
+
+    /// The value of [`Slot::eval`] alone (the same number).
+    #[inline]
+    fn value(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> f64 {
+        let hit = match &self.single {
+            Some(t) => t.value(d),
+            None => self.tab.lookup_value(d),
+        };
+        match hit {
+            Some(v) => v,
+            None => fallback(&self.tab, terms, d).0,
         }
     }
 }
@@ -527,6 +551,19 @@ impl InterfaceForces {
         Ok(me)
     }
 
+    /// The value of [`InterfaceForces::sum`] alone (the same number).
+    #[inline]
+    fn sum_value(&self, slots: &PerGap, g: Gaps) -> f64 {
+        let mut v = 0.0;
+        if let Some(t) = &slots[0] {
+            v += t.value(&self.terms, g.bulge);
+        }
+        if let Some(t) = &slots[1] {
+            v += t.value(&self.terms, g.pad);
+        }
+        v
+    }
+
     #[inline]
     fn sum(&self, slots: &PerGap, g: Gaps) -> ForceEval {
         let mut e = ForceEval::default();
@@ -660,7 +697,7 @@ impl InterfaceForces {
         };
         match fused {
             Some([_, _, _, a]) => a,
-            None => self.sum(&self.area, g).value,
+            None => self.sum_value(&self.area, g),
         }
         .max(0.0)
     }
@@ -715,10 +752,16 @@ impl InterfaceForces {
                 },
             };
         }
-        let h = self.evaluate_with(g, true, volt2 != 0.0);
+        let per_volt2 = if volt2 != 0.0 {
+            self.sum_value(&self.per_volt2, g)
+        } else {
+            0.0
+        };
+        let contact = self.sum_value(&self.contact, g);
         HotValues {
-            interface: by_coupling(h.static_part.value, h.per_volt2.value, volt2),
-            contact: h.contact.value,
+            interface: by_coupling(self.sum_value(&self.static_part, g), per_volt2, volt2),
+            // Clamped as `contact` clamps it.
+            contact: if contact < 0.0 { 0.0 } else { contact },
             area: self.real_contact_area(g),
         }
     }

@@ -194,14 +194,22 @@ struct Pending {
 /// a correction that vanishes at both ends, so node values are reproduced exactly.
 #[inline(always)]
 fn cubic(y0: f64, hm0: f64, y1: f64, hm1: f64, t: f64) -> (f64, f64) {
+    let (v, [delta, a, b, u, bracket]) = cubic_value(y0, hm0, y1, hm1, t);
+    let dv = delta + (u - t) * bracket - t * u * (a + b);
+    (v, dv)
+}
+
+/// The value of [`cubic`] alone (the same operations), with the intermediates its derivative
+/// reuses.
+#[inline(always)]
+fn cubic_value(y0: f64, hm0: f64, y1: f64, hm1: f64, t: f64) -> (f64, [f64; 5]) {
     let delta = y1 - y0;
     let a = hm0 - delta;
     let b = hm1 - delta;
     let u = 1.0 - t;
     let bracket = u * a - t * b;
     let v = u * y0 + t * y1 + t * u * bracket;
-    let dv = delta + (u - t) * bracket - t * u * (a + b);
-    (v, dv)
+    (v, [delta, a, b, u, bracket])
 }
 
 impl Table {
@@ -438,6 +446,22 @@ impl Table {
     /// `(value, derivative)` at `d`, or `None` outside `[lo, hi]` (or for NaN).
     #[inline]
     pub fn eval(&self, d: f64) -> Option<(f64, f64)> {
+        let (pair, t, inv_h) = self.locate(d)?;
+        let (v, dt) = cubic(pair[0][0], pair[0][1], pair[1][0], pair[1][1], t);
+        Some((v, dt * inv_h))
+    }
+
+    /// The value of [`Table::eval`] alone (the same number), or `None` outside `[lo, hi]`.
+    #[inline]
+    pub fn value(&self, d: f64) -> Option<f64> {
+        let (pair, t, _) = self.locate(d)?;
+        Some(cubic_value(pair[0][0], pair[0][1], pair[1][0], pair[1][1], t).0)
+    }
+
+    /// The two nodes of the interval holding `d`, the local coordinate in it and the inverse
+    /// of its width; `None` outside `[lo, hi]` (or for NaN).
+    #[inline(always)]
+    fn locate(&self, d: f64) -> Option<(&[[f64; 2]], f64, f64)> {
         if !(d >= self.lo && d <= self.hi) {
             return None;
         }
@@ -449,9 +473,7 @@ impl Table {
         let t = s - f64::from(j);
         let j = j as usize;
         let k = p.start as usize + j;
-        let pair = &self.nodes[k..k + 2];
-        let (v, dt) = cubic(pair[0][0], pair[0][1], pair[1][0], pair[1][1], t);
-        Some((v, dt * p.inv_h))
+        Some((&self.nodes[k..k + 2], t, p.inv_h))
     }
 
     /// Bounds of [`Table::eval`]'s value and derivative at every `d` in `[a, b]`, or `None`
