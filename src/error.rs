@@ -378,6 +378,25 @@ pub enum AnalysisError {
         /// (1/s), the likely cause.
         stiff_rate_per_s: Option<f64>,
     },
+    /// Cycle, with [`CycleOptions::stop_outside_tables`](crate::analysis::CycleOptions): the bulge
+    /// gap of an accepted step is deeper than the force tables reach while the steps are spent
+    /// more than twice as fast as an even pace over the programme would spend
+    /// `solver.max_steps` (the step pace without its start allowance): a contact that bounces
+    /// without bound, where the contact model is far outside its light-contact validity.
+    LeftTheTables {
+        /// Time reached (ms).
+        t_ms: f64,
+        /// Bulge gap `d` there (nm).
+        bulge_gap_nm: f64,
+        /// The low end of the force tables (nm).
+        table_low_nm: f64,
+        /// Steps taken so far (accepted and rejected).
+        steps: usize,
+        /// Length of the heater programme (ms).
+        span_ms: f64,
+        /// The step budget.
+        max_steps: usize,
+    },
     /// Drive controller: it did not stop within its budget of periods.
     NotFinished {
         /// The budget.
@@ -478,7 +497,10 @@ impl AnalysisError {
             A::NoAcVoltage => Stage::SimulatedDither,
             A::FlyingBranchEnds { .. } | A::NoFlyingEquilibrium { .. } => Stage::FlyingEquilibrium,
             A::TooManySegments { .. } => Stage::TriggeredCycle,
-            A::LeftTheModel { .. } | A::StepLimit { .. } | A::StepPace { .. } => Stage::Cycle,
+            A::LeftTheModel { .. }
+            | A::LeftTheTables { .. }
+            | A::StepLimit { .. }
+            | A::StepPace { .. } => Stage::Cycle,
             A::NotFinished { .. } => Stage::DriveController,
             A::ContactAtStart { .. } => Stage::ClearanceCalibration,
             A::NoModelStart { .. } | A::TooFewSettled { .. } => Stage::Fit,
@@ -511,6 +533,7 @@ impl AnalysisError {
             A::LeftTheModel { .. } => "LeftTheModel",
             A::StepLimit { .. } => "StepLimit",
             A::StepPace { .. } => "StepPace",
+            A::LeftTheTables { .. } => "LeftTheTables",
             A::NotFinished { .. } => "NotFinished",
             A::ContactAtStart { .. } => "ContactAtStart",
             A::NotFinite { .. } => "NotFinite",
@@ -691,6 +714,24 @@ impl AnalysisError {
                     ),
                 }
             }
+            A::LeftTheTables {
+                t_ms,
+                bulge_gap_nm,
+                table_low_nm,
+                steps,
+                span_ms,
+                max_steps,
+            } => format!(
+                "at t = {} ms the bulge gap d = {} nm is deeper than the force tables reach \
+                 (down to {} nm), where the contact model is far outside its light-contact \
+                 validity and every force is an exact quadrature, and the cycle has taken {steps} \
+                 steps, more than twice the pace that spends solver.max_steps = {max_steps} evenly \
+                 over the {} ms programme: a contact that bounces without bound",
+                num(*t_ms),
+                num(*bulge_gap_nm),
+                num(*table_low_nm),
+                num(*span_ms)
+            ),
             A::NotFinished { max_periods } => {
                 format!("did not finish within {max_periods} periods")
             }

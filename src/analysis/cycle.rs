@@ -85,6 +85,39 @@ pub struct CycleOptions {
     pub solver: SolverSettings,
     /// Keep the time series of forces and spacing (costs memory and some time).
     pub keep_series: bool,
+    /// Stop a cycle whose contact bounces without bound deep in the disk: once the bulge gap of
+    /// an accepted step is below the low end of the force tables
+    /// ([`InterfaceForces::table_range`](crate::force::InterfaceForces::table_range)) while the
+    /// steps are spent at more than twice the even pace of
+    /// [`max_steps`](SolverSettings::max_steps) (the step pace without its start allowance),
+    /// the cycle ends with [`AnalysisError::LeftTheTables`](crate::error::AnalysisError). Below
+    /// the tables the few-peak or Greenwood–Williamson contact is far outside its light-contact
+    /// validity, and every force is an exact quadrature (ten times the cost of a step inside).
+    /// A cycle that dips below the tables at a steady pace (a hard contact at 1 V AC does) runs
+    /// on as before. Off by default ([`CycleOptions::from_scene`]).
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
+    /// use hdi_tribology::error::AnalysisError;
+    /// use hdi_tribology::{model::SliderModel, scene::Scene, Error};
+    /// let scene = Scene::from_path(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper_bulge.toml"))?;
+    /// let mut model = SliderModel::from_scene(&scene)?;
+    /// // A 0.1 ns interface lag at 1 V AC: the few-peak contact bounces without bound.
+    /// model.voltage.ac_amplitude = 1.0;
+    /// model.interface_lag = 1e-10;
+    /// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
+    /// let mut opts = CycleOptions::from_scene(&scene)?;
+    /// opts.solver.max_steps = 300_000;
+    /// opts.stop_outside_tables = true;
+    /// match simulate_cycle(&model, &programme, &opts) {
+    ///     Err(Error::Analysis(AnalysisError::LeftTheTables { bulge_gap_nm, table_low_nm, .. })) => {
+    ///         assert!(bulge_gap_nm < table_low_nm);
+    ///     }
+    ///     other => panic!("{other:?}"),
+    /// }
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub stop_outside_tables: bool,
 }
 
 impl CycleOptions {
@@ -442,7 +475,8 @@ impl<D: DimName> Run<'_, D>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    /// One accepted step, recorded; the pad-contact guard ends the cycle with an error.
+    /// One accepted step, recorded; the step pace, the pad-contact guard and (when asked for) a
+    /// bounce below the force tables end the cycle with an error.
     fn step(&mut self) -> Result<StepStatus> {
         let (model, opts) = (self.model, self.opts);
         let status = self
@@ -465,6 +499,23 @@ where
                 self.it.t(),
                 self.it.state(),
             ));
+        }
+        if opts.stop_outside_tables {
+            let t = self.it.t();
+            let d = self.it.system().gaps(t, self.it.state()).bulge;
+            let low = model.forces().table_range().0;
+            let steps = st.accepted + st.rejected;
+            if d < low && steps as f64 > max * 2.0 * (t - t0) / span {
+                return Err(crate::error::AnalysisError::LeftTheTables {
+                    t_ms: t * 1e3,
+                    bulge_gap_nm: crate::units::to_nm(d),
+                    table_low_nm: crate::units::to_nm(low),
+                    steps,
+                    span_ms: span * 1e3,
+                    max_steps: opts.solver.max_steps,
+                }
+                .into());
+            }
         }
         self.rec.times.push(self.it.t());
         if let Some(st) = self.rec.states.as_mut() {
