@@ -381,8 +381,9 @@ pub enum AnalysisError {
     /// Cycle, with [`CycleOptions::stop_outside_tables`](crate::analysis::CycleOptions): the bulge
     /// gap of an accepted step is deeper than the force tables reach while the steps are spent
     /// more than twice as fast as an even pace over the programme would spend
-    /// `solver.max_steps` (the step pace without its start allowance): a contact that bounces
-    /// without bound, where the contact model is far outside its light-contact validity.
+    /// `solver.max_steps` (the step pace without its start allowance): a contact bouncing deep
+    /// in the disk, where the contact model is far outside its light-contact validity, at a
+    /// pace that would use up the step budget.
     LeftTheTables {
         /// Time reached (ms).
         t_ms: f64,
@@ -726,7 +727,8 @@ impl AnalysisError {
                  (down to {} nm), where the contact model is far outside its light-contact \
                  validity and every force is an exact quadrature, and the cycle has taken {steps} \
                  steps, more than twice the pace that spends solver.max_steps = {max_steps} evenly \
-                 over the {} ms programme: a contact that bounces without bound",
+                 over the {} ms programme: a contact bouncing below the tables that would use up \
+                 the step budget",
                 num(*t_ms),
                 num(*bulge_gap_nm),
                 num(*table_low_nm),

@@ -85,14 +85,15 @@ pub struct CycleOptions {
     pub solver: SolverSettings,
     /// Keep the time series of forces and spacing (costs memory and some time).
     pub keep_series: bool,
-    /// Stop a cycle whose contact bounces without bound deep in the disk: once the bulge gap of
-    /// an accepted step is below the low end of the force tables
+    /// Stop a cycle whose contact bounces deep in the disk at a pace that would use up the step
+    /// budget: once the bulge gap of an accepted step is below the low end of the force tables
     /// ([`InterfaceForces::table_range`](crate::force::InterfaceForces::table_range)) while the
     /// steps are spent at more than twice the even pace of
     /// [`max_steps`](SolverSettings::max_steps) (the step pace without its start allowance),
     /// the cycle ends with [`AnalysisError::LeftTheTables`](crate::error::AnalysisError). Below
     /// the tables the few-peak or Greenwood–Williamson contact is far outside its light-contact
-    /// validity, and every force is an exact quadrature (ten times the cost of a step inside).
+    /// validity, and every force is an exact quadrature (a step there costs up to ten times one
+    /// inside).
     /// A cycle that dips below the tables at a steady pace (a hard contact at 1 V AC does) runs
     /// on as before. Off by default ([`CycleOptions::from_scene`]).
     ///
@@ -102,7 +103,7 @@ pub struct CycleOptions {
     /// use hdi_tribology::{model::SliderModel, scene::Scene, Error};
     /// let scene = Scene::from_path(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper_bulge.toml"))?;
     /// let mut model = SliderModel::from_scene(&scene)?;
-    /// // A 0.1 ns interface lag at 1 V AC: the few-peak contact bounces without bound.
+    /// // A 0.1 ns interface lag at 1 V AC: the few-peak contact bounces deep into the disk.
     /// model.voltage.ac_amplitude = 1.0;
     /// model.interface_lag = 1e-10;
     /// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
