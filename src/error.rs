@@ -381,9 +381,10 @@ pub enum AnalysisError {
     /// Cycle, with [`CycleOptions::stop_outside_tables`](crate::analysis::CycleOptions): the bulge
     /// gap of an accepted step is deeper than the force tables reach while the steps are spent
     /// more than twice as fast as an even pace over the programme would spend
-    /// `solver.max_steps` (the step pace without its start allowance): a contact bouncing deep
-    /// in the disk, where the contact model is far outside its light-contact validity, at a
-    /// pace that would use up the step budget.
+    /// `solver.max_steps` (from the start, or since the first step below the tables after an
+    /// allowance of 1 % of the budget): a contact bouncing deep in the disk, where the contact
+    /// model is far outside its light-contact validity, at a pace that would use up the step
+    /// budget.
     LeftTheTables {
         /// Time reached (ms).
         t_ms: f64,
@@ -393,6 +394,10 @@ pub enum AnalysisError {
         table_low_nm: f64,
         /// Steps taken so far (accepted and rejected).
         steps: usize,
+        /// Time of the first accepted step below the tables (ms).
+        first_below_ms: f64,
+        /// Steps taken since then.
+        steps_below: usize,
         /// Length of the heater programme (ms).
         span_ms: f64,
         /// The step budget.
@@ -720,19 +725,23 @@ impl AnalysisError {
                 bulge_gap_nm,
                 table_low_nm,
                 steps,
+                first_below_ms,
+                steps_below,
                 span_ms,
                 max_steps,
             } => format!(
                 "at t = {} ms the bulge gap d = {} nm is deeper than the force tables reach \
                  (down to {} nm), where the contact model is far outside its light-contact \
-                 validity and every force is an exact quadrature, and the cycle has taken {steps} \
-                 steps, more than twice the pace that spends solver.max_steps = {max_steps} evenly \
-                 over the {} ms programme: a contact bouncing below the tables that would use up \
-                 the step budget",
+                 validity and every force is an exact quadrature, and the cycle spends its steps \
+                 at more than twice the pace that uses solver.max_steps = {max_steps} evenly over \
+                 the {} ms programme ({steps} steps, {steps_below} of them since the gap first \
+                 went below the tables at {} ms): a contact bouncing below the tables that would \
+                 use up the step budget",
                 num(*t_ms),
                 num(*bulge_gap_nm),
                 num(*table_low_nm),
-                num(*span_ms)
+                num(*span_ms),
+                num(*first_below_ms)
             ),
             A::NotFinished { max_periods } => {
                 format!("did not finish within {max_periods} periods")

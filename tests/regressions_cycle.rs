@@ -111,10 +111,12 @@ fn auto_on_a_stiff_structure_starts_stiff() {
 }
 
 /// The cycle of `a_cycle_spending_steps_too_fast_stops_early` with the stop below the force
-/// tables asked for: its contact bounces below the tables' low end (−3.5 nm) at 20 times the even
-/// step pace 25 µs into the programme, and the cycle stops there (after 1.7e4 steps, 0.05 s),
-/// where the step pace alone let it run on to 3.2e4 steps (1.1 s: out there every force is an
-/// exact quadrature).
+/// tables asked for: at 1 V its contact bounces below the tables' low end (−3.5 nm) at 20 times
+/// the even step pace 25 µs into the programme, and the cycle stops at that first step below the
+/// tables (1.7e4 steps, 0.05 s), where the step pace alone let it run on to 3.2e4 steps (1.1 s:
+/// out there every force is an exact quadrature). At 0.8 V it first goes below the tables at
+/// 1.07 ms, within the even pace, and then spends 3e4 steps in 2 µs: it now stops once it has
+/// spent the allowance of 1 % of the budget since then at more than twice the even pace.
 #[test]
 fn a_bounce_below_the_tables_stops_when_asked() {
     let scene = Scene::from_path(concat!(
@@ -123,7 +125,6 @@ fn a_bounce_below_the_tables_stops_when_asked() {
     ))
     .unwrap();
     let mut model = SliderModel::from_scene(&scene).unwrap();
-    model.voltage.ac_amplitude = 1.0;
     model.interface_lag = 1e-10;
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
@@ -131,28 +132,43 @@ fn a_bounce_below_the_tables_stops_when_asked() {
     opts.solver.max_steps = 300_000;
     opts.stop_outside_tables = true;
     let low_nm = model.forces().table_range().0 * 1e9;
-    match simulate_cycle(&model, &programme, &opts) {
-        Err(Error::Analysis(
-            e @ AnalysisError::LeftTheTables {
-                t_ms,
-                bulge_gap_nm,
-                table_low_nm,
-                steps,
-                span_ms,
-                max_steps,
-            },
-        )) => {
-            assert_eq!(e.stage(), Stage::Cycle);
-            assert_eq!(e.kind(), "LeftTheTables");
-            assert!((table_low_nm - low_nm).abs() <= 1e-12 * low_nm.abs(), "{e}");
-            assert!(bulge_gap_nm < table_low_nm, "{e}");
-            assert_eq!((max_steps, span_ms), (300_000, 10.0));
-            // Past twice the even pace, well before the step pace's start allowance ran out.
-            assert!(steps as f64 > 2.0 * 300_000.0 * t_ms / span_ms, "{e}");
-            assert!(steps < 30_000, "{e}");
-            assert!(!e.to_string().contains('\n'));
+    for v_ac in [1.0, 0.8] {
+        model.voltage.ac_amplitude = v_ac;
+        match simulate_cycle(&model, &programme, &opts) {
+            Err(Error::Analysis(
+                e @ AnalysisError::LeftTheTables {
+                    t_ms,
+                    bulge_gap_nm,
+                    table_low_nm,
+                    steps,
+                    first_below_ms,
+                    steps_below,
+                    span_ms,
+                    max_steps,
+                },
+            )) => {
+                assert_eq!(e.stage(), Stage::Cycle);
+                assert_eq!(e.kind(), "LeftTheTables");
+                assert!((table_low_nm - low_nm).abs() <= 1e-12 * low_nm.abs(), "{e}");
+                assert!(bulge_gap_nm < table_low_nm, "{e}");
+                assert_eq!((max_steps, span_ms), (300_000, 10.0));
+                assert!(first_below_ms <= t_ms && steps_below <= steps, "{e}");
+                let pace = |n: usize, ms: f64| n as f64 > 2.0 * 300_000.0 * ms / span_ms;
+                if v_ac == 1.0 {
+                    // Past twice the even pace from the start, at the first step below.
+                    assert!(pace(steps, t_ms) && steps_below == 0, "{e}");
+                    assert!(steps < 30_000, "{e}");
+                } else {
+                    // Within the even pace from the start; past it since the first step below,
+                    // after the allowance of 3 000 steps.
+                    assert!(!pace(steps, t_ms), "{e}");
+                    assert!(pace(steps_below - 3_000, t_ms - first_below_ms), "{e}");
+                    assert!(steps_below < 10_000, "{e}");
+                }
+                assert!(!e.to_string().contains('\n'));
+            }
+            other => panic!("{v_ac} V: expected the stop below the tables, got {other:?}"),
         }
-        other => panic!("expected the stop below the tables, got {other:?}"),
     }
 }
 
