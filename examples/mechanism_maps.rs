@@ -9,8 +9,10 @@
 //! gives touchdown and take-off, once more at a tolerance ten times tighter as a check: a point
 //! counts as converged when touchdown and take-off move by at most 0.05 mW between the two
 //! (`--full-check`: both runs at every point and the tighter one shown, `ac_sweep_refined` with
-//! two runs, as the maps in docs/analyses.md were made). The output gives each map's CPU time
-//! per status. The heatmaps colour only converged
+//! two runs, as the maps in docs/analyses.md were made). A cycle that bounces below the force
+//! tables at more than twice the even step pace stops there (`CycleOptions::stop_outside_tables`).
+//! The output gives each map's CPU time per status, and for the runaways per cause (also in the
+//! CSV's `cause` column). The heatmaps colour only converged
 //! points with both detections (and, for `ΔP`, a non-negative value); the others are drawn in
 //! grey or black and named in the legend. A white dot marks a point whose contact force drops to
 //! zero during the hold at the highest power (the contact bounces). The outlined band is the
