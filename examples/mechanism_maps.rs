@@ -9,8 +9,10 @@
 //! gives touchdown and take-off, once more at a tolerance ten times tighter as a check: a point
 //! counts as converged when touchdown and take-off move by at most 0.05 mW between the two
 //! (`--full-check`: both runs at every point and the tighter one shown, `ac_sweep_refined` with
-//! two runs, as the maps in docs/analyses.md were made). The output gives each map's CPU time
-//! per status. The heatmaps colour only converged
+//! two runs, as the maps in docs/analyses.md were made). A cycle that bounces below the force
+//! tables at more than twice the even step pace stops there (`CycleOptions::stop_outside_tables`).
+//! The output gives each map's CPU time per status, and for the runaways per cause (also in the
+//! CSV's `cause` column). The heatmaps colour only converged
 //! points with both detections (and, for `ΔP`, a non-negative value); the others are drawn in
 //! grey or black and named in the legend. A white dot marks a point whose contact force drops to
 //! zero during the hold at the highest power (the contact bounces). The outlined band is the
@@ -126,8 +128,43 @@ enum Status {
     Unconverged,
     /// No touchdown, or no take-off, under the programme.
     Undetected,
-    /// The cycle failed: the slider ran into the disk or the solver gave up.
+    /// The cycle failed: the slider ran into the disk, bounced below the force tables, or the
+    /// solver gave up.
     Runaway,
+}
+
+/// Why a runaway point's cycle failed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Cause {
+    /// The pad gap reached zero (`LeftTheModel`).
+    HitTheDisk,
+    /// A bounce below the force tables at more than twice the even step pace (`LeftTheTables`).
+    LeftTheTables,
+    /// The steps were spent too fast (`StepPace`).
+    StepPace,
+    /// Anything else: the step limit, a non-finite state, no flying equilibrium at the start.
+    Other,
+}
+
+impl Cause {
+    fn of(e: &hdi_tribology::Error) -> Self {
+        use hdi_tribology::error::AnalysisError as A;
+        match e {
+            hdi_tribology::Error::Analysis(A::LeftTheModel { .. }) => Cause::HitTheDisk,
+            hdi_tribology::Error::Analysis(A::LeftTheTables { .. }) => Cause::LeftTheTables,
+            hdi_tribology::Error::Analysis(A::StepPace { .. }) => Cause::StepPace,
+            _ => Cause::Other,
+        }
+    }
+
+    fn code(self) -> f64 {
+        match self {
+            Cause::HitTheDisk => 1.0,
+            Cause::LeftTheTables => 2.0,
+            Cause::StepPace => 3.0,
+            Cause::Other => 4.0,
+        }
+    }
 }
 
 impl Status {
@@ -148,6 +185,8 @@ struct Point {
     td: Option<f64>,
     to: Option<f64>,
     status: Status,
+    /// Why the cycle failed, for a runaway.
+    cause: Option<Cause>,
     bounce: bool,
     /// CPU time of the point's cycles (s) and their accepted steps.
     cpu: f64,
@@ -190,6 +229,9 @@ impl Setup {
         // A cycle of this scene takes 1e3 … 5e4 steps; one that needs more is bouncing without
         // bound and is marked as a runaway instead of running for minutes.
         opts.solver.max_steps = opts.solver.max_steps.min(MAX_STEPS);
+        // A bounce below the force tables at more than twice the even step pace stops at once,
+        // not after the step pace's start allowance of exact-quadrature steps.
+        opts.stop_outside_tables = true;
         Ok(Setup {
             base: SliderModel::from_scene(scene)?,
             programme: HeaterProgramme::Fixed(SliderModel::programme_from_knots(knots)?),
@@ -245,6 +287,7 @@ impl Setup {
             td: None,
             to: None,
             status: Status::Runaway,
+            cause: None,
             bounce: false,
             cpu: 0.0,
             steps: 0,
@@ -291,8 +334,12 @@ impl Setup {
         p.cpu = thread_cpu_seconds() - cpu0;
         // The slider entering the disk, or the stepper giving up, is a property of this point:
         // mark it, do not stop the map.
-        let Ok((r, converged)) = outcome else {
-            return Ok(p);
+        let (r, converged) = match outcome {
+            Ok(x) => x,
+            Err(e) => {
+                p.cause = Some(Cause::of(&e));
+                return Ok(p);
+            }
         };
         (p.td, p.to) = power(&r);
         p.status = match (p.td, p.to, converged) {
@@ -489,7 +536,10 @@ fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> 
             "not converged (TD or TO moves > 0.05 mW at 10× rtol)",
         ),
         (UNDETECTED, "no touchdown or no take-off"),
-        (BLACK, "runaway: slider hits the disk, or > 3e5 steps"),
+        (
+            BLACK,
+            "runaway: hits the disk, bounces below the tables, or too many steps",
+        ),
         (NEGATIVE, "ΔP < 0 (ΔP panel)"),
     ];
     let style = ("sans-serif", 15).into_font();
@@ -535,6 +585,7 @@ fn write_points(path: &Path, points: &[Point]) -> Res<()> {
             "cpu_s",
             "steps",
             "runs",
+            "cause",
         ],
         &[
             &col(&|p| p.v_ac),
@@ -547,6 +598,7 @@ fn write_points(path: &Path, points: &[Point]) -> Res<()> {
             &col(&|p| p.cpu),
             &col(&|p| p.steps as f64),
             &col(&|p| p.runs as f64),
+            &col(&|p| p.cause.map_or(0.0, Cause::code)),
         ],
     )?;
     Ok(())
@@ -586,6 +638,22 @@ fn cost(spec: &MapSpec, points: &[Point], wall: f64) {
             steps as f64 / runs.max(1) as f64,
             runs as f64 / these.len() as f64
         );
+    }
+    for c in [
+        Cause::HitTheDisk,
+        Cause::LeftTheTables,
+        Cause::StepPace,
+        Cause::Other,
+    ] {
+        let these: Vec<&Point> = points.iter().filter(|p| p.cause == Some(c)).collect();
+        if !these.is_empty() {
+            println!(
+                "{:<10}     runaway, {c:?}: {} points, CPU {:.1} s",
+                "",
+                these.len(),
+                these.iter().map(|p| p.cpu).sum::<f64>()
+            );
+        }
     }
 }
 

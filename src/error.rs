@@ -378,6 +378,31 @@ pub enum AnalysisError {
         /// (1/s), the likely cause.
         stiff_rate_per_s: Option<f64>,
     },
+    /// Cycle, with [`CycleOptions::stop_outside_tables`](crate::analysis::CycleOptions): the bulge
+    /// gap of an accepted step is deeper than the force tables reach while the steps are spent
+    /// more than twice as fast as an even pace over the programme would spend
+    /// `solver.max_steps` (from the start, or since the first step below the tables after an
+    /// allowance of 1 % of the budget): a contact bouncing deep in the disk, where the contact
+    /// model is far outside its light-contact validity, at a pace that would use up the step
+    /// budget.
+    LeftTheTables {
+        /// Time reached (ms).
+        t_ms: f64,
+        /// Bulge gap `d` there (nm).
+        bulge_gap_nm: f64,
+        /// The low end of the force tables (nm).
+        table_low_nm: f64,
+        /// Steps taken so far (accepted and rejected).
+        steps: usize,
+        /// Time of the first accepted step below the tables (ms).
+        first_below_ms: f64,
+        /// Steps taken since then.
+        steps_below: usize,
+        /// Length of the heater programme (ms).
+        span_ms: f64,
+        /// The step budget.
+        max_steps: usize,
+    },
     /// Drive controller: it did not stop within its budget of periods.
     NotFinished {
         /// The budget.
@@ -478,7 +503,10 @@ impl AnalysisError {
             A::NoAcVoltage => Stage::SimulatedDither,
             A::FlyingBranchEnds { .. } | A::NoFlyingEquilibrium { .. } => Stage::FlyingEquilibrium,
             A::TooManySegments { .. } => Stage::TriggeredCycle,
-            A::LeftTheModel { .. } | A::StepLimit { .. } | A::StepPace { .. } => Stage::Cycle,
+            A::LeftTheModel { .. }
+            | A::LeftTheTables { .. }
+            | A::StepLimit { .. }
+            | A::StepPace { .. } => Stage::Cycle,
             A::NotFinished { .. } => Stage::DriveController,
             A::ContactAtStart { .. } => Stage::ClearanceCalibration,
             A::NoModelStart { .. } | A::TooFewSettled { .. } => Stage::Fit,
@@ -511,6 +539,7 @@ impl AnalysisError {
             A::LeftTheModel { .. } => "LeftTheModel",
             A::StepLimit { .. } => "StepLimit",
             A::StepPace { .. } => "StepPace",
+            A::LeftTheTables { .. } => "LeftTheTables",
             A::NotFinished { .. } => "NotFinished",
             A::ContactAtStart { .. } => "ContactAtStart",
             A::NotFinite { .. } => "NotFinite",
@@ -691,6 +720,29 @@ impl AnalysisError {
                     ),
                 }
             }
+            A::LeftTheTables {
+                t_ms,
+                bulge_gap_nm,
+                table_low_nm,
+                steps,
+                first_below_ms,
+                steps_below,
+                span_ms,
+                max_steps,
+            } => format!(
+                "at t = {} ms the bulge gap d = {} nm is deeper than the force tables reach \
+                 (down to {} nm), where the contact model is far outside its light-contact \
+                 validity and every force is an exact quadrature, and the cycle spends its steps \
+                 at more than twice the pace that uses solver.max_steps = {max_steps} evenly over \
+                 the {} ms programme ({steps} steps, {steps_below} of them since the gap first \
+                 went below the tables at {} ms): a contact bouncing below the tables that would \
+                 use up the step budget",
+                num(*t_ms),
+                num(*bulge_gap_nm),
+                num(*table_low_nm),
+                num(*span_ms),
+                num(*first_below_ms)
+            ),
             A::NotFinished { max_periods } => {
                 format!("did not finish within {max_periods} periods")
             }

@@ -455,6 +455,7 @@ fn cycles_reject_bad_detectors_solvers_and_programmes() {
         detector: det,
         solver: sol,
         keep_series: false,
+        stop_outside_tables: false,
     };
     for x in BAD {
         let mut d = base.detector;

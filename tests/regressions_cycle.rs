@@ -109,3 +109,123 @@ fn auto_on_a_stiff_structure_starts_stiff() {
     let r = simulate_cycle(&rigid, &programme, &opts).unwrap();
     assert!(r.stats.stiff_steps < r.stats.accepted, "{:?}", r.stats);
 }
+
+/// The cycle of `a_cycle_spending_steps_too_fast_stops_early` with the stop below the force
+/// tables asked for: at 1 V its contact bounces below the tables' low end (−3.5 nm) at 20 times
+/// the even step pace 25 µs into the programme, and the cycle stops at that first step below the
+/// tables (1.7e4 steps, 0.05 s), where the step pace alone let it run on to 3.2e4 steps (1.1 s:
+/// out there every force is an exact quadrature). At 0.8 V it first goes below the tables at
+/// 1.07 ms, within the even pace, and then spends 3e4 steps in 2 µs: it now stops once it has
+/// spent the allowance of 1 % of the budget since then at more than twice the even pace.
+#[test]
+fn a_bounce_below_the_tables_stops_when_asked() {
+    let scene = Scene::from_path(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/paper_bulge.toml"
+    ))
+    .unwrap();
+    let mut model = SliderModel::from_scene(&scene).unwrap();
+    model.interface_lag = 1e-10;
+    let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
+    let mut opts = CycleOptions::from_scene(&scene).unwrap();
+    assert!(!opts.stop_outside_tables);
+    opts.solver.max_steps = 300_000;
+    opts.stop_outside_tables = true;
+    let low_nm = model.forces().table_range().0 * 1e9;
+    for v_ac in [1.0, 0.8] {
+        model.voltage.ac_amplitude = v_ac;
+        match simulate_cycle(&model, &programme, &opts) {
+            Err(Error::Analysis(
+                e @ AnalysisError::LeftTheTables {
+                    t_ms,
+                    bulge_gap_nm,
+                    table_low_nm,
+                    steps,
+                    first_below_ms,
+                    steps_below,
+                    span_ms,
+                    max_steps,
+                },
+            )) => {
+                assert_eq!(e.stage(), Stage::Cycle);
+                assert_eq!(e.kind(), "LeftTheTables");
+                assert!((table_low_nm - low_nm).abs() <= 1e-12 * low_nm.abs(), "{e}");
+                assert!(bulge_gap_nm < table_low_nm, "{e}");
+                assert_eq!((max_steps, span_ms), (300_000, 10.0));
+                assert!(first_below_ms <= t_ms && steps_below <= steps, "{e}");
+                let pace = |n: usize, ms: f64| n as f64 > 2.0 * 300_000.0 * ms / span_ms;
+                if v_ac == 1.0 {
+                    // Past twice the even pace from the start, at the first step below.
+                    assert!(pace(steps, t_ms) && steps_below == 0, "{e}");
+                    assert!(steps < 30_000, "{e}");
+                } else {
+                    // Within the even pace from the start; past it since the first step below,
+                    // after the allowance of 3 000 steps.
+                    assert!(!pace(steps, t_ms), "{e}");
+                    assert!(pace(steps_below - 3_000, t_ms - first_below_ms), "{e}");
+                    assert!(steps_below < 10_000, "{e}");
+                }
+                assert!(!e.to_string().contains('\n'));
+            }
+            other => panic!("{v_ac} V: expected the stop below the tables, got {other:?}"),
+        }
+    }
+}
+
+/// The stop below the tables leaves cycles alone that do not bounce without bound: the bulge
+/// scene's own cycle, and a rigid slider with a 10 µs lag at 1 V AC whose hard contact dips
+/// below the tables (to −4.8 nm, for about 0.2 ms) at a steady pace. Both come out bit for bit
+/// as without it.
+#[test]
+fn the_stop_below_the_tables_leaves_finished_cycles_alone() {
+    use hdi_tribology::model::Structure;
+    let scene = Scene::from_path(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/paper_bulge.toml"
+    ))
+    .unwrap();
+    let bulge = SliderModel::from_scene(&scene).unwrap();
+    let mut rigid = bulge.clone();
+    rigid.structure = Structure::rigid(scene.slider.mass_kg).unwrap();
+    rigid.interface_lag = 1e-5;
+    rigid.voltage.ac_amplitude = 1.0;
+    let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
+    let mut opts = CycleOptions::from_scene(&scene).unwrap();
+    opts.solver.max_steps = 300_000;
+    opts.keep_series = true;
+    let low = bulge.forces().table_range().0;
+    for (model, dips) in [(&bulge, false), (&rigid, true)] {
+        let off = simulate_cycle(model, &programme, &opts).unwrap();
+        let mut on_opts = opts;
+        on_opts.stop_outside_tables = true;
+        let on = simulate_cycle(model, &programme, &on_opts).unwrap();
+        let deepest = off
+            .series
+            .as_ref()
+            .unwrap()
+            .d
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(
+            deepest < low,
+            dips,
+            "deepest {deepest:e} m, tables from {low:e} m"
+        );
+        assert!(off.hysteresis.is_some());
+        assert_eq!(
+            (off.touchdown, off.takeoff, off.hysteresis, off.stats),
+            (on.touchdown, on.takeoff, on.hysteresis, on.stats)
+        );
+        assert_eq!(
+            off.mean_temperature_rise.to_bits(),
+            on.mean_temperature_rise.to_bits()
+        );
+        let bits = |r: &hdi_tribology::analysis::CycleResult| {
+            let s = r.series.as_ref().unwrap();
+            [&s.t, &s.d, &s.contact, &s.indicator]
+                .map(|v| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>())
+        };
+        assert_eq!(bits(&off), bits(&on));
+    }
+}

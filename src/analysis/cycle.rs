@@ -24,6 +24,10 @@ use std::time::Instant;
 /// time each; the paper scene's search spans 200).
 const MAX_TRIGGERED_SEGMENTS: f64 = 1e5;
 
+/// The start allowance of the step pace taken afresh from a cycle's first step below the force
+/// tables, as a fraction of `max_steps` ([`CycleOptions::stop_outside_tables`]).
+const BELOW_TABLES_ALLOWANCE: f64 = 0.01;
+
 /// `Auto` starts with the stiff method when the explicit method's stability limit alone would
 /// take more steps than this over the programme (the rigid paper scene needs about 1.3e3; a bulge
 /// ringing at hundreds of MHz, or a nanosecond interface lag, 1e6 and more). Auto would switch
@@ -85,6 +89,40 @@ pub struct CycleOptions {
     pub solver: SolverSettings,
     /// Keep the time series of forces and spacing (costs memory and some time).
     pub keep_series: bool,
+    /// Stop a cycle whose contact bounces deep in the disk at a pace that would use up the step
+    /// budget. At an accepted step whose bulge gap is below the low end of the force tables
+    /// ([`InterfaceForces::table_range`](crate::force::InterfaceForces::table_range)), the cycle
+    /// ends with [`AnalysisError::LeftTheTables`](crate::error::AnalysisError) when it has spent
+    /// its steps at more than twice the even pace of [`max_steps`](SolverSettings::max_steps),
+    /// either from the start without the step pace's start allowance, or since its first step
+    /// below the tables after an allowance of 1 % of `max_steps`. Below the tables the few-peak
+    /// or Greenwood–Williamson contact is far outside its light-contact validity, and every force
+    /// is an exact quadrature (a step there costs up to ten times one inside).
+    /// A cycle that dips below the tables at a steady pace (a hard contact at 1 V AC does) runs
+    /// on as before. Off by default ([`CycleOptions::from_scene`]).
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
+    /// use hdi_tribology::error::AnalysisError;
+    /// use hdi_tribology::{model::SliderModel, scene::Scene, Error};
+    /// let scene = Scene::from_path(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper_bulge.toml"))?;
+    /// let mut model = SliderModel::from_scene(&scene)?;
+    /// // A 0.1 ns interface lag at 1 V AC: the few-peak contact bounces deep into the disk.
+    /// model.voltage.ac_amplitude = 1.0;
+    /// model.interface_lag = 1e-10;
+    /// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
+    /// let mut opts = CycleOptions::from_scene(&scene)?;
+    /// opts.solver.max_steps = 300_000;
+    /// opts.stop_outside_tables = true;
+    /// match simulate_cycle(&model, &programme, &opts) {
+    ///     Err(Error::Analysis(AnalysisError::LeftTheTables { bulge_gap_nm, table_low_nm, .. })) => {
+    ///         assert!(bulge_gap_nm < table_low_nm);
+    ///     }
+    ///     other => panic!("{other:?}"),
+    /// }
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub stop_outside_tables: bool,
 }
 
 impl CycleOptions {
@@ -436,13 +474,16 @@ where
     opts: &'m CycleOptions,
     /// Start and length of the programme, for the step pace.
     span: (f64, f64),
+    /// Time and steps taken at the first accepted step below the force tables.
+    below_since: Option<(f64, usize)>,
 }
 
 impl<D: DimName> Run<'_, D>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    /// One accepted step, recorded; the pad-contact guard ends the cycle with an error.
+    /// One accepted step, recorded; the step pace, the pad-contact guard and (when asked for) a
+    /// bounce below the force tables end the cycle with an error.
     fn step(&mut self) -> Result<StepStatus> {
         let (model, opts) = (self.model, self.opts);
         let status = self
@@ -465,6 +506,32 @@ where
                 self.it.t(),
                 self.it.state(),
             ));
+        }
+        if opts.stop_outside_tables {
+            let t = self.it.t();
+            let d = self.it.system().gaps(t, self.it.state()).bulge;
+            let low = model.forces().table_range().0;
+            if d < low {
+                let steps = st.accepted + st.rejected;
+                let (t1, n1) = *self.below_since.get_or_insert((t, steps));
+                let allowance = (BELOW_TABLES_ALLOWANCE * max) as usize;
+                // More than twice the even pace: from the start without the step pace's start
+                // allowance, or afresh from the first step below the tables with a small one.
+                let too_fast = |n: usize, from: f64| n as f64 > max * 2.0 * (t - from) / span;
+                if too_fast(steps, t0) || too_fast((steps - n1).saturating_sub(allowance), t1) {
+                    return Err(crate::error::AnalysisError::LeftTheTables {
+                        t_ms: t * 1e3,
+                        bulge_gap_nm: crate::units::to_nm(d),
+                        table_low_nm: crate::units::to_nm(low),
+                        steps,
+                        first_below_ms: t1 * 1e3,
+                        steps_below: steps - n1,
+                        span_ms: span * 1e3,
+                        max_steps: opts.solver.max_steps,
+                    }
+                    .into());
+                }
+            }
         }
         self.rec.times.push(self.it.t());
         if let Some(st) = self.rec.states.as_mut() {
@@ -563,6 +630,7 @@ where
         model,
         opts,
         span: (t0, end - t0),
+        below_since: None,
     };
 
     let final_programme;

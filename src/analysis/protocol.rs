@@ -88,7 +88,8 @@ impl StaticOptions {
 }
 
 impl CycleOptions {
-    /// The detector and solver settings of a scene, without time series.
+    /// The detector and solver settings of a scene, without time series and without the stop
+    /// below the force tables ([`CycleOptions::stop_outside_tables`]).
     pub fn from_scene(scene: &Scene) -> Result<Self> {
         let method: Method = scene
             .solver
@@ -108,6 +109,7 @@ impl CycleOptions {
                 max_steps: scene.solver.max_steps,
             },
             keep_series: false,
+            stop_outside_tables: false,
         })
     }
 }
