@@ -452,6 +452,14 @@ impl Table {
     }
 
     /// The value of [`Table::eval`] alone (the same number), or `None` outside `[lo, hi]`.
+    ///
+    /// ```
+    /// use hdi_tribology::quadrature::{Table, TableOptions};
+    /// let t = Table::build(|x: f64| Ok((x.sin(), x.cos())), 0.0, 3.0, &TableOptions::default())
+    ///     .unwrap();
+    /// assert_eq!(t.value(1.3), t.eval(1.3).map(|(v, _)| v));
+    /// assert_eq!(t.value(3.5), None);
+    /// ```
     #[inline]
     pub fn value(&self, d: f64) -> Option<f64> {
         let (pair, t, _) = self.locate(d)?;
