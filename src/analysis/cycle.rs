@@ -24,6 +24,9 @@ use std::time::Instant;
 /// time each; the paper scene's search spans 200).
 const MAX_TRIGGERED_SEGMENTS: f64 = 1e5;
 
+/// The step pace's start allowance, as a fraction of `max_steps` ([`SolverSettings::max_steps`]).
+const STEP_PACE_ALLOWANCE: f64 = 0.1;
+
 /// The start allowance of the step pace taken afresh from a cycle's first step below the force
 /// tables, as a fraction of `max_steps` ([`CycleOptions::stop_outside_tables`]).
 const BELOW_TABLES_ALLOWANCE: f64 = 0.01;
@@ -495,9 +498,14 @@ where
         let st = self.it.stats();
         let (t0, span) = self.span;
         let max = opts.solver.max_steps as f64;
-        let pace_limit = max * (0.1 + 2.0 * (self.it.t() - t0) / span);
-        if (st.accepted + st.rejected) as f64 > pace_limit && self.it.t() < t0 + span {
-            return Err(out_of_step_budget(model, opts, self.it.t(), st, span));
+        let t = self.it.t();
+        let steps = st.accepted + st.rejected;
+        // More than twice the even pace of `max_steps` since `from`, after `allowance` steps.
+        let too_fast = |n: usize, from: f64, allowance: f64| {
+            n as f64 > max * (allowance + 2.0 * (t - from) / span)
+        };
+        if too_fast(steps, t0, STEP_PACE_ALLOWANCE) && t < t0 + span {
+            return Err(out_of_step_budget(model, opts, t, st, span));
         }
         if let StepStatus::Terminated(_) = status {
             return Err(left_the_model(
@@ -508,17 +516,13 @@ where
             ));
         }
         if opts.stop_outside_tables {
-            let t = self.it.t();
             let d = self.it.system().gaps(t, self.it.state()).bulge;
             let low = model.forces().table_range().0;
             if d < low {
-                let steps = st.accepted + st.rejected;
                 let (t1, n1) = *self.below_since.get_or_insert((t, steps));
-                let allowance = (BELOW_TABLES_ALLOWANCE * max) as usize;
-                // More than twice the even pace: from the start without the step pace's start
-                // allowance, or afresh from the first step below the tables with a small one.
-                let too_fast = |n: usize, from: f64| n as f64 > max * 2.0 * (t - from) / span;
-                if too_fast(steps, t0) || too_fast((steps - n1).saturating_sub(allowance), t1) {
+                // From the start without the step pace's start allowance, or afresh from the
+                // first step below the tables with a small one.
+                if too_fast(steps, t0, 0.0) || too_fast(steps - n1, t1, BELOW_TABLES_ALLOWANCE) {
                     return Err(crate::error::AnalysisError::LeftTheTables {
                         t_ms: t * 1e3,
                         bulge_gap_nm: crate::units::to_nm(d),
