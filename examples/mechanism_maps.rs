@@ -320,6 +320,7 @@ impl Setup {
                 temperature_tol: f64::MAX,
                 factor: 0.1,
                 max_runs: 2,
+                agreeing_runs: 2,
             };
             ac_sweep_refined(&m, &self.programme, &self.opts, &[v_ac], &refine).map(|mut r| {
                 let r = r.remove(0);

@@ -103,6 +103,69 @@ fn refinement_options_are_checked_by_field() {
     for max_runs in [0, 1, 13] {
         assert_eq!(field(Refinement { max_runs, ..ok }), "refinement.max_runs");
     }
+    for agreeing_runs in [0, 1, ok.max_runs + 1] {
+        assert_eq!(
+            field(Refinement {
+                agreeing_runs,
+                ..ok
+            }),
+            "refinement.agreeing_runs"
+        );
+    }
+}
+
+/// With `agreeing_runs = 3` a converged amplitude is one whose last three runs agree pairwise
+/// within the tolerances, and the cycle kept is the last run itself: each run is redone here
+/// with `simulate_cycle` at its tolerance.
+#[test]
+fn three_agreeing_runs_mean_three_agreeing_runs() {
+    let (model, programme, opts) = paper();
+    let refine = Refinement {
+        agreeing_runs: 3,
+        max_runs: 5,
+        ..Refinement::new(6e-5)
+    };
+    for v_ac in [0.0, 0.3] {
+        let r = &ac_sweep_refined(&model, &programme, &opts, &[v_ac], &refine).unwrap()[0];
+        assert!(r.converged, "{v_ac} V: {r:?}");
+        assert!(r.runs >= 3, "{v_ac} V: converged after {} runs", r.runs);
+        let m = model.with_voltage(Voltage {
+            ac_amplitude: v_ac,
+            ..model.voltage
+        });
+        // Tightened as the refinement does, one factor at a time (the same rounding).
+        let run = |k: usize| {
+            let mut o = opts;
+            for _ in 0..k {
+                o.solver.rtol *= refine.factor;
+                o.solver.atol_displacement *= refine.factor;
+            }
+            simulate_cycle(&m, &programme, &o).unwrap()
+        };
+        let cycles: Vec<_> = (r.runs - 3..r.runs).map(run).collect();
+        let last = &cycles[2];
+        assert_eq!(last.touchdown, r.cycle.touchdown);
+        assert_eq!(last.takeoff, r.cycle.takeoff);
+        for w in cycles.windows(2) {
+            for (a, b) in [
+                (w[0].touchdown, w[1].touchdown),
+                (w[0].takeoff, w[1].takeoff),
+            ] {
+                let moved = (a.unwrap().power - b.unwrap().power).abs();
+                assert!(moved <= refine.power_tol, "{v_ac} V: moved {moved:e} W");
+            }
+            let dt = (w[0].mean_temperature_rise - w[1].mean_temperature_rise).abs();
+            assert!(dt <= refine.temperature_tol, "{v_ac} V: ΔT moved {dt} K");
+        }
+        // With two agreeing runs the same amplitude stops earlier, on a run of this sequence.
+        let two = &ac_sweep_refined(&model, &programme, &opts, &[v_ac], &Refinement::new(6e-5))
+            .unwrap()[0];
+        assert!(
+            two.converged && two.runs < r.runs,
+            "{v_ac} V: {} runs",
+            two.runs
+        );
+    }
 }
 
 /// The refinement watches the mean temperature rise too: at 0.8 V the powers settle at rtol

@@ -111,6 +111,18 @@ fn usage_errors_exit_2_and_name_the_option_and_value_as_typed() {
             vec!["--no-refine", "--refine-mw"],
         ),
         (vec!["cycle", "--paper", "scene.toml"], vec!["--paper"]),
+        (
+            vec!["sweep", "--paper", "--agree", "6", "--max-runs", "5"],
+            vec!["'6'", "--agree", "--max-runs (5)"],
+        ),
+        (
+            vec!["cycle", "--paper", "--agree", "1"],
+            vec!["'1'", "--agree"],
+        ),
+        (
+            vec!["cycle", "--paper", "--no-refine", "--agree", "3"],
+            vec!["--no-refine", "--agree"],
+        ),
     ] {
         let out = hdi(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -231,6 +243,12 @@ fn every_cycle_prints_its_convergence_status() {
     let converged = r["power_change"].as_f64().unwrap() <= 1e-5
         && r["temperature_change"].as_f64().unwrap() <= 0.05;
     assert_eq!(status == "converged", converged, "{r}");
+    // --agree 3: one agreeing pair more, so at least one run more
+    let strict = stdout_json(&hdi(&["cycle", "--paper", "--v-ac", "0.7", "--agree", "3"]));
+    assert!(
+        strict["runs"].as_u64().unwrap() > r["runs"].as_u64().unwrap(),
+        "{strict} {r}"
+    );
     let unchecked = stdout_json(&hdi(&["cycle", "--paper", "--v-ac", "0.7", "--no-refine"]));
     assert_eq!(unchecked["status"].as_str(), Some("unchecked"));
     assert_eq!(unchecked["runs"].as_u64(), Some(1));

@@ -411,6 +411,7 @@ def ac_sweep_refined(
     *,
     temperature_tol_k: float = 0.05,
     max_runs: int = 4,
+    agreeing_runs: int = 2,
     triggered: bool = False,
     method: Optional[str] = None,
     rtol: Optional[float] = None,
@@ -419,7 +420,8 @@ def ac_sweep_refined(
 ) -> List[RefinedCycle]:
     """``ac_sweep`` with the tolerances tightened tenfold per run (at most ``max_runs``) until
     touchdown and take-off move by at most ``power_tol_mw`` (mW) and the mean temperature rise
-    by at most ``temperature_tol_k`` (K)."""
+    by at most ``temperature_tol_k`` (K) over ``agreeing_runs`` successive runs (3 also catches
+    a take-off a whole period of V² off in two successive runs alike)."""
 
 def linear_response(target: Target, power_mw: float) -> LinearResponse:
     """The linearised slider about its flying equilibrium at ``power_mw`` (mW): modes,

@@ -1033,10 +1033,10 @@ impl RefinedCycle {
 
 /// `ac_sweep` with the tolerances refined per amplitude (tenfold tighter per run, at most
 /// `max_runs` runs) until touchdown and take-off move by at most `power_tol_mw` (mW) and the
-/// mean temperature rise by at most `temperature_tol_k` (K). Returns a list of `RefinedCycle`;
-/// check `converged` (or `flags`) before trusting a row.
+/// mean temperature rise by at most `temperature_tol_k` (K) over `agreeing_runs` successive runs.
+/// Returns a list of `RefinedCycle`; check `converged` (or `flags`) before trusting a row.
 #[pyfunction]
-#[pyo3(signature = (target, power_tol_mw, amplitudes_v = None, *, temperature_tol_k = 0.05, max_runs = 4, triggered = false, method = None, rtol = None, atol_nm = None, threads = None))]
+#[pyo3(signature = (target, power_tol_mw, amplitudes_v = None, *, temperature_tol_k = 0.05, max_runs = 4, agreeing_runs = 2, triggered = false, method = None, rtol = None, atol_nm = None, threads = None))]
 fn ac_sweep_refined(
     py: Python<'_>,
     target: &Bound<'_, PyAny>,
@@ -1044,6 +1044,7 @@ fn ac_sweep_refined(
     amplitudes_v: Option<Vec<f64>>,
     temperature_tol_k: f64,
     max_runs: usize,
+    agreeing_runs: usize,
     triggered: bool,
     method: Option<&str>,
     rtol: Option<f64>,
@@ -1055,6 +1056,7 @@ fn ac_sweep_refined(
     let refine = Refinement {
         temperature_tol: temperature_tol_k,
         max_runs,
+        agreeing_runs,
         ..Refinement::new(units::mw(power_tol_mw))
     };
     let rows = py.detach(|| {

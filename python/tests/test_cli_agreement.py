@@ -2,6 +2,7 @@
 for bit (the CLI prints JSON with round-trip floats, so `==` on floats is the test)."""
 
 import numpy as np
+import pytest
 
 import hdi_tribology as hdi
 from conftest import REPO
@@ -87,6 +88,17 @@ def test_refined_sweep(paper_model, hdi_cli):
         # steps: the CLI counts those of every run (compared above as r.steps)
         assert _cli_tuple(r_cli)[:5] == _cycle_tuple(r.cycle)[:5]
     assert len(cli) == len(py) == 3
+
+
+def test_refined_sweep_with_three_agreeing_runs(paper_model, hdi_cli):
+    cli = hdi_cli("sweep", "--paper", "--v-ac", "0,0.5", "--refine-mw", "0.06", "--agree", "3")
+    py = hdi.ac_sweep_refined(paper_model, 0.06, [0.0, 0.5], max_runs=5, agreeing_runs=3)
+    pair = hdi.ac_sweep_refined(paper_model, 0.06, [0.0, 0.5], max_runs=5)
+    for r_cli, r, p in zip(cli, py, pair):
+        assert (r_cli["rtol"], r_cli["runs"], r_cli["status"]) == (r.rtol, r.runs, r.status)
+        assert r.status == "converged" and r.runs >= 3 and r.runs > p.runs
+    with pytest.raises(ValueError, match="agreeing_runs"):
+        hdi.ac_sweep_refined(paper_model, 0.06, [0.0], max_runs=3, agreeing_runs=4)
 
 
 def test_calibration(paper_model, hdi_cli):

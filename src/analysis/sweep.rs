@@ -78,6 +78,11 @@ fn per_amplitude<T: Send>(
 /// use hdi_tribology::analysis::sweep::Refinement;
 /// let r = Refinement::new(6e-5);
 /// assert_eq!((r.factor, r.max_runs, r.temperature_tol), (0.1, 4, 0.05));
+/// assert_eq!(r.agreeing_runs, 2);
+/// // Stricter: three successive tolerances must agree (at most five runs). With AC the detected
+/// // take-off can land a whole period of V² early in two successive runs alike.
+/// let strict = Refinement { agreeing_runs: 3, max_runs: 5, ..r };
+/// # let _ = strict;
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Refinement {
@@ -91,6 +96,13 @@ pub struct Refinement {
     pub factor: f64,
     /// Most cycles run per amplitude, the first included, 2 to 12.
     pub max_runs: usize,
+    /// How many successive runs must agree: converged when each of the last `agreeing_runs − 1`
+    /// tightenings moved the powers and the temperature by at most their tolerances; 2 to
+    /// `max_runs`. With 2 (the default) one agreeing pair suffices. Under AC the detected
+    /// take-off (or touchdown) can be a whole period of `V²` off in two successive runs alike
+    /// (one more burst of contact before leaving, a trajectory effect that no single tolerance
+    /// resolves); 3 catches that at the cost of one more, tighter run per amplitude.
+    pub agreeing_runs: usize,
 }
 
 impl Refinement {
@@ -103,6 +115,7 @@ impl Refinement {
             temperature_tol: 0.05,
             factor: 0.1,
             max_runs: 4,
+            agreeing_runs: 2,
         }
     }
 
@@ -119,6 +132,15 @@ impl Refinement {
             return Err(Error::invalid(
                 "refinement.max_runs",
                 format!("must lie in 2..=12, got {}", self.max_runs),
+            ));
+        }
+        if !(2..=self.max_runs.max(2)).contains(&self.agreeing_runs) {
+            return Err(Error::invalid(
+                "refinement.agreeing_runs",
+                format!(
+                    "must lie in 2..=max_runs ({}), got {}",
+                    self.max_runs, self.agreeing_runs
+                ),
             ));
         }
         Ok(())
@@ -139,7 +161,8 @@ pub struct RefinedCycle {
     pub change: f64,
     /// Change of the mean flash-temperature rise between the last two runs (K).
     pub temperature_change: f64,
-    /// Whether `change ≤ power_tol` and `temperature_change ≤ temperature_tol`.
+    /// Whether `change ≤ power_tol` and `temperature_change ≤ temperature_tol` held for each of
+    /// the last `agreeing_runs − 1` tightenings.
     pub converged: bool,
     /// Cycles run.
     pub runs: usize,
@@ -162,9 +185,10 @@ fn power_change(a: &CycleResult, b: &CycleResult) -> f64 {
 
 /// [`ac_sweep`], with the relative and absolute tolerances at each amplitude tightened by
 /// `refine.factor` until the detected touchdown and take-off powers move by at most
-/// `refine.power_tol` and the mean flash-temperature rise by at most `refine.temperature_tol`, or
-/// `refine.max_runs` cycles have run. The cycle kept is the last (most accurate) one; the
-/// change from the one before is its error estimate, conservative.
+/// `refine.power_tol` and the mean flash-temperature rise by at most `refine.temperature_tol`
+/// over `refine.agreeing_runs` successive runs, or `refine.max_runs` cycles have run. The cycle
+/// kept is the last (most accurate) one; the change from the one before is its error estimate,
+/// conservative.
 ///
 /// ```no_run
 /// use hdi_tribology::analysis::sweep::{ac_sweep_refined, Refinement};
@@ -193,6 +217,8 @@ pub fn ac_sweep_refined(
         let mut last = simulate_cycle(m, programme, &o)?;
         let (mut stats, mut wall) = (last.stats, last.wall_seconds);
         let mut runs = 1;
+        // Successive runs that agree, the last one included.
+        let mut agreeing = 1;
         loop {
             o.solver.rtol *= refine.factor;
             o.solver.atol_displacement *= refine.factor;
@@ -204,8 +230,13 @@ pub fn ac_sweep_refined(
             let temperature_change =
                 (next.mean_temperature_rise - last.mean_temperature_rise).abs();
             last = next;
-            let converged =
-                change <= refine.power_tol && temperature_change <= refine.temperature_tol;
+            agreeing = if change <= refine.power_tol && temperature_change <= refine.temperature_tol
+            {
+                agreeing + 1
+            } else {
+                1
+            };
+            let converged = agreeing >= refine.agreeing_runs;
             if converged || runs >= refine.max_runs {
                 return Ok(RefinedCycle {
                     cycle: last,

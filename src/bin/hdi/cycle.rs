@@ -69,9 +69,14 @@ pub struct CycleArgs {
     #[arg(long, value_name = "N", default_value = "5",
           value_parser = clap::value_parser!(u8).range(2..=12))]
     max_runs: u8,
+    /// Successive runs that must agree (2: one agreeing pair; 3 also catches a take-off a
+    /// whole period of V² off in two runs alike), at most --max-runs.
+    #[arg(long, value_name = "N", default_value = "2",
+          value_parser = clap::value_parser!(u8).range(2..=12))]
+    agree: u8,
     /// Run each cycle once at the given tolerances, without checking convergence (status
     /// "unchecked").
-    #[arg(long, conflicts_with_all = ["refine_mw", "refine_k", "max_runs"])]
+    #[arg(long, conflicts_with_all = ["refine_mw", "refine_k", "max_runs", "agree"])]
     no_refine: bool,
 }
 
@@ -117,10 +122,17 @@ impl CycleArgs {
                 .map(|c| (Report::unchecked(&c, opts), c))
                 .collect()
         } else {
+            if self.agree > self.max_runs {
+                return Err(CliError::Usage(format!(
+                    "invalid value '{}' for '--agree <N>': must be at most --max-runs ({})",
+                    self.agree, self.max_runs
+                )));
+            }
             let refine = Refinement {
                 power_tol: from_mw(self.refine_mw),
                 temperature_tol: self.refine_k,
                 max_runs: usize::from(self.max_runs),
+                agreeing_runs: usize::from(self.agree),
                 ..Refinement::new(from_mw(self.refine_mw))
             };
             ac_sweep_refined(model, programme, opts, amplitudes, &refine)?
