@@ -25,8 +25,9 @@
 mod calibrate;
 mod detector;
 mod filters;
-mod zone;
 
+/// The zone lives with the drive it configures; it is named here too, where calibrations use it.
+pub use crate::drive::Zone;
 pub use calibrate::{
     calibrate, Calibration, CalibrationOptions, Staircase, StepRecord, MAX_LEVELS,
 };
@@ -34,4 +35,3 @@ pub use detector::{
     ContactForceRms, MeanContactForce, Relative, Sample, TouchdownDetector, VibrationRms,
 };
 pub use filters::{HighPass, MeanSquare};
-pub use zone::Zone;

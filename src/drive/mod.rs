@@ -1,7 +1,8 @@
 //! A simulated drive that firmware code can drive: step it at the controller's rate, read its
 //! sensors, close the loop.
 //!
-//! [`Plant`] is the drive before it runs: the slider of a scene in a [`crate::clearance::Zone`], over a disk
+//! [`Plant`] is the drive before it runs: the slider of a scene in a [`Zone`] (a radius and disk
+//! speed, with the flying conditions there), over a disk
 //! with run-out and waviness ([`DiskSpec`]), with a heater behind its thermal lag and a
 //! head–disk voltage ([`Command`]); [`Plant::drive`] starts a [`Drive`] on it, and
 //! [`Drive::step`] advances it by one controller period and
@@ -35,6 +36,7 @@ mod replay;
 mod rng;
 mod roc;
 mod sensors;
+mod zone;
 
 pub use controller::{
     run, AcousticLevel, Action, Channel, ClearanceHold, ContactSensorSlope, Controller, HoldPhase,
@@ -51,3 +53,4 @@ pub use roc::{touchdown_roc, RocPoint};
 pub use sensors::{
     AcousticSpec, ContactSensorSpec, Readback, ReadbackSpec, SensorSpec, Sensors, Truth,
 };
+pub use zone::Zone;

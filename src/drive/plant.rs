@@ -2,8 +2,8 @@
 
 use super::disk::{Disk, DiskSpec};
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, Truth};
+use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
-use crate::clearance::Zone;
 use crate::error::{check_finite, check_non_negative, Error, Result};
 use crate::heater::Programme;
 use crate::model::{Rest, SliderModel, SliderSystem, StateLayout, Voltage};

@@ -1,4 +1,4 @@
-//! Calibration zones: a radius and disk speed, with the flying conditions the drive sees there.
+//! Zones: a radius and disk speed, with the flying conditions the drive sees there.
 
 use crate::error::{check_positive, Result};
 use crate::force::AirBearingModel;
@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 /// model, so the speed does not move the touchdown power by itself.
 ///
 /// ```
-/// use hdi_tribology::clearance::Zone;
+/// use hdi_tribology::drive::Zone;
 /// let z = Zone::at_rpm("MD", 0.03, 7200.0, 10e-9, 3e5);
 /// assert!((z.disk_speed - 2.0 * std::f64::consts::PI * 0.03 * 120.0).abs() < 1e-12);
 /// ```
@@ -58,7 +58,7 @@ impl Zone {
     /// `k h0 / n` that gives stiffness `k`.
     ///
     /// ```
-    /// use hdi_tribology::{clearance::Zone, scene::Scene};
+    /// use hdi_tribology::{drive::Zone, scene::Scene};
     /// let z = Zone::at_rpm("OD", 0.045, 5400.0, 12e-9, 4e5);
     /// let s = z.scene(&Scene::paper())?;
     /// assert_eq!(s.nominal_clearance_m, 12e-9);
