@@ -24,7 +24,9 @@
 //!
 //! `cargo run --release --example mechanism_maps -- --grid 12 --out docs/img/maps` draws the
 //! maps of docs/analyses.md; `--maps freq,zeta` picks maps, `--check` reruns a few points with
-//! Radau5 at a hundredfold tighter tolerance. Without `--grid` a 6 × 6 grid runs (a few minutes
+//! Radau5 at a hundredfold tighter tolerance, `--probe` reruns the unconverged points of the
+//! plausible band with both stiff methods at rtol 1e-6 … 1e-9 and compares their take-off with
+//! the row's at `V_ac = 0`. Without `--grid` a 6 × 6 grid runs (a few minutes
 //! for all four maps on two cores; the test runs a 3 × 3 map in seconds).
 
 use hdi_tribology::analysis::cycle::{CycleOptions, CycleResult, HeaterProgramme};
@@ -767,6 +769,120 @@ fn check(setup: &Setup, spec: &MapSpec, points: &[Point]) -> Res<()> {
     Ok(())
 }
 
+/// Inside the plausible band, the points that did not converge, rerun with Auto and Radau5 at
+/// rtol 1e-6 … 1e-9 (displacement tolerance scaled alike): the spread of their take-off against
+/// the converged take-off at `V_ac = 0` on the same row. An unconverged point is not counted
+/// either way on the map; this says whether any of its runs takes off above `V_ac = 0`.
+fn probe(setup: &Setup, spec: &MapSpec, points: &[Point]) -> Res<()> {
+    let inside = |p: &Point| {
+        let y = p.param.log10();
+        y >= spec.plausible.0 - 1e-9 && y <= spec.plausible.1 + 1e-9
+    };
+    let row0 = |p: &Point| {
+        points
+            .iter()
+            .find(|q| q.param == p.param && q.v_ac == 0.0 && q.status == Status::Fine)
+            .and_then(|q| q.to)
+    };
+    let targets: Vec<&Point> = points
+        .iter()
+        .filter(|p| p.status == Status::Unconverged && inside(p))
+        .collect();
+    let methods = [setup.opts.solver.method, Method::Radau5];
+    let rtols = [1e-6, 1e-7, 1e-8, 1e-9];
+    let mut jobs: Vec<(usize, Method, f64)> = Vec::new();
+    for i in 0..targets.len() {
+        for m in methods {
+            for r in rtols {
+                jobs.push((i, m, r));
+            }
+        }
+    }
+    let runs: Vec<(usize, Result<Option<f64>, String>)> = jobs
+        .par_iter()
+        .map(|&(i, method, rtol)| {
+            let p = targets[i];
+            let mut o = setup.opts;
+            o.keep_series = false;
+            o.solver.method = method;
+            o.solver.atol_displacement *= rtol / o.solver.rtol;
+            o.solver.rtol = rtol;
+            let r = setup
+                .model(spec.axis, p.param, p.v_ac)
+                .map_err(|e| e.to_string())
+                .and_then(|m| {
+                    simulate_cycle(&m, &setup.programme, &o)
+                        .map_err(|e| format!("{method:?} at rtol {rtol:.0e}: {:?}", Cause::of(&e)))
+                });
+            (i, r.map(|c| c.takeoff.map(|d| d.power)))
+        })
+        .collect();
+    let mut largest = f64::NEG_INFINITY;
+    for (i, p) in targets.iter().enumerate() {
+        let mine: Vec<&Result<Option<f64>, String>> = runs
+            .iter()
+            .filter(|(j, _)| *j == i)
+            .map(|(_, r)| r)
+            .collect();
+        let to: Vec<f64> = mine
+            .iter()
+            .filter_map(|r| r.as_ref().ok().copied().flatten())
+            .collect();
+        let none = mine.iter().filter(|r| matches!(r, Ok(None))).count();
+        let failed: Vec<&str> = mine
+            .iter()
+            .filter_map(|r| r.as_ref().err().map(String::as_str))
+            .collect();
+        let lo = to.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = to.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let zero = row0(p);
+        let rise = zero.map(|z| hi - z);
+        if let Some(r) = rise.filter(|r| r.is_finite()) {
+            largest = largest.max(r);
+        }
+        println!(
+            "  probe {:<10} {:.3e} at {:.3} V: P_TO {}…{} mW over {} runs ({} without take-off, \
+             {} failed{}); V = 0: {} mW; highest minus V = 0: {} mW",
+            spec.name,
+            p.param,
+            p.v_ac,
+            fmt_mw(lo),
+            fmt_mw(hi),
+            to.len(),
+            none,
+            failed.len(),
+            if failed.is_empty() {
+                String::new()
+            } else {
+                format!(": {}", failed.join("; "))
+            },
+            zero.map_or("—".into(), fmt_mw),
+            rise.map_or("—".into(), |r| format!("{:+.3}", r * 1e3)),
+        );
+    }
+    println!(
+        "{:<10} probe: {} unconverged points in the plausible band, {} runs; largest P_TO rise \
+         over V = 0 in any run: {} mW",
+        spec.name,
+        targets.len(),
+        runs.len(),
+        if largest.is_finite() {
+            format!("{:+.3}", largest * 1e3)
+        } else {
+            "—".into()
+        }
+    );
+    Ok(())
+}
+
+fn fmt_mw(x: f64) -> String {
+    if x.is_finite() {
+        format!("{:.3}", x * 1e3)
+    } else {
+        "—".into()
+    }
+}
+
 fn main() -> Res<()> {
     let args: Vec<String> = std::env::args().collect();
     let value = |flag: &str| {
@@ -819,6 +935,9 @@ fn main() -> Res<()> {
         summarise(spec, &points);
         if args.iter().any(|a| a == "--check") {
             check(&setup, spec, &points)?;
+        }
+        if args.iter().any(|a| a == "--probe") {
+            probe(&setup, spec, &points)?;
         }
     }
     Ok(())
