@@ -337,6 +337,10 @@ where
             }
         }
 
+        // Inverse weights of the increment's norm, fixed over the iteration (no division in it).
+        for r in 0..n {
+            self.f2[r] = 1.0 / ((ctx.atol[r] + ctx.rtol * y[r].abs()) * self.tol_scale);
+        }
         let mut converged = false;
         let mut dnorm_old = 0.0f64;
         self.theta = 1.0;
@@ -377,11 +381,11 @@ where
                 for (wi, dwi) in self.w.iter_mut().zip(dw) {
                     wi[r] += dwi;
                 }
+                let wr = self.f2[r];
                 for i in 0..3 {
                     let dz = k.t[(i, 0)] * dw[0] + k.t[(i, 1)] * dw[1] + k.t[(i, 2)] * dw[2];
                     self.z[i][r] += dz;
-                    let sc = (ctx.atol[r] + ctx.rtol * y[r].abs()) * self.tol_scale;
-                    dnorm_sq += (dz / sc) * (dz / sc);
+                    dnorm_sq += (dz * wr) * (dz * wr);
                 }
             }
             let dnorm = (dnorm_sq / (3 * n) as f64).sqrt();
