@@ -102,3 +102,62 @@ fn a_problem_value_solves_and_steps_like_solve() {
     let bad = OdeProblem::new(FnSystem::new(vdp_rhs), (1.0, 0.0), Vector2::new(2.0, 0.0));
     assert!(bad.solve(Method::Tsit5, &opts).is_err());
 }
+
+/// A non-autonomous Van der Pol (a forcing `sin t` on the second equation) whose Jacobian and
+/// `∂f/∂t` come either from the two methods or only from the combined one.
+struct Forced {
+    combined_only: bool,
+}
+
+impl hdi_tribology::ode::OdeSystem<hdi_tribology::nalgebra::U2> for Forced {
+    fn rhs(&self, t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>) {
+        vdp_rhs(t, y, dy);
+        dy[1] += t.sin();
+    }
+    fn jacobian(&self, t: f64, y: &Vector2<f64>, j: &mut Matrix2<f64>) -> bool {
+        vdp_jac(t, y, j);
+        !self.combined_only
+    }
+    fn time_derivative(&self, t: f64, _y: &Vector2<f64>, d: &mut Vector2<f64>) -> bool {
+        *d = Vector2::new(0.0, t.cos());
+        !self.combined_only
+    }
+    fn jacobian_and_time_derivative(
+        &self,
+        t: f64,
+        y: &Vector2<f64>,
+        j: &mut Matrix2<f64>,
+        d: &mut Vector2<f64>,
+    ) -> (bool, bool) {
+        vdp_jac(t, y, j);
+        *d = Vector2::new(0.0, t.cos());
+        (true, true)
+    }
+}
+
+#[test]
+fn rodas5p_takes_both_derivatives_from_the_combined_method() {
+    let opts = Options::default()
+        .rtol(1e-6)
+        .atol(1e-6)
+        .save(SaveAt::Final)
+        .dense(false);
+    let y0 = Vector2::new(2.0, 0.0);
+    let run = |combined_only| {
+        solve(
+            &Forced { combined_only },
+            0.0,
+            y0,
+            100.0,
+            Method::Rodas5P,
+            &opts,
+            &mut [],
+        )
+        .unwrap()
+    };
+    // The separate methods return `false` for the first system: had Rodas5P called them, it
+    // would have differenced (more right-hand sides, other rounding).
+    let (a, b) = (run(true), run(false));
+    assert_eq!(a.y_final(), b.y_final());
+    assert_eq!(a.stats, b.stats);
+}

@@ -1,7 +1,8 @@
 //! The slider's analytic Jacobian and `∂f/∂t` against central differences of its right-hand side,
 //! in contact (with the contact-impulse and flash-temperature states), for the rigid slider with
 //! and without lags, and for the few-peak deformable slider: every row, the flash temperature's
-//! included, is the derivative of what the right-hand side reads.
+//! included, is the derivative of what the right-hand side reads; the two from one force
+//! evaluation (`jacobian_and_time_derivative`) equal the two alone.
 
 use hdi_tribology::heater::Programme;
 use hdi_tribology::model::{Dofs, SliderModel, SliderSystem};
@@ -95,6 +96,13 @@ fn check(model: &SliderModel, programme: Programme, t: f64, gap: f64, speed: f64
     let (mut j, mut dt) = (DMatrix::zeros(n, n), DVector::zeros(n));
     assert!(OdeSystem::<Dyn>::jacobian(&sys, t, &s, &mut j));
     assert!(OdeSystem::<Dyn>::time_derivative(&sys, t, &s, &mut dt));
+    // The two from one force evaluation (what Rodas5P asks for) are the same numbers, to the bit.
+    let (mut j2, mut dt2) = (DMatrix::from_element(n, n, f64::NAN), DVector::zeros(n));
+    assert_eq!(
+        OdeSystem::<Dyn>::jacobian_and_time_derivative(&sys, t, &s, &mut j2, &mut dt2),
+        (true, true)
+    );
+    assert_eq!((&j2, &dt2), (&j, &dt));
     let (jd, dtd) = differences(&sys, t, &s);
     let heat = lay.heat.expect("integrals on: a heat state");
     assert!(

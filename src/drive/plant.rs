@@ -239,6 +239,28 @@ where
 
     fn time_derivative(&self, t: f64, y: &OVector<f64, D>, d: &mut OVector<f64, D>) -> bool {
         let ok = self.slider().time_derivative(t, y, d);
+        self.add_base_jerk(ok, t, d)
+    }
+
+    fn jacobian_and_time_derivative(
+        &self,
+        t: f64,
+        y: &OVector<f64, D>,
+        j: &mut OMatrix<f64, D, D>,
+        d: &mut OVector<f64, D>,
+    ) -> (bool, bool) {
+        let (jac, ok) = self.slider().jacobian_and_time_derivative(t, y, j, d);
+        (jac, self.add_base_jerk(ok, t, d))
+    }
+}
+
+impl DriveSystem {
+    /// The disk's motion in `∂f/∂t`: its jerk on the coordinates it moves, when `ok` (the
+    /// slider's part was written). Returns `ok`.
+    fn add_base_jerk<D: Dim>(&self, ok: bool, t: f64, d: &mut OVector<f64, D>) -> bool
+    where
+        DefaultAllocator: Allocator<D>,
+    {
         if ok && !self.disk.is_flat() {
             let jerk = self.disk.acceleration(t).1;
             for &(i, r) in &self.base[..self.n_base] {

@@ -239,50 +239,30 @@ impl<'a> SliderSystem<'a> {
         m.friction
             .flash_temperature_slope(c.value, c.d_bulge, area, area_rate)
     }
-}
 
-impl<D: Dim> OdeSystem<D> for SliderSystem<'_>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
-        let m = self.model;
-        let st = &m.structure;
-        let lay = self.layout;
-        // The values alone: no slope is needed here.
-        let (q, v) = (self.coordinates(s), self.velocities(s));
-        let delta = self.protrusion(t, s);
-        let hot = m.hot_values(m.gaps(&q, delta), m.voltage.squared(t));
-        let drive = match lay.lagged_force {
-            Some(i) => s[i],
-            None => hot.interface,
-        };
-        let f_ab = m.bearing().force(q[0], v[0]);
-        let a = st.mass_solve(&st.generalised_force(&q, &v, f_ab, drive));
-        for i in 0..lay.dofs {
-            ds[i] = v[i];
-            ds[lay.velocity(i)] = a[i];
-        }
-        if let Some(i) = lay.delta {
-            ds[i] = (m.protrusion(self.programme.power(t)) - delta) / m.thermal_lag;
-        }
-        if let Some(i) = lay.lagged_force {
-            ds[i] = (hot.interface - s[i]) / m.interface_lag;
-        }
-        if let Some(i) = lay.contact_impulse {
-            ds[i] = hot.contact;
-        }
-        if let Some(i) = lay.heat {
-            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
+    /// [`Self::heat_slope`] when the state keeps the heat integral, else zero (unused).
+    fn heat_slope_if_kept(&self, l: &Local) -> f64 {
+        if self.layout.heat.is_some() {
+            self.heat_slope(l)
+        } else {
+            0.0
         }
     }
 
-    fn jacobian(&self, t: f64, s: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
+    /// The Jacobian at the point of `l` (state `s`), `dd` the flash temperature's slope there.
+    fn jacobian_at<D: Dim>(
+        &self,
+        l: &Local,
+        dd: f64,
+        s: &OVector<f64, D>,
+        j: &mut OMatrix<f64, D, D>,
+    ) where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
         let m = self.model;
         let st = &m.structure;
         let lay = self.layout;
         let n = lay.dofs;
-        let l = self.local(t, s);
         j.fill(0.0);
         let b = st.bulge_vector();
         // ∂F/∂q_c = f_b b_c + f_p [c = 0]: the bulge gap moves with bᵀq, the pad gap with q₀.
@@ -354,7 +334,6 @@ where
             }
         }
         if let Some(i) = lay.heat {
-            let dd = self.heat_slope(&l);
             for col in 0..n {
                 j[(i, col)] = dd * b[col];
             }
@@ -362,12 +341,14 @@ where
                 j[(i, k)] = -dd;
             }
         }
-        true
     }
 
-    fn time_derivative(&self, t: f64, s: &OVector<f64, D>, dfdt: &mut OVector<f64, D>) -> bool {
+    /// `∂f/∂t` at time `t` and the point of `l`, `dd` the flash temperature's slope there.
+    fn time_derivative_at<D: Dim>(&self, t: f64, l: &Local, dd: f64, dfdt: &mut OVector<f64, D>)
+    where
+        DefaultAllocator: Allocator<D>,
+    {
         let m = self.model;
-        let l = self.local(t, s);
         dfdt.fill(0.0);
         let (_, p_rate) = self.programme.power_and_rate(t);
         // Protrusion moves with the programme only without a thermal lag.
@@ -393,10 +374,72 @@ where
             dfdt[i] = -l.hot.contact.d_bulge * delta_rate;
         }
         if let Some(i) = self.layout.heat {
-            let dd = self.heat_slope(&l);
             dfdt[i] = -dd * delta_rate;
         }
+    }
+}
+
+impl<D: Dim> OdeSystem<D> for SliderSystem<'_>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
+        let m = self.model;
+        let st = &m.structure;
+        let lay = self.layout;
+        // The values alone: no slope is needed here.
+        let (q, v) = (self.coordinates(s), self.velocities(s));
+        let delta = self.protrusion(t, s);
+        let hot = m.hot_values(m.gaps(&q, delta), m.voltage.squared(t));
+        let drive = match lay.lagged_force {
+            Some(i) => s[i],
+            None => hot.interface,
+        };
+        let f_ab = m.bearing().force(q[0], v[0]);
+        let a = st.mass_solve(&st.generalised_force(&q, &v, f_ab, drive));
+        for i in 0..lay.dofs {
+            ds[i] = v[i];
+            ds[lay.velocity(i)] = a[i];
+        }
+        if let Some(i) = lay.delta {
+            ds[i] = (m.protrusion(self.programme.power(t)) - delta) / m.thermal_lag;
+        }
+        if let Some(i) = lay.lagged_force {
+            ds[i] = (hot.interface - s[i]) / m.interface_lag;
+        }
+        if let Some(i) = lay.contact_impulse {
+            ds[i] = hot.contact;
+        }
+        if let Some(i) = lay.heat {
+            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
+        }
+    }
+
+    fn jacobian(&self, t: f64, s: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
+        let l = self.local(t, s);
+        self.jacobian_at(&l, self.heat_slope_if_kept(&l), s, j);
         true
+    }
+
+    fn time_derivative(&self, t: f64, s: &OVector<f64, D>, dfdt: &mut OVector<f64, D>) -> bool {
+        let l = self.local(t, s);
+        self.time_derivative_at(t, &l, self.heat_slope_if_kept(&l), dfdt);
+        true
+    }
+
+    /// Both from one evaluation of the forces (and of the flash temperature's slope) at `(t, s)`.
+    fn jacobian_and_time_derivative(
+        &self,
+        t: f64,
+        s: &OVector<f64, D>,
+        j: &mut OMatrix<f64, D, D>,
+        dfdt: &mut OVector<f64, D>,
+    ) -> (bool, bool) {
+        let l = self.local(t, s);
+        let dd = self.heat_slope_if_kept(&l);
+        self.jacobian_at(&l, dd, s, j);
+        self.time_derivative_at(t, &l, dd, dfdt);
+        (true, true)
     }
 }
 

@@ -25,9 +25,42 @@ where
     jac.as_slice().iter().all(|v| v.is_finite())
 }
 
-/// Fills `dfdt` with ∂f/∂t at `(t, y)`, by a forward difference when the system does not
-/// provide it; `h` sets the time scale of the increment.
-pub(crate) fn eval_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
+/// [`eval_jacobian`] and `∂f/∂t` at one point, through
+/// [`OdeSystem::jacobian_and_time_derivative`] (one call for a system whose two share work):
+/// zero for an autonomous system, a forward difference when the system does not give it;
+/// `false` if the Jacobian is not finite.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn eval_jacobian_and_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
+    sys: &S,
+    t: f64,
+    y: &OVector<f64, D>,
+    f0: &OVector<f64, D>,
+    h: f64,
+    jac: &mut OMatrix<f64, D, D>,
+    dfdt: &mut OVector<f64, D>,
+    work: &mut OVector<f64, D>,
+    ctx: &mut Ctx<D>,
+) -> bool
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    if sys.is_autonomous() {
+        dfdt.fill(0.0);
+        return eval_jacobian(sys, t, y, f0, jac, work, ctx);
+    }
+    ctx.stats.jac_evals += 1;
+    let (jac_given, dfdt_given) = sys.jacobian_and_time_derivative(t, y, jac, dfdt);
+    if !jac_given {
+        ctx.stats.rhs_evals += finite_difference_jacobian(sys, t, y, f0, &ctx.atol, jac, work);
+    }
+    if !dfdt_given {
+        difference_time_derivative(sys, t, y, f0, h, dfdt, ctx);
+    }
+    jac.as_slice().iter().all(|v| v.is_finite())
+}
+
+/// `∂f/∂t` by a forward difference, `h` setting the time scale of the increment.
+fn difference_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
     sys: &S,
     t: f64,
     y: &OVector<f64, D>,
@@ -38,13 +71,6 @@ pub(crate) fn eval_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
 ) where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    if sys.is_autonomous() {
-        dfdt.fill(0.0);
-        return;
-    }
-    if sys.time_derivative(t, y, dfdt) {
-        return;
-    }
     let delta = f64::EPSILON.sqrt() * t.abs().max(h.abs()).max(f64::MIN_POSITIVE);
     let tp = t + delta;
     let delta = tp - t;

@@ -3,7 +3,7 @@
 //! 8 stages, order 5, L-stable, embedded order 4, 4th-order dense output.
 
 use super::dense::StepPoly;
-use super::jacobian::{eval_jacobian, eval_time_derivative, spectral_radius};
+use super::jacobian::{eval_jacobian_and_time_derivative, spectral_radius};
 use super::lu::Lu;
 use super::stepper::{add_scaled, all_finite, sum_into, zeros_like, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
@@ -300,10 +300,19 @@ where
             return fail(FailKind::NonFinite);
         }
         if !self.jac_valid {
-            if !eval_jacobian(sys, t, y, &self.f0, &mut self.jac, &mut self.fu, ctx) {
+            if !eval_jacobian_and_time_derivative(
+                sys,
+                t,
+                y,
+                &self.f0,
+                h,
+                &mut self.jac,
+                &mut self.dfdt,
+                &mut self.fu,
+                ctx,
+            ) {
                 return fail(FailKind::NonFinite);
             }
-            eval_time_derivative(sys, t, y, &self.f0, h, &mut self.dfdt, ctx);
             if !all_finite(&self.dfdt) {
                 return fail(FailKind::NonFinite);
             }

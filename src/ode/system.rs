@@ -53,6 +53,44 @@ where
     fn is_autonomous(&self) -> bool {
         false
     }
+
+    /// `∂f/∂y` into `jac` and `∂f/∂t` into `dfdt` at one point, for the methods that need both
+    /// at every step (Rodas5P on a non-autonomous system). Returns whether each was written, as
+    /// [`jacobian`](OdeSystem::jacobian) and [`time_derivative`](OdeSystem::time_derivative) do
+    /// (`false`: finite differences); by default it calls the two in turn. Override it when the
+    /// two share work, such as one evaluation of the forces at `(t, y)`.
+    ///
+    /// ```
+    /// use hdi_tribology::ode::OdeSystem;
+    /// use nalgebra::{Matrix1, U1, Vector1};
+    /// /// y' = -k(t) y with k(t) = 1 + t: the two share k.
+    /// struct Decay;
+    /// impl OdeSystem<U1> for Decay {
+    ///     fn rhs(&self, t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>) {
+    ///         dy[0] = -(1.0 + t) * y[0];
+    ///     }
+    ///     fn jacobian_and_time_derivative(
+    ///         &self, t: f64, y: &Vector1<f64>, j: &mut Matrix1<f64>, dfdt: &mut Vector1<f64>,
+    ///     ) -> (bool, bool) {
+    ///         let k = 1.0 + t;
+    ///         j[0] = -k;
+    ///         dfdt[0] = -y[0];
+    ///         (true, true)
+    ///     }
+    /// }
+    /// let (mut j, mut d) = (Matrix1::zeros(), Vector1::zeros());
+    /// assert_eq!(Decay.jacobian_and_time_derivative(1.0, &Vector1::new(2.0), &mut j, &mut d), (true, true));
+    /// assert_eq!((j[0], d[0]), (-2.0, -2.0));
+    /// ```
+    fn jacobian_and_time_derivative(
+        &self,
+        t: f64,
+        y: &OVector<f64, D>,
+        jac: &mut OMatrix<f64, D, D>,
+        dfdt: &mut OVector<f64, D>,
+    ) -> (bool, bool) {
+        (self.jacobian(t, y, jac), self.time_derivative(t, y, dfdt))
+    }
 }
 
 /// Forwards every method of [`OdeSystem`] through a pointer type.
@@ -83,6 +121,16 @@ macro_rules! forward_system {
             #[inline]
             fn is_autonomous(&self) -> bool {
                 (**self).is_autonomous()
+            }
+            #[inline]
+            fn jacobian_and_time_derivative(
+                &self,
+                t: f64,
+                y: &OVector<f64, D>,
+                jac: &mut OMatrix<f64, D, D>,
+                dfdt: &mut OVector<f64, D>,
+            ) -> (bool, bool) {
+                (**self).jacobian_and_time_derivative(t, y, jac, dfdt)
             }
         }
     };
