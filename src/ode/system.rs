@@ -8,7 +8,9 @@ use num_complex::Complex64;
 /// Only [`rhs`](OdeSystem::rhs) is required. Stiff methods use
 /// [`jacobian`](OdeSystem::jacobian) when it returns `true` and finite differences otherwise;
 /// Rosenbrock methods also use [`time_derivative`](OdeSystem::time_derivative), or nothing
-/// when the system declares itself [autonomous](OdeSystem::is_autonomous).
+/// when the system declares itself [autonomous](OdeSystem::is_autonomous). They ask for the two
+/// together through [`jacobian_and_time_derivative`](OdeSystem::jacobian_and_time_derivative),
+/// which calls both unless a system overrides it to share their work.
 ///
 /// ```
 /// use hdi_tribology::ode::OdeSystem;
