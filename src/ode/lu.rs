@@ -10,6 +10,9 @@ where
     /// The matrix to factor; after `factor`, L (unit lower, below the diagonal) and U.
     pub m: OMatrix<T, D, D>,
     piv: OVector<usize, D>,
+    /// Reciprocals of U's diagonal: the solves multiply by them (a division costs several
+    /// multiplications' time, complex ones more).
+    inv_diag: OVector<T, D>,
     valid: bool,
 }
 
@@ -21,6 +24,7 @@ where
         Lu {
             m: OMatrix::from_element_generic(dim, dim, T::zero()),
             piv: OVector::from_element_generic(dim, nalgebra::U1, 0),
+            inv_diag: OVector::from_element_generic(dim, nalgebra::U1, T::zero()),
             valid: false,
         }
     }
@@ -57,6 +61,7 @@ where
                 self.m.swap_rows(p, k);
             }
             let inv_pivot = T::one() / self.m[(k, k)].clone();
+            self.inv_diag[k] = inv_pivot.clone();
             for i in k + 1..n {
                 self.m[(i, k)] *= inv_pivot.clone();
             }
@@ -98,7 +103,7 @@ where
             for j in i + 1..n {
                 s -= self.m[(i, j)].clone() * b[j].clone();
             }
-            b[i] = s / self.m[(i, i)].clone();
+            b[i] = s * self.inv_diag[i].clone();
         }
     }
 }
