@@ -1026,8 +1026,12 @@ where
             }
             self.stiff_count >= STIFF_CHECKS_TO_SWITCH
         } else {
-            match self.steppers.get::<S>(self.active).stiffness() {
-                Some(rho) if h_acc * rho < RETURN_FRACTION * boundary => {
+            // The stiff method may hold only a lower bound of ρ: a bound that already keeps
+            // the step stiff settles the test; otherwise the test takes the estimate itself.
+            let below = |rho: f64| h_acc * rho < RETURN_FRACTION * boundary;
+            let stepper = self.steppers.get::<S>(self.active);
+            match stepper.stiffness() {
+                Some(rho) if below(rho) && stepper.stiffness_exact().is_some_and(below) => {
                     self.return_count += 1;
                 }
                 _ => self.return_count = 0,

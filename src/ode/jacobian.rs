@@ -80,6 +80,16 @@ fn difference_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
     *dfdt /= delta;
 }
 
+/// A lower bound of the spectral radius of `jac`: `|tr J| / n` (the trace is the sum of the
+/// eigenvalues), at the cost of `n` additions.
+pub(crate) fn radius_lower_bound<D: Dim>(jac: &OMatrix<f64, D, D>) -> f64
+where
+    DefaultAllocator: Allocator<D, D>,
+{
+    let n = jac.nrows();
+    (0..n).map(|i| jac[(i, i)]).sum::<f64>().abs() / n.max(1) as f64
+}
+
 /// Estimate of the spectral radius of `jac` by the growth rate of power iterations (valid for
 /// complex dominant pairs too, where the direction does not converge but the growth does).
 pub(crate) fn spectral_radius<D: Dim>(jac: &OMatrix<f64, D, D>, like: &OVector<f64, D>) -> f64
@@ -133,5 +143,23 @@ mod tests {
             &Vector3::zeros(),
         );
         assert!((r / 1e4 - 1.0).abs() < 1e-6, "{r}");
+    }
+
+    #[test]
+    fn trace_bound_lies_below_the_radius() {
+        // Stiff diagonal: |tr|/n = 3335 against ρ = 1e4; the oscillator's trace is zero.
+        let d = Matrix3::from_diagonal(&Vector3::new(-1e4, -1.0, -4.0));
+        assert_eq!(radius_lower_bound(&d), 10005.0 / 3.0);
+        assert!(radius_lower_bound(&d) <= spectral_radius(&d, &Vector3::zeros()));
+        let w = 5.0;
+        assert_eq!(
+            radius_lower_bound(&Matrix2::new(0.0, 1.0, -w * w, 0.0)),
+            0.0
+        );
+        // A damped oscillator with a full matrix: eigenvalues −0.5 ± i·√(w² − 0.25).
+        let j = Matrix2::new(0.0, 1.0, -w * w, -1.0);
+        let b = radius_lower_bound(&j);
+        assert_eq!(b, 0.5);
+        assert!(b <= w, "{b}");
     }
 }

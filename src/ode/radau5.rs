@@ -5,7 +5,7 @@
 //! dense output (order 3).
 
 use super::dense::StepPoly;
-use super::jacobian::{eval_jacobian, spectral_radius};
+use super::jacobian::{eval_jacobian, radius_lower_bound, spectral_radius};
 use super::lu::Lu;
 use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
@@ -162,6 +162,8 @@ where
     newton_tol: f64,
     /// Spectral radius of the last Jacobian, when stiffness switching asks for it.
     rho: Option<f64>,
+    /// `rho` is the power-iteration estimate (not only the lower bound from the trace).
+    rho_exact: bool,
 }
 
 impl<D: Dim> Radau5<D>
@@ -197,6 +199,7 @@ where
             tol_scale: rtol_inner / rtol,
             newton_tol: (10.0 * f64::EPSILON / rtol_inner).max(0.03f64.min(rtol_inner.sqrt())),
             rho: None,
+            rho_exact: false,
         }
     }
 
@@ -300,7 +303,10 @@ where
             self.jac_fresh = true;
             self.lu_h = f64::NAN;
             if ctx.want_stiffness {
-                self.rho = Some(spectral_radius(&self.jac, y));
+                // The power iteration costs 16 products with J: the bound first, the estimate
+                // only when the return test asks for it (`stiffness_exact`).
+                self.rho = Some(radius_lower_bound(&self.jac));
+                self.rho_exact = false;
             }
         }
         if self.lu_h != h && !self.factor(h, ctx) {
@@ -504,6 +510,14 @@ where
     }
 
     fn stiffness(&self) -> Option<f64> {
+        self.rho
+    }
+
+    fn stiffness_exact(&mut self) -> Option<f64> {
+        if !self.rho_exact && self.rho.is_some() {
+            self.rho = Some(spectral_radius(&self.jac, &self.f0));
+            self.rho_exact = true;
+        }
         self.rho
     }
 

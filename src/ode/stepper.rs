@@ -104,8 +104,15 @@ where
     );
 
     /// Stiffness indicator of the last accepted step: for explicit methods `h·ρ` (ρ estimated
-    /// spectral radius), for stiff methods `ρ`; `None` when not available.
+    /// spectral radius), for stiff methods `ρ`, or a lower bound of it (see
+    /// [`stiffness_exact`](Stepper::stiffness_exact)); `None` when not available.
     fn stiffness(&self) -> Option<f64>;
+
+    /// [`stiffness`](Stepper::stiffness) with a lower bound replaced by the estimate itself
+    /// (the stiff methods keep `|tr J|/n ≤ ρ` and run the power iteration only when asked).
+    fn stiffness_exact(&mut self) -> Option<f64> {
+        self.stiffness()
+    }
 
     /// Where the method's stability region meets the negative real axis, as `h·ρ`: the limit of
     /// an explicit step on a stiff problem (infinite for the stiff methods).
