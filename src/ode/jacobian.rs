@@ -80,6 +80,44 @@ fn difference_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
     *dfdt /= delta;
 }
 
+/// A stiff method's spectral radius for Auto's return test, kept at each new Jacobian as the
+/// cheap lower bound `|tr J|/n` and replaced by the power-iteration estimate (16 products with
+/// J) only when asked: the one home of that rule for Rodas5P and Radau5.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Radius {
+    rho: Option<f64>,
+    /// `rho` is the estimate, not only the bound.
+    exact: bool,
+}
+
+impl Radius {
+    /// A new Jacobian: its bound.
+    pub fn at_new_jacobian<D: Dim>(&mut self, jac: &OMatrix<f64, D, D>)
+    where
+        DefaultAllocator: Allocator<D, D>,
+    {
+        self.rho = Some(radius_lower_bound(jac));
+        self.exact = false;
+    }
+
+    /// The bound or the estimate, whichever is held.
+    pub fn get(&self) -> Option<f64> {
+        self.rho
+    }
+
+    /// The estimate for `jac` (the Jacobian of the bound held), computed once.
+    pub fn exact<D: Dim>(&mut self, jac: &OMatrix<f64, D, D>, like: &OVector<f64, D>) -> Option<f64>
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        if !self.exact && self.rho.is_some() {
+            self.rho = Some(spectral_radius(jac, like));
+            self.exact = true;
+        }
+        self.rho
+    }
+}
+
 /// A lower bound of the spectral radius of `jac`: `|tr J| / n` (the trace is the sum of the
 /// eigenvalues), at the cost of `n` additions.
 pub(crate) fn radius_lower_bound<D: Dim>(jac: &OMatrix<f64, D, D>) -> f64

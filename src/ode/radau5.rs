@@ -5,7 +5,7 @@
 //! dense output (order 3).
 
 use super::dense::StepPoly;
-use super::jacobian::{eval_jacobian, radius_lower_bound, spectral_radius};
+use super::jacobian::{eval_jacobian, Radius};
 use super::lu::Lu;
 use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
@@ -147,6 +147,8 @@ where
     tmp: OVector<f64, D>,
     cont: OVector<f64, D>,
     f2: OVector<f64, D>,
+    /// Inverse weights of the Newton increment's norm, fixed over one attempt.
+    newton_weights: OVector<f64, D>,
     /// Stage increments and step of the last accepted step, for the starting guess.
     z_prev: [OVector<f64, D>; 3],
     h_prev: Option<f64>,
@@ -161,9 +163,7 @@ where
     tol_scale: f64,
     newton_tol: f64,
     /// Spectral radius of the last Jacobian, when stiffness switching asks for it.
-    rho: Option<f64>,
-    /// `rho` is the power-iteration estimate (not only the lower bound from the trace).
-    rho_exact: bool,
+    rho: Radius,
 }
 
 impl<D: Dim> Radau5<D>
@@ -190,6 +190,7 @@ where
             tmp: z.clone(),
             cont: z.clone(),
             f2: z.clone(),
+            newton_weights: z.clone(),
             z_prev: std::array::from_fn(|_| z.clone()),
             h_prev: None,
             theta: 1.0,
@@ -198,8 +199,7 @@ where
             last_rejected: false,
             tol_scale: rtol_inner / rtol,
             newton_tol: (10.0 * f64::EPSILON / rtol_inner).max(0.03f64.min(rtol_inner.sqrt())),
-            rho: None,
-            rho_exact: false,
+            rho: Radius::default(),
         }
     }
 
@@ -303,10 +303,7 @@ where
             self.jac_fresh = true;
             self.lu_h = f64::NAN;
             if ctx.want_stiffness {
-                // The power iteration costs 16 products with J: the bound first, the estimate
-                // only when the return test asks for it (`stiffness_exact`).
-                self.rho = Some(radius_lower_bound(&self.jac));
-                self.rho_exact = false;
+                self.rho.at_new_jacobian(&self.jac);
             }
         }
         if self.lu_h != h && !self.factor(h, ctx) {
@@ -345,7 +342,7 @@ where
 
         // Inverse weights of the increment's norm, fixed over the iteration (no division in it).
         for r in 0..n {
-            self.f2[r] = 1.0 / ((ctx.atol[r] + ctx.rtol * y[r].abs()) * self.tol_scale);
+            self.newton_weights[r] = 1.0 / ((ctx.atol[r] + ctx.rtol * y[r].abs()) * self.tol_scale);
         }
         let mut converged = false;
         let mut dnorm_old = 0.0f64;
@@ -387,7 +384,7 @@ where
                 for (wi, dwi) in self.w.iter_mut().zip(dw) {
                     wi[r] += dwi;
                 }
-                let wr = self.f2[r];
+                let wr = self.newton_weights[r];
                 for i in 0..3 {
                     let dz = k.t[(i, 0)] * dw[0] + k.t[(i, 1)] * dw[1] + k.t[(i, 2)] * dw[2];
                     self.z[i][r] += dz;
@@ -510,15 +507,11 @@ where
     }
 
     fn stiffness(&self) -> Option<f64> {
-        self.rho
+        self.rho.get()
     }
 
     fn stiffness_exact(&mut self) -> Option<f64> {
-        if !self.rho_exact && self.rho.is_some() {
-            self.rho = Some(spectral_radius(&self.jac, &self.f0));
-            self.rho_exact = true;
-        }
-        self.rho
+        self.rho.exact(&self.jac, &self.f0)
     }
 
     fn propose(&self, h_acc: f64, h_new: f64) -> f64 {

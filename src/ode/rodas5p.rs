@@ -3,7 +3,7 @@
 //! 8 stages, order 5, L-stable, embedded order 4, 4th-order dense output.
 
 use super::dense::StepPoly;
-use super::jacobian::{eval_jacobian_and_time_derivative, radius_lower_bound, spectral_radius};
+use super::jacobian::{eval_jacobian_and_time_derivative, Radius};
 use super::lu::Lu;
 use super::stepper::{add_scaled, all_finite, sum_into, zeros_like, Ctx, FailKind, Stepper, Trial};
 use super::system::OdeSystem;
@@ -180,9 +180,7 @@ where
     k: [OVector<f64, D>; 8],
     u: OVector<f64, D>,
     fu: OVector<f64, D>,
-    rho: Option<f64>,
-    /// `rho` is the power-iteration estimate (not only the lower bound from the trace).
-    rho_exact: bool,
+    rho: Radius,
     /// Component and floor of the last step refused for its rounding floor.
     floor_hit: Option<(usize, f64)>,
 }
@@ -206,8 +204,7 @@ where
             k: std::array::from_fn(|_| z.clone()),
             u: z.clone(),
             fu: z,
-            rho: None,
-            rho_exact: false,
+            rho: Radius::default(),
             floor_hit: None,
         }
     }
@@ -323,10 +320,7 @@ where
             self.jac_valid = true;
             self.lu.invalidate();
             if ctx.want_stiffness {
-                // The power iteration costs 16 products with J: the bound first, the estimate
-                // only when the return test asks for it (`stiffness_exact`).
-                self.rho = Some(radius_lower_bound(&self.jac));
-                self.rho_exact = false;
+                self.rho.at_new_jacobian(&self.jac);
             }
         }
         if !self.lu.is_valid() || self.lu_h != h {
@@ -429,14 +423,10 @@ where
     }
 
     fn stiffness(&self) -> Option<f64> {
-        self.rho
+        self.rho.get()
     }
 
     fn stiffness_exact(&mut self) -> Option<f64> {
-        if !self.rho_exact && self.rho.is_some() {
-            self.rho = Some(spectral_radius(&self.jac, &self.f0));
-            self.rho_exact = true;
-        }
-        self.rho
+        self.rho.exact(&self.jac, &self.f0)
     }
 }
