@@ -115,6 +115,37 @@ pub fn check_finite(field: &str, value: f64) -> Result<f64> {
     }
 }
 
+/// Checks that `value` is finite and not below `bound`, the value of the field `bound_field`;
+/// the message gives both in `unit`, `scale` being that unit's size in SI (`1e-3` for mW).
+///
+/// ```
+/// use hdi_tribology::error::check_not_below;
+/// assert!(check_not_below("max_power", 0.08, "start_power", 0.06, "mW", 1e-3).is_ok());
+/// let e = check_not_below("max_power", 0.05, "start_power", 0.06, "mW", 1e-3).unwrap_err();
+/// assert!(e.to_string().contains("start_power (60 mW), got 50 mW"));
+/// ```
+pub fn check_not_below(
+    field: &str,
+    value: f64,
+    bound_field: &str,
+    bound: f64,
+    unit: &str,
+    scale: f64,
+) -> Result<f64> {
+    check_finite(field, value)?;
+    if value < bound {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must not be below {bound_field} ({} {unit}), got {} {unit}",
+                bound / scale,
+                value / scale
+            ),
+        ));
+    }
+    Ok(value)
+}
+
 /// Checks that `value` is finite and strictly positive.
 ///
 /// ```

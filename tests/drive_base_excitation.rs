@@ -121,6 +121,7 @@ fn check(structure: StructureSpec, order: u32, amplitude: f64, what: &str) -> f6
         method: Method::Rodas5P,
         rtol: 1e-10,
         atol_displacement: 1e-17,
+        atol_displacement_flight: 1e-17,
         ..DriveOptions::default()
     };
     let plant = Plant::new(&scene, &zone, 1, opts).unwrap();

@@ -2,7 +2,9 @@
 //! harmonic-ratio clearance change against the true one, typed errors.
 
 use hdi_tribology::analysis::{flying_equilibrium, ScanGrid};
-use hdi_tribology::drive::{scene_zone, Command, DiskSpec, Drive, DriveOptions, Plant, Sensors};
+use hdi_tribology::drive::{
+    scene_zone, Command, DiskSpec, Drive, DriveOptions, Plant, SensorSpec, Sensors,
+};
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
 
@@ -91,16 +93,66 @@ fn bad_commands_are_typed_errors() {
     );
 }
 
-/// The default drive (Rodas5P, 0.01 pm, steps across period ends, restarts only on a new command)
-/// against a tight reference (Radau5 at `rtol` 1e-10 and 1e-17 m, steps no longer than a
-/// quarter period): a wavy disk, a heater staircase into contact and back, a dither, and runs of
-/// unchanged commands. The gap agrees within ten times the default tolerance, and the sensors
-/// (same noise) agree within a small fraction of their noise.
 #[test]
-fn spanning_steps_agree_with_a_tight_reference() {
+fn bad_tolerances_are_typed_errors() {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).unwrap();
-    let fast = Plant::new(&scene, &zone, 5, DriveOptions::default()).unwrap();
+    let d = DriveOptions::default();
+    for (opts, field) in [
+        (
+            DriveOptions {
+                atol_displacement_flight: 0.5 * d.atol_displacement,
+                ..d.clone()
+            },
+            "atol_displacement_flight",
+        ),
+        (
+            DriveOptions {
+                atol_displacement_flight: f64::INFINITY,
+                ..d.clone()
+            },
+            "atol_displacement_flight",
+        ),
+        (
+            DriveOptions {
+                contact_force_tolerance: 0.0,
+                ..d.clone()
+            },
+            "contact_force_tolerance",
+        ),
+    ] {
+        let e = Plant::new(&scene, &zone, 1, opts).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidInput { field: ref f, .. } if f == field),
+            "{e}"
+        );
+    }
+}
+
+/// How far a drive strays from a tight reference over one programme.
+struct Deviation {
+    /// Largest gap difference in periods in flight and in contact (m).
+    gap_flight: f64,
+    gap_contact: f64,
+    /// Largest period-mean contact force difference (N).
+    force: f64,
+    /// Largest and rms contact-sensor difference (Ω).
+    sensor: f64,
+    sensor_rms: f64,
+    /// Largest read-back log-ratio difference.
+    readback: f64,
+    contact_periods: usize,
+    steps: usize,
+}
+
+/// Runs `opts` and a tight reference (Radau5 at `rtol` 1e-10 and 1e-17 m, steps no longer than
+/// a quarter period) through one programme on the default wavy disk: a heater staircase into
+/// contact and back, a dither, and a command that changes every period, besides runs of
+/// unchanged commands. Both see the same noise.
+fn deviation(opts: DriveOptions) -> Deviation {
+    let scene = Scene::paper();
+    let zone = scene_zone(&scene, 0.025).unwrap();
+    let fast = Plant::new(&scene, &zone, 5, opts).unwrap();
     let tight = Plant::new(
         &scene,
         &zone,
@@ -109,6 +161,7 @@ fn spanning_steps_agree_with_a_tight_reference() {
             method: hdi_tribology::ode::Method::Radau5,
             rtol: 1e-10,
             atol_displacement: 1e-17,
+            atol_displacement_flight: 1e-17,
             max_step: Some(DT / 4.0),
             ..DriveOptions::default()
         },
@@ -123,59 +176,123 @@ fn spanning_steps_agree_with_a_tight_reference() {
     // A controller that changes the command every period.
     programme.extend((0..40).map(|k| Command::heater_mw(70.0 + 0.05 * k as f64)));
     let (mut a, mut b) = (fast.drive().unwrap(), tight.drive().unwrap());
-    let spec = fast.sensor_spec();
-    let (mut worst_gap, mut worst_force, mut worst_r) = (0.0f64, 0.0f64, 0.0f64);
-    let mut contact = 0;
+    let mut dev = Deviation {
+        gap_flight: 0.0,
+        gap_contact: 0.0,
+        force: 0.0,
+        sensor: 0.0,
+        sensor_rms: 0.0,
+        readback: 0.0,
+        contact_periods: 0,
+        steps: 0,
+    };
     let mut ms_r = 0.0;
-    let mut worst_at = (0, 0.0);
     for c in &programme {
         let (x, y) = (a.step(c, DT).unwrap(), b.step(c, DT).unwrap());
-        if (x.contact_resistance - y.contact_resistance).abs() > worst_r {
-            worst_at = (contact, y.truth.mean_contact_force);
-        }
-        worst_gap = worst_gap.max((x.truth.gap - y.truth.gap).abs());
-        worst_force =
-            worst_force.max((x.truth.mean_contact_force - y.truth.mean_contact_force).abs());
-        worst_r = worst_r.max((x.contact_resistance - y.contact_resistance).abs());
-        ms_r += (x.contact_resistance - y.contact_resistance).powi(2) / programme.len() as f64;
+        let gap = (x.truth.gap - y.truth.gap).abs();
         if y.truth.mean_contact_force > 5e-5 {
-            contact += 1;
+            dev.contact_periods += 1;
+            dev.gap_contact = dev.gap_contact.max(gap);
+        } else {
+            dev.gap_flight = dev.gap_flight.max(gap);
         }
+        dev.force = dev
+            .force
+            .max((x.truth.mean_contact_force - y.truth.mean_contact_force).abs());
+        let dr = (x.contact_resistance - y.contact_resistance).abs();
+        dev.sensor = dev.sensor.max(dr);
+        ms_r += dr * dr / programme.len() as f64;
+        dev.readback = dev
+            .readback
+            .max((x.readback.log_ratio() - y.readback.log_ratio()).abs());
     }
+    dev.sensor_rms = ms_r.sqrt();
+    dev.steps = a.stats().accepted;
     println!(
-        "worst gap {:.3} pm, mean contact force {:.3} µN, contact sensor {:.2e} Ω (rms {:.2e}); {contact} periods in contact; steps {} vs {}",
-        worst_gap * 1e12,
-        worst_force * 1e6,
-        worst_r,
-        ms_r.sqrt(),
-        a.stats().accepted,
+        "worst gap {:.3} pm in flight, {:.3} pm in contact ({} periods); mean contact force {:.3} µN; contact sensor {:.2e} Ω (rms {:.2e}); read-back log ratio {:.2e}; steps {} vs {}",
+        dev.gap_flight * 1e12,
+        dev.gap_contact * 1e12,
+        dev.contact_periods,
+        dev.force * 1e6,
+        dev.sensor,
+        dev.sensor_rms,
+        dev.readback,
+        dev.steps,
         b.stats().accepted
     );
-    assert!(contact > 50, "the programme should reach contact");
-    // Ten times the displacement tolerance (0.1 pm); 0.1 µN of period-mean contact force (the
-    // contact sensor resolves ~0.2 µN per period in contact, where the force changes by ~4 µN
-    // per pm of gap).
-    assert!(worst_gap < 1e-13, "gap differs by {worst_gap} m");
     assert!(
-        worst_force < 1e-7,
-        "mean contact force differs by {worst_force} N"
+        dev.contact_periods > 50,
+        "the programme should reach contact"
     );
-    // The worst period is the jump into contact, where the mean contact force rises from a few
-    // µN to a millinewton within the period; even there the contact sensor differs by a small
-    // fraction of its noise, and over the run by a tiny one.
-    println!(
-        "worst contact-sensor period: after {} periods in contact, mean force {:.1} µN",
-        worst_at.0,
-        worst_at.1 * 1e6
-    );
+    dev
+}
+
+/// 0.1 µN of period-mean contact force (the contact sensor resolves ~0.2 µN per period in
+/// contact, where the force changes by ~4 µN per pm of gap). The worst period is the jump into
+/// contact, where the mean contact force rises from a few µN to a millinewton within the
+/// period; even there the contact sensor must differ by a small fraction of its noise, and over
+/// the run by a tiny one.
+fn sensors_within_their_noise(dev: &Deviation) {
+    let noise = SensorSpec::default().contact.noise;
     assert!(
-        worst_r < 0.2 * spec.contact.noise,
-        "contact sensor differs by {worst_r} Ω"
+        dev.force < 1e-7,
+        "mean contact force differs by {} N",
+        dev.force
     );
     assert!(
-        ms_r.sqrt() < 0.01 * spec.contact.noise,
+        dev.sensor < 0.2 * noise,
+        "contact sensor differs by {} Ω",
+        dev.sensor
+    );
+    assert!(
+        dev.sensor_rms < 0.01 * noise,
         "contact sensor differs by {} Ω rms",
-        ms_r.sqrt()
+        dev.sensor_rms
+    );
+}
+
+/// One displacement tolerance throughout (0.01 pm): the drive agrees with the tight reference
+/// within a small fraction of every sensor's noise.
+#[test]
+fn spanning_steps_agree_with_a_tight_reference() {
+    let opts = DriveOptions {
+        atol_displacement_flight: DriveOptions::default().atol_displacement,
+        ..DriveOptions::default()
+    };
+    let dev = deviation(opts);
+    // Ten times the displacement tolerance (0.1 pm).
+    let gap = dev.gap_flight.max(dev.gap_contact);
+    assert!(gap < 1e-13, "gap differs by {gap} m");
+    sensors_within_their_noise(&dev);
+}
+
+/// The default: 1 pm where the contact force barely depends on the gap, 0.01 pm near contact
+/// and for a few periods after each new command. Each sensor still agrees with the tight
+/// reference within the same fractions of its noise as with one tolerance throughout; the gap
+/// within ten times the tolerance of its period.
+#[test]
+fn the_default_tolerance_follows_the_contact_force() {
+    let o = DriveOptions::default();
+    let dev = deviation(o.clone());
+    let spec = SensorSpec::default();
+    assert!(
+        dev.gap_contact < 10.0 * o.atol_displacement,
+        "gap in contact differs by {} m",
+        dev.gap_contact
+    );
+    assert!(
+        dev.gap_flight < 10.0 * o.atol_displacement_flight,
+        "gap in flight differs by {} m",
+        dev.gap_flight
+    );
+    sensors_within_their_noise(&dev);
+    // The read-back's log ratio: each amplitude carries a relative noise `noise`, so the log
+    // ratio's per period is √2·noise (about 22 pm of spacing at the default wavelength).
+    let rb_noise = (2.0f64).sqrt() * spec.readback.noise;
+    assert!(
+        dev.readback < 0.05 * rb_noise,
+        "read-back log ratio differs by {}",
+        dev.readback
     );
 }
 

@@ -7,7 +7,7 @@ use crate::drive::{
     run, DiskSpec, DriveOptions, LevelDetector, LevelStats, Plant, Sensors,
     Staircase as DriveStaircase, StaircaseSettings,
 };
-use crate::error::{check_finite, check_non_negative, check_positive, Error, Result};
+use crate::error::{check_non_negative, check_not_below, check_positive, Error, Result};
 use crate::model::SliderModel;
 use crate::ode::{Method, Stats};
 use serde::Serialize;
@@ -38,16 +38,14 @@ impl Staircase {
     fn validate(&self) -> Result<()> {
         check_non_negative("staircase.start_power", self.start_power)?;
         check_positive("staircase.step", self.step)?;
-        check_finite("staircase.max_power", self.max_power)?;
-        if self.max_power < self.start_power {
-            return Err(Error::invalid(
-                "staircase.max_power",
-                format!(
-                    "must not be below start_power = {} W, got {} W",
-                    self.start_power, self.max_power
-                ),
-            ));
-        }
+        check_not_below(
+            "staircase.max_power",
+            self.max_power,
+            "start_power",
+            self.start_power,
+            "W",
+            1.0,
+        )?;
         if (self.max_power - self.start_power) / self.step > MAX_LEVELS as f64 {
             return Err(Error::invalid(
                 "staircase.step",
@@ -275,6 +273,8 @@ pub fn calibrate(
         method: opts.method,
         rtol: opts.rtol,
         atol_displacement: opts.atol_displacement,
+        // One tolerance throughout: the staircase is compared with the static model.
+        atol_displacement_flight: opts.atol_displacement,
         max_step: h_max.is_finite().then_some(h_max),
         ..DriveOptions::default()
     };

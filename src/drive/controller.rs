@@ -429,17 +429,14 @@ impl StaircaseSettings {
     fn validate(&self, dt: f64) -> Result<(usize, usize, usize)> {
         check_non_negative("staircase.start_power", self.start_power)?;
         check_positive("staircase.step", self.step)?;
-        crate::error::check_finite("staircase.max_power", self.max_power)?;
-        if self.max_power < self.start_power {
-            return Err(Error::invalid(
-                "staircase.max_power",
-                format!(
-                    "must not be below start_power = {} mW, got {} mW",
-                    self.start_power * 1e3,
-                    self.max_power * 1e3
-                ),
-            ));
-        }
+        crate::error::check_not_below(
+            "staircase.max_power",
+            self.max_power,
+            "start_power",
+            self.start_power,
+            "mW",
+            1e-3,
+        )?;
         if (self.max_power - self.start_power) / self.step > 100_000.0 {
             return Err(Error::invalid(
                 "staircase.step",

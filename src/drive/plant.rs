@@ -118,6 +118,10 @@ impl Ambient {
 /// let o = DriveOptions::default();
 /// assert_eq!(o.initial_power, 0.060);
 /// assert_eq!(o.atol_displacement, 1e-14);
+/// assert_eq!(o.atol_displacement_flight, 1e-12);
+/// // One displacement tolerance, 0.01 pm, in every period:
+/// let fixed = DriveOptions { atol_displacement_flight: o.atol_displacement, ..o };
+/// assert_eq!(fixed.atol_displacement_flight, 1e-14);
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct DriveOptions {
@@ -138,16 +142,29 @@ pub struct DriveOptions {
     pub method: Method,
     /// Relative tolerance of the slider integration.
     pub rtol: f64,
-    /// Absolute tolerance on the displacements (m; velocities scaled by their modal
-    /// frequencies). The default, 0.01 pm (the scene's own default), keeps the integration
-    /// error below what the sensors resolve in one period, in flight and in contact. The
-    /// read-back harmonic ratio resolves `λ/(4π)·√2·noise ≈ 22 pm` of spacing per period and
-    /// the contact sensor about 0.1 nm in flight; in contact, though, the contact sensor
-    /// resolves about 0.2 µN of contact force per period, and the contact force grows by
-    /// ~4 µN per pm of gap: 0.05 pm. At 0.1 pm the contact sensor's integration error in
-    /// contact reaches 0.4 of its noise (rms) when the command changes every period;
-    /// tests/drive_plant.rs checks the default against a tight reference.
+    /// Absolute tolerance on the displacements where the contact force depends strongly on
+    /// the gap (m; velocities scaled by their modal frequencies). The default, 0.01 pm (the
+    /// scene's own default), keeps the integration error below what the sensors resolve in one
+    /// period in contact: there the contact sensor resolves about 0.2 µN of contact force per
+    /// period, and the contact force grows by ~4 µN per pm of gap (0.05 pm). At 0.1 pm
+    /// throughout, the contact sensor's integration error in contact reaches 0.4 of its noise
+    /// (rms) when the command changes every period. tests/drive_plant.rs checks the default
+    /// against a tight reference.
     pub atol_displacement: f64,
+    /// Absolute tolerance on the displacements where the contact force barely depends on the
+    /// gap (m, ≥ `atol_displacement`). Each period runs at
+    /// `contact_force_tolerance / |∂F_c/∂d|`, the largest slope of the contact force seen at
+    /// the previous period's step ends, held between `atol_displacement` and this; a period
+    /// that finds a slope its tolerance was too loose for is run again from its start at
+    /// `atol_displacement`. The default, 1 pm, is a twentieth of the spacing the read-back
+    /// harmonic ratio resolves per period (`λ/(4π)·√2·noise ≈ 22 pm`) and a hundredth of what
+    /// the contact sensor resolves in flight (about 0.1 nm). Set it to `atol_displacement` for
+    /// one tolerance throughout.
+    pub atol_displacement_flight: f64,
+    /// Contact-force error the displacement tolerance is sized for (N, > 0): the tolerance
+    /// times the contact force's slope. The default, 0.04 µN, is what 0.01 pm gives in the
+    /// paper scene's contact (~4 µN/pm), a fifth of the contact sensor's resolution per period.
+    pub contact_force_tolerance: f64,
     /// Largest integration step (s); `None`: unlimited (a step may span many controller
     /// periods; the sensors are read on its interpolant).
     pub max_step: Option<f64>,
@@ -155,7 +172,8 @@ pub struct DriveOptions {
 
 impl Default for DriveOptions {
     /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift;
-    /// Rodas5P at `rtol = 1e-6`, `atol = 0.01 pm`; no step limit.
+    /// Rodas5P at `rtol = 1e-6`, `atol` from 0.01 pm in contact to 1 pm in flight (0.04 µN of
+    /// contact force); no step limit.
     fn default() -> Self {
         DriveOptions {
             initial_power: 0.060,
@@ -166,6 +184,8 @@ impl Default for DriveOptions {
             method: Method::Rodas5P,
             rtol: 1e-6,
             atol_displacement: 1e-14,
+            atol_displacement_flight: 1e-12,
+            contact_force_tolerance: 4e-8,
             max_step: None,
         }
     }
@@ -303,6 +323,8 @@ pub struct Plant {
     ambient: Ambient,
     method: Method,
     ode: Options,
+    /// How each period's displacement tolerance is chosen.
+    tol: TolRule,
     /// See `Span::rebase`.
     rebase: [f64; 2],
     max_steps: usize,
@@ -407,6 +429,15 @@ impl Plant {
         opts.sensors.validate()?;
         crate::error::check_positive("rtol", opts.rtol)?;
         crate::error::check_positive("atol_displacement", opts.atol_displacement)?;
+        crate::error::check_not_below(
+            "atol_displacement_flight",
+            opts.atol_displacement_flight,
+            "atol_displacement",
+            opts.atol_displacement,
+            "pm",
+            1e-12,
+        )?;
+        crate::error::check_positive("contact_force_tolerance", opts.contact_force_tolerance)?;
         if let Some(h) = opts.max_step {
             crate::error::check_positive("max_step", h)?;
         }
@@ -432,6 +463,12 @@ impl Plant {
         // contact; the flash temperature is a truth value only, hundreds of kelvin in contact).
         let (impulse, heat) = (3e-8 * 5e-5, 0.1 * 5e-5);
         let atol = probe.tolerances(opts.atol_displacement, impulse, heat);
+        let tol = TolRule::new(
+            &probe.tolerances(1.0, 0.0, 0.0),
+            &probe.tolerances(0.0, impulse, heat),
+            (opts.atol_displacement, opts.atol_displacement_flight),
+            opts.contact_force_tolerance,
+        );
         // Beyond these the relative tolerance allows ten times the absolute one.
         let rebase = [10.0 * impulse / opts.rtol, 10.0 * heat / opts.rtol];
         let ode = Options::default()
@@ -476,6 +513,7 @@ impl Plant {
             ambient: opts.ambient,
             method: opts.method,
             ode,
+            tol,
             rebase,
             max_steps,
             zone,
@@ -587,6 +625,8 @@ pub struct Drive {
     unchanged: usize,
     /// The contact impulse and heat integrals at the start of the period.
     integrals0: (f64, f64),
+    /// The running displacement tolerance and the state at the period's start.
+    tol: TolState,
 }
 
 impl std::fmt::Debug for Drive {
@@ -614,9 +654,14 @@ impl Drive {
         sys.model.efficiency = plant.base.efficiency * plant.start_sensors.heater_power;
         let (m, o) = (plant.method, &plant.ode);
         let rest = plant.start;
+        let mut tol = TolState {
+            atol: plant.tol.range.0,
+            y0: [0.0; MAX_STATE],
+        };
         macro_rules! start {
             ($variant:ident, $dim:expr) => {{
                 let y0 = sys.slider().initial_state($dim, &rest);
+                tol.y0[..y0.len()].copy_from_slice(y0.as_slice());
                 Integ::$variant(Integrator::new(sys, 0.0, y0, HORIZON, m, o)?)
             }};
         }
@@ -644,6 +689,7 @@ impl Drive {
             held: None,
             unchanged: 0,
             integrals0: (0.0, 0.0),
+            tol,
         })
     }
 
@@ -672,6 +718,7 @@ impl Drive {
             t1,
             max_steps: plant.max_steps,
             land: self.unchanged < 2,
+            settling: self.unchanged < SETTLE_PERIODS,
             rebase: plant.rebase,
         };
         let set = changed.then_some(Held {
@@ -679,8 +726,9 @@ impl Drive {
             clearance,
             base: &plant.base,
         });
+        let tol = plant.tol.adapts().then_some((&plant.tol, &mut self.tol));
         let (truth, integrals) = with_integ!(&mut self.integ, it => {
-            let y1 = advance(it, &layout, set, &mut self.integrals0, span)?;
+            let y1 = advance(it, &layout, set, &mut self.integrals0, span, tol)?;
             let s = it.system().slider();
             let integrals = (
                 layout.contact_impulse.map_or(0.0, |i| y1[i]),
@@ -763,6 +811,84 @@ impl Held<'_> {
     }
 }
 
+/// Longest state a drive integrates (`Integ`'s largest size).
+const MAX_STATE: usize = 10;
+
+/// How a period's displacement tolerance follows the contact force's slope
+/// ([`DriveOptions::atol_displacement_flight`]).
+#[derive(Clone, Debug)]
+struct TolRule {
+    /// Per-component absolute tolerance per metre of displacement tolerance, and the part that
+    /// does not scale with it (the period integrals).
+    per_m: [f64; MAX_STATE],
+    fixed: [f64; MAX_STATE],
+    n: usize,
+    /// Displacement tolerance in contact and in flight (m).
+    range: (f64, f64),
+    /// Contact-force error the tolerance is sized for (N).
+    force: f64,
+}
+
+impl TolRule {
+    fn new(per_m: &[f64], fixed: &[f64], range: (f64, f64), force: f64) -> Self {
+        let (mut a, mut b) = ([0.0; MAX_STATE], [0.0; MAX_STATE]);
+        let n = per_m.len().min(MAX_STATE);
+        a[..n].copy_from_slice(&per_m[..n]);
+        b[..n].copy_from_slice(&fixed[..n]);
+        TolRule {
+            per_m: a,
+            fixed: b,
+            n,
+            range,
+            force,
+        }
+    }
+
+    /// Whether the tolerance ever changes.
+    fn adapts(&self) -> bool {
+        self.range.1 > self.range.0
+    }
+
+    /// The displacement tolerance a contact-force slope (N/m) asks for.
+    fn required(&self, slope: f64) -> f64 {
+        let (lo, hi) = self.range;
+        if slope > 0.0 {
+            (self.force / slope).clamp(lo, hi)
+        } else {
+            hi
+        }
+    }
+
+    /// Sets the integrator's per-component tolerance for displacement tolerance `x` (m).
+    fn apply<D: Dim>(&self, x: f64, it: &mut Integrator<'static, D, DriveSystem>) -> Result<()>
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let mut atol = [0.0; MAX_STATE];
+        for (i, a) in atol[..self.n].iter_mut().enumerate() {
+            *a = self.fixed[i] + x * self.per_m[i];
+        }
+        Ok(it.set_atol(&atol[..self.n])?)
+    }
+}
+
+/// The displacement tolerance of the running period and the state at its start (for a rerun).
+#[derive(Clone, Copy)]
+struct TolState {
+    atol: f64,
+    y0: [f64; MAX_STATE],
+}
+
+/// Largest slope of the contact force at a state (N/m), on either gap.
+fn contact_slope<D: Dim>(sys: &DriveSystem, t: f64, y: &OVector<f64, D>) -> f64
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let s = sys.slider();
+    let c = sys.model.forces().contact(s.gaps(t, y));
+    c.d_bulge.abs().max(c.d_pad.abs())
+}
+
 /// One period `[t0, t1]`.
 #[derive(Clone, Copy)]
 struct Span {
@@ -773,7 +899,14 @@ struct Span {
     land: bool,
     /// Sizes of the contact impulse and heat integrals beyond which they are set back to zero.
     rebase: [f64; 2],
+    /// Within `SETTLE_PERIODS` of a new command: the contact tolerance throughout.
+    settling: bool,
 }
+
+/// Periods after a new command that run at the contact tolerance: a command past the
+/// touchdown fold snaps the slider into contact within two or three periods, and the snap
+/// amplifies any error of the state it starts from.
+const SETTLE_PERIODS: usize = 4;
 
 /// Integrates one period and returns the state at its end; the one place the drive calls the
 /// ODE stepper.
@@ -790,28 +923,30 @@ struct Span {
 /// The period integrals (contact impulse, heat) run on across periods; the period means are
 /// their differences. They are set back to zero at a restart once they have grown so large
 /// that the relative tolerance would loosen their error control more than tenfold.
+///
+/// With `tol`, the displacement tolerance follows the contact force's slope at the step ends
+/// ([`DriveOptions::atol_displacement_flight`]): a period that meets a slope its tolerance was
+/// more than twice too loose for is run again from `t0` at the contact tolerance; otherwise
+/// the next period tightens to what the slope asks, or loosens once that is twice the
+/// tolerance or more.
 fn advance<D: Dim>(
     it: &mut Integrator<'static, D, DriveSystem>,
     layout: &StateLayout,
     set: Option<Held<'_>>,
     integrals0: &mut (f64, f64),
     span: Span,
+    tol: Option<(&TolRule, &mut TolState)>,
 ) -> Result<OVector<f64, D>>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    let Span {
-        t0,
-        t1,
-        max_steps,
-        land,
-        rebase,
-    } = span;
+    let Span { t0, t1, rebase, .. } = span;
     let integrals = [layout.contact_impulse, layout.heat];
     let grown = integrals
         .iter()
         .zip(rebase)
         .any(|(i, bound)| i.is_some_and(|i| it.state()[i].abs() > bound));
+    let mut tol = tol;
     if set.is_some() || grown {
         let mut y = if it.t() > t0 {
             it.interpolate(t0)?
@@ -827,11 +962,68 @@ where
         if let Some(held) = set {
             held.apply(&mut it.system_mut().model);
         }
+        if let Some((rule, st)) = tol.as_mut() {
+            st.y0[..y.len()].copy_from_slice(y.as_slice());
+            if span.settling && st.atol > rule.range.0 {
+                st.atol = rule.range.0;
+                rule.apply(st.atol, it)?;
+            }
+        }
         if it.tf() <= t0 {
             it.set_tf(t1)?;
         }
         it.reinit(t0, y)?;
     }
+    let slope = run_period(it, span, tol.is_some())?;
+    if let Some((rule, st)) = tol {
+        let need = if span.settling {
+            rule.range.0
+        } else {
+            slope.map_or(st.atol, |s| rule.required(s))
+        };
+        if need < 0.5 * st.atol {
+            // Too loose for this period: again from its start at the contact tolerance.
+            st.atol = rule.range.0;
+            rule.apply(st.atol, it)?;
+            let y0 = OVector::<f64, D>::from_iterator_generic(
+                D::from_usize(layout.len()),
+                nalgebra::U1,
+                st.y0.iter().copied(),
+            );
+            if it.tf() <= t0 {
+                it.set_tf(t1)?;
+            }
+            it.reinit(t0, y0)?;
+            run_period(it, span, false)?;
+        } else if need < st.atol || need >= 2.0 * st.atol {
+            st.atol = need;
+            rule.apply(need, it)?;
+        }
+        let y1 = end_state(it, t1)?;
+        st.y0[..y1.len()].copy_from_slice(y1.as_slice());
+        return Ok(y1);
+    }
+    end_state(it, t1)
+}
+
+/// Steps until the integrator's time reaches `t1` (the end time set for landing or a horizon
+/// ahead). With `slopes`, returns the largest contact-force slope at the step ends (`None`
+/// when no step ended: the last one spans the period).
+fn run_period<D: Dim>(
+    it: &mut Integrator<'static, D, DriveSystem>,
+    span: Span,
+    slopes: bool,
+) -> Result<Option<f64>>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let Span {
+        t0,
+        t1,
+        max_steps,
+        land,
+        ..
+    } = span;
     // Landing: the period's end is the integrator's end time, so the last step is shortened
     // onto it. Otherwise the end time stays a horizon ahead.
     let tf = if land { t1 } else { t1 + HORIZON };
@@ -839,6 +1031,7 @@ where
         it.set_tf(tf)?;
     }
     let mut n = 0usize;
+    let mut slope = None;
     while it.t() < t1 {
         if n >= max_steps {
             return Err(Error::no_convergence(
@@ -847,8 +1040,20 @@ where
             ));
         }
         it.step()?;
+        if slopes {
+            let s = contact_slope(it.system(), it.t(), it.state());
+            slope = Some(slope.map_or(s, |m: f64| m.max(s)));
+        }
         n += 1;
     }
+    Ok(slope)
+}
+
+/// The state at `t1`, on the interpolant of the last step when it ran past.
+fn end_state<D: Dim>(it: &Integrator<'static, D, DriveSystem>, t1: f64) -> Result<OVector<f64, D>>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
     Ok(if it.t() == t1 {
         it.state().clone()
     } else {

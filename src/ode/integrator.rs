@@ -587,6 +587,43 @@ where
         Ok(())
     }
 
+    /// Changes the absolute tolerance of every component for the following steps, without a
+    /// restart and without allocating (the relative tolerance and the step size stay).
+    ///
+    /// ```
+    /// use hdi_tribology::nalgebra::{Vector2, U2};
+    /// use hdi_tribology::ode::{Integrator, Method, OdeSystem, Options};
+    /// /// y'' = -y.
+    /// struct Spring;
+    /// impl OdeSystem<U2> for Spring {
+    ///     fn rhs(&self, _t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>) {
+    ///         dy[0] = y[1];
+    ///         dy[1] = -y[0];
+    ///     }
+    ///     fn is_autonomous(&self) -> bool { true }
+    /// }
+    /// let opts = Options::default().rtol(1e-6).atol(1e-12);
+    /// let mut it = Integrator::new(Spring, 0.0, Vector2::new(1.0, 0.0), 10.0, Method::Tsit5, &opts)?;
+    /// it.advance_to(5.0)?;
+    /// let tight = it.stats().accepted;
+    /// it.set_atol(&[1e-3, 1e-3])?; // looser from here on: longer steps
+    /// it.advance_to(10.0)?;
+    /// assert!(it.stats().accepted - tight < tight);
+    /// assert!(it.set_atol(&[1e-3]).is_err()); // one per component
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] naming `options.atol` (wrong length) or `options.atol[i]` (not
+    /// finite, or negative); nothing is changed then.
+    pub fn set_atol(&mut self, atol: &[f64]) -> Result<(), OdeError> {
+        super::options::check_atol_components(atol, self.y.len())?;
+        for (a, &b) in self.ctx.atol.iter_mut().zip(atol) {
+            *a = b;
+        }
+        Ok(())
+    }
+
     /// Restarts from `(t, y)` after a discontinuity (a jump of the state or of the system's
     /// parameters): the method drops what it carried over, a new initial step size is chosen,
     /// and events are evaluated afresh. `t` may be earlier than the current time but must be

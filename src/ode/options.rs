@@ -99,6 +99,27 @@ pub enum Tolerance {
     PerComponent(Vec<f64>),
 }
 
+/// Checks a per-component absolute tolerance: `n` entries, each finite and `>= 0`.
+pub(crate) fn check_atol_components(v: &[f64], n: usize) -> Result<(), OdeError> {
+    if v.len() != n {
+        return Err(OdeError::invalid(
+            "options.atol",
+            format!("has {} components, the state has {n}", v.len()),
+        ));
+    }
+    if let Some((i, a)) = v
+        .iter()
+        .enumerate()
+        .find(|(_, a)| !(a.is_finite() && **a >= 0.0))
+    {
+        return Err(OdeError::invalid(
+            format!("options.atol[{i}]"),
+            format!("must be finite and >= 0, got {a}"),
+        ));
+    }
+    Ok(())
+}
+
 impl Tolerance {
     /// Tolerance of component `i` (`PerComponent` must have been validated for length).
     pub fn get(&self, i: usize) -> f64 {
@@ -263,24 +284,7 @@ impl Options {
                     ));
                 }
             }
-            Tolerance::PerComponent(v) => {
-                if v.len() != n {
-                    return Err(OdeError::invalid(
-                        "options.atol",
-                        format!("has {} components, the state has {n}", v.len()),
-                    ));
-                }
-                if let Some((i, a)) = v
-                    .iter()
-                    .enumerate()
-                    .find(|(_, a)| !(a.is_finite() && **a >= 0.0))
-                {
-                    return Err(OdeError::invalid(
-                        format!("options.atol[{i}]"),
-                        format!("must be finite and >= 0, got {a}"),
-                    ));
-                }
-            }
+            Tolerance::PerComponent(v) => check_atol_components(v, n)?,
         }
         if let Some(h) = self.h_init {
             if !(h.is_finite() && h > 0.0) {
