@@ -53,3 +53,38 @@ fn hdi_drive_bad_command_file_writes_nothing() {
     assert!(err.contains("line 3, heater_mw"), "{err}");
     assert!(!out.exists());
 }
+
+#[test]
+fn hdi_drive_tolerance_flags_that_do_not_fit_write_nothing() {
+    let cmds = tmp("tol.csv");
+    std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,65,0\n").unwrap();
+    for (flags, named) in [
+        (
+            vec!["--atol-pm", "0.1", "--atol-flight-pm", "0.05"],
+            "--atol-flight-pm",
+        ),
+        (vec!["--atol-pm", "2"], ""),
+        (vec!["--atol-pm", "0"], "--atol-pm"),
+    ] {
+        let out = tmp("tol-out.csv");
+        let _ = std::fs::remove_file(&out);
+        let o = Command::new(env!("CARGO_BIN_EXE_hdi"))
+            .args(["drive", "--paper", "--commands"])
+            .arg(&cmds)
+            .arg("--out")
+            .arg(&out)
+            .args(&flags)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        if named.is_empty() {
+            // A contact tolerance above the default flight one raises the flight one with it.
+            assert!(o.status.success(), "{flags:?}: {err}");
+            assert!(out.exists());
+        } else {
+            assert_eq!(o.status.code(), Some(2), "{flags:?}: {err}");
+            assert!(err.contains(named), "{flags:?}: {err}");
+            assert!(!out.exists());
+        }
+    }
+}

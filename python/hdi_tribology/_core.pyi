@@ -312,10 +312,14 @@ class Drive:
     and waviness (or a flat one), with a heater, a head–disk voltage and the sensors firmware
     reads, stepped at the controller's rate. Starts at rest in the flying equilibrium at
     ``initial_power_mw``. The same seed gives the same stream, bit for bit. A ``Drive``
-    belongs to the thread that made it."""
+    belongs to the thread that made it. ``atol_pm`` (default 0.01) and ``atol_flight_pm``
+    (default 1, at least ``atol_pm``) are the integration's displacement tolerances near
+    contact and in flight (pm; equal for one tolerance throughout)."""
 
     def __init__(self, scene: Scene, *, seed: int = 1, radius_mm: float = 25.0,
-                 flat_disk: bool = False, initial_power_mw: float = 60.0) -> None: ...
+                 flat_disk: bool = False, initial_power_mw: float = 60.0,
+                 atol_pm: Optional[float] = None,
+                 atol_flight_pm: Optional[float] = None) -> None: ...
     def step(self, heater_mw: float, *, dc_v: float = 0.0, ac_v: float = 0.0,
              ac_khz: float = 0.0, dt_us: float = 50.0) -> Sensors:
         """Holds the heater at ``heater_mw`` (mW) and the voltage at ``dc_v`` (V) plus an AC
@@ -334,7 +338,9 @@ class Drive:
 def replay(scene: Scene, time_s: Sequence[float], heater_mw: Sequence[float],
            voltage_dc_v: Sequence[float], voltage_ac_v: Optional[Sequence[float]] = None,
            ac_frequency_khz: Optional[Sequence[float]] = None, *, rate_khz: float = 20.0,
-           seed: int = 1, radius_mm: float = 25.0, flat_disk: bool = False) -> Dict[str, F64Array]:
+           seed: int = 1, radius_mm: float = 25.0, flat_disk: bool = False,
+           atol_pm: Optional[float] = None,
+           atol_flight_pm: Optional[float] = None) -> Dict[str, F64Array]:
     """Replays commands (each holds from its ``time_s`` until the next; the last time ends the
     run) through a new drive, as ``hdi drive SCENE --commands FILE`` does: the sensor columns
     of ``SENSOR_COLUMNS`` as float64 arrays, one value per period, bit for bit the CLI's.

@@ -1424,6 +1424,7 @@ fn plant_of(
     radius_mm: f64,
     flat_disk: bool,
     initial_power_mw: f64,
+    atol_pm: [Option<f64>; 2],
 ) -> PyResult<Plant> {
     if !(radius_mm.is_finite() && radius_mm > 0.0) {
         return Err(invalid(
@@ -1445,7 +1446,9 @@ fn plant_of(
             DiskSpec::default()
         },
         ..DriveOptions::default()
-    };
+    }
+    .with_tolerances_pm(atol_pm[0], atol_pm[1], ["atol_pm", "atol_flight_pm"])
+    .py()?;
     let scene = &scene.inner;
     py.detach(|| Plant::new(scene, &scene_zone(scene, radius_mm * 1e-3)?, seed, opts))
         .py()
@@ -1529,8 +1532,11 @@ impl Sensors {
 /// run-out and waviness (or a flat one), with a heater, a head–disk voltage and the sensors
 /// firmware reads, stepped at the controller's rate (`docs/clearance.md`).
 ///
-/// `Drive(scene, *, seed=1, radius_mm=25, flat_disk=False, initial_power_mw=60)` starts at rest
-/// in the flying equilibrium at `initial_power_mw`. The same seed gives the same disk and the
+/// `Drive(scene, *, seed=1, radius_mm=25, flat_disk=False, initial_power_mw=60, atol_pm=None,
+/// atol_flight_pm=None)` starts at rest in the flying equilibrium at `initial_power_mw`.
+/// `atol_pm` (default 0.01) and `atol_flight_pm` (default 1, at least `atol_pm`) are the
+/// integration's displacement tolerances near contact and in flight (pm; equal for one
+/// tolerance throughout; `docs/clearance.md`, "Accuracy"). The same seed gives the same disk and the
 /// same sensor noise, bit for bit; stepping it with the commands of a command file gives the
 /// rows `replay` (and `hdi drive`) gives. A `Drive` belongs to the thread that made it.
 #[pyclass(module = "hdi_tribology", name = "Drive", unsendable)]
@@ -1544,7 +1550,7 @@ struct PyDrive {
 #[pymethods]
 impl PyDrive {
     #[new]
-    #[pyo3(signature = (scene, *, seed = 1, radius_mm = 25.0, flat_disk = false, initial_power_mw = 60.0))]
+    #[pyo3(signature = (scene, *, seed = 1, radius_mm = 25.0, flat_disk = false, initial_power_mw = 60.0, atol_pm = None, atol_flight_pm = None))]
     fn new(
         py: Python<'_>,
         scene: &Scene,
@@ -1552,8 +1558,11 @@ impl PyDrive {
         radius_mm: f64,
         flat_disk: bool,
         initial_power_mw: f64,
+        atol_pm: Option<f64>,
+        atol_flight_pm: Option<f64>,
     ) -> PyResult<Self> {
-        let plant = plant_of(py, scene, seed, radius_mm, flat_disk, initial_power_mw)?;
+        let tol = [atol_pm, atol_flight_pm];
+        let plant = plant_of(py, scene, seed, radius_mm, flat_disk, initial_power_mw, tol)?;
         let wavelength = plant.sensor_spec().readback.wavelength;
         Ok(PyDrive {
             inner: plant.into_drive().py()?,
@@ -1654,10 +1663,10 @@ impl PyDrive {
 /// Replays commands through a new drive, as `hdi drive SCENE --commands FILE` does, and returns
 /// the sensor columns as float64 arrays (the CSV's columns, `SENSOR_COLUMNS`; units in their
 /// names), bit for bit the CLI's. Each command holds from its `time_s` until the next; the last
-/// time ends the run. `voltage_ac_v` and `ac_frequency_khz` default to zeros. The GIL is released
-/// while the drive runs.
+/// time ends the run. `voltage_ac_v` and `ac_frequency_khz` default to zeros; `atol_pm` and
+/// `atol_flight_pm` are the tolerances of `Drive`. The GIL is released while the drive runs.
 #[pyfunction]
-#[pyo3(signature = (scene, time_s, heater_mw, voltage_dc_v, voltage_ac_v = None, ac_frequency_khz = None, *, rate_khz = 20.0, seed = 1, radius_mm = 25.0, flat_disk = false))]
+#[pyo3(signature = (scene, time_s, heater_mw, voltage_dc_v, voltage_ac_v = None, ac_frequency_khz = None, *, rate_khz = 20.0, seed = 1, radius_mm = 25.0, flat_disk = false, atol_pm = None, atol_flight_pm = None))]
 fn replay<'py>(
     py: Python<'py>,
     scene: &Scene,
@@ -1670,6 +1679,8 @@ fn replay<'py>(
     seed: u64,
     radius_mm: f64,
     flat_disk: bool,
+    atol_pm: Option<f64>,
+    atol_flight_pm: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let n = time_s.len();
     let ac = voltage_ac_v.unwrap_or_else(|| vec![0.0; n]);
@@ -1710,6 +1721,7 @@ fn replay<'py>(
         radius_mm,
         flat_disk,
         units::to_mw(DriveOptions::default().initial_power),
+        [atol_pm, atol_flight_pm],
     )?;
     let dt = 1e-3 / rate_khz;
     let columns = py

@@ -191,6 +191,49 @@ impl Default for DriveOptions {
     }
 }
 
+impl DriveOptions {
+    /// The same options with the displacement tolerances given in picometres: `contact_pm` near
+    /// contact ([`atol_displacement`](DriveOptions::atol_displacement), by default the one these
+    /// options hold) and `flight_pm` in flight
+    /// ([`atol_displacement_flight`](DriveOptions::atol_displacement_flight), at least
+    /// `contact_pm`, equal to it for one tolerance throughout; by default the one these options
+    /// hold, or `contact_pm` if that is larger). `names` are the two inputs as the caller's user
+    /// writes them (flags, arguments), for the errors.
+    ///
+    /// ```
+    /// use hdi_tribology::drive::DriveOptions;
+    /// let names = ["--atol-pm", "--atol-flight-pm"];
+    /// let o = DriveOptions::default().with_tolerances_pm(Some(0.01), Some(0.01), names)?;
+    /// assert_eq!(o.atol_displacement_flight, o.atol_displacement);
+    /// // A larger contact tolerance raises the default flight one with it.
+    /// let o = DriveOptions::default().with_tolerances_pm(Some(5.0), None, names)?;
+    /// assert_eq!(o.atol_displacement_flight, 5e-12);
+    /// let e = DriveOptions::default().with_tolerances_pm(Some(0.1), Some(0.05), names);
+    /// assert!(e.unwrap_err().to_string().contains("--atol-flight-pm"));
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] naming `names[0]` when `contact_pm` is not positive and finite, or
+    /// `names[1]` when `flight_pm` is not finite or below `contact_pm`.
+    pub fn with_tolerances_pm(
+        self,
+        contact_pm: Option<f64>,
+        flight_pm: Option<f64>,
+        names: [&str; 2],
+    ) -> Result<Self> {
+        let contact = contact_pm.unwrap_or(self.atol_displacement * 1e12);
+        crate::error::check_positive(names[0], contact)?;
+        let flight = flight_pm.unwrap_or((self.atol_displacement_flight * 1e12).max(contact));
+        crate::error::check_not_below(names[1], flight, names[0], contact, "pm", 1.0)?;
+        Ok(DriveOptions {
+            atol_displacement: contact * 1e-12,
+            atol_displacement_flight: flight * 1e-12,
+            ..self
+        })
+    }
+}
+
 /// The zone a scene describes by itself: its own clearance, air-bearing stiffness and disk speed,
 /// at `radius` (m).
 ///

@@ -38,10 +38,33 @@ pub struct Args {
     /// A flat disk (no run-out, no waviness).
     #[arg(long)]
     flat_disk: bool,
+    /// Displacement tolerance of the integration near contact (pm) [default: 0.01].
+    #[arg(long, value_name = "PM", value_parser = positive, allow_hyphen_values = true)]
+    atol_pm: Option<f64>,
+    /// Displacement tolerance in flight, where the contact force barely depends on the gap (pm,
+    /// at least --atol-pm; equal to it for one tolerance throughout; docs/clearance.md,
+    /// "Accuracy") [default: 1, or --atol-pm if that is larger].
+    #[arg(long, value_name = "PM", value_parser = positive, allow_hyphen_values = true)]
+    atol_flight_pm: Option<f64>,
 }
 
 pub fn run(a: Args) -> Result<(), CliError> {
     let scene = a.scene.load()?;
+    let opts = DriveOptions {
+        disk: if a.flat_disk {
+            DiskSpec::flat()
+        } else {
+            DiskSpec::default()
+        },
+        ..DriveOptions::default()
+    }
+    .with_tolerances_pm(
+        a.atol_pm,
+        a.atol_flight_pm,
+        ["--atol-pm", "--atol-flight-pm"],
+    )
+    // Both are positive numbers by now: what is left is a flag that does not fit the other.
+    .map_err(|e| CliError::Usage(e.to_string()))?;
     let shown = a.commands.display().to_string();
     let file = std::fs::File::open(&a.commands)
         .map_err(|e| CliError::Failed(format!("--commands {shown}: {e}")))?;
@@ -51,14 +74,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .as_deref()
         .map(|p| Output::prepare(p, "--out"))
         .transpose()?;
-    let opts = DriveOptions {
-        disk: if a.flat_disk {
-            DiskSpec::flat()
-        } else {
-            DiskSpec::default()
-        },
-        ..DriveOptions::default()
-    };
     let plant = Plant::new(
         &scene,
         &scene_zone(&scene, a.radius_mm * 1e-3)?,
