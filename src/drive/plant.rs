@@ -156,9 +156,9 @@ pub struct DriveOptions {
     /// `contact_force_tolerance / |∂F_c/∂d|`, the largest slope of the contact force seen at
     /// the previous period's step ends, held between `atol_displacement` and this; a period
     /// that finds a slope its tolerance was too loose for is run again from its start at
-    /// `atol_displacement`, and so are the four periods after each new command (a command past
-    /// the touchdown fold snaps the slider into contact, and the snap amplifies the error of
-    /// the state it starts from). The default, 1 pm, is a twentieth of the spacing the read-back
+    /// `atol_displacement`; the four periods after each new command also run at
+    /// `atol_displacement` (a command past the touchdown fold snaps the slider into contact,
+    /// and the snap amplifies the error of the state it starts from). The default, 1 pm, is a twentieth of the spacing the read-back
     /// harmonic ratio resolves per period (`λ/(4π)·√2·noise ≈ 22 pm`) and a hundredth of what
     /// the contact sensor resolves in flight (about 0.1 nm). Set it to `atol_displacement` for
     /// one tolerance throughout.
