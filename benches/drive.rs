@@ -1,6 +1,7 @@
 //! `Drive::step` at a 20 kHz controller rate against real time: in flight and in contact, on a
 //! flat and on the default wavy disk, with and without an AC dither, and with a command that
-//! changes every period. Prints a table.
+//! changes every period; at the default tolerance (0.01 pm throughout) and with 1 pm in flight
+//! (`DriveOptions::atol_displacement_flight`). Prints a table.
 //!
 //! `cargo bench --bench drive`. Each case settles 20 ms at its heater power, then times blocks
 //! of 200 periods (10 ms of drive time) for at least 1 s; the table gives the fastest block's
@@ -20,55 +21,63 @@ const BLOCK: usize = 200;
 fn main() {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).expect("zone");
-    println!("| disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period |");
-    println!("|---|---|---|---|---|---|---|---|---|");
-    for (disk_name, disk) in [("flat", DiskSpec::flat()), ("wavy", DiskSpec::default())] {
-        let plant = Plant::new(
-            &scene,
-            &zone,
-            1,
-            DriveOptions {
-                disk: disk.clone(),
-                ..DriveOptions::default()
-            },
-        )
-        .expect("plant");
-        for (state, mw) in [("flight", 70.0), ("contact", 80.0)] {
-            // Held commands, with and without dither; then a command that changes every period
-            // (a heater dithered by ±1 µW, alternating): the worst case, a restart per period.
-            for (dither, alternate) in [(None, false), (Some((0.5, 10.5e3)), false), (None, true)] {
-                let mut d = plant.drive().expect("drive");
-                let mut cmd = Command::heater_mw(mw);
-                if let Some((a, f)) = dither {
-                    cmd = cmd.with_dither(a, f);
-                }
-                for _ in 0..400 {
-                    d.step(&cmd, DT).expect("settle");
-                }
-                let s0 = d.stats().accepted;
-                let t0 = d.time();
-                let mut k = 0usize;
-                let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
-                    let mut s = None;
-                    for _ in 0..BLOCK {
-                        let mut c = cmd;
-                        if alternate {
-                            k += 1;
-                            c.heater_power += if k.is_multiple_of(2) { 1e-6 } else { -1e-6 };
-                        }
-                        s = Some(d.step(&c, DT).expect("step"));
+    println!("| flight atol | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let configs = [
+        ("0.01 pm", DriveOptions::default().atol_displacement),
+        ("1 pm", 1e-12),
+    ];
+    for (atol_name, flight) in configs {
+        for (disk_name, disk) in [("flat", DiskSpec::flat()), ("wavy", DiskSpec::default())] {
+            let plant = Plant::new(
+                &scene,
+                &zone,
+                1,
+                DriveOptions {
+                    disk: disk.clone(),
+                    atol_displacement_flight: flight,
+                    ..DriveOptions::default()
+                },
+            )
+            .expect("plant");
+            for (state, mw) in [("flight", 70.0), ("contact", 80.0)] {
+                // Held commands, with and without dither; then a command that changes every period
+                // (a heater dithered by ±1 µW, alternating): the worst case, a restart per period.
+                for (dither, alternate) in
+                    [(None, false), (Some((0.5, 10.5e3)), false), (None, true)]
+                {
+                    let mut d = plant.drive().expect("drive");
+                    let mut cmd = Command::heater_mw(mw);
+                    if let Some((a, f)) = dither {
+                        cmd = cmd.with_dither(a, f);
                     }
-                    s
-                });
-                let periods = (d.time() - t0) / DT;
-                let steps = (d.stats().accepted - s0) as f64 / periods;
-                let last = last.expect("ran");
-                // The state the case claims: in contact the true contact force is far above F_th.
-                let in_contact = last.truth.mean_contact_force > 5e-5;
-                assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
-                let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
-                println!(
-                    "| {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} |",
+                    for _ in 0..400 {
+                        d.step(&cmd, DT).expect("settle");
+                    }
+                    let s0 = d.stats().accepted;
+                    let t0 = d.time();
+                    let mut k = 0usize;
+                    let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
+                        let mut s = None;
+                        for _ in 0..BLOCK {
+                            let mut c = cmd;
+                            if alternate {
+                                k += 1;
+                                c.heater_power += if k.is_multiple_of(2) { 1e-6 } else { -1e-6 };
+                            }
+                            s = Some(d.step(&c, DT).expect("step"));
+                        }
+                        s
+                    });
+                    let periods = (d.time() - t0) / DT;
+                    let steps = (d.stats().accepted - s0) as f64 / periods;
+                    let last = last.expect("ran");
+                    // The state the case claims: in contact the true contact force is far above F_th.
+                    let in_contact = last.truth.mean_contact_force > 5e-5;
+                    assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
+                    let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
+                    println!(
+                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} |",
                     match (dither, alternate) {
                         (Some((a, f)), _) => format!("{a} V, {:.1} kHz", f / 1e3),
                         (None, true) => "off, ±1 µW every period".to_string(),
@@ -80,6 +89,7 @@ fn main() {
                     DT / cpu,
                     steps
                 );
+                }
             }
         }
     }

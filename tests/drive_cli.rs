@@ -78,7 +78,7 @@ fn hdi_drive_tolerance_flags_that_do_not_fit_write_nothing() {
             .unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         if named.is_empty() {
-            // A contact tolerance above the default flight one raises the flight one with it.
+            // The flight tolerance follows a larger contact one by default.
             assert!(o.status.success(), "{flags:?}: {err}");
             assert!(out.exists());
         } else {

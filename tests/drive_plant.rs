@@ -251,28 +251,29 @@ fn sensors_within_their_noise(dev: &Deviation) {
     );
 }
 
-/// One displacement tolerance throughout (0.01 pm): the drive agrees with the tight reference
-/// within a small fraction of every sensor's noise.
+/// The default, one displacement tolerance throughout (0.01 pm): the drive agrees with the
+/// tight reference within a small fraction of every sensor's noise.
 #[test]
 fn spanning_steps_agree_with_a_tight_reference() {
-    let opts = DriveOptions {
-        atol_displacement_flight: DriveOptions::default().atol_displacement,
-        ..DriveOptions::default()
-    };
-    let dev = deviation(opts);
+    let dev = deviation(DriveOptions::default());
     // Ten times the displacement tolerance (0.1 pm).
     let gap = dev.gap_flight.max(dev.gap_contact);
     assert!(gap < 1e-13, "gap differs by {gap} m");
     sensors_within_their_noise(&dev);
 }
 
-/// The default: 1 pm where the contact force barely depends on the gap, 0.01 pm near contact
-/// and for a few periods after each new command. Each sensor still agrees with the tight
-/// reference within the same fractions of its noise as with one tolerance throughout; the gap
-/// within ten times the tolerance of its period.
+/// The looser flight tolerance (an option): 1 pm where the contact force barely depends on the
+/// gap, 0.01 pm near contact and for a few periods after each new command. On this programme
+/// each sensor still agrees with the tight reference within the same fractions of its noise as
+/// with one tolerance throughout, and the gap within ten times the tolerance of its period.
+/// (A head that the waviness snaps into contact at a held command is another matter:
+/// docs/clearance.md, "Accuracy".)
 #[test]
-fn the_default_tolerance_follows_the_contact_force() {
-    let o = DriveOptions::default();
+fn a_looser_flight_tolerance_keeps_the_sensors_within_their_noise_here() {
+    let o = DriveOptions {
+        atol_displacement_flight: 1e-12,
+        ..DriveOptions::default()
+    };
     let dev = deviation(o.clone());
     let spec = SensorSpec::default();
     assert!(

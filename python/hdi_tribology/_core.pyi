@@ -313,8 +313,8 @@ class Drive:
     reads, stepped at the controller's rate. Starts at rest in the flying equilibrium at
     ``initial_power_mw``. The same seed gives the same stream, bit for bit. A ``Drive``
     belongs to the thread that made it. ``atol_pm`` (default 0.01) and ``atol_flight_pm``
-    (default 1, at least ``atol_pm``) are the integration's displacement tolerances near
-    contact and in flight (pm; equal for one tolerance throughout)."""
+    (default ``atol_pm``, at least ``atol_pm``) are the integration's displacement tolerances
+    near contact and in flight (pm; equal for one tolerance throughout)."""
 
     def __init__(self, scene: Scene, *, seed: int = 1, radius_mm: float = 25.0,
                  flat_disk: bool = False, initial_power_mw: float = 60.0,

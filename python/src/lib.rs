@@ -1534,8 +1534,8 @@ impl Sensors {
 ///
 /// `Drive(scene, *, seed=1, radius_mm=25, flat_disk=False, initial_power_mw=60, atol_pm=None,
 /// atol_flight_pm=None)` starts at rest in the flying equilibrium at `initial_power_mw`.
-/// `atol_pm` (default 0.01) and `atol_flight_pm` (default 1, at least `atol_pm`) are the
-/// integration's displacement tolerances near contact and in flight (pm; equal for one
+/// `atol_pm` (default 0.01) and `atol_flight_pm` (default `atol_pm`, at least `atol_pm`) are
+/// the integration's displacement tolerances near contact and in flight (pm; equal for one
 /// tolerance throughout; `docs/clearance.md`, "Accuracy"). The same seed gives the same disk and the
 /// same sensor noise, bit for bit; stepping it with the commands of a command file gives the
 /// rows `replay` (and `hdi drive`) gives. A `Drive` belongs to the thread that made it.

@@ -138,23 +138,25 @@ def test_replay_errors_name_the_argument(paper_scene, args, kwargs, field):
 
 
 def test_tolerances_match_the_cli_and_name_the_argument(tmp_path, paper_scene, hdi_cli):
-    """One tolerance throughout (0.01 pm) against the default: the same columns as the CLI with
-    the same flags, bit for bit, and another stream than the default's on a wavy disk in
-    flight; bad tolerances name the argument and nothing runs."""
+    """A looser flight tolerance (0.01 pm near contact, 1 pm in flight): the same columns as the
+    CLI with the same flags, bit for bit, and another stream than the default's (one tolerance,
+    0.01 pm) on a wavy disk in flight, within ten times the flight tolerance of it; bad
+    tolerances name the argument and nothing runs."""
     times, heater, dc = [0.0, 2e-3], [68.0, 68.0], [0.0, 0.0]
     commands = tmp_path / "commands.csv"
     commands.write_text("time_s,heater_mw,voltage_dc_v\n0,68,0\n0.002,68,0\n")
     csv = tmp_path / "sensors.csv"
     hdi_cli("drive", "--paper", "--commands", str(commands), "--out", str(csv),
-            "--atol-pm", "0.01", "--atol-flight-pm", "0.01")
+            "--atol-pm", "0.01", "--atol-flight-pm", "1")
     table = np.genfromtxt(csv, delimiter=",", names=True)
-    fixed = hdi.replay(paper_scene, times, heater, dc, atol_pm=0.01, atol_flight_pm=0.01)
+    loose = hdi.replay(paper_scene, times, heater, dc, atol_pm=0.01, atol_flight_pm=1.0)
     for name in hdi.SENSOR_COLUMNS:
-        assert table[name].tolist() == fixed[name].tolist(), name
+        assert table[name].tolist() == loose[name].tolist(), name
     default = hdi.replay(paper_scene, times, heater, dc)
-    assert default["true_gap_nm"].tobytes() != fixed["true_gap_nm"].tobytes()
-    # Both within the default's flight tolerance of each other (1 pm, ten times over).
-    assert np.max(np.abs(default["true_gap_nm"] - fixed["true_gap_nm"])) < 1e-2
+    fixed = hdi.replay(paper_scene, times, heater, dc, atol_pm=0.01, atol_flight_pm=0.01)
+    assert default["true_gap_nm"].tobytes() == fixed["true_gap_nm"].tobytes()
+    assert default["true_gap_nm"].tobytes() != loose["true_gap_nm"].tobytes()
+    assert np.max(np.abs(default["true_gap_nm"] - loose["true_gap_nm"])) < 1e-2
     for kwargs, field in [(dict(atol_pm=0.0), "atol_pm"),
                           (dict(atol_pm=0.1, atol_flight_pm=0.05), "atol_flight_pm"),
                           (dict(atol_flight_pm=float("nan")), "atol_flight_pm")]:
