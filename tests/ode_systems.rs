@@ -23,6 +23,15 @@ fn vdp_jac(_t: f64, y: &Vector2<f64>, j: &mut Matrix2<f64>) {
     );
 }
 
+/// rtol = atol = 1e-6, the final state only, no interpolants.
+fn final_only() -> Options {
+    Options::default()
+        .rtol(1e-6)
+        .atol(1e-6)
+        .save(SaveAt::Final)
+        .dense(false)
+}
+
 #[test]
 fn jacobian_closure_gives_the_trait_implementations_steps() {
     // The problem table's Van der Pol implements `OdeSystem::jacobian` by hand; the closure
@@ -30,11 +39,7 @@ fn jacobian_closure_gives_the_trait_implementations_steps() {
     // Both declare the system autonomous (the problem table does).
     let by_trait = problems::van_der_pol();
     let by_closure = FnSystem::new(vdp_rhs).with_jacobian(vdp_jac).autonomous();
-    let opts = Options::default()
-        .rtol(1e-6)
-        .atol(1e-6)
-        .save(SaveAt::Final)
-        .dense(false);
+    let opts = final_only();
     for m in [Method::Rodas5P, Method::Radau5, Method::Auto] {
         let a = solve(
             &by_trait,
@@ -67,11 +72,7 @@ fn jacobian_closure_gives_the_trait_implementations_steps() {
 
 #[test]
 fn autonomous_declaration_skips_the_time_difference_only() {
-    let opts = Options::default()
-        .rtol(1e-6)
-        .atol(1e-6)
-        .save(SaveAt::Final)
-        .dense(false);
+    let opts = final_only();
     let plain = FnSystem::new(vdp_rhs).with_jacobian(vdp_jac);
     let auto = FnSystem::new(vdp_rhs).with_jacobian(vdp_jac).autonomous();
     let y0 = Vector2::new(2.0, 0.0);
@@ -137,11 +138,7 @@ impl hdi_tribology::ode::OdeSystem<hdi_tribology::nalgebra::U2> for Forced {
 
 #[test]
 fn rodas5p_takes_both_derivatives_from_the_combined_method() {
-    let opts = Options::default()
-        .rtol(1e-6)
-        .atol(1e-6)
-        .save(SaveAt::Final)
-        .dense(false);
+    let opts = final_only();
     let y0 = Vector2::new(2.0, 0.0);
     let run = |combined_only| {
         solve(
