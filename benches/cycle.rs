@@ -42,7 +42,7 @@ fn cycles(c: &mut Criterion) {
     for v_ac in [0.0, 0.6] {
         let model = s.model.with_voltage(Voltage {
             ac_amplitude: v_ac,
-            ..s.model.voltage
+            ..s.model.voltage()
         });
         for method in [
             Method::Tsit5,

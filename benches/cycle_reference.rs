@@ -42,7 +42,7 @@ impl Setup {
     fn at(&self, v_ac: f64) -> SliderModel {
         self.model.with_voltage(Voltage {
             ac_amplitude: v_ac,
-            ..self.model.voltage
+            ..self.model.voltage()
         })
     }
 

@@ -38,7 +38,7 @@ fn run(args: &[String], out: &Path) -> Res<()> {
     if let Some(v) = value("--v-ac") {
         model = model.with_voltage(Voltage {
             ac_amplitude: v.parse()?,
-            ..model.voltage
+            ..model.voltage()
         });
     }
     let programme = if flag("--triggered").is_some() {
@@ -56,7 +56,7 @@ fn run(args: &[String], out: &Path) -> Res<()> {
     let what = format!(
         "{}, V_ac = {} V, {} programme",
         scene.name,
-        model.voltage.ac_amplitude,
+        model.voltage().ac_amplitude,
         if flag("--triggered").is_some() {
             "touchdown-triggered"
         } else {
@@ -108,7 +108,8 @@ fn run(args: &[String], out: &Path) -> Res<()> {
     let mw = |p: Option<f64>| p.map_or("none".to_string(), |p| format!("{:.3} mW", p * 1e3));
     println!(
         "scene {}: V_ac = {} V",
-        scene.name, model.voltage.ac_amplitude
+        scene.name,
+        model.voltage().ac_amplitude
     );
     println!(
         "touchdown {}, take-off {}, hysteresis {}",

@@ -52,16 +52,16 @@ fn main() -> Res<()> {
         let dithered = model.with_voltage(Voltage {
             ac_amplitude: DITHER_V,
             frequency: DITHER_HZ,
-            ..model.voltage
+            ..model.voltage()
         });
         // Quasi-static estimate with dither: touchdown at the pull-in of the peak V².
         let peak = model.with_voltage(Voltage {
-            dc: model.voltage.dc + DITHER_V,
-            ..model.voltage
+            dc: model.voltage().dc + DITHER_V,
+            ..model.voltage()
         });
         let td_peak = touchdown_power(&peak, &StaticOptions::new(th))?;
         // What the static model says the margin leaves (dither off, as in operation).
-        let dc2 = model.voltage.effective_dc().powi(2);
+        let dc2 = model.voltage().effective_dc().powi(2);
         let set = stat.touchdown.power - mw(MARGIN_MW);
         let target = flying_equilibrium(&model, set, dc2, &ScanGrid::default())?.d;
         println!(

@@ -266,7 +266,7 @@ impl Setup {
     fn model(&self, axis: Axis, param: f64, v_ac: f64) -> Res<SliderModel> {
         let b = self.bulge;
         let mut m = self.base.clone();
-        m.structure = match axis {
+        let structure = match axis {
             Axis::Frequency => Structure::bulge(
                 self.body_mass,
                 b.mass,
@@ -275,16 +275,15 @@ impl Setup {
             )?,
             Axis::Damping => Structure::bulge(self.body_mass, b.mass, b.stiffness, param)?,
             Axis::Lag { bulge: true } => {
-                m.interface_lag = param;
+                m = m.with_interface_lag(param);
                 Structure::bulge(self.body_mass, b.mass, b.stiffness, b.zeta)?
             }
             Axis::Lag { bulge: false } => {
-                m.interface_lag = param;
+                m = m.with_interface_lag(param);
                 Structure::rigid(self.body_mass)?
             }
         };
-        m.voltage.ac_amplitude = v_ac;
-        Ok(m)
+        Ok(m.with_structure(structure).with_ac_amplitude(v_ac))
     }
 
     /// One map point. The cycle at the scene's tolerance gives the values; a second cycle at a

@@ -264,7 +264,7 @@ fn rigid_slider(
     let at = |v_ac: f64| {
         model.with_voltage(Voltage {
             ac_amplitude: v_ac,
-            ..model.voltage
+            ..model.voltage()
         })
     };
     let c0 = simulate_cycle(&at(0.0), &fixed, &with_series)?;

@@ -183,7 +183,7 @@ impl Slider {
     fn cycle(&self, v_ac: f64, method: Method, rtol: f64) -> hdi_tribology::Result<CycleResult> {
         let model = self.model.with_voltage(Voltage {
             ac_amplitude: v_ac,
-            ..self.model.voltage
+            ..self.model.voltage()
         });
         let mut opts = CycleOptions::from_scene(&self.scene)?;
         opts.solver.method = method;

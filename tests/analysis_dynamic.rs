@@ -21,7 +21,7 @@ fn paper() -> (Scene, SliderModel, CycleOptions, HeaterProgramme) {
 fn with_ac(model: &SliderModel, v_ac: f64) -> SliderModel {
     model.with_voltage(Voltage {
         ac_amplitude: v_ac,
-        ..model.voltage
+        ..model.voltage()
     })
 }
 
@@ -99,7 +99,11 @@ fn undamped_unforced_slider_conserves_energy() {
     let model = SliderModel::from_scene(&scene).unwrap();
     let power = 0.03;
     let delta = model.protrusion(power);
-    let sys = SliderSystem::new(&model, Programme::constant(power, 1.0).unwrap(), false);
+    let sys = SliderSystem::new(
+        &model,
+        model.inputs(Programme::constant(power, 1.0).unwrap()),
+        false,
+    );
     // Start 2 nm above the flying position, at rest: a large, anharmonic oscillation that comes
     // within a few nanometres of the disk.
     let eq = flying_equilibrium(&model, power, 1.0, &ScanGrid::default()).unwrap();
@@ -134,7 +138,7 @@ fn undamped_unforced_slider_conserves_energy() {
             },
         )
         .unwrap();
-        0.5 * model.structure.body_mass() * v * v + 0.5 * 3e5 * y * y - q.value
+        0.5 * model.structure().body_mass() * v * v + 0.5 * 3e5 * y * y - q.value
     };
     let e0 = energy(sol.y[0][0], sol.y[0][1]);
     let scale = 0.5 * 3e5 * (2e-9f64).powi(2);

@@ -28,7 +28,7 @@ fn reference(
 ) -> (f64, f64) {
     let m = model.with_voltage(Voltage {
         ac_amplitude: v_ac,
-        ..model.voltage
+        ..model.voltage()
     });
     let mut o = *opts;
     o.solver.method = Method::Radau5;
@@ -131,7 +131,7 @@ fn three_agreeing_runs_mean_three_agreeing_runs() {
         assert!(r.runs >= 3, "{v_ac} V: converged after {} runs", r.runs);
         let m = model.with_voltage(Voltage {
             ac_amplitude: v_ac,
-            ..model.voltage
+            ..model.voltage()
         });
         // Tightened as the refinement does, one factor at a time (the same rounding).
         let run = |k: usize| {
@@ -177,7 +177,7 @@ fn the_mean_temperature_is_refined_too() {
     let r = &ac_sweep_refined(&model, &programme, &opts, &[0.8], &refine).unwrap()[0];
     let m = model.with_voltage(Voltage {
         ac_amplitude: 0.8,
-        ..model.voltage
+        ..model.voltage()
     });
     let mut o = opts;
     o.solver.method = Method::Radau5;

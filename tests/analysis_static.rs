@@ -119,7 +119,7 @@ fn equilibria_satisfy_the_force_balance() {
     for e in curve.points.iter().step_by(97) {
         let g = Gaps {
             bulge: e.d,
-            pad: model.nominal_clearance + e.y,
+            pad: model.nominal_clearance() + e.y,
         };
         let f = model.interface_force_exact(g, volt2).unwrap().value;
         let fab = model.bearing().force(e.y, 0.0);
@@ -144,7 +144,7 @@ fn fold_is_a_power_maximum_of_the_flying_branch() {
     // The same fold without voltage terms' help: a DC voltage lowers touchdown.
     let m1 = model.with_voltage(Voltage {
         dc: 1.0,
-        ..model.voltage
+        ..model.voltage()
     });
     assert!(touchdown_power(&m1, &opts).unwrap().power < td.power);
 }

@@ -51,9 +51,9 @@ fn calibrated_touchdown_and_clearance_match_the_static_model() {
     // Same margin on both: the clearances differ by the slope of the flying branch times the power
     // difference. Along the branch |dd/dP| = η k/k_tot ≥ η, with k_tot the total stiffness, which
     // falls towards the fold; so the bound is η·step·k/min(k_tot) at the two set points.
-    let eta = model.efficiency;
+    let eta = model.efficiency();
     let k = model.bearing().stiffness(0.0);
-    let dc2 = model.voltage.effective_dc().powi(2);
+    let dc2 = model.voltage().effective_dc().powi(2);
     let grid = ScanGrid::default();
     let at_cal = flying_equilibrium(&model, cal.set_power, dc2, &grid).unwrap();
     let at_static = flying_equilibrium(&model, td.power - MARGIN, dc2, &grid).unwrap();
@@ -78,7 +78,7 @@ fn calibrated_touchdown_and_clearance_match_the_static_model() {
         cal.clearance,
         at_static.d
     );
-    assert!(cal.clearance > 0.0 && cal.clearance < model.nominal_clearance);
+    assert!(cal.clearance > 0.0 && cal.clearance < model.nominal_clearance());
     // Every level below touchdown was judged flying.
     let n = cal.steps.len();
     assert!(cal.steps[..n - 1].iter().all(|s| !s.contact));
@@ -131,7 +131,7 @@ fn zone_with_more_clearance_moves_touchdown_by_clearance_over_efficiency() {
     // With a linear bearing and every term on the bulge gap, the S-curve δ(d) = h0 − d + F(d)/k
     // shifts by exactly Δh0: the fold moves by Δh0/η = 10 mW. Folds are refined to 1e-12 in d on
     // exact forces, hence 1e-9 relative here.
-    let shift = 1e-9 / m0.efficiency;
+    let shift = 1e-9 / m0.efficiency();
     assert!(
         ((p1 - p0) / shift - 1.0).abs() < 1e-9,
         "shift {} W",
@@ -157,7 +157,7 @@ fn zone_with_more_clearance_moves_touchdown_by_clearance_over_efficiency() {
         m0.bearing().damping(0.0),
         "damping"
     );
-    assert_eq!(m1.friction.disk_speed, zone.disk_speed);
+    assert_eq!(m1.friction().disk_speed, zone.disk_speed);
 }
 
 #[test]
@@ -190,14 +190,14 @@ fn dither_brings_touchdown_earlier() {
     let dithered = model.with_voltage(Voltage {
         ac_amplitude: v_ac,
         frequency: 10.5e3,
-        ..model.voltage
+        ..model.voltage()
     });
     // Quasi-static bounds: the head follows V² (2f = 21 kHz is far below the 87 kHz air-bearing
     // mode), so it cannot touch down later than the static touchdown at the mean V² = V_ac²/2.
     let at = |v: f64| {
         let m = model.with_voltage(Voltage {
             dc: v,
-            ..model.voltage
+            ..model.voltage()
         });
         touchdown_power(&m, &StaticOptions::new(th)).unwrap().power
     };

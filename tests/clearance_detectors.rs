@@ -142,5 +142,5 @@ fn a_user_detector_plugs_into_the_loop() {
         .unwrap();
     let softening = model.bearing().stiffness(0.0) / below.stiffness;
     assert!(cal.clearance < d_star);
-    assert!(d_star - cal.clearance <= model.efficiency * step * softening);
+    assert!(d_star - cal.clearance <= model.efficiency() * step * softening);
 }

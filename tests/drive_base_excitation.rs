@@ -20,7 +20,11 @@ const POWER: f64 = 0.060;
 /// linearised at its flying equilibrium, for a disk `A sin(Ωt + φ)`.
 fn linear_response(plant: &Plant, omega: f64, amplitude: f64) -> (f64, f64) {
     let model = plant.model();
-    let sys = SliderSystem::new(model, Programme::constant(POWER, 1.0).unwrap(), false);
+    let sys = SliderSystem::new(
+        model,
+        model.inputs(Programme::constant(POWER, 1.0).unwrap()),
+        false,
+    );
     let lay = sys.layout();
     let n = lay.len();
     let eq = flying_equilibrium(model, POWER, 0.0, &ScanGrid::default()).unwrap();
@@ -59,7 +63,7 @@ fn linear_response(plant: &Plant, omega: f64, amplitude: f64) -> (f64, f64) {
         big[(r, n + r)] = -omega;
         big[(n + r, r)] = omega;
     }
-    for (i, &r) in model.structure.base_influence().iter().enumerate() {
+    for (i, &r) in model.structure().base_influence().iter().enumerate() {
         rhs[lay.velocity(i)] = r * omega * omega * amplitude;
     }
     let z = big.lu().solve(&rhs).expect("regular");

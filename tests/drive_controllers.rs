@@ -211,7 +211,7 @@ fn clearance_hold_follows_an_ambient_drift() {
     };
     let wavelength = opts.sensors.readback.wavelength;
     let p = plant(4, opts);
-    let eta = p.model().efficiency;
+    let eta = p.model().efficiency();
     let mut stair = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
     stair.find_takeoff = false;
     let settings = HoldSettings {

@@ -23,7 +23,7 @@ const EXPLICIT_LIMIT: f64 = 5.0;
 /// The stable equilibrium on the contact side at `power`: scanning up from the bottom of the
 /// table, the first stable one whose protrusion does not exceed `η P`.
 fn contact_equilibrium(model: &SliderModel, power: f64) -> Option<Equilibrium> {
-    let solver = EquilibriumSolver::new(model, model.voltage.effective_dc().powi(2));
+    let solver = EquilibriumSolver::new(model, model.voltage().effective_dc().powi(2));
     let (lo, hi) = model.forces().table_range();
     let target = model.protrusion(power);
     let mut grid = ScanGrid::default().descending(lo, hi).ok()?;
@@ -44,7 +44,11 @@ fn contact_equilibrium(model: &SliderModel, power: f64) -> Option<Equilibrium> {
 
 /// Magnitudes of the eigenvalues of the slider's Jacobian (dynamic states only) at rest at `e`.
 fn eigen_magnitudes(model: &SliderModel, power: f64, e: &Equilibrium) -> Vec<f64> {
-    let sys = SliderSystem::new(model, Programme::constant(power, 1.0).unwrap(), false);
+    let sys = SliderSystem::new(
+        model,
+        model.inputs(Programme::constant(power, 1.0).unwrap()),
+        false,
+    );
     let n = sys.layout().len();
     let s: DVector<f64> = sys.initial_state(Dyn(n), &e.rest());
     let mut j = DMatrix::zeros(n, n);
@@ -71,7 +75,7 @@ fn contact_ramp_steps(method: Method) -> (Vec<f64>, f64, ode::Stats) {
         .into_iter()
         .fold(0.0, f64::max);
     let programme = Programme::new(vec![(0.0, p0), (1e-3, p0 + 0.005)]).unwrap();
-    let sys = SliderSystem::new(&model, programme, false);
+    let sys = SliderSystem::new(&model, model.inputs(programme), false);
     assert_eq!(sys.layout().len(), 3);
     let y0: DVector<f64> = sys.initial_state(Dyn(3), &e.rest());
     let (k, m) = (3e5f64, 1e-6f64);
@@ -201,7 +205,7 @@ fn stiffness_ratios_of_the_extreme_scenes() {
         let model = SliderModel::from_scene(&scene).unwrap();
         let prog = SliderModel::programme_from_knots(&scene.heater.programme).unwrap();
         let p0 = prog.power(prog.start_time());
-        let volt2 = model.voltage.effective_dc().powi(2);
+        let volt2 = model.voltage().effective_dc().powi(2);
         let mut all = Vec::new();
         let flying = flying_equilibrium(&model, p0, volt2, &ScanGrid::default())
             .ok()
@@ -234,13 +238,13 @@ fn stiffness_ratios_of_the_extreme_scenes() {
         );
         // Independent check of the Jacobian on two-state scenes: the product of the
         // eigenvalues is K/m with K the total stiffness of the static analysis.
-        if model.thermal_lag == 0.0 && model.interface_lag == 0.0 {
+        if model.thermal_lag() == 0.0 && model.interface_lag() == 0.0 {
             if let (Some(v), Ok(e)) = (
                 &flying,
                 flying_equilibrium(&model, p0, volt2, &ScanGrid::default()),
             ) {
                 let prod = v[0] * v[1];
-                let want = e.stiffness / model.structure.body_mass();
+                let want = e.stiffness / model.structure().body_mass();
                 assert!(
                     (prod - want).abs() <= 1e-9 * want,
                     "{}: {prod:e} vs {want:e}",

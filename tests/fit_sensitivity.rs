@@ -66,7 +66,7 @@ fn at_dc(m: &SliderModel, dc: f64) -> SliderModel {
     m.with_voltage(Voltage {
         dc,
         ac_amplitude: 0.0,
-        ..m.voltage
+        ..m.voltage()
     })
 }
 

@@ -176,7 +176,7 @@ proptest! {
         let s = scene(a, sigma, 1e11, 1.5e14, k, v);
         let model = SliderModel::from_scene(&s).unwrap();
         let Ok((td, _)) = hysteresis_of(&s) else { return Ok(()) };
-        let volt2 = model.voltage.effective_dc().powi(2);
+        let volt2 = model.voltage().effective_dc().powi(2);
         let e = flying_equilibrium(&model, frac * td, volt2, &ScanGrid::default()).unwrap();
         let g = model.gaps(&e.q, e.protrusion);
         let f = model.interface_force_exact(g, volt2).unwrap();

@@ -65,9 +65,10 @@ fn a_cycle_spending_steps_too_fast_stops_early() {
         "/scenes/paper_bulge.toml"
     ))
     .unwrap();
-    let mut model = SliderModel::from_scene(&scene).unwrap();
-    model.voltage.ac_amplitude = 1.0;
-    model.interface_lag = 1e-10;
+    let model = SliderModel::from_scene(&scene)
+        .unwrap()
+        .with_ac_amplitude(1.0)
+        .with_interface_lag(1e-10);
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
     opts.solver.max_steps = 300_000;
@@ -91,8 +92,9 @@ fn auto_on_a_stiff_structure_starts_stiff() {
     use hdi_tribology::model::Structure;
     use hdi_tribology::ode::Method;
     let scene = Scene::paper();
-    let mut model = SliderModel::from_scene(&scene).unwrap();
-    model.structure = Structure::bulge(scene.slider.mass_kg, 1e-13, 8e5, 0.05).unwrap();
+    let model = SliderModel::from_scene(&scene)
+        .unwrap()
+        .with_structure(Structure::bulge(scene.slider.mass_kg, 1e-13, 8e5, 0.05).unwrap());
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
     assert_eq!((opts.solver.method, opts.solver.rtol), (Method::Auto, 1e-6));
@@ -124,8 +126,9 @@ fn a_bounce_below_the_tables_stops_when_asked() {
         "/scenes/paper_bulge.toml"
     ))
     .unwrap();
-    let mut model = SliderModel::from_scene(&scene).unwrap();
-    model.interface_lag = 1e-10;
+    let mut model = SliderModel::from_scene(&scene)
+        .unwrap()
+        .with_interface_lag(1e-10);
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
     assert!(!opts.stop_outside_tables);
@@ -133,7 +136,7 @@ fn a_bounce_below_the_tables_stops_when_asked() {
     opts.stop_outside_tables = true;
     let low_nm = model.forces().table_range().0 * 1e9;
     for v_ac in [1.0, 0.8] {
-        model.voltage.ac_amplitude = v_ac;
+        model = model.with_ac_amplitude(v_ac);
         match simulate_cycle(&model, &programme, &opts) {
             Err(Error::Analysis(
                 e @ AnalysisError::LeftTheTables {
@@ -185,10 +188,10 @@ fn the_stop_below_the_tables_leaves_finished_cycles_alone() {
     ))
     .unwrap();
     let bulge = SliderModel::from_scene(&scene).unwrap();
-    let mut rigid = bulge.clone();
-    rigid.structure = Structure::rigid(scene.slider.mass_kg).unwrap();
-    rigid.interface_lag = 1e-5;
-    rigid.voltage.ac_amplitude = 1.0;
+    let rigid = bulge
+        .with_structure(Structure::rigid(scene.slider.mass_kg).unwrap())
+        .with_interface_lag(1e-5)
+        .with_ac_amplitude(1.0);
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
     opts.solver.max_steps = 300_000;

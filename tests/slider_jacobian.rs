@@ -20,7 +20,7 @@ const H_DISPLACEMENT: f64 = 1e-14;
 fn contact_state(sys: &SliderSystem, t: f64, gap: f64, speed: f64) -> DVector<f64> {
     let m = sys.model();
     let lay = sys.layout();
-    let delta = m.protrusion(sys.programme().power(t));
+    let delta = m.protrusion(sys.inputs().heater.power(t));
     let at = |x: f64| {
         let mut q = Dofs::zeros();
         for i in 0..lay.dofs {
@@ -45,7 +45,7 @@ fn contact_state(sys: &SliderSystem, t: f64, gap: f64, speed: f64) -> DVector<f6
             q[k] = x;
         }
         let g = m.gaps(&q, delta);
-        s[i] = 0.9 * m.interface_force(g, m.voltage.squared(t)).value;
+        s[i] = 0.9 * m.interface_force(g, m.voltage().squared(t)).value;
     }
     s
 }
@@ -89,7 +89,7 @@ fn differences(sys: &SliderSystem, t: f64, s: &DVector<f64>) -> (DMatrix<f64>, D
 /// Every entry of the analytic Jacobian and `∂f/∂t` agrees with the differences to `1e-5` of its
 /// row's largest entry (a row's scale: accelerations, rates of lag states, the heat rate).
 fn check(model: &SliderModel, programme: Programme, t: f64, gap: f64, speed: f64) {
-    let sys = SliderSystem::new(model, programme, true);
+    let sys = SliderSystem::new(model, model.inputs(programme), true);
     let lay = sys.layout();
     let s = contact_state(&sys, t, gap, speed);
     let n = s.len();
@@ -135,8 +135,9 @@ fn ramp(p: f64) -> Programme {
 
 #[test]
 fn rigid_slider_in_contact() {
-    let mut model = SliderModel::from_scene(&Scene::paper()).unwrap();
-    model.voltage.ac_amplitude = 0.5;
+    let model = SliderModel::from_scene(&Scene::paper())
+        .unwrap()
+        .with_ac_amplitude(0.5);
     for gap in [0.2e-9, 0.6e-9, 1.0e-9] {
         check(&model, ramp(0.080), 1.1e-3, gap, 1e-4);
     }
@@ -147,8 +148,9 @@ fn rigid_slider_with_interface_and_thermal_lags() {
     let mut scene = Scene::paper();
     scene.slider.interface_lag_s = 1e-9;
     scene.heater.thermal_lag_s = 1e-5;
-    let mut model = SliderModel::from_scene(&scene).unwrap();
-    model.voltage.ac_amplitude = 0.5;
+    let model = SliderModel::from_scene(&scene)
+        .unwrap()
+        .with_ac_amplitude(0.5);
     check(&model, ramp(0.080), 1.1e-3, 0.5e-9, 1e-4);
 }
 
@@ -159,8 +161,9 @@ fn few_peak_bulge_in_contact() {
         "/scenes/paper_bulge.toml"
     ))
     .unwrap();
-    let mut model = SliderModel::from_scene(&scene).unwrap();
-    model.voltage.ac_amplitude = 0.5;
+    let model = SliderModel::from_scene(&scene)
+        .unwrap()
+        .with_ac_amplitude(0.5);
     // Between the peaks (1.0 … 2.0 nm high): two, three and all five in contact.
     for gap in [1.6e-9, 1.4e-9, 0.6e-9] {
         check(&model, ramp(0.080), 1.1e-3, gap, 1e-4);

@@ -91,7 +91,7 @@ fn skipping_gives_the_full_scan_at_other_voltages_and_thresholds() {
         for dc in [0.5, 1.5, 2.5] {
             let v = Voltage {
                 dc,
-                ..model.voltage
+                ..model.voltage()
             };
             let m = model.with_voltage(v);
             for threshold in [1e-7, 5e-5, 1e-3] {
@@ -131,7 +131,7 @@ proptest! {
         }
         .unwrap();
         let model = rigid.with_structure(structure);
-        let model = model.with_voltage(Voltage { dc, ..model.voltage });
+        let model = model.with_voltage(Voltage { dc, ..model.voltage() });
         check("random", &model, 10f64.powf(log_th), excess);
     }
 }

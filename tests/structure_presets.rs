@@ -59,7 +59,7 @@ fn bulge_modes_match_the_two_mass_closed_form() {
     // det(K − ω² M) = 0 with K = [[k_ab + k_b, −k_b], [−k_b, k_b]], M = diag(m, m_b).
     let w2 = quadratic_roots(M * mb, M * kb + mb * (K_AB + kb), K_AB * kb);
     let exact = w2.map(|w| w.sqrt() / (2.0 * PI));
-    let nat = model.structure.natural_frequencies(K_AB);
+    let nat = model.structure().natural_frequencies(K_AB);
     for i in 0..2 {
         assert!(rel(nat[i], exact[i]) < 1e-9, "{nat:?} vs {exact:?}");
     }
@@ -135,7 +135,7 @@ fn static_deflection_of_the_presets_matches_closed_forms() {
         // must make: P_bulge − P_rigid = F/(η k_b).
         assert!((b.y - r.y).abs() <= 1e-12 * r.y.abs(), "{} {}", b.y, r.y);
         assert!(rel(b.q[1] - b.q[0], f / kb) < 1e-9, "d = {d:e}");
-        let dp = f / (rigid.efficiency * kb);
+        let dp = f / (rigid.efficiency() * kb);
         assert!(
             rel(b.power - r.power, dp) < 1e-6,
             "d = {d:e}: {}",
@@ -228,7 +228,7 @@ fn energy_balance_of_a_bulge_cycle() {
     let programme = Programme::new(vec![(0.0, 0.06), (1e-3, 0.08), (2e-3, 0.06)]).unwrap();
     let eq = equilibrium::flying_equilibrium(&model, 0.06, 1.0, &equilibrium::ScanGrid::default())
         .unwrap();
-    let sys = SliderSystem::new(&model, programme.clone(), false);
+    let sys = SliderSystem::new(&model, model.inputs(programme.clone()), false);
     let y0 = sys.initial_state(U4, &eq.rest());
     let o = Options::default()
         .rtol(1e-11)
@@ -256,7 +256,7 @@ fn energy_balance_of_a_bulge_cycle() {
             let t = 0.5 * (a + b) + 0.5 * (b - a) * x;
             let s = sol.sample(t).unwrap();
             let f = model
-                .interface_force(sys.gaps(t, &s), model.voltage.squared(t))
+                .interface_force(sys.gaps(t, &s), model.voltage().squared(t))
                 .value;
             work += 0.5 * (b - a) * wt * f * s[3];
             loss += 0.5 * (b - a) * wt * (c_ab * s[2] * s[2] + cb * (s[3] - s[2]).powi(2));

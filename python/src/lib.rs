@@ -319,7 +319,7 @@ impl Model {
     /// Degrees of freedom of the structure: the length of `Equilibrium.q` and `Mode.shape`.
     #[getter]
     fn dofs(&self) -> usize {
-        self.model.structure.dofs()
+        self.model.structure().dofs()
     }
 
     /// The scene the model was built from (a copy).
@@ -599,7 +599,7 @@ fn static_hysteresis(
     let h = py
         .detach(|| analysis::static_hysteresis(&model, &opts))
         .py()?;
-    let dofs = model.structure.dofs();
+    let dofs = model.structure().dofs();
     Ok(StaticHysteresis {
         touchdown: Transition::of(&h.touchdown, dofs),
         takeoff: Transition::of(&h.takeoff, dofs),
@@ -907,7 +907,7 @@ fn simulate_cycle<'py>(
             Some(a) => {
                 let m = setup.model.with_voltage(Voltage {
                     ac_amplitude: a,
-                    ..setup.model.voltage
+                    ..setup.model.voltage()
                 });
                 analysis::simulate_cycle(&m, &setup.programme, &setup.opts)
             }
@@ -1231,7 +1231,7 @@ fn linear_response(
         .py()?;
     Ok(LinearResponse {
         inner,
-        dofs: model.structure.dofs(),
+        dofs: model.structure().dofs(),
     })
 }
 
@@ -1242,7 +1242,7 @@ fn at_amplitude(model: &SliderModel, v_ac: Option<f64>) -> PyResult<Option<Slide
         Some(a) if !a.is_finite() => Err(invalid("v_ac", format!("must be finite, got {a:?} V"))),
         Some(a) => Ok(Some(model.with_voltage(Voltage {
             ac_amplitude: a,
-            ..model.voltage
+            ..model.voltage()
         }))),
     }
 }
@@ -1268,12 +1268,12 @@ fn flying_equilibrium(
             analysis::flying_equilibrium(
                 m,
                 units::mw(power_mw),
-                m.voltage.mean_squared(),
+                m.voltage().mean_squared(),
                 &ScanGrid::default(),
             )
         })
         .py()?;
-    Ok(Equilibrium::of(&e, model.structure.dofs()))
+    Ok(Equilibrium::of(&e, model.structure().dofs()))
 }
 
 /// The dither of the bulge at twice the AC frequency from a simulation at constant heater power
@@ -1379,7 +1379,7 @@ fn calibrate(
     let dithered = dither_v.map(|v| {
         model.with_voltage(Voltage {
             ac_amplitude: v,
-            ..model.voltage
+            ..model.voltage()
         })
     });
     let model: &SliderModel = dithered.as_ref().unwrap_or(&model);

@@ -109,10 +109,10 @@ pub struct CycleOptions {
     /// use hdi_tribology::error::AnalysisError;
     /// use hdi_tribology::{model::SliderModel, scene::Scene, Error};
     /// let scene = Scene::from_path(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper_bulge.toml"))?;
-    /// let mut model = SliderModel::from_scene(&scene)?;
     /// // A 0.1 ns interface lag at 1 V AC: the few-peak contact bounces deep into the disk.
-    /// model.voltage.ac_amplitude = 1.0;
-    /// model.interface_lag = 1e-10;
+    /// let model = SliderModel::from_scene(&scene)?
+    ///     .with_ac_amplitude(1.0)
+    ///     .with_interface_lag(1e-10);
     /// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
     /// let mut opts = CycleOptions::from_scene(&scene)?;
     /// opts.solver.max_steps = 300_000;
@@ -304,9 +304,9 @@ pub fn simulate_cycle(
     // Dispatch on the state size to stack vectors: a step allocates nothing, and a scene pays
     // only for the coordinates and lags it uses.
     let layout = StateLayout::new(
-        model.structure.dofs(),
-        model.thermal_lag > 0.0,
-        model.interface_lag > 0.0,
+        model.structure().dofs(),
+        model.thermal_lag() > 0.0,
+        model.interface_lag() > 0.0,
         true,
     );
     match layout.len() {
@@ -471,7 +471,7 @@ struct Run<'m, D: DimName>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    it: Integrator<'static, D, SliderSystem<'m>>,
+    it: Integrator<'static, D, SliderSystem>,
     rec: Record<D>,
     model: &'m SliderModel,
     opts: &'m CycleOptions,
@@ -573,7 +573,7 @@ where
             check_positive("programme.overshoot", overshoot)?;
             crate::error::check_non_negative("programme.start_power", start_power)?;
             // Search up to the power whose protrusion is twice the nominal clearance.
-            let span = 2.0 * model.nominal_clearance / model.efficiency;
+            let span = 2.0 * model.nominal_clearance() / model.efficiency();
             // Bound the search, in overshoots, so that a heater too weak to ever reach touchdown
             // fails at once instead of running for ever.
             let segments = span / overshoot;
@@ -595,14 +595,14 @@ where
     };
 
     let t0 = initial_programme.start_time();
-    let volt2_0 = model.voltage.squared(t0);
+    let volt2_0 = model.voltage().squared(t0);
     let eq = flying_equilibrium(
         model,
         initial_programme.power(t0),
         volt2_0,
         &ScanGrid::default(),
     )?;
-    let sys = SliderSystem::new(model, initial_programme.clone(), true);
+    let sys = SliderSystem::new(model, model.inputs(initial_programme.clone()), true);
     let layout = sys.layout();
     let q = layout
         .contact_impulse
@@ -619,7 +619,7 @@ where
     let ode_opts = ode_options(&sys, opts, kinks)?;
     // Stop where the lumped model ends: the pad gap h0 + y reaching zero puts the slider body
     // into the disk (no pad contact is modelled; a power-law bearing is singular there).
-    let h0 = model.nominal_clearance;
+    let h0 = model.nominal_clearance();
     let guard = ode::Event::new(move |_t, s: &OVector<f64, D>| h0 + s[0])
         .direction(ode::Direction::Falling)
         .terminal(true);
@@ -697,7 +697,9 @@ where
                 }
                 run.it.reinit(t_peak, y).map_err(ode_err)?;
             }
-            *run.it.system_mut() = SliderSystem::new(model, final_programme.clone(), true);
+            run.it
+                .system_mut()
+                .set_inputs(model.inputs(final_programme.clone()));
             run.it.set_tf(t_end).map_err(ode_err)?;
             run.run_to_end()?;
             search_from = t_peak;
@@ -732,7 +734,7 @@ where
         .as_ref()
         .map(|states| series_of(run.it.system(), &run.rec.times, states, &detecting));
     Ok(CycleResult {
-        v_ac: model.voltage.ac_amplitude,
+        v_ac: model.voltage().ac_amplitude,
         touchdown,
         takeoff,
         hysteresis,
@@ -774,7 +776,7 @@ fn ode_options(sys: &SliderSystem, opts: &CycleOptions, kinks: Vec<f64>) -> Resu
     let o = Options::default()
         .rtol(s.rtol)
         .atol_per_component(atol)
-        .h_max(sys.model().max_step(s.max_step))
+        .h_max(sys.max_step(s.max_step))
         .max_steps(s.max_steps)
         .t_stops(kinks)
         .dense(true);
@@ -796,12 +798,12 @@ where
 {
     let g = sys.gaps(t, s);
     let mut self_excited = None;
-    if model.interface_lag > 0.0 {
+    if model.interface_lag() > 0.0 {
         let k_contact = -model.forces().contact(g).d_bulge;
         let c = model.bearing().damping(s[0]);
-        if k_contact > 0.0 && model.interface_lag > c / k_contact {
+        if k_contact > 0.0 && model.interface_lag() > c / k_contact {
             self_excited = Some(crate::error::SelfExcitation {
-                interface_lag_ns: model.interface_lag * 1e9,
+                interface_lag_ns: model.interface_lag() * 1e9,
                 limit_ns: c / k_contact * 1e9,
             });
         }
@@ -876,11 +878,11 @@ where
     for (t, s) in times.iter().zip(states) {
         let t = *t;
         let g = sys.gaps(t, s);
-        let volt2 = model.voltage.squared(t);
+        let volt2 = model.voltage().squared(t);
         let b = model.breakdown(g, volt2);
         let f_ab = sys.bearing_force(s);
         out.t.push(t);
-        out.power.push(sys.programme().power(t));
+        out.power.push(sys.inputs().heater.power(t));
         out.d.push(g.bulge);
         out.air_bearing.push(f_ab);
         out.intermolecular.push(b.intermolecular);

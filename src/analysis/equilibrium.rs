@@ -245,7 +245,7 @@ impl<'a> Skipper<'a> {
 /// Analyses in heater power need a heater that moves the bulge: `η > 0` (with `η = 0` every
 /// power gives the same protrusion, and powers found from protrusions would be ±∞ or NaN).
 pub(crate) fn check_heater(model: &SliderModel) -> Result<()> {
-    crate::error::check_positive("heater.efficiency_m_per_w", model.efficiency).map(|_| ())
+    crate::error::check_positive("heater.efficiency_m_per_w", model.efficiency()).map(|_| ())
 }
 
 /// Evaluates equilibria of one model at one `V²`, tabulated or exact.
@@ -292,7 +292,7 @@ impl<'a> EquilibriumSolver<'a> {
         b: f64,
         quantity: impl Fn(&Equilibrium) -> f64,
     ) -> Result<Equilibrium> {
-        let tol = fold_tolerance(a, b, self.model.nominal_clearance);
+        let tol = fold_tolerance(a, b, self.model.nominal_clearance());
         let mut seen: Vec<Equilibrium> = Vec::new();
         let exact = |d| match self.at_gap_exact(d) {
             Ok(e) => {
@@ -335,7 +335,7 @@ impl<'a> EquilibriumSolver<'a> {
     /// `δ = h0 + bᵀq − d`: the gap geometry solved for the protrusion.
     fn protrusion(&self, d: f64, q: &Dofs) -> f64 {
         let m = self.model;
-        m.nominal_clearance + m.structure.bulge_displacement(q) - d
+        m.nominal_clearance() + m.structure().bulge_displacement(q) - d
     }
 
     fn assemble(&self, d: f64, q: Dofs, f: &ForceEval) -> Equilibrium {
@@ -395,7 +395,7 @@ pub struct SCurve {
 /// ```
 pub fn s_curve(model: &SliderModel, range: Option<(f64, f64)>, grid: &ScanGrid) -> Result<SCurve> {
     check_heater(model)?;
-    let volt2 = model.voltage.dc_squared();
+    let volt2 = model.voltage().dc_squared();
     let (lo, hi) = range.unwrap_or_else(|| model.forces().table_range());
     if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
         return Err(Error::invalid(
@@ -481,7 +481,7 @@ pub fn flying_equilibrium(
                 }
                 .into());
             };
-            let tol = fold_tolerance(e.d, p.d, model.nominal_clearance);
+            let tol = fold_tolerance(e.d, p.d, model.nominal_clearance());
             let d = brent(
                 |x| solver.at_gap(x).map_or(f64::NAN, |q| q.protrusion - target),
                 e.d,

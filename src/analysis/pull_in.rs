@@ -64,7 +64,7 @@ impl VoltageBalance<'_> {
     /// `(V², total stiffness, contact force)` at gap `d`, tabulated or exact.
     fn at(&self, d: f64, exact: bool) -> Result<(f64, f64, f64)> {
         let m = self.model;
-        let (q, load, k_structure) = m.bulge_load(d - m.nominal_clearance + self.delta)?;
+        let (q, load, k_structure) = m.bulge_load(d - m.nominal_clearance() + self.delta)?;
         let g = m.gaps(&q, self.delta);
         let (s, e) = if exact {
             m.interface_parts_exact(g)?
@@ -124,7 +124,7 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
         }
         let (v2, k, fc) = vb.at(d, false)?;
         if let Some((pd, _pv2, _pk, _)) = prev {
-            let tol = 1e-12 * d.abs().max(1e-3 * model.nominal_clearance);
+            let tol = 1e-12 * d.abs().max(1e-3 * model.nominal_clearance());
             let polish = opts.grid.polish_from_tables;
             if k <= 0.0 {
                 let (df, (v2f, _, _)) = vb.refine(d, pd, tol, polish, |r| r.1)?;
@@ -192,7 +192,7 @@ pub fn clearance_change(
     opts: &StaticOptions,
 ) -> Result<Vec<ClearanceChange>> {
     super::equilibrium::check_heater(model)?;
-    let phi = model.voltage.contact_potential;
+    let phi = model.voltage().contact_potential;
     let reference = touchdown_at(model, 0.0, opts)?.power;
     dc_voltages
         .iter()
@@ -201,13 +201,13 @@ pub fn clearance_change(
             check_finite(&format!("dc_voltages[{i}]"), v)?;
             let m = model.with_voltage(Voltage {
                 dc: v,
-                ..model.voltage
+                ..model.voltage()
             });
             let p = touchdown_at(&m, (v - phi).powi(2), opts)?.power;
             Ok(ClearanceChange {
                 dc_voltage: v,
                 touchdown_power: p,
-                clearance_change: model.efficiency * (p - reference),
+                clearance_change: model.efficiency() * (p - reference),
             })
         })
         .collect()

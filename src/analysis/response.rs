@@ -174,7 +174,7 @@ fn mode_shape(b: &DMatrix<f64>, scale: &DVector<f64>, l: Complex64, dofs: usize)
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse> {
-    let v = model.voltage;
+    let v = model.voltage();
     let mean_volt2 = v.mean_squared();
     let eq = flying_equilibrium(model, power, mean_volt2, &ScanGrid::default())?;
     // Freeze the voltage at its mean square: a DC voltage with the same V².
@@ -183,17 +183,21 @@ pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse
         ac_amplitude: 0.0,
         ..v
     });
-    let sys = SliderSystem::new(&frozen, Programme::constant(power, 1.0)?, false);
+    let sys = SliderSystem::new(
+        &frozen,
+        frozen.inputs(Programme::constant(power, 1.0)?),
+        false,
+    );
     let layout = sys.layout();
     let n = layout.len();
     let state = sys.initial_state(Dyn(n), &eq.rest());
     let mut a = DMatrix::<f64>::zeros(n, n);
     OdeSystem::<Dyn>::jacobian(&sys, 0.0, &state, &mut a);
     // A unit interface force enters through the lag, or through M⁻¹b on the accelerations.
-    let st = &model.structure;
+    let st = &model.structure();
     let mut input = DVector::<f64>::zeros(n);
     match layout.lagged_force {
-        Some(i) => input[i] = 1.0 / model.interface_lag,
+        Some(i) => input[i] = 1.0 / model.interface_lag(),
         None => {
             let per_force = st.mass_solve(&st.bulge_vector());
             for r in 0..layout.dofs {
@@ -278,7 +282,7 @@ pub fn simulated_dither(
     periods: usize,
 ) -> Result<f64> {
     use crate::ode::{solve, Options, SaveAt};
-    let v = model.voltage;
+    let v = model.voltage();
     if !v.is_time_dependent() {
         return Err(AnalysisError::NoAcVoltage.into());
     }
@@ -288,7 +292,11 @@ pub fn simulated_dither(
     let period = 1.0 / (2.0 * v.frequency.abs());
     let t_end = (settle + periods) as f64 * period;
     let eq = flying_equilibrium(model, power, v.squared(0.0), &ScanGrid::default())?;
-    let sys = SliderSystem::new(model, Programme::constant(power, t_end)?, false);
+    let sys = SliderSystem::new(
+        model,
+        model.inputs(Programme::constant(power, t_end)?),
+        false,
+    );
     let y0 = sys.initial_state(Dyn(sys.layout().len()), &eq.rest());
     let t_start = settle as f64 * period;
     let samples = 400 * periods;
@@ -299,14 +307,14 @@ pub fn simulated_dither(
     let o = Options::default()
         .rtol(s.rtol)
         .atol_per_component(sys.tolerances(s.atol_displacement, 0.0, 0.0))
-        .h_max(model.max_step(None))
+        .h_max(sys.max_step(None))
         .max_steps(s.max_steps)
         .save(SaveAt::Times(times));
     let sol = solve(&sys, 0.0, y0, t_end, s.method, &o, &mut [])?;
     let (lo, hi) = sol
         .y
         .iter()
-        .map(|x| model.structure.bulge_displacement(&sys.coordinates(x)))
+        .map(|x| model.structure().bulge_displacement(&sys.coordinates(x)))
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
             (a.min(y), b.max(y))
         });

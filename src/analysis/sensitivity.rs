@@ -40,7 +40,7 @@ fn contact_force_exact(model: &SliderModel, q: &Dofs, delta: f64) -> Result<f64>
 /// The balance of `changed` at gap `d`, one Newton step from `q` (a balance of a nearby model):
 /// its coordinates and protrusion, exact to first order in the difference of the models.
 fn stepped(changed: &SliderModel, d: f64, q: &Dofs) -> Result<(Dofs, f64)> {
-    let (step, _) = changed.exact_balance_step(d, changed.voltage.dc_squared(), q)?;
+    let (step, _) = changed.exact_balance_step(d, changed.voltage().dc_squared(), q)?;
     let step = step.ok_or_else(|| {
         Error::from(crate::error::AnalysisError::NoSensitivity {
             gap_nm: d * 1e9,
@@ -83,8 +83,8 @@ pub fn transition_shift(model: &SliderModel, changed: &SliderModel, t: &Transiti
         Cause::Fold => Ok(dp_fixed_gap),
         Cause::Threshold => {
             // Slopes along the gap of the unchanged model, by central differences.
-            let base = EquilibriumSolver::new(model, model.voltage.dc_squared());
-            let h = 1e-5 * model.nominal_clearance.abs().max(1e-12);
+            let base = EquilibriumSolver::new(model, model.voltage().dc_squared());
+            let h = 1e-5 * model.nominal_clearance().abs().max(1e-12);
             let (lo, hi) = (base.at_gap_exact(d - h)?, base.at_gap_exact(d + h)?);
             let dp_dd = (hi.power - lo.power) / (2.0 * h);
             let fc = |m: &SliderModel, e: &Equilibrium| contact_force_exact(m, &e.q, e.protrusion);

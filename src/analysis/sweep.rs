@@ -58,7 +58,7 @@ fn per_amplitude<T: Send>(
     let one = |&v_ac: &f64| {
         run(&model.with_voltage(Voltage {
             ac_amplitude: v_ac,
-            ..model.voltage
+            ..model.voltage()
         }))
     };
     #[cfg(feature = "parallel")]

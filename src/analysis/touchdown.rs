@@ -111,7 +111,7 @@ impl StaticHysteresis {
 pub fn touchdown_power(model: &SliderModel, opts: &StaticOptions) -> Result<Transition> {
     opts.validate()?;
     super::equilibrium::check_heater(model)?;
-    let volt2 = model.voltage.dc_squared();
+    let volt2 = model.voltage().dc_squared();
     touchdown_at(model, volt2, opts)
 }
 
@@ -264,7 +264,7 @@ pub fn takeoff_power(
     opts.validate()?;
     super::equilibrium::check_heater(model)?;
     crate::error::check_finite("start_power", start_power)?;
-    let volt2 = model.voltage.dc_squared();
+    let volt2 = model.voltage().dc_squared();
     takeoff_at(model, volt2, start_power, opts)
 }
 

@@ -265,7 +265,7 @@ pub fn calibrate(
     let dt = opts.sample_interval;
     // The drive of the model as it is: a flat disk, the model's own heater (no added lag), its
     // voltage carried by every command; the detector reads the true values of each sample.
-    let h_max = model.max_step(None);
+    let h_max = model.voltage().max_step(None);
     let drive_opts = DriveOptions {
         initial_power: sc.start_power,
         heater_time_constant: 0.0,
@@ -279,7 +279,7 @@ pub fn calibrate(
         ..DriveOptions::default()
     };
     let mut drive = Plant::from_model(model, 0.025, 0, drive_opts)?.into_drive()?;
-    let v = model.voltage;
+    let v = model.voltage();
     let settings = StaircaseSettings {
         start_power: sc.start_power,
         step: sc.step,
@@ -346,7 +346,7 @@ pub fn calibrate(
             ),
         ));
     }
-    let dc2 = model.voltage.dc_squared();
+    let dc2 = model.voltage().dc_squared();
     let clearance = flying_equilibrium(model, set_power, dc2, &ScanGrid::default())?.d;
     Ok(Calibration {
         detector: name,

@@ -235,6 +235,16 @@ impl Disk {
     }
 }
 
+impl crate::model::BaseMotion for Disk {
+    fn acceleration(&self, t: f64) -> (f64, f64) {
+        Disk::acceleration(self, t)
+    }
+    #[inline]
+    fn acceleration_value(&self, t: f64) -> f64 {
+        Disk::acceleration_value(self, t)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

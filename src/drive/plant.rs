@@ -5,13 +5,10 @@ use super::sensors::{Physical, SensorSpec, SensorState, Sensors, Truth};
 use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
 use crate::error::{check_finite, check_non_negative, Error, Result};
-use crate::heater::Programme;
-use crate::model::{Rest, SliderModel, SliderSystem, StateLayout, Voltage};
-use crate::ode::{Integrator, Method, OdeSystem, Options, Stats};
+use crate::model::{Heater, Inputs, Rest, SliderModel, SliderSystem, StateLayout, Voltage};
+use crate::ode::{Integrator, Method, Options, Stats};
 use crate::scene::Scene;
-use nalgebra::{
-    allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector, U10, U4, U5, U6, U7, U8, U9,
-};
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector, U10, U4, U5, U6, U7, U8, U9};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -262,86 +259,6 @@ pub fn scene_zone(scene: &Scene, radius: f64) -> Result<Zone> {
     })
 }
 
-/// The slider's ODE with the disk surface moving under it.
-///
-/// The state is relative to the disk surface `w(t)` (every force of the model depends on the
-/// gaps and their rates only), so the surface's motion enters as the base excitation
-/// `−M r ẅ(t)`, with `r` the structure's influence of a rigid disk translation on each
-/// coordinate ([`crate::model::Structure::base_influence`]): `−r_i ẅ` on each acceleration.
-/// Everything else is the model's own [`SliderSystem`], evaluated on `model`, the model of the
-/// current command (heater, voltage, ambient clearance), which [`Drive::step`] sets through
-/// [`Integrator::system_mut`] when the command changes.
-#[derive(Clone)]
-struct DriveSystem {
-    model: SliderModel,
-    programme: Programme,
-    disk: Disk,
-    /// `(velocity index, r_i)` of the coordinates a disk translation moves.
-    base: [(usize, f64); crate::scene::MAX_DOF],
-    n_base: usize,
-}
-
-impl DriveSystem {
-    /// The model's ODE for the current command. Cloning the programme shares its knots: no
-    /// allocation.
-    #[inline]
-    fn slider(&self) -> SliderSystem<'_> {
-        SliderSystem::new(&self.model, self.programme.clone(), true)
-    }
-}
-
-impl<D: Dim> OdeSystem<D> for DriveSystem
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    fn rhs(&self, t: f64, y: &OVector<f64, D>, dy: &mut OVector<f64, D>) {
-        self.slider().rhs(t, y, dy);
-        if !self.disk.is_flat() {
-            let a = self.disk.acceleration_value(t);
-            for &(i, r) in &self.base[..self.n_base] {
-                dy[i] -= r * a;
-            }
-        }
-    }
-
-    fn jacobian(&self, t: f64, y: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
-        self.slider().jacobian(t, y, j)
-    }
-
-    fn time_derivative(&self, t: f64, y: &OVector<f64, D>, d: &mut OVector<f64, D>) -> bool {
-        let ok = self.slider().time_derivative(t, y, d);
-        self.add_base_jerk(ok, t, d)
-    }
-
-    fn jacobian_and_time_derivative(
-        &self,
-        t: f64,
-        y: &OVector<f64, D>,
-        j: &mut OMatrix<f64, D, D>,
-        d: &mut OVector<f64, D>,
-    ) -> (bool, bool) {
-        let (jac, ok) = self.slider().jacobian_and_time_derivative(t, y, j, d);
-        (jac, self.add_base_jerk(ok, t, d))
-    }
-}
-
-impl DriveSystem {
-    /// The disk's motion in `∂f/∂t`: its jerk on the coordinates it moves, when `ok` (the
-    /// slider's part was written). Returns `ok`.
-    fn add_base_jerk<D: Dim>(&self, ok: bool, t: f64, d: &mut OVector<f64, D>) -> bool
-    where
-        DefaultAllocator: Allocator<D>,
-    {
-        if ok && !self.disk.is_flat() {
-            let jerk = self.disk.acceleration(t).1;
-            for &(i, r) in &self.base[..self.n_base] {
-                d[i] -= r * jerk;
-            }
-        }
-        ok
-    }
-}
-
 /// A drive before it runs: the slider of a scene in a zone, its disk, heater, sensors and
 /// solver settings. [`Plant::drive`] starts a [`Drive`] on it (several in turn, each from the
 /// same start); [`Plant::into_drive`] and [`Drive::new`] start one that shares the plant
@@ -364,11 +281,13 @@ impl DriveSystem {
 /// ```
 #[derive(Clone)]
 pub struct Plant {
-    system: DriveSystem,
+    /// The slider under the start's inputs, the disk's motion among them.
+    system: SliderSystem,
+    /// The disk surface (its motion is in the system's inputs).
+    disk: Arc<Disk>,
     base: SliderModel,
     layout: StateLayout,
     start: Rest,
-    start_voltage: Voltage,
     start_sensors: Physical,
     sensors: SensorSpec,
     ambient: Ambient,
@@ -409,7 +328,7 @@ impl Plant {
         let start_voltage = Voltage {
             dc: 0.0,
             ac_amplitude: 0.0,
-            ..base.voltage
+            ..base.voltage()
         };
         Self::build(base, zone.clone(), seed, opts, start_voltage, max_steps)
     }
@@ -426,10 +345,10 @@ impl Plant {
     /// let opts = DriveOptions { disk: DiskSpec::flat(), ..DriveOptions::default() };
     /// let mut drive = Plant::from_model(&model, 0.025, 1, opts)?.into_drive()?;
     /// // The commands carry the model's own DC voltage.
-    /// let cmd = Command { dc_voltage: model.voltage.dc, ..Command::heater_mw(60.0) };
+    /// let cmd = Command { dc_voltage: model.voltage().dc, ..Command::heater_mw(60.0) };
     /// let s = drive.step(&cmd, 50e-6)?;
     /// // Flying: the heater has closed part of the nominal clearance.
-    /// assert!(s.truth.gap > 1e-9 && s.truth.gap < model.nominal_clearance);
+    /// assert!(s.truth.gap > 1e-9 && s.truth.gap < model.nominal_clearance());
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
     ///
@@ -445,11 +364,11 @@ impl Plant {
         let zone = Zone {
             name: "model".into(),
             radius,
-            disk_speed: model.friction.disk_speed,
-            nominal_clearance: model.nominal_clearance,
+            disk_speed: model.friction().disk_speed,
+            nominal_clearance: model.nominal_clearance(),
             bearing_stiffness: model.bearing().stiffness(0.0),
         };
-        let v = model.voltage;
+        let v = model.voltage();
         Self::build(
             model.clone(),
             zone,
@@ -492,22 +411,27 @@ impl Plant {
         if let Some(h) = opts.max_step {
             crate::error::check_positive("max_step", h)?;
         }
-        if base.thermal_lag == 0.0 {
-            base.thermal_lag = opts.heater_time_constant;
+        if base.thermal_lag() == 0.0 {
+            base = base.with_thermal_lag(opts.heater_time_constant);
         }
         let rpm = zone.disk_speed * 60.0 / (2.0 * PI * zone.radius);
         let disk = Disk::new(&opts.disk, rpm, seed)?;
-        // The heater command enters as the protrusion per unit power of a constant 1 W programme
-        // (`η P` = `(η P) · 1 W`), so a new command needs no new programme.
-        let programme = Programme::constant(1.0, 1.0)?;
         let at_start = base.with_voltage(start_voltage);
         let eq = flying_equilibrium(
             &at_start,
             opts.initial_power,
-            at_start.voltage.squared(0.0),
+            at_start.voltage().squared(0.0),
             &ScanGrid::default(),
         )?;
-        let probe = SliderSystem::new(&base, programme.clone(), true);
+        let disk = Arc::new(disk);
+        let start_inputs = Inputs {
+            heater: Heater::Power(opts.initial_power),
+            voltage: start_voltage,
+            clearance_offset: 0.0,
+            base_motion: base_motion(&disk),
+        };
+        let system = SliderSystem::new(&base, start_inputs, true);
+        let probe = &system;
         let layout = probe.layout();
         // The period means of the contact force and flash temperature: 0.1 µN and 0.1 K over
         // 50 µs (the contact sensor resolves about 0.2 µN of contact force per period in
@@ -532,7 +456,7 @@ impl Plant {
             .dense(true);
         ode.validate(layout.len())
             .map_err(|e| Error::invalid("solver", e.to_string()))?;
-        let friction = base.friction.coefficient * zone.disk_speed;
+        let friction = base.friction().coefficient * zone.disk_speed;
         let start_sensors = Physical {
             gap: eq.d,
             heater_power: opts.initial_power,
@@ -541,24 +465,18 @@ impl Plant {
         };
         let mut bases = [(0usize, 0.0); crate::scene::MAX_DOF];
         let mut n_base = 0;
-        for (i, &r) in base.structure.base_influence().iter().enumerate() {
+        for (i, &r) in base.structure().base_influence().iter().enumerate() {
             if r != 0.0 {
                 bases[n_base] = (layout.velocity(i), r);
                 n_base += 1;
             }
         }
         Ok(Plant {
-            system: DriveSystem {
-                model: base.clone(),
-                programme,
-                disk,
-                base: bases,
-                n_base,
-            },
+            system,
+            disk,
             base,
             layout,
             start: eq.rest(),
-            start_voltage,
             start_sensors,
             sensors: opts.sensors,
             ambient: opts.ambient,
@@ -581,7 +499,10 @@ impl Plant {
     /// None in practice (the disk was valid for the first seed).
     pub fn with_seed(&self, seed: u64) -> Result<Plant> {
         let mut p = self.clone();
-        p.system.disk = Disk::new(&self.disk_spec, self.rpm, seed)?;
+        p.disk = Arc::new(Disk::new(&self.disk_spec, self.rpm, seed)?);
+        let mut inputs = p.system.inputs().clone();
+        inputs.base_motion = base_motion(&p.disk);
+        p.system.set_inputs(inputs);
         p.seed = seed;
         Ok(p)
     }
@@ -629,13 +550,13 @@ impl Plant {
 // One per drive, built once and never moved per step: the size difference costs nothing.
 #[allow(clippy::large_enum_variant)]
 enum Integ {
-    S4(Integrator<'static, U4, DriveSystem>),
-    S5(Integrator<'static, U5, DriveSystem>),
-    S6(Integrator<'static, U6, DriveSystem>),
-    S7(Integrator<'static, U7, DriveSystem>),
-    S8(Integrator<'static, U8, DriveSystem>),
-    S9(Integrator<'static, U9, DriveSystem>),
-    S10(Integrator<'static, U10, DriveSystem>),
+    S4(Integrator<'static, U4, SliderSystem>),
+    S5(Integrator<'static, U5, SliderSystem>),
+    S6(Integrator<'static, U6, SliderSystem>),
+    S7(Integrator<'static, U7, SliderSystem>),
+    S8(Integrator<'static, U8, SliderSystem>),
+    S9(Integrator<'static, U9, SliderSystem>),
+    S10(Integrator<'static, U10, SliderSystem>),
 }
 
 macro_rules! with_integ {
@@ -700,9 +621,7 @@ impl Drive {
     /// # Errors
     /// A state size the drive has no fixed-size vector for; integrator set-up failures.
     pub fn new(plant: Arc<Plant>) -> Result<Self> {
-        let mut sys = plant.system.clone();
-        sys.model.voltage = plant.start_voltage;
-        sys.model.efficiency = plant.base.efficiency * plant.start_sensors.heater_power;
+        let sys = plant.system.clone();
         let (m, o) = (plant.method, &plant.ode);
         let rest = plant.start;
         let mut tol = TolState {
@@ -711,7 +630,7 @@ impl Drive {
         };
         macro_rules! start {
             ($variant:ident, $dim:expr) => {{
-                let y0 = sys.slider().initial_state($dim, &rest);
+                let y0 = sys.initial_state($dim, &rest);
                 tol.y0[..y0.len()].copy_from_slice(y0.as_slice());
                 Integ::$variant(Integrator::new(sys, 0.0, y0, HORIZON, m, o)?)
             }};
@@ -760,7 +679,7 @@ impl Drive {
         let plant = &*self.plant;
         let (t0, t1) = (self.t, self.t + dt);
         let ambient = plant.ambient.temperature(t0);
-        let clearance = plant.base.nominal_clearance + plant.ambient.clearance_per_kelvin * ambient;
+        let clearance = plant.ambient.clearance_per_kelvin * ambient;
         let changed = self.held != Some((*command, clearance));
         self.unchanged = if changed { 0 } else { self.unchanged + 1 };
         let layout = plant.layout;
@@ -775,23 +694,23 @@ impl Drive {
         let set = changed.then_some(Held {
             command,
             clearance,
-            base: &plant.base,
+            contact_potential: plant.base.voltage().contact_potential,
         });
         let tol = plant.tol.adapts().then_some((&plant.tol, &mut self.tol));
         let (truth, integrals) = with_integ!(&mut self.integ, it => {
             let y1 = advance(it, &layout, set, &mut self.integrals0, span, tol)?;
-            let s = it.system().slider();
+            let s = it.system();
             let integrals = (
                 layout.contact_impulse.map_or(0.0, |i| y1[i]),
                 layout.heat.map_or(0.0, |i| y1[i]),
             );
-            (observe(&s, &y1, &layout, t1, dt, self.integrals0), integrals)
+            (observe(s, &y1, &layout, t1, dt, self.integrals0), integrals)
         });
         self.held = Some((*command, clearance));
         self.integrals0 = integrals;
         self.t = t1;
         let friction_power =
-            plant.base.friction.coefficient * plant.zone.disk_speed * truth.mean_contact_force;
+            plant.base.friction().coefficient * plant.zone.disk_speed * truth.mean_contact_force;
         let phys = Physical {
             gap: truth.gap,
             heater_power: command.heater_power,
@@ -808,7 +727,7 @@ impl Drive {
             truth: Truth {
                 friction_power,
                 sensor_temperature: temp,
-                disk_height: plant.system.disk.height(t1).0,
+                disk_height: plant.disk.height(t1).0,
                 ambient,
                 ..truth
             },
@@ -844,22 +763,33 @@ impl Drive {
 /// A new command to set in the integrator's system.
 struct Held<'a> {
     command: &'a Command,
+    /// The ambient change of the clearance (m).
     clearance: f64,
-    base: &'a SliderModel,
+    /// The model's contact potential (V).
+    contact_potential: f64,
 }
 
 impl Held<'_> {
-    /// The model of the command: no clone, four numbers written.
-    fn apply(&self, m: &mut SliderModel) {
-        m.efficiency = self.base.efficiency * self.command.heater_power;
-        m.nominal_clearance = self.clearance;
-        m.voltage = Voltage {
-            dc: self.command.dc_voltage,
-            ac_amplitude: self.command.ac_amplitude,
-            frequency: self.command.ac_frequency,
-            contact_potential: self.base.voltage.contact_potential,
+    /// The inputs of the command, the disk's motion kept.
+    fn apply(&self, sys: &mut SliderSystem) {
+        let inputs = Inputs {
+            heater: Heater::Power(self.command.heater_power),
+            voltage: Voltage {
+                dc: self.command.dc_voltage,
+                ac_amplitude: self.command.ac_amplitude,
+                frequency: self.command.ac_frequency,
+                contact_potential: self.contact_potential,
+            },
+            clearance_offset: self.clearance,
+            base_motion: sys.inputs().base_motion.clone(),
         };
+        sys.set_inputs(inputs);
     }
+}
+
+/// The disk's motion as an input: `None` for a flat disk (nothing to add).
+fn base_motion(disk: &Arc<Disk>) -> Option<Arc<dyn crate::model::BaseMotion>> {
+    (!disk.is_flat()).then(|| disk.clone() as Arc<dyn crate::model::BaseMotion>)
 }
 
 /// Longest state a drive integrates (`Integ`'s largest size).
@@ -911,7 +841,7 @@ impl TolRule {
     }
 
     /// Sets the integrator's per-component tolerance for displacement tolerance `x` (m).
-    fn apply<D: Dim>(&self, x: f64, it: &mut Integrator<'static, D, DriveSystem>) -> Result<()>
+    fn apply<D: Dim>(&self, x: f64, it: &mut Integrator<'static, D, SliderSystem>) -> Result<()>
     where
         DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {
@@ -931,12 +861,11 @@ struct TolState {
 }
 
 /// Largest slope of the contact force at a state (N/m), on either gap.
-fn contact_slope<D: Dim>(sys: &DriveSystem, t: f64, y: &OVector<f64, D>) -> f64
+fn contact_slope<D: Dim>(sys: &SliderSystem, t: f64, y: &OVector<f64, D>) -> f64
 where
     DefaultAllocator: Allocator<D>,
 {
-    let s = sys.slider();
-    let c = sys.model.forces().contact(s.gaps(t, y));
+    let c = sys.model().forces().contact(sys.gaps(t, y));
     c.d_bulge.abs().max(c.d_pad.abs())
 }
 
@@ -981,7 +910,7 @@ const SETTLE_PERIODS: usize = 4;
 /// the next period tightens to what the slope asks, or loosens once that is twice the
 /// tolerance or more.
 fn advance<D: Dim>(
-    it: &mut Integrator<'static, D, DriveSystem>,
+    it: &mut Integrator<'static, D, SliderSystem>,
     layout: &StateLayout,
     set: Option<Held<'_>>,
     integrals0: &mut (f64, f64),
@@ -1011,7 +940,7 @@ where
             *integrals0 = (0.0, 0.0);
         }
         if let Some(held) = set {
-            held.apply(&mut it.system_mut().model);
+            held.apply(it.system_mut());
         }
         if let Some((rule, st)) = tol.as_mut() {
             st.y0[..y.len()].copy_from_slice(y.as_slice());
@@ -1061,7 +990,7 @@ where
 /// ahead). With `slopes`, returns the largest contact-force slope at the step ends (`None`
 /// when no step ended: the last one spans the period).
 fn run_period<D: Dim>(
-    it: &mut Integrator<'static, D, DriveSystem>,
+    it: &mut Integrator<'static, D, SliderSystem>,
     span: Span,
     slopes: bool,
 ) -> Result<Option<f64>>
@@ -1101,7 +1030,7 @@ where
 }
 
 /// The state at `t1`, on the interpolant of the last step when it ran past.
-fn end_state<D: Dim>(it: &Integrator<'static, D, DriveSystem>, t1: f64) -> Result<OVector<f64, D>>
+fn end_state<D: Dim>(it: &Integrator<'static, D, SliderSystem>, t1: f64) -> Result<OVector<f64, D>>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
@@ -1115,7 +1044,7 @@ where
 /// The true values at the end of a period, the period means from the integrals' change since
 /// `integrals0`.
 fn observe<D: Dim>(
-    sys: &SliderSystem<'_>,
+    sys: &SliderSystem,
     y: &OVector<f64, D>,
     layout: &StateLayout,
     t: f64,
@@ -1136,7 +1065,7 @@ where
         protrusion: sys.protrusion(t, y),
         mean_contact_force: mean(layout.contact_impulse, integrals0.0),
         contact_force: m.contact_force(g),
-        interface_force: m.interface_force(g, m.voltage.squared(t)).value,
+        interface_force: m.interface_force(g, sys.inputs().voltage.squared(t)).value,
         mean_flash_temperature: mean(layout.heat, integrals0.1),
         ..Truth::default()
     }

@@ -275,7 +275,7 @@ impl<'a> Evaluator<'a> {
                             m.with_voltage(Voltage {
                                 dc: ds.x[i],
                                 ac_amplitude: 0.0,
-                                ..m.voltage
+                                ..m.voltage()
                             })
                         };
                         let b = at(base);
@@ -378,7 +378,7 @@ fn predict_static(m: &SliderModel, scene: &Scene, ds: &DataSet) -> Result<Vec<Ve
         let mv = m.with_voltage(Voltage {
             dc: v,
             ac_amplitude: 0.0,
-            ..m.voltage
+            ..m.voltage()
         });
         rows.push(if needs_takeoff {
             let h = static_hysteresis(&mv, &opts)?;

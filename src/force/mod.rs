@@ -32,6 +32,7 @@ mod fused;
 mod interface;
 mod intermolecular;
 mod pressure;
+mod stateful;
 mod term;
 
 pub use air_bearing::{AirBearing, AirBearingModel, CubicBearing, LinearBearing, PowerLawBearing};
@@ -43,4 +44,5 @@ pub(crate) use interface::by_coupling;
 pub use interface::{Breakdown, ForceEval, Gaps, HotForces, HotValues, InterfaceForces};
 pub use intermolecular::Intermolecular;
 pub use pressure::{lj_zero, Coulomb, LennardJones39, PressureLaw};
+pub use stateful::{RatePartials, RelaxingState, StateForce, StatefulTerm, MAX_TERM_STATES};
 pub use term::{Coupling, GapReference, InterfaceTerm, TermForce, TermKind};

@@ -4,16 +4,18 @@
 //! [`SliderSystem`] lays that physics out as an ODE for [`crate::ode`]. This is the only module
 //! that knows both the physics and the stepper.
 
+mod inputs;
 mod structure;
 mod system;
 
+pub use inputs::{BaseMotion, Heater, Inputs};
 pub use structure::{Dofs, Structure};
 pub use system::{Rest, SliderSystem, StateLayout};
 
 use crate::error::{Error, Result};
 use crate::force::{
     by_coupling, AirBearing, AirBearingModel, Breakdown, ForceEval, Gaps, HotForces, HotValues,
-    InterfaceForces,
+    InterfaceForces, StatefulTerm,
 };
 use crate::heater::Programme;
 use crate::quadrature::Span;
@@ -91,6 +93,23 @@ impl Voltage {
     /// The DC part of the effective voltage, `V_dc − φ`.
     pub fn effective_dc(&self) -> f64 {
         self.dc - self.contact_potential
+    }
+
+    /// The largest step (s) of an integration under this voltage: `given`, else a fortieth of
+    /// the period of `V²`'s source with AC (no peak of `V²` is stepped over), else unlimited.
+    ///
+    /// ```
+    /// # use hdi_tribology::model::Voltage;
+    /// let v = Voltage { dc: 0.0, ac_amplitude: 0.5, frequency: 1.0e4, contact_potential: 0.0 };
+    /// assert_eq!(v.max_step(None), 1.0 / 4.0e5);
+    /// assert_eq!(v.max_step(Some(1e-3)), 1e-3);
+    /// ```
+    pub fn max_step(&self, given: Option<f64>) -> f64 {
+        given.unwrap_or(if self.is_time_dependent() {
+            1.0 / (40.0 * self.frequency.abs())
+        } else {
+            f64::INFINITY
+        })
     }
 }
 
@@ -171,19 +190,21 @@ pub struct SliderModel {
     forces: Arc<InterfaceForces>,
     bearing: Arc<dyn AirBearing>,
     /// Masses, springs and dampers, and where the bulge sits.
-    pub structure: Structure,
+    structure: Structure,
     /// Nominal clearance `h0` (m).
-    pub nominal_clearance: f64,
+    nominal_clearance: f64,
     /// Heater efficiency `η` (m/W).
-    pub efficiency: f64,
+    efficiency: f64,
     /// Thermal lag `τ_th` (s); 0 removes the state.
-    pub thermal_lag: f64,
+    thermal_lag: f64,
     /// Interface lag `τ_lag` (s); 0 removes the state.
-    pub interface_lag: f64,
-    /// Head–disk voltage.
-    pub voltage: Voltage,
+    interface_lag: f64,
+    /// The scene's head–disk voltage: the voltage of [`SliderModel::inputs`].
+    voltage: Voltage,
     /// Friction and flash temperature.
-    pub friction: Friction,
+    friction: Friction,
+    /// Terms that carry states of their own (none unless added).
+    stateful: Arc<[Arc<dyn StatefulTerm>]>,
     /// Whether the bearing is the linear spring (its stiffness does not depend on `y`).
     linear_bearing: bool,
 }
@@ -238,16 +259,135 @@ impl SliderModel {
                 disk_speed: scene.friction.disk_speed_m_per_s,
                 conductivity: scene.friction.head_conductivity_w_per_m_k,
             },
+            stateful: Arc::new([]),
             linear_bearing: matches!(scene.air_bearing, AirBearingModel::Linear { .. }),
         })
     }
 
-    /// The same model with another voltage (tables are shared, not rebuilt).
+    /// The inputs of the scene for a heater: the scene's voltage, no change of clearance, the
+    /// disk at rest.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{model::{Heater, SliderModel}, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let inputs = model.inputs(Heater::Power(0.06));
+    /// assert_eq!(inputs.voltage, model.voltage());
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn inputs(&self, heater: impl Into<Heater>) -> Inputs {
+        Inputs::new(heater.into(), self.voltage)
+    }
+
+    /// The same model with another voltage for its analyses (tables are shared, not rebuilt).
     pub fn with_voltage(&self, voltage: Voltage) -> Self {
         SliderModel {
             voltage,
             ..self.clone()
         }
+    }
+
+    /// The same model with the AC amplitude `v_ac` (V) of its voltage changed (tables shared).
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?.with_ac_amplitude(0.6);
+    /// assert_eq!(model.voltage().ac_amplitude, 0.6);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn with_ac_amplitude(&self, v_ac: f64) -> Self {
+        self.with_voltage(Voltage {
+            ac_amplitude: v_ac,
+            ..self.voltage
+        })
+    }
+
+    /// The same model with the thermal lag `τ_th` (s; 0 removes the state).
+    pub fn with_thermal_lag(&self, tau: f64) -> Self {
+        SliderModel {
+            thermal_lag: tau,
+            ..self.clone()
+        }
+    }
+
+    /// The same model with the interface lag `τ_lag` (s; 0 removes the state).
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?.with_interface_lag(1e-8);
+    /// assert_eq!(model.interface_lag(), 1e-8);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn with_interface_lag(&self, tau: f64) -> Self {
+        SliderModel {
+            interface_lag: tau,
+            ..self.clone()
+        }
+    }
+
+    /// The same model with one more term that carries states of its own ([`StatefulTerm`]):
+    /// every dynamic analysis then integrates its states, and the static analyses take their
+    /// equilibrium.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{force::RelaxingState, model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let with = model.with_stateful_term(RelaxingState::relaxation(1e-4, 1.0)?);
+    /// assert_eq!(with.stateful_terms().len(), 1);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn with_stateful_term(&self, term: impl StatefulTerm + 'static) -> Self {
+        let mut all: Vec<Arc<dyn StatefulTerm>> = self.stateful.to_vec();
+        all.push(Arc::new(term));
+        SliderModel {
+            stateful: all.into(),
+            ..self.clone()
+        }
+    }
+
+    /// The terms that carry states of their own.
+    pub fn stateful_terms(&self) -> &[Arc<dyn StatefulTerm>] {
+        &self.stateful
+    }
+
+    /// The number of states the stateful terms add.
+    pub fn term_states(&self) -> usize {
+        self.stateful.iter().map(|t| t.states()).sum()
+    }
+
+    /// Masses, springs and dampers, and where the bulge sits.
+    pub fn structure(&self) -> &Structure {
+        &self.structure
+    }
+
+    /// Nominal clearance `h0` (m).
+    pub fn nominal_clearance(&self) -> f64 {
+        self.nominal_clearance
+    }
+
+    /// Heater efficiency `η` (m/W).
+    pub fn efficiency(&self) -> f64 {
+        self.efficiency
+    }
+
+    /// Thermal lag `τ_th` (s); 0 when there is none.
+    pub fn thermal_lag(&self) -> f64 {
+        self.thermal_lag
+    }
+
+    /// Interface lag `τ_lag` (s); 0 when there is none.
+    pub fn interface_lag(&self) -> f64 {
+        self.interface_lag
+    }
+
+    /// The scene's head–disk voltage (the voltage of [`SliderModel::inputs`] and of the static
+    /// analyses).
+    pub fn voltage(&self) -> Voltage {
+        self.voltage
+    }
+
+    /// Friction and flash-temperature parameters.
+    pub fn friction(&self) -> Friction {
+        self.friction
     }
 
     /// The same model on another structure (tables are shared, not rebuilt): a map over the
@@ -257,7 +397,7 @@ impl SliderModel {
     /// use hdi_tribology::{model::{SliderModel, Structure}, scene::Scene};
     /// let rigid = SliderModel::from_scene(&Scene::paper())?;
     /// let bulge = rigid.with_structure(Structure::bulge(1e-6, 1e-13, 4e5, 0.05)?);
-    /// assert_eq!(bulge.structure.dofs(), 2);
+    /// assert_eq!(bulge.structure().dofs(), 2);
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
     pub fn with_structure(&self, structure: Structure) -> Self {
@@ -291,10 +431,18 @@ impl SliderModel {
     /// is `h0 + bᵀq − δ` and the pad gap `h0 + q₀` (for the rigid slider: `h0 + y − δ`, `h0 + y`).
     #[inline]
     pub fn gaps(&self, q: &Dofs, delta: f64) -> Gaps {
-        self.gaps_at(
-            self.nominal_clearance + self.structure.bulge_displacement(q) - delta,
-            q[0],
-        )
+        self.gaps_offset(q, delta, 0.0)
+    }
+
+    /// [`SliderModel::gaps`] with the nominal clearance changed by `offset` (m): `h0 + offset`
+    /// in place of `h0` ([`Inputs::clearance_offset`]).
+    #[inline]
+    pub fn gaps_offset(&self, q: &Dofs, delta: f64, offset: f64) -> Gaps {
+        let h0 = self.nominal_clearance + offset;
+        Gaps {
+            bulge: h0 + self.structure.bulge_displacement(q) - delta,
+            pad: h0 + q[0],
+        }
     }
 
     /// The gaps when the bulge gap is held at `d` and the body heaves by `y` (m): the pad gap

@@ -1,15 +1,16 @@
 //! The slider as an ODE: state layout, right-hand side and analytic Jacobian.
 
-use super::{Dofs, SliderModel};
-use crate::force::Gaps;
-use crate::heater::Programme;
+use super::{Dofs, Inputs, SliderModel};
+use crate::force::{Gaps, MAX_TERM_STATES};
 use crate::ode::OdeSystem;
+use crate::scene::MAX_DOF;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
+use std::sync::Arc;
 
 /// Where each quantity sits in the state vector. Only what the scene needs is there: one position
 /// and one velocity per degree of freedom of the structure, the protrusion only with a thermal
-/// lag, the lagged force only with an interface lag, and the two running integrals only when a
-/// cycle needs them.
+/// lag, the lagged force only with an interface lag, the states of the model's stateful terms
+/// ([`crate::force::StatefulTerm`]), and the two running integrals only when a cycle needs them.
 ///
 /// ```
 /// use hdi_tribology::model::StateLayout;
@@ -27,6 +28,9 @@ pub struct StateLayout {
     pub delta: Option<usize>,
     /// Lagged interface force `F_eff` (N), with an interface lag.
     pub lagged_force: Option<usize>,
+    /// The states of the stateful terms, in the order of the model's terms: `n` of them from
+    /// index `start`, as `(start, n)`.
+    pub term_states: (usize, usize),
     /// `Q = ∫ F_c dt` (N s): the running mean of the contact force is `(Q(t) − Q(t − T_w))/T_w`.
     pub contact_impulse: Option<usize>,
     /// `Θ = ∫ ΔT dt` (K s): the time mean of the flash temperature.
@@ -35,8 +39,20 @@ pub struct StateLayout {
 }
 
 impl StateLayout {
-    /// Positions and velocities of `dofs` coordinates first, then the optional states.
+    /// Positions and velocities of `dofs` coordinates first, then the optional states (no
+    /// states of stateful terms; see [`StateLayout::of`]).
     pub fn new(dofs: usize, thermal_lag: bool, interface_lag: bool, integrals: bool) -> Self {
+        Self::with_term_states(dofs, thermal_lag, interface_lag, 0, integrals)
+    }
+
+    /// As [`StateLayout::new`], with `terms` states of stateful terms after the lags.
+    pub fn with_term_states(
+        dofs: usize,
+        thermal_lag: bool,
+        interface_lag: bool,
+        terms: usize,
+        integrals: bool,
+    ) -> Self {
         let mut len = 2 * dofs;
         let mut next = |on: bool| {
             on.then(|| {
@@ -46,16 +62,47 @@ impl StateLayout {
         };
         let delta = next(thermal_lag);
         let lagged_force = next(interface_lag);
+        let term_states = (len, terms);
+        len += terms;
+        let mut next = |on: bool| {
+            on.then(|| {
+                len += 1;
+                len - 1
+            })
+        };
         let contact_impulse = next(integrals);
         let heat = next(integrals);
         StateLayout {
             dofs,
             delta,
             lagged_force,
+            term_states,
             contact_impulse,
             heat,
             len,
         }
+    }
+
+    /// The one home of a model's layout: its structure's coordinates, its lags and its stateful
+    /// terms' states, plus the integrals when asked for.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{force::RelaxingState, model::{SliderModel, StateLayout}, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// assert_eq!(StateLayout::of(&model, true).len(), 4);
+    /// let with = model.with_stateful_term(RelaxingState::relaxation(1e-4, 1.0)?);
+    /// let l = StateLayout::of(&with, true);
+    /// assert_eq!((l.len(), l.term_states, l.contact_impulse), (5, (2, 1), Some(3)));
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn of(model: &SliderModel, integrals: bool) -> Self {
+        Self::with_term_states(
+            model.structure().dofs(),
+            model.thermal_lag() > 0.0,
+            model.interface_lag() > 0.0,
+            model.term_states(),
+            integrals,
+        )
     }
 
     /// Index of the velocity of coordinate `i`.
@@ -86,20 +133,27 @@ pub struct Rest {
     pub interface_force: f64,
 }
 
-/// [`SliderModel`] under a heater programme, as an [`OdeSystem`].
+/// [`SliderModel`] under its [`Inputs`], as an [`OdeSystem`].
+///
+/// The system shares the model (its tables are not copied) and owns the inputs, which
+/// [`SliderSystem::set_inputs`] replaces between steps: a new heater power, voltage, clearance
+/// change or disk motion is a new value, and the model is never rewritten.
 ///
 /// ```no_run
 /// use hdi_tribology::{heater::Programme, model::{SliderModel, SliderSystem}, scene::Scene};
 /// let model = SliderModel::from_scene(&Scene::paper())?;
-/// let sys = SliderSystem::new(&model, Programme::constant(0.06, 1e-3)?, false);
-/// assert_eq!(sys.layout().len(), 2 * model.structure.dofs());
+/// let sys = SliderSystem::new(&model, model.inputs(Programme::constant(0.06, 1e-3)?), false);
+/// assert_eq!(sys.layout().len(), 2 * model.structure().dofs());
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 #[derive(Clone, Debug)]
-pub struct SliderSystem<'a> {
-    model: &'a SliderModel,
-    programme: Programme,
+pub struct SliderSystem {
+    model: Arc<SliderModel>,
+    inputs: Inputs,
     layout: StateLayout,
+    /// `(velocity index, r_i)` of the coordinates a disk translation moves.
+    base: [(usize, f64); MAX_DOF],
+    n_base: usize,
 }
 
 /// Forces and their derivatives at one state.
@@ -111,19 +165,30 @@ struct Local {
     hot: crate::force::HotForces,
 }
 
-impl<'a> SliderSystem<'a> {
-    /// The slider under `programme`; `integrals` adds the contact impulse and heat states.
-    pub fn new(model: &'a SliderModel, programme: Programme, integrals: bool) -> Self {
-        let layout = StateLayout::new(
-            model.structure.dofs(),
-            model.thermal_lag > 0.0,
-            model.interface_lag > 0.0,
-            integrals,
-        );
+impl SliderSystem {
+    /// The slider of `model` under `inputs`; `integrals` adds the contact impulse and heat
+    /// states. The model is shared with the system (a copy that shares its tables).
+    pub fn new(model: &SliderModel, inputs: Inputs, integrals: bool) -> Self {
+        Self::shared(Arc::new(model.clone()), inputs, integrals)
+    }
+
+    /// [`SliderSystem::new`] on a model already shared.
+    pub fn shared(model: Arc<SliderModel>, inputs: Inputs, integrals: bool) -> Self {
+        let layout = StateLayout::of(&model, integrals);
+        let mut base = [(0usize, 0.0); MAX_DOF];
+        let mut n_base = 0;
+        for (i, &r) in model.structure().base_influence().iter().enumerate() {
+            if r != 0.0 {
+                base[n_base] = (layout.velocity(i), r);
+                n_base += 1;
+            }
+        }
         SliderSystem {
             model,
-            programme,
+            inputs,
             layout,
+            base,
+            n_base,
         }
     }
 
@@ -132,14 +197,30 @@ impl<'a> SliderSystem<'a> {
         self.layout
     }
 
-    /// The heater programme.
-    pub fn programme(&self) -> &Programme {
-        &self.programme
+    /// The inputs.
+    pub fn inputs(&self) -> &Inputs {
+        &self.inputs
+    }
+
+    /// Replaces the inputs (a discontinuity of the right-hand side: an integrator restarts after
+    /// it, see [`crate::ode::Integrator::reinit`]).
+    pub fn set_inputs(&mut self, inputs: Inputs) {
+        self.inputs = inputs;
     }
 
     /// The model.
     pub fn model(&self) -> &SliderModel {
-        self.model
+        &self.model
+    }
+
+    /// The model, shared.
+    pub fn model_arc(&self) -> &Arc<SliderModel> {
+        &self.model
+    }
+
+    /// The largest step (s) under the inputs' voltage ([`super::Voltage::max_step`]).
+    pub fn max_step(&self, given: Option<f64>) -> f64 {
+        self.inputs.voltage.max_step(given)
     }
 
     /// The one home of "start at rest": the state at `rest` with zero velocities, in a vector of
@@ -157,6 +238,22 @@ impl<'a> SliderSystem<'a> {
         }
         if let Some(i) = self.layout.lagged_force {
             s[i] = rest.interface_force;
+        }
+        let (start, n) = self.layout.term_states;
+        if n > 0 {
+            let g = self
+                .model
+                .gaps_offset(&rest.q, rest.protrusion, self.inputs.clearance_offset);
+            let mut at = start;
+            for term in self.model.stateful_terms() {
+                let k = term.states();
+                let mut x = [0.0; MAX_TERM_STATES];
+                term.initial(g, &mut x[..k]);
+                for (j, v) in x[..k].iter().enumerate() {
+                    s[at + j] = *v;
+                }
+                at += k;
+            }
         }
         s
     }
@@ -199,7 +296,7 @@ impl<'a> SliderSystem<'a> {
     {
         match self.layout.delta {
             Some(i) => s[i],
-            None => self.model.protrusion(self.programme.power(t)),
+            None => self.model.protrusion(self.inputs.heater.power(t)),
         }
     }
 
@@ -208,7 +305,11 @@ impl<'a> SliderSystem<'a> {
     where
         DefaultAllocator: Allocator<D>,
     {
-        self.model.gaps(&self.coordinates(s), self.protrusion(t, s))
+        self.model.gaps_offset(
+            &self.coordinates(s),
+            self.protrusion(t, s),
+            self.inputs.clearance_offset,
+        )
     }
 
     /// The air-bearing force at state `s` (N).
@@ -223,9 +324,8 @@ impl<'a> SliderSystem<'a> {
     where
         DefaultAllocator: Allocator<D>,
     {
-        let delta = self.protrusion(t, s);
-        let g = self.model.gaps(&self.coordinates(s), delta);
-        let volt2 = self.model.voltage.squared(t);
+        let g = self.gaps(t, s);
+        let volt2 = self.inputs.voltage.squared(t);
         let (f, hot) = self.model.hot_forces(g, volt2);
         Local { g, f, hot }
     }
@@ -233,7 +333,7 @@ impl<'a> SliderSystem<'a> {
     /// The derivative of the flash temperature (the heat state's rate) along the bulge gap at
     /// the point of `l`: the derivative of the interpolants the right-hand side reads.
     fn heat_slope(&self, l: &Local) -> f64 {
-        let m = self.model;
+        let m = &*self.model;
         let (area, area_rate) = m.forces().real_contact_area_with_slope(l.g);
         let c = &l.hot.contact;
         m.friction
@@ -259,7 +359,7 @@ impl<'a> SliderSystem<'a> {
     ) where
         DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {
-        let m = self.model;
+        let m = &*self.model;
         let st = &m.structure;
         let lay = self.layout;
         let n = lay.dofs;
@@ -341,22 +441,32 @@ impl<'a> SliderSystem<'a> {
                 j[(i, k)] = -dd;
             }
         }
+        if lay.term_states.1 > 0 {
+            self.term_jacobian(l.g, s, j);
+        }
     }
 
     /// `∂f/∂t` at time `t` and the point of `l`, `dd` the flash temperature's slope there.
-    fn time_derivative_at<D: Dim>(&self, t: f64, l: &Local, dd: f64, dfdt: &mut OVector<f64, D>)
-    where
+    fn time_derivative_at<D: Dim>(
+        &self,
+        t: f64,
+        l: &Local,
+        dd: f64,
+        s: &OVector<f64, D>,
+        dfdt: &mut OVector<f64, D>,
+    ) where
         DefaultAllocator: Allocator<D>,
     {
-        let m = self.model;
+        let m = &*self.model;
         dfdt.fill(0.0);
-        let (_, p_rate) = self.programme.power_and_rate(t);
+        let (_, p_rate) = self.inputs.heater.power_and_rate(t);
         // Protrusion moves with the programme only without a thermal lag.
         let delta_rate = match self.layout.delta {
             Some(_) => 0.0,
             None => m.protrusion(p_rate),
         };
-        let f_t = -l.f.d_bulge * delta_rate + m.voltage.squared_rate(t) * l.hot.per_volt2.value;
+        let f_t =
+            -l.f.d_bulge * delta_rate + self.inputs.voltage.squared_rate(t) * l.hot.per_volt2.value;
         match self.layout.lagged_force {
             Some(i) => dfdt[i] = f_t / m.interface_lag,
             None => {
@@ -376,25 +486,141 @@ impl<'a> SliderSystem<'a> {
         if let Some(i) = self.layout.heat {
             dfdt[i] = -dd * delta_rate;
         }
+        if self.layout.term_states.1 > 0 {
+            self.term_time_derivative(l.g, s, delta_rate, dfdt);
+        }
+        if let Some(b) = &self.inputs.base_motion {
+            let jerk = b.acceleration(t).1;
+            for &(i, r) in &self.base[..self.n_base] {
+                dfdt[i] -= r * jerk;
+            }
+        }
+    }
+
+    /// Calls `f(term, index of its first state)` for every stateful term.
+    fn for_terms(&self, mut f: impl FnMut(&dyn crate::force::StatefulTerm, usize)) {
+        let mut at = self.layout.term_states.0;
+        for term in self.model.stateful_terms() {
+            f(&**term, at);
+            at += term.states();
+        }
+    }
+
+    /// The sum of the stateful terms' forces at gaps `g` and state `s` (N), with their rates
+    /// written into `ds`.
+    fn term_rates<D: Dim>(&self, g: Gaps, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) -> f64
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let mut force = 0.0;
+        self.for_terms(|term, at| {
+            let k = term.states();
+            let x = &s.as_slice()[at..at + k];
+            let mut dx = [0.0; MAX_TERM_STATES];
+            term.rates(g, x, &mut dx[..k]);
+            ds.as_mut_slice()[at..at + k].copy_from_slice(&dx[..k]);
+            force += term.force(g, x).force.value;
+        });
+        force
+    }
+
+    /// The stateful terms' part of the Jacobian: their forces on the accelerations (through
+    /// `M⁻¹b`, not lagged) and their rates' rows.
+    fn term_jacobian<D: Dim>(&self, g: Gaps, s: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>)
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let st = &self.model.structure;
+        let lay = self.layout;
+        let n = lay.dofs;
+        let b = st.bulge_vector();
+        let per_force = st.mass_solve(&b);
+        let along = |d_bulge: f64, d_pad: f64, c: usize| {
+            let pad = if c == 0 { d_pad } else { 0.0 };
+            d_bulge * b[c] + pad
+        };
+        self.for_terms(|term, at| {
+            let k = term.states();
+            let x = &s.as_slice()[at..at + k];
+            let f = term.force(g, x);
+            let p = term.rate_partials(g, x);
+            for r in 0..n {
+                let v = lay.velocity(r);
+                for col in 0..n {
+                    j[(v, col)] += per_force[r] * along(f.force.d_bulge, f.force.d_pad, col);
+                }
+                if let Some(kd) = lay.delta {
+                    j[(v, kd)] += per_force[r] * -f.force.d_bulge;
+                }
+                for c in 0..k {
+                    j[(v, at + c)] += per_force[r] * f.d_state[c];
+                }
+            }
+            for i in 0..k {
+                for col in 0..n {
+                    j[(at + i, col)] = along(p.d_bulge[i], p.d_pad[i], col);
+                }
+                if let Some(kd) = lay.delta {
+                    j[(at + i, kd)] = -p.d_bulge[i];
+                }
+                for c in 0..k {
+                    j[(at + i, at + c)] = p.d_state[i][c];
+                }
+            }
+        });
+    }
+
+    /// The stateful terms' part of `∂f/∂t`: through the protrusion's rate `delta_rate` (m/s).
+    fn term_time_derivative<D: Dim>(
+        &self,
+        g: Gaps,
+        s: &OVector<f64, D>,
+        delta_rate: f64,
+        dfdt: &mut OVector<f64, D>,
+    ) where
+        DefaultAllocator: Allocator<D>,
+    {
+        if delta_rate == 0.0 {
+            return;
+        }
+        let st = &self.model.structure;
+        let lay = self.layout;
+        let per_force = st.mass_solve(&st.bulge_vector());
+        self.for_terms(|term, at| {
+            let k = term.states();
+            let x = &s.as_slice()[at..at + k];
+            let f = term.force(g, x);
+            let p = term.rate_partials(g, x);
+            for r in 0..lay.dofs {
+                dfdt[lay.velocity(r)] += per_force[r] * (-f.force.d_bulge * delta_rate);
+            }
+            for i in 0..k {
+                dfdt[at + i] = -p.d_bulge[i] * delta_rate;
+            }
+        });
     }
 }
 
-impl<D: Dim> OdeSystem<D> for SliderSystem<'_>
+impl<D: Dim> OdeSystem<D> for SliderSystem
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
-        let m = self.model;
+        let m = &*self.model;
         let st = &m.structure;
         let lay = self.layout;
         // The values alone: no slope is needed here.
         let (q, v) = (self.coordinates(s), self.velocities(s));
         let delta = self.protrusion(t, s);
-        let hot = m.hot_values(m.gaps(&q, delta), m.voltage.squared(t));
-        let drive = match lay.lagged_force {
+        let g = m.gaps_offset(&q, delta, self.inputs.clearance_offset);
+        let hot = m.hot_values(g, self.inputs.voltage.squared(t));
+        let mut drive = match lay.lagged_force {
             Some(i) => s[i],
             None => hot.interface,
         };
+        if lay.term_states.1 > 0 {
+            drive += self.term_rates(g, s, ds);
+        }
         let f_ab = m.bearing().force(q[0], v[0]);
         let a = st.mass_solve(&st.generalised_force(&q, &v, f_ab, drive));
         for i in 0..lay.dofs {
@@ -402,7 +628,7 @@ where
             ds[lay.velocity(i)] = a[i];
         }
         if let Some(i) = lay.delta {
-            ds[i] = (m.protrusion(self.programme.power(t)) - delta) / m.thermal_lag;
+            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - delta) / m.thermal_lag;
         }
         if let Some(i) = lay.lagged_force {
             ds[i] = (hot.interface - s[i]) / m.interface_lag;
@@ -412,6 +638,12 @@ where
         }
         if let Some(i) = lay.heat {
             ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
+        }
+        if let Some(b) = &self.inputs.base_motion {
+            let a = b.acceleration_value(t);
+            for &(i, r) in &self.base[..self.n_base] {
+                ds[i] -= r * a;
+            }
         }
     }
 
@@ -423,7 +655,7 @@ where
 
     fn time_derivative(&self, t: f64, s: &OVector<f64, D>, dfdt: &mut OVector<f64, D>) -> bool {
         let l = self.local(t, s);
-        self.time_derivative_at(t, &l, self.heat_slope_if_kept(&l), dfdt);
+        self.time_derivative_at(t, &l, self.heat_slope_if_kept(&l), s, dfdt);
         true
     }
 
@@ -438,7 +670,7 @@ where
         let l = self.local(t, s);
         let dd = self.heat_slope_if_kept(&l);
         self.jacobian_at(&l, dd, s, j);
-        self.time_derivative_at(t, &l, dd, dfdt);
+        self.time_derivative_at(t, &l, dd, s, dfdt);
         (true, true)
     }
 }
@@ -478,36 +710,27 @@ impl SliderModel {
         }
         r
     }
-
-    /// The largest step (s): `given`, else a fortieth of the voltage period with AC (no peak of
-    /// `V²` is stepped over), else unlimited.
-    pub fn max_step(&self, given: Option<f64>) -> f64 {
-        let v = self.voltage;
-        given.unwrap_or(if v.is_time_dependent() {
-            1.0 / (40.0 * v.frequency.abs())
-        } else {
-            f64::INFINITY
-        })
-    }
 }
 
-impl SliderSystem<'_> {
+impl SliderSystem {
     /// Absolute tolerances of every state for the displacement tolerance `displacement` (m):
     /// positions to `displacement` (rotations to it over their lever), velocities times their
     /// angular frequency, the protrusion to `displacement`, the lagged force times the stiffness
-    /// at the bulge, and the integrals to `impulse` (N s) and `heat` (K s).
+    /// at the bulge, the stateful terms' states as each term says
+    /// ([`crate::force::StatefulTerm::tolerances`]), and the integrals to `impulse` (N s) and
+    /// `heat` (K s).
     ///
     /// ```
     /// use hdi_tribology::{heater::Programme, model::{SliderModel, SliderSystem}, scene::Scene};
     /// let model = SliderModel::from_scene(&Scene::paper())?;
-    /// let sys = SliderSystem::new(&model, Programme::constant(0.06, 1e-3)?, true);
+    /// let sys = SliderSystem::new(&model, model.inputs(Programme::constant(0.06, 1e-3)?), true);
     /// let atol = sys.tolerances(1e-14, 1e-12, 1e-10);
     /// assert_eq!(atol.len(), 4);
     /// assert!((atol[1] / 1e-14 - (3e5f64 / 1e-6).sqrt()).abs() < 1e-6);
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
     pub fn tolerances(&self, displacement: f64, impulse: f64, heat: f64) -> Vec<f64> {
-        let m = self.model;
+        let m = &*self.model;
         let st = &m.structure;
         let lay = self.layout;
         let w = m.angular_frequencies();
@@ -530,6 +753,10 @@ impl SliderSystem<'_> {
         if let Some(i) = lay.heat {
             atol[i] = heat;
         }
+        self.for_terms(|term, at| {
+            let k = term.states();
+            term.tolerances(displacement, &mut atol[at..at + k]);
+        });
         atol
     }
 }

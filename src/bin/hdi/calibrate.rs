@@ -104,7 +104,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     if let Some(v) = a.dither_v {
         model = model.with_voltage(Voltage {
             ac_amplitude: v,
-            ..model.voltage
+            ..model.voltage()
         });
     }
     let (th, window) = (scene.detector.contact_threshold_n, scene.detector.window_s);

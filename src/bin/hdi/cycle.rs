@@ -251,7 +251,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let scene = a.scene.load()?;
     let (model, programme, mut opts) = a.cycle.setup(&scene)?;
     opts.keep_series = out.is_some();
-    let v_ac = a.v_ac.unwrap_or(model.voltage.ac_amplitude);
+    let v_ac = a.v_ac.unwrap_or(model.voltage().ac_amplitude);
     let (report, cycle) = a
         .cycle
         .run(&model, &programme, &opts, &[v_ac])?
