@@ -169,3 +169,15 @@ fn few_peak_bulge_in_contact() {
         check(&model, ramp(0.080), 1.1e-3, gap, 1e-4);
     }
 }
+
+/// A stateful term's force on the accelerations and its rate's row (`τ ẋ = a d − x`, `F = k x`).
+#[test]
+fn rigid_slider_with_a_stateful_term() {
+    use hdi_tribology::force::RelaxingState;
+    let model = SliderModel::from_scene(&Scene::paper())
+        .unwrap()
+        .with_ac_amplitude(0.5)
+        .with_stateful_term(RelaxingState::new(1e-6, 1e9, -2e-5, None).unwrap())
+        .unwrap();
+    check(&model, ramp(0.080), 1.1e-3, 0.5e-9, 1e-4);
+}

@@ -57,6 +57,13 @@ class Model:
     Building takes a fraction of a second, without the GIL; share one model across analyses."""
 
     def __init__(self, scene: Scene) -> None: ...
+    def with_relaxing_state(self, tau_s: float, start: Optional[float] = None, *,
+                            target_per_nm: float = 0.0,
+                            force_un_per_state: float = 0.0) -> "Model":
+        """The same model with one more state of its own, relaxing towards ``target_per_nm``
+        times the bulge gap (nm) with time constant ``tau_s`` (s) and adding the force
+        ``force_un_per_state`` · x (µN); it starts from ``start`` (its equilibrium when None).
+        With the defaults, the pure relaxation ``start · exp(−t/τ)``."""
     @property
     def scene(self) -> Scene:
         """A copy of the scene the model was built from."""
@@ -316,7 +323,7 @@ class Drive:
     (default ``atol_pm``, at least ``atol_pm``) are the integration's displacement tolerances
     near contact and in flight (pm; equal for one tolerance throughout)."""
 
-    def __init__(self, scene: Scene, *, seed: int = 1, radius_mm: float = 25.0,
+    def __init__(self, scene: Union[Scene, Model], *, seed: int = 1, radius_mm: float = 25.0,
                  flat_disk: bool = False, initial_power_mw: float = 60.0,
                  atol_pm: Optional[float] = None,
                  atol_flight_pm: Optional[float] = None) -> None: ...
@@ -328,6 +335,9 @@ class Drive:
     @property
     def time_s(self) -> float:
         """Simulated time so far (s)."""
+    @property
+    def term_states(self) -> List[float]:
+        """The states of the model's terms with memory at the drive's time."""
     @property
     def stats(self) -> Dict[str, int]:
         """Integrator work so far: accepted, rejected, rhs_evals, jac_evals, lu_decomps."""

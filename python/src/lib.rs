@@ -23,7 +23,7 @@ use hdi_tribology::drive::{
     DriveOptions, Plant, SENSOR_COLUMNS,
 };
 use hdi_tribology::fit::{DataSet, FitError, FitOptions, FreeParameter};
-use hdi_tribology::force::Gaps;
+use hdi_tribology::force::{Gaps, RelaxingState};
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::units;
 use numpy::{PyArray1, PyReadonlyArray1};
@@ -320,6 +320,45 @@ impl Model {
     #[getter]
     fn dofs(&self) -> usize {
         self.model.structure().dofs()
+    }
+
+    /// The same model with one more state of its own: `x` relaxing towards `target_per_nm`
+    /// times the bulge gap (nm) with time constant `tau_s` (s), adding the force
+    /// `force_un_per_state` · x (µN), and starting from `start` (its equilibrium when `None`).
+    /// With the defaults it is the pure relaxation `x(t) = start · e^{−t/τ}`, which changes
+    /// nothing else: a check that every analysis carries the states of terms with memory
+    /// (`term_states` of `simulate_cycle` and of `Drive`).
+    #[pyo3(signature = (tau_s, start = None, *, target_per_nm = 0.0, force_un_per_state = 0.0))]
+    fn with_relaxing_state(
+        &self,
+        tau_s: f64,
+        start: Option<f64>,
+        target_per_nm: f64,
+        force_un_per_state: f64,
+    ) -> PyResult<Self> {
+        let term = RelaxingState::new(
+            tau_s,
+            target_per_nm * 1e9,
+            force_un_per_state * 1e-6,
+            start,
+        )
+        .map_err(|e| match e {
+            hdi_tribology::Error::InvalidInput { field, reason } => {
+                let arg = match field.as_str() {
+                    "relaxing_state.tau_s" => "tau_s",
+                    "relaxing_state.target_per_m" => "target_per_nm",
+                    "relaxing_state.force_n" => "force_un_per_state",
+                    "relaxing_state.start" => "start",
+                    other => other,
+                };
+                invalid(arg, reason)
+            }
+            other => to_py_err(other),
+        })?;
+        Ok(Model {
+            scene: self.scene.clone(),
+            model: Arc::new(self.model.with_stateful_term(term).py()?),
+        })
     }
 
     /// The scene the model was built from (a copy).
@@ -930,6 +969,10 @@ fn simulate_cycle<'py>(
         out.set_item("total_n", array(py, s.total))?;
         out.set_item("temperature_rise_k", array(py, s.temperature_rise))?;
         out.set_item("indicator_n", array(py, s.indicator))?;
+        if !s.term_states.is_empty() {
+            let rows: Vec<Vec<f64>> = s.term_states;
+            out.set_item("term_states", numpy::PyArray2::from_vec2(py, &rows)?)?;
+        }
     }
     Ok(out)
 }
@@ -1419,7 +1462,7 @@ fn calibrate(
 /// seed, with the drive's default sensors, heater lag and solver.
 fn plant_of(
     py: Python<'_>,
-    scene: &Scene,
+    scene: &Bound<'_, PyAny>,
     seed: u64,
     radius_mm: f64,
     flat_disk: bool,
@@ -1449,7 +1492,17 @@ fn plant_of(
     }
     .with_tolerances_pm(atol_pm[0], atol_pm[1], ["atol_pm", "atol_flight_pm"])
     .py()?;
-    let scene = &scene.inner;
+    // A `Model` drives as it is (its terms with memory included), a `Scene` at its own zone.
+    if let Ok(m) = scene.cast::<Model>() {
+        let model = m.get().model.clone();
+        return py
+            .detach(|| Plant::from_model(&model, radius_mm * 1e-3, seed, opts))
+            .py();
+    }
+    let scene = scene.cast::<Scene>().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err("scene: expected a Scene or a Model")
+    })?;
+    let scene = &scene.borrow().inner;
     py.detach(|| Plant::new(scene, &scene_zone(scene, radius_mm * 1e-3)?, seed, opts))
         .py()
 }
@@ -1553,7 +1606,7 @@ impl PyDrive {
     #[pyo3(signature = (scene, *, seed = 1, radius_mm = 25.0, flat_disk = false, initial_power_mw = 60.0, atol_pm = None, atol_flight_pm = None))]
     fn new(
         py: Python<'_>,
-        scene: &Scene,
+        scene: &Bound<'_, PyAny>,
         seed: u64,
         radius_mm: f64,
         flat_disk: bool,
@@ -1627,6 +1680,13 @@ impl PyDrive {
     #[getter]
     fn time_s(&self) -> f64 {
         self.inner.time()
+    }
+
+    /// The states of the model's terms with memory at the drive's time (a list; empty without
+    /// such terms, see `Model.with_relaxing_state`).
+    #[getter]
+    fn term_states(&self) -> Vec<f64> {
+        self.inner.term_states().to_vec()
     }
 
     /// The integrator's work so far: a dict of `accepted`, `rejected`, `rhs_evals`,

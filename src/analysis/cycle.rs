@@ -191,6 +191,9 @@ pub struct TimeSeries {
     pub temperature_rise: Vec<f64>,
     /// Running mean of the contact force over the detector window (N); NaN before `T_w`.
     pub indicator: Vec<f64>,
+    /// The states of the model's stateful terms ([`crate::force::StatefulTerm`]), one series
+    /// per state in the order of the terms; empty without such terms (not in the CSV).
+    pub term_states: Vec<Vec<f64>>,
 }
 
 impl TimeSeries {
@@ -303,12 +306,7 @@ pub fn simulate_cycle(
     super::equilibrium::check_heater(model)?;
     // Dispatch on the state size to stack vectors: a step allocates nothing, and a scene pays
     // only for the coordinates and lags it uses.
-    let layout = StateLayout::new(
-        model.structure().dofs(),
-        model.thermal_lag() > 0.0,
-        model.interface_lag() > 0.0,
-        true,
-    );
+    let layout = StateLayout::of(model, true);
     match layout.len() {
         4 => run::<U4>(model, programme, opts),
         5 => run::<U5>(model, programme, opts),
@@ -875,10 +873,12 @@ where
 {
     let model = sys.model();
     let mut out = TimeSeries::default();
+    let (first, n_terms) = sys.layout().term_states;
+    out.term_states = vec![Vec::with_capacity(times.len()); n_terms];
     for (t, s) in times.iter().zip(states) {
         let t = *t;
         let g = sys.gaps(t, s);
-        let volt2 = model.voltage().squared(t);
+        let volt2 = sys.inputs().voltage.squared(t);
         let b = model.breakdown(g, volt2);
         let f_ab = sys.bearing_force(s);
         out.t.push(t);
@@ -895,6 +895,9 @@ where
         } else {
             f64::NAN
         });
+        for (j, series) in out.term_states.iter_mut().enumerate() {
+            series.push(s[first + j]);
+        }
     }
     out
 }

@@ -12,7 +12,7 @@
 //! use hdi_tribology::scene::Scene;
 //! let model = SliderModel::from_scene(&Scene::paper())?;
 //! // A 0.5 V dither at 10.5 kHz while calibrating.
-//! let dithered = model.with_voltage(Voltage { ac_amplitude: 0.5, frequency: 10.5e3, ..model.voltage });
+//! let dithered = model.with_voltage(Voltage { ac_amplitude: 0.5, frequency: 10.5e3, ..model.voltage() });
 //! let mut ae = ContactForceRms::new(1e-5, 5e3, 5e-5)?;
 //! let cal = calibrate(&dithered, &mut ae, &CalibrationOptions::new(0.060, 0.0005, 0.120, 0.010))?;
 //! // Take-off (stepping down) comes below touchdown: the hysteresis of the interface.

@@ -599,6 +599,27 @@ pub struct Drive {
     integrals0: (f64, f64),
     /// The running displacement tolerance and the state at the period's start.
     tol: TolState,
+    /// The states of the model's stateful terms at the drive's time.
+    terms: TermStates,
+}
+
+/// The states of the stateful terms, copied out of a state vector.
+#[derive(Clone, Copy, Debug, Default)]
+struct TermStates {
+    x: [f64; crate::force::MAX_TERM_STATES],
+    n: usize,
+}
+
+impl TermStates {
+    fn of<D: Dim>(layout: &StateLayout, y: &OVector<f64, D>) -> Self
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let (first, n) = layout.term_states;
+        let mut x = [0.0; crate::force::MAX_TERM_STATES];
+        x[..n].copy_from_slice(&y.as_slice()[first..first + n]);
+        TermStates { x, n }
+    }
 }
 
 impl std::fmt::Debug for Drive {
@@ -623,6 +644,7 @@ impl Drive {
     pub fn new(plant: Arc<Plant>) -> Result<Self> {
         let sys = plant.system.clone();
         let (m, o) = (plant.method, &plant.ode);
+        let terms;
         let rest = plant.start;
         let mut tol = TolState {
             atol: plant.tol.range.0,
@@ -632,6 +654,7 @@ impl Drive {
             ($variant:ident, $dim:expr) => {{
                 let y0 = sys.initial_state($dim, &rest);
                 tol.y0[..y0.len()].copy_from_slice(y0.as_slice());
+                terms = TermStates::of(&plant.layout, &y0);
                 Integ::$variant(Integrator::new(sys, 0.0, y0, HORIZON, m, o)?)
             }};
         }
@@ -660,6 +683,7 @@ impl Drive {
             unchanged: 0,
             integrals0: (0.0, 0.0),
             tol,
+            terms,
         })
     }
 
@@ -697,15 +721,17 @@ impl Drive {
             contact_potential: plant.base.voltage().contact_potential,
         });
         let tol = plant.tol.adapts().then_some((&plant.tol, &mut self.tol));
-        let (truth, integrals) = with_integ!(&mut self.integ, it => {
+        let (truth, integrals, terms) = with_integ!(&mut self.integ, it => {
             let y1 = advance(it, &layout, set, &mut self.integrals0, span, tol)?;
+            let terms = TermStates::of(&layout, &y1);
             let s = it.system();
             let integrals = (
                 layout.contact_impulse.map_or(0.0, |i| y1[i]),
                 layout.heat.map_or(0.0, |i| y1[i]),
             );
-            (observe(s, &y1, &layout, t1, dt, self.integrals0), integrals)
+            (observe(s, &y1, &layout, t1, dt, self.integrals0), integrals, terms)
         });
+        self.terms = terms;
         self.held = Some((*command, clearance));
         self.integrals0 = integrals;
         self.t = t1;
@@ -732,6 +758,23 @@ impl Drive {
                 ..truth
             },
         })
+    }
+
+    /// The states of the model's stateful terms ([`crate::force::StatefulTerm`]) at the drive's
+    /// time, in the order of the terms; empty without such terms.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::drive::{Command, DriveOptions, Plant};
+    /// use hdi_tribology::{force::RelaxingState, model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?
+    ///     .with_stateful_term(RelaxingState::relaxation(2e-4, 1.0)?)?;
+    /// let mut drive = Plant::from_model(&model, 0.025, 1, DriveOptions::default())?.into_drive()?;
+    /// drive.step(&Command::heater_mw(60.0), 50e-6)?;
+    /// assert!((drive.term_states()[0] - (-0.25f64).exp()).abs() < 1e-4);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn term_states(&self) -> &[f64] {
+        &self.terms.x[..self.terms.n]
     }
 
     /// Simulated time so far (s).

@@ -331,17 +331,32 @@ impl SliderModel {
     /// ```no_run
     /// use hdi_tribology::{force::RelaxingState, model::SliderModel, scene::Scene};
     /// let model = SliderModel::from_scene(&Scene::paper())?;
-    /// let with = model.with_stateful_term(RelaxingState::relaxation(1e-4, 1.0)?);
+    /// let with = model.with_stateful_term(RelaxingState::relaxation(1e-4, 1.0)?)?;
     /// assert_eq!(with.stateful_terms().len(), 1);
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
-    pub fn with_stateful_term(&self, term: impl StatefulTerm + 'static) -> Self {
+    ///
+    /// # Errors
+    /// More than [`crate::force::MAX_TERM_STATES`] states over all terms, or a term with none.
+    pub fn with_stateful_term(&self, term: impl StatefulTerm + 'static) -> Result<Self> {
+        let (n, total) = (term.states(), self.term_states() + term.states());
+        if n == 0 || total > crate::force::MAX_TERM_STATES {
+            return Err(Error::invalid(
+                term.name(),
+                format!(
+                    "a stateful term needs 1 to {} states over all terms of a model, got {n} \
+                     more to the {} there",
+                    crate::force::MAX_TERM_STATES,
+                    self.term_states()
+                ),
+            ));
+        }
         let mut all: Vec<Arc<dyn StatefulTerm>> = self.stateful.to_vec();
         all.push(Arc::new(term));
-        SliderModel {
+        Ok(SliderModel {
             stateful: all.into(),
             ..self.clone()
-        }
+        })
     }
 
     /// The terms that carry states of their own.
@@ -458,7 +473,44 @@ impl SliderModel {
     /// Interface force `F_if = F_static + V² G_e` and its partial derivatives.
     pub fn interface_force(&self, g: Gaps, volt2: f64) -> ForceEval {
         let (s, e) = self.forces.coupled_sums(g, volt2 != 0.0);
-        add_scaled(s, e, volt2)
+        self.with_stateful(add_scaled(s, e, volt2), g)
+    }
+
+    /// `f` plus the forces of the stateful terms with their states at equilibrium at `g`, and
+    /// the total derivatives along the gaps (through the equilibrium's own slope,
+    /// `∂x/∂d = −(∂ẋ/∂x)⁻¹ ∂ẋ/∂d`): what a static analysis sees of a term with memory. `f` as
+    /// it is when the model has no such terms.
+    fn with_stateful(&self, mut f: ForceEval, g: Gaps) -> ForceEval {
+        use crate::force::MAX_TERM_STATES;
+        use nalgebra::{SMatrix, SVector};
+        for term in self.stateful.iter() {
+            let k = term.states();
+            let mut x = [0.0; MAX_TERM_STATES];
+            term.equilibrium(g, &mut x[..k]);
+            let s = term.force(g, &x[..k]);
+            let p = term.rate_partials(g, &x[..k]);
+            // ∂ẋ/∂x, padded with the identity beyond the term's states.
+            let a = SMatrix::<f64, MAX_TERM_STATES, MAX_TERM_STATES>::from_fn(|r, c| {
+                if r < k && c < k {
+                    p.d_state[r][c]
+                } else if r == c {
+                    1.0
+                } else {
+                    0.0
+                }
+            });
+            let lu = a.lu();
+            let slope = |rate: [f64; MAX_TERM_STATES]| -> f64 {
+                let dx = lu
+                    .solve(&SVector::<f64, MAX_TERM_STATES>::from(rate))
+                    .unwrap_or_default();
+                -(0..k).map(|j| s.d_state[j] * dx[j]).sum::<f64>()
+            };
+            f.value += s.force.value;
+            f.d_bulge += s.force.d_bulge + slope(p.d_bulge);
+            f.d_pad += s.force.d_pad + slope(p.d_pad);
+        }
+        f
     }
 
     /// `F_if` and the three tabulated sums it is made of (static, per V², contact), from one
@@ -516,7 +568,7 @@ impl SliderModel {
     /// Interface force from direct (untabulated) evaluation of every term.
     pub fn interface_force_exact(&self, g: Gaps, volt2: f64) -> Result<ForceEval> {
         let (s, e) = self.interface_parts_exact(g)?;
-        Ok(add_scaled(s, e, volt2))
+        Ok(self.with_stateful(add_scaled(s, e, volt2), g))
     }
 
     /// Every force at one state, for reports.
@@ -553,7 +605,7 @@ impl SliderModel {
         let residual = |q: &Dofs, f: &ForceEval| self.balance_residual(q, f);
         // With no pad-gap term the interface force depends on `d` alone, which is held: one
         // evaluation serves every Newton step (the same numbers, fewer look-ups).
-        let pad_free = !self.forces.uses_pad_gap();
+        let pad_free = !self.forces.uses_pad_gap() && self.stateful.is_empty();
         // Start from the linearised bearing.
         let f0 = self.interface_force(at(0.0), volt2);
         let j0 = st.tangent(self.bearing.stiffness(0.0), 0.0, 0.0);
@@ -633,7 +685,7 @@ impl SliderModel {
     /// `1/s − ∂F_if/∂d` (Sherman–Morrison). `None` for other models, or where `J₀` is not positive
     /// (the balance then fails at every gap).
     pub(crate) fn linear_balance(&self, volt2: f64) -> Option<LinearBalance> {
-        if !self.linear_bearing || self.forces.uses_pad_gap() {
+        if !self.linear_bearing || self.forces.uses_pad_gap() || !self.stateful.is_empty() {
             return None;
         }
         let st = &self.structure;

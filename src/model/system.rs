@@ -90,7 +90,7 @@ impl StateLayout {
     /// use hdi_tribology::{force::RelaxingState, model::{SliderModel, StateLayout}, scene::Scene};
     /// let model = SliderModel::from_scene(&Scene::paper())?;
     /// assert_eq!(StateLayout::of(&model, true).len(), 4);
-    /// let with = model.with_stateful_term(RelaxingState::relaxation(1e-4, 1.0)?);
+    /// let with = model.with_stateful_term(RelaxingState::relaxation(1e-4, 1.0)?)?;
     /// let l = StateLayout::of(&with, true);
     /// assert_eq!((l.len(), l.term_states, l.contact_impulse), (5, (2, 1), Some(3)));
     /// # Ok::<(), hdi_tribology::Error>(())
