@@ -100,7 +100,12 @@ fn a_stateful_force_enters_the_statics_at_its_equilibrium() {
     let p = 0.06;
     let eq = flying_equilibrium(&model, p, 0.0, &ScanGrid::default()).unwrap();
     let eq0 = flying_equilibrium(&plain, p, 0.0, &ScanGrid::default()).unwrap();
-    assert!(eq.d < eq0.d - 1e-11, "the attraction closes the gap: {} vs {}", eq.d, eq0.d);
+    assert!(
+        eq.d < eq0.d - 1e-11,
+        "the attraction closes the gap: {} vs {}",
+        eq.d,
+        eq0.d
+    );
     let opts = DriveOptions {
         disk: DiskSpec::flat(),
         initial_power: p,

@@ -345,7 +345,7 @@ class Drive:
     def seed(self) -> int:
         """Seed of the disk's random waviness and of the sensor noise."""
 
-def replay(scene: Scene, time_s: Sequence[float], heater_mw: Sequence[float],
+def replay(scene: Union[Scene, Model], time_s: Sequence[float], heater_mw: Sequence[float],
            voltage_dc_v: Sequence[float], voltage_ac_v: Optional[Sequence[float]] = None,
            ac_frequency_khz: Optional[Sequence[float]] = None, *, rate_khz: float = 20.0,
            seed: int = 1, radius_mm: float = 25.0, flat_disk: bool = False,

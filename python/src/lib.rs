@@ -336,25 +336,20 @@ impl Model {
         target_per_nm: f64,
         force_un_per_state: f64,
     ) -> PyResult<Self> {
-        let term = RelaxingState::new(
-            tau_s,
-            target_per_nm * 1e9,
-            force_un_per_state * 1e-6,
-            start,
-        )
-        .map_err(|e| match e {
-            hdi_tribology::Error::InvalidInput { field, reason } => {
-                let arg = match field.as_str() {
-                    "relaxing_state.tau_s" => "tau_s",
-                    "relaxing_state.target_per_m" => "target_per_nm",
-                    "relaxing_state.force_n" => "force_un_per_state",
-                    "relaxing_state.start" => "start",
-                    other => other,
-                };
-                invalid(arg, reason)
-            }
-            other => to_py_err(other),
-        })?;
+        let term = RelaxingState::new(tau_s, target_per_nm * 1e9, force_un_per_state * 1e-6, start)
+            .map_err(|e| match e {
+                hdi_tribology::Error::InvalidInput { field, reason } => {
+                    let arg = match field.as_str() {
+                        "relaxing_state.tau_s" => "tau_s",
+                        "relaxing_state.target_per_m" => "target_per_nm",
+                        "relaxing_state.force_n" => "force_un_per_state",
+                        "relaxing_state.start" => "start",
+                        other => other,
+                    };
+                    invalid(arg, reason)
+                }
+                other => to_py_err(other),
+            })?;
         Ok(Model {
             scene: self.scene.clone(),
             model: Arc::new(self.model.with_stateful_term(term).py()?),
@@ -1729,7 +1724,7 @@ impl PyDrive {
 #[pyo3(signature = (scene, time_s, heater_mw, voltage_dc_v, voltage_ac_v = None, ac_frequency_khz = None, *, rate_khz = 20.0, seed = 1, radius_mm = 25.0, flat_disk = false, atol_pm = None, atol_flight_pm = None))]
 fn replay<'py>(
     py: Python<'py>,
-    scene: &Scene,
+    scene: &Bound<'py, PyAny>,
     time_s: Vec<f64>,
     heater_mw: Vec<f64>,
     voltage_dc_v: Vec<f64>,
