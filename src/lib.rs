@@ -59,6 +59,7 @@
 //! ## Layout
 //!
 //! Data flows one way:
+//! - [`numerics`]: building blocks that know no physics (seeded random generators);
 //! - [`surface`]: surface-height and asperity-peak-height statistics;
 //! - [`quadrature`]: adaptive integration and precomputed tables;
 //! - [`force`]: interface terms (trait based), footprints and air bearings;
@@ -90,6 +91,7 @@ pub mod fit;
 pub mod force;
 pub mod heater;
 pub mod model;
+pub mod numerics;
 pub mod ode;
 pub mod quadrature;
 pub mod report;

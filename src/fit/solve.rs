@@ -14,8 +14,8 @@ use super::model::{weighted, weights, Evaluator, Predicted, Sets};
 use super::params::{resolve, FreeParameter, Resolved};
 use super::FitError;
 use crate::analysis::sweep::Refinement;
+use crate::numerics::rng::Xoshiro256;
 use crate::scene::Scene;
-use crate::surface::Xoshiro256;
 use crate::Error;
 
 /// Settings of a fit.
