@@ -31,7 +31,7 @@ impl Rng {
         self.bits.next_u64()
     }
 
-    /// Uniform on (0, 1): 53 random bits, never 0.
+    /// Uniform on (0, 1]: 53 random bits, never 0 ([`open01`](crate::numerics::rng::open01)).
     pub(crate) fn uniform(&mut self) -> f64 {
         self.bits.next_open01()
     }

@@ -10,13 +10,15 @@
 //! assert_eq!(open01(a.next_u64()), b.next_open01());
 //! ```
 
-/// Uniform in the open interval (0, 1) from 64 random bits: their top 53, centred in their cell,
-/// so that neither 0 nor 1 comes out.
+/// Uniform on (0, 1] from 64 random bits: their top 53, centred in their cell, so that 0 never
+/// comes out. Above 1/2 the centre rounds to an end of its cell, and the last cell's to exactly 1
+/// (one draw in 2^53); the generators' streams are fixed by this formula and stay as they are.
 ///
 /// ```
 /// use hdi_tribology::numerics::rng::open01;
 /// assert_eq!(open01(0), 0.5 / (1u64 << 53) as f64);
-/// assert!(open01(u64::MAX) < 1.0);
+/// assert!(open01(u64::MAX - (1 << 11)) < 1.0);
+/// assert_eq!(open01(u64::MAX), 1.0);
 /// ```
 pub fn open01(bits: u64) -> f64 {
     ((bits >> 11) as f64 + 0.5) * (1.0 / (1u64 << 53) as f64)
@@ -51,7 +53,7 @@ impl SplitMix64 {
         z ^ (z >> 31)
     }
 
-    /// Uniform in the open interval (0, 1), 53-bit resolution ([`open01`]).
+    /// Uniform on (0, 1], 53-bit resolution ([`open01`]: 1 comes out once in 2^53 draws).
     pub fn next_open01(&mut self) -> f64 {
         open01(self.next_u64())
     }
@@ -99,7 +101,7 @@ impl Xoshiro256 {
         result
     }
 
-    /// Uniform in the open interval (0, 1), 53-bit resolution ([`open01`]).
+    /// Uniform on (0, 1], 53-bit resolution ([`open01`]: 1 comes out once in 2^53 draws).
     pub fn next_open01(&mut self) -> f64 {
         open01(self.next_u64())
     }
@@ -118,39 +120,34 @@ mod tests {
     /// and fit starts depend on them.
     #[test]
     fn streams_keep_their_recorded_first_values() {
+        let mut got = Vec::new();
         let mut r = SplitMix64::new(0);
-        let words: Vec<u64> = (0..4).map(|_| r.next_u64()).collect();
-        assert_eq!(
-            words,
-            [
-                0xE220_A839_7B1D_CDAF,
-                0x6E78_9E6A_A1B9_65F4,
-                0x06C4_5D18_8009_454F,
-                0xF88B_B8A8_724C_81EC
-            ]
-        );
+        got.extend((0..4).map(|_| r.next_u64()));
         let mut x = Xoshiro256::new(42);
-        let words: Vec<u64> = (0..4).map(|_| x.next_u64()).collect();
-        assert_eq!(
-            words,
-            [
-                0x1578_0B2E_0C2E_C716,
-                0x6104_D986_6D11_3A7E,
-                0xAE17_5332_39E4_99A1,
-                0xECB8_AD47_03B3_60A1
-            ]
-        );
+        got.extend((0..4).map(|_| x.next_u64()));
         let mut x = Xoshiro256::new(7);
-        let bits: Vec<u64> = (0..3).map(|_| x.next_open01().to_bits()).collect();
-        assert_eq!(
-            bits,
-            [
-                0x3FE6_6B1F_5EE9_DF2E,
-                0x3FD1_D70F_6593_D20B,
-                0x3FEA_DE3A_6932_A590
-            ]
-        );
-        let below: Vec<usize> = (0..4).map(|_| x.next_below(1000)).collect();
-        assert_eq!(below, [981, 990, 872, 60]);
+        got.extend((0..3).map(|_| x.next_open01().to_bits()));
+        got.extend((0..4).map(|_| x.next_below(1000) as u64));
+        let recorded: [u64; 15] = [
+            // SplitMix64, seed 0 (the published reference stream)
+            0xE220_A839_7B1D_CDAF,
+            0x6E78_9E6A_A1B9_65F4,
+            0x06C4_5D18_8009_454F,
+            0xF88B_B8A8_724C_81EC,
+            // xoshiro256**, seed 42
+            0x1578_0B2E_0C2E_C716,
+            0x6104_D986_6D11_3A7E,
+            0xAE17_5332_39E4_99A1,
+            0xECB8_AD47_03B3_60A1,
+            // xoshiro256**, seed 7: three draws in (0, 1) (their bits), four below 1000
+            0x3FE6_6B1F_5EE9_DF2E,
+            0x3FD1_D70F_6593_D20B,
+            0x3FEA_DE3A_6932_A590,
+            981,
+            990,
+            872,
+            60,
+        ];
+        assert_eq!(got, recorded);
     }
 }
