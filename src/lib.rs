@@ -63,7 +63,8 @@
 //! - [`surface`]: surface-height and asperity-peak-height statistics;
 //! - [`quadrature`]: adaptive integration and precomputed tables;
 //! - [`force`]: interface terms (trait based), footprints and air bearings;
-//! - [`scene`]: a serde description of a whole scene, validated into parts;
+//! - [`scene`]: a serde description of a whole scene, validated into parts, and its fields by
+//!   dotted name ([`scene::FieldPath`]);
 //! - [`ode`]: a generic ODE stepper that knows no physics;
 //! - [`heater`]: heater power programmes;
 //! - [`model`] and [`analysis`]: the slider model and the analyses (touchdown, take-off,
