@@ -59,10 +59,12 @@
 //! ## Layout
 //!
 //! Data flows one way:
+//! - [`numerics`]: building blocks that know no physics (seeded random generators);
 //! - [`surface`]: surface-height and asperity-peak-height statistics;
 //! - [`quadrature`]: adaptive integration and precomputed tables;
 //! - [`force`]: interface terms (trait based), footprints and air bearings;
-//! - [`scene`]: a serde description of a whole scene, validated into parts;
+//! - [`scene`]: a serde description of a whole scene, validated into parts, and its fields by
+//!   dotted name ([`scene::FieldPath`]);
 //! - [`ode`]: a generic ODE stepper that knows no physics;
 //! - [`heater`]: heater power programmes;
 //! - [`model`] and [`analysis`]: the slider model and the analyses (touchdown, take-off,
@@ -90,6 +92,7 @@ pub mod fit;
 pub mod force;
 pub mod heater;
 pub mod model;
+pub mod numerics;
 pub mod ode;
 pub mod quadrature;
 pub mod report;

@@ -25,9 +25,10 @@ use hdi_tribology::drive::{
 use hdi_tribology::fit::{DataSet, FitError, FitOptions, FreeParameter};
 use hdi_tribology::force::{Gaps, RelaxingState};
 use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::scene::{FieldPath, PathError};
 use hdi_tribology::units;
 use numpy::{PyArray1, PyReadonlyArray1};
-use pyo3::exceptions::PyKeyError;
+use pyo3::exceptions::{PyKeyError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -131,34 +132,36 @@ fn scene_from_dict(py: Python<'_>, d: &Bound<'_, PyAny>) -> PyResult<Scn> {
     py.detach(|| Scn::from_json_str(&text)).py()
 }
 
-/// The dict holding the last key of a dotted path, and that key.
-fn walk<'py>(root: &Bound<'py, PyAny>, path: &str) -> PyResult<(Bound<'py, PyDict>, String)> {
-    let mut parts: Vec<&str> = path.split('.').collect();
-    let last = parts.pop().unwrap_or_default().to_string();
-    let mut node = root.clone();
-    for p in parts {
-        node = node
-            .cast::<PyDict>()
-            .ok()
-            .and_then(|d| d.get_item(p).ok().flatten())
-            .filter(|n| !n.is_none())
-            .ok_or_else(|| {
-                PyKeyError::new_err(format!("scene has no section `{p}` in `{path}`"))
-            })?;
-    }
-    let dict = node
-        .cast_into::<PyDict>()
-        .map_err(|_| PyKeyError::new_err(format!("`{path}` is not a field of the scene")))?;
-    Ok((dict, last))
+/// The scene's serde form (SI), which the library's field paths resolve against.
+fn scene_value(s: &Scn) -> PyResult<serde_json::Value> {
+    serde_json::to_value(s).map_err(|e| invalid("scene", e.to_string()))
 }
 
-fn scale<'py>(v: &Bound<'py, PyAny>, factor: f64) -> PyResult<Bound<'py, PyAny>> {
-    let py = v.py();
-    if let Ok(x) = v.extract::<f64>() {
-        return Ok(pyo3::types::PyFloat::new(py, x / factor).into_any());
+/// A name that is not a field of the scene is a `KeyError`; a field without a number to convert
+/// to the name's unit a `TypeError`.
+fn path_err(e: PathError) -> PyErr {
+    match e {
+        PathError::NoSection { .. } | PathError::NoField { .. } => {
+            PyKeyError::new_err(e.to_string())
+        }
+        PathError::NotANumber { .. } => PyTypeError::new_err(e.to_string()),
+        other => to_py_err(other.into()),
     }
-    let xs: Vec<f64> = v.extract()?;
-    Ok(PyList::new(py, xs.into_iter().map(|x| x / factor))?.into_any())
+}
+
+fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    json_module(py)?.call_method1("loads", (v.to_string(),))
+}
+
+/// A Python value for the field `path`, as the scene's serde form holds values.
+fn py_to_json(py: Python<'_>, path: &str, v: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
+    let text: String = json_module(py)?.call_method1("dumps", (v,))?.extract()?;
+    serde_json::from_str(&text).map_err(|e| {
+        invalid(
+            path,
+            format!("`{text}` is not a value a scene can hold: {e}"),
+        )
+    })
 }
 
 #[pymethods]
@@ -226,22 +229,11 @@ impl Scene {
     /// A field by its dotted path, in SI (`"surface.height_sigma_m"`) or in an engineering unit
     /// (`"surface.height_sigma_nm"`).
     fn __getitem__<'py>(&self, py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyAny>> {
-        let root = scene_to_dict(py, &self.inner)?;
-        let (dict, key) = walk(&root, path)?;
-        if let Some(v) = dict.get_item(&key)? {
-            return Ok(v);
-        }
-        if let Some((si_key, factor, _unit)) = hdi_tribology::scene::engineering_unit(&key) {
-            if let Some(v) = dict.get_item(&si_key)? {
-                if v.is_none() {
-                    return Ok(v);
-                }
-                return scale(&v, factor);
-            }
-        }
-        Err(PyKeyError::new_err(format!(
-            "`{path}` is not a field of the scene"
-        )))
+        let root = scene_value(&self.inner)?;
+        let v = FieldPath::at(&root, path)
+            .and_then(|f| f.read(&root))
+            .map_err(path_err)?;
+        json_to_py(py, &v)
     }
 
     /// Sets a field by its dotted path (SI or engineering unit); the scene is validated again and
@@ -260,19 +252,18 @@ impl Scene {
 
     /// A copy with the given fields (dotted paths, SI or engineering units) replaced, validated.
     fn with_values(&self, py: Python<'_>, values: &Bound<'_, PyDict>) -> PyResult<Self> {
-        let root = scene_to_dict(py, &self.inner)?;
+        let mut root = scene_value(&self.inner)?;
         for (k, v) in values.iter() {
             let path: String = k.extract()?;
-            let (dict, key) = walk(&root, &path)?;
-            if let Some((si_key, _, _)) = hdi_tribology::scene::engineering_unit(&key) {
-                if !dict.contains(&key)? {
-                    // the reader converts the engineering unit; the SI spelling must go
-                    let _ = dict.del_item(&si_key);
-                }
-            }
-            dict.set_item(&key, v)?;
+            let value = py_to_json(py, &path, &v)?;
+            FieldPath::at(&root, &path)
+                .map_err(path_err)?
+                .write(&mut root, value);
         }
-        Self::from_dict(py, &root)
+        let text = root.to_string();
+        Ok(Scene {
+            inner: py.detach(|| Scn::from_json_str(&text)).py()?,
+        })
     }
 
     fn __repr__(&self) -> String {

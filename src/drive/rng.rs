@@ -1,15 +1,15 @@
-//! A small seeded random source whose stream is fixed by this file alone.
+//! The drive's seeded random source: one independent stream per noise source, normal deviates.
 //!
 //! The drive's noise must be the same bit for bit for a seed on every platform and with every
-//! version of the dependencies, so the generator is written out here rather than taken from a
-//! crate whose stream may change between releases: SplitMix64 (Steele, Lea and Flood,
-//! "Fast splittable pseudorandom number generators", OOPSLA 2014) for the bits, and the
-//! Box–Muller transform for normal deviates.
+//! version of the dependencies: the bits come from the crate's own SplitMix64
+//! ([`crate::numerics::rng`]), the normal deviates from the Box–Muller transform.
+
+use crate::numerics::rng::SplitMix64;
 
 /// SplitMix64 with a cached second normal deviate.
 #[derive(Clone, Debug)]
 pub(crate) struct Rng {
-    state: u64,
+    bits: SplitMix64,
     spare: Option<f64>,
 }
 
@@ -18,7 +18,7 @@ impl Rng {
     /// turning one source on or off does not change the others).
     pub(crate) fn new(seed: u64, stream: u64) -> Self {
         let mut r = Rng {
-            state: seed ^ stream.wrapping_mul(0xD1B5_4A32_D192_ED03),
+            bits: SplitMix64::new(seed ^ stream.wrapping_mul(0xD1B5_4A32_D192_ED03)),
             spare: None,
         };
         // Decorrelate nearby seeds.
@@ -28,16 +28,12 @@ impl Rng {
     }
 
     pub(crate) fn next_u64(&mut self) -> u64 {
-        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.bits.next_u64()
     }
 
-    /// Uniform on (0, 1): 53 random bits, never 0.
+    /// Uniform on (0, 1]: 53 random bits, never 0 ([`open01`](crate::numerics::rng::open01)).
     pub(crate) fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 0.5) * (1.0 / (1u64 << 53) as f64)
+        self.bits.next_open01()
     }
 
     /// Standard normal deviate (Box–Muller).
@@ -99,5 +95,35 @@ mod tests {
             .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
+    }
+
+    /// First values recorded before the generator shared its bits with the surface's: the
+    /// drive's replay files depend on them.
+    #[test]
+    fn streams_keep_their_recorded_first_values() {
+        let mut r = Rng::new(1, 0);
+        let words: Vec<u64> = (0..4).map(|_| r.next_u64()).collect();
+        assert_eq!(
+            words,
+            [
+                0xF893_A2EE_FB32_555E,
+                0x71C1_8690_EE42_C90B,
+                0x71BB_54D8_D101_B5B9,
+                0xC34D_0BFF_9015_0280
+            ]
+        );
+        let mut r = Rng::new(2024, 0xEC5);
+        let mut bits: Vec<u64> = (0..2).map(|_| r.uniform().to_bits()).collect();
+        bits.extend((0..3).map(|_| r.normal().to_bits()));
+        assert_eq!(
+            bits,
+            [
+                0x3FE1_8CC6_400D_473E,
+                0x3FE2_4CA0_923C_DDC6,
+                0xBFF5_6FD7_F5B0_144A,
+                0xBFF9_9E60_B0C9_4856,
+                0xBFDD_3989_4181_933D
+            ]
+        );
     }
 }

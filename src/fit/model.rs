@@ -6,7 +6,7 @@ use std::sync::Mutex;
 use serde_json::Value;
 
 use super::data::{CurveKind, DataSet, Quantity};
-use super::params::{set, Resolved};
+use super::params::Resolved;
 use crate::analysis::sweep::Refinement;
 use crate::analysis::{
     ac_sweep_refined, static_hysteresis, touchdown_power, transition_shift, CycleOptions,
@@ -104,11 +104,7 @@ impl<'a> Evaluator<'a> {
     pub fn scene(&self, x: &[f64]) -> Result<Scene> {
         let mut v = self.base.clone();
         for (p, &xi) in self.params.iter().zip(x) {
-            let si = xi * p.factor;
-            set(&mut v, &p.path, si);
-            for l in &p.linked {
-                set(&mut v, l, si);
-            }
+            p.write(&mut v, xi);
         }
         Scene::from_json_str(&v.to_string())
     }

@@ -1,13 +1,14 @@
 //! Free parameters: scene fields named as a scene file names them, in the unit of that name.
 //!
-//! A name is resolved against the scene's own serde form: the field whose key it is, or whose
-//! key the scene reader renames it to (`height_sigma_nm` → `surface.height_sigma_m`, factor
-//! 1e-9). No list of fittable fields is kept here: any numeric field of the scene can be freed.
+//! A name is resolved against the scene's own serde form by [`FieldPath::find_numeric`]: the
+//! field whose key it is, or whose key the scene reader renames it to (`height_sigma_nm` →
+//! `surface.height_sigma_m`, factor 1e-9). No list of fittable fields is kept here: any numeric
+//! field of the scene can be freed.
 
 use serde::Serialize;
 use serde_json::Value;
 
-use crate::scene::Scene;
+use crate::scene::FieldPath;
 use crate::{Error, Result};
 
 /// A parameter to fit, in the unit its name carries.
@@ -151,16 +152,10 @@ impl Transform {
 /// A free parameter resolved to its scene field.
 #[derive(Clone, Debug)]
 pub(super) struct Resolved {
-    /// The name as given.
-    pub name: String,
-    /// The unit suffix of the name (`nm`, `v`, `j`, `nm_per_mw`, …).
-    pub unit: String,
-    /// Keys from the scene's root to the SI field.
-    pub path: Vec<String>,
+    /// The field, named as given, with the unit of the name and its factor to SI.
+    pub field: FieldPath,
     /// Other fields set to the same SI value (one physical quantity held in two fields).
-    pub linked: Vec<Vec<String>>,
-    /// SI value = value in the name's unit × `factor`.
-    pub factor: f64,
+    pub linked: Vec<FieldPath>,
     /// Starting value (name's unit).
     pub start: f64,
     /// Bounds (name's unit); `None` is open.
@@ -173,123 +168,31 @@ pub(super) struct Resolved {
     pub transform: Transform,
 }
 
-pub(super) fn get<'a>(v: &'a Value, path: &[String]) -> Option<&'a Value> {
-    path.iter().try_fold(v, |v, k| v.get(k))
-}
+impl Resolved {
+    /// The name as given.
+    pub(super) fn name(&self) -> &str {
+        self.field.name()
+    }
 
-pub(super) fn set(v: &mut Value, path: &[String], x: f64) {
-    let Some((last, parents)) = path.split_last() else {
-        return;
-    };
-    let mut cur = v;
-    for k in parents {
-        match cur.get_mut(k) {
-            Some(next) => cur = next,
-            None => return,
+    /// Sets the parameter, and the fields linked to it, to `x` in its unit.
+    pub(super) fn write(&self, scene: &mut Value, x: f64) {
+        let si = x * self.field.factor();
+        self.field.write_si(scene, si);
+        for l in &self.linked {
+            l.write_si(scene, si);
         }
     }
-    if let Some(obj) = cur.as_object_mut() {
-        obj.insert(
-            last.clone(),
-            serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number),
-        );
-    }
-}
-
-/// Every numeric field of the scene (outside lists), as key paths.
-fn numeric_leaves(v: &Value, prefix: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
-    if let Value::Object(m) = v {
-        for (k, x) in m {
-            prefix.push(k.clone());
-            match x {
-                Value::Number(_) => out.push(prefix.clone()),
-                Value::Object(_) => numeric_leaves(x, prefix, out),
-                _ => {}
-            }
-            prefix.pop();
-        }
-    }
-}
-
-/// The SI value the scene reader gives field `leaf` when the file writes `key = 1` in its place,
-/// or `None` when `key` is not another spelling of `leaf`.
-fn reader_factor(base: &Value, leaf: &[String], key: &str) -> Option<f64> {
-    let (last, parents) = leaf.split_last()?;
-    if last == key {
-        return Some(1.0);
-    }
-    let first = |s: &str| s.split('_').next().map(str::to_owned);
-    if first(last) != first(key) {
-        return None;
-    }
-    let mut trial = base.clone();
-    let obj = parents
-        .iter()
-        .try_fold(&mut trial, |v, k| v.get_mut(k))?
-        .as_object_mut()?;
-    obj.remove(last.as_str());
-    obj.insert(key.to_string(), Value::from(1.0));
-    // the probe moves one σ of the surface alone: say so, or the reader refuses it
-    if let Some(Value::Object(surface)) = trial.get_mut("surface") {
-        surface.insert("independent_peak_sigma".into(), Value::Bool(true));
-    }
-    let scene = Scene::from_json_str(&trial.to_string()).ok()?;
-    let back = serde_json::to_value(&scene).ok()?;
-    get(&back, leaf)?
-        .as_f64()
-        .filter(|f| f.is_finite() && *f != 0.0)
 }
 
 /// Resolves `p` against the scene's serde form `base`.
 pub(super) fn resolve(base: &Value, p: &FreeParameter) -> Result<Resolved> {
     let field = format!("--free {}", p.name);
-    let segments: Vec<&str> = p.name.split('.').collect();
-    let Some((key, sections)) = segments.split_last() else {
-        return Err(Error::invalid(field, "empty name"));
-    };
-    let mut leaves = Vec::new();
-    numeric_leaves(base, &mut Vec::new(), &mut leaves);
-    let matches: Vec<(Vec<String>, f64)> = leaves
-        .into_iter()
-        .filter(|l| {
-            l.len() > sections.len()
-                && l[l.len() - 1 - sections.len()..l.len() - 1]
-                    .iter()
-                    .zip(sections)
-                    .all(|(a, b)| a == b)
-        })
-        .filter_map(|l| reader_factor(base, &l, key).map(|f| (l, f)))
-        .collect();
-    let (path, factor) = match matches.as_slice() {
-        [] => {
-            return Err(Error::invalid(
-                field,
-                "no numeric scene field of that name (write it as in a scene file, e.g. \
-                 `height_sigma_nm`, `contact_potential_v`, `efficiency_nm_per_mw`)",
-            ))
-        }
-        [one] => one.clone(),
-        many => {
-            let paths: Vec<String> = many
-                .iter()
-                .map(|(l, _)| {
-                    let mut l = l.clone();
-                    if let Some(last) = l.last_mut() {
-                        *last = key.to_string();
-                    }
-                    l.join(".")
-                })
-                .collect();
-            return Err(Error::invalid(
-                field,
-                format!("ambiguous; name one of: {}", paths.join(", ")),
-            ));
-        }
-    };
-    let si = get(base, &path).and_then(Value::as_f64).unwrap_or(f64::NAN);
+    let path = FieldPath::find_numeric(base, &p.name)
+        .map_err(|e| Error::invalid(field.clone(), e.reason()))?;
+    let si = path.get(base).and_then(Value::as_f64).unwrap_or(f64::NAN);
     let linked = linked_fields(base, &path);
-    let start = p.start.unwrap_or(si / factor);
-    let unit = unit_suffix(key, &path);
+    let start = p.start.unwrap_or(si / path.factor());
+    let unit = path.unit();
     let bad = |what: &str, v: f64| {
         Error::invalid(
             field.clone(),
@@ -356,11 +259,8 @@ pub(super) fn resolve(base: &Value, p: &FreeParameter) -> Result<Resolved> {
         _ => start.abs().max(1.0),
     };
     Ok(Resolved {
-        name: p.name.clone(),
-        unit,
-        path,
+        field: path,
         linked,
-        factor,
         start,
         lower,
         upper,
@@ -369,72 +269,55 @@ pub(super) fn resolve(base: &Value, p: &FreeParameter) -> Result<Resolved> {
     })
 }
 
-/// The unit a name carries: what follows the SI field's stem (`height_sigma_nm` → `nm`); for an
-/// SI name, from its first SI unit token on (`stiffness_n_per_m` → `n_per_m`).
-fn unit_suffix(key: &str, path: &[String]) -> String {
-    const SI_TOKENS: &[&str] = &[
-        "m", "n", "v", "j", "w", "s", "pa", "hz", "kg", "m2", "per", "k",
-    ];
-    let si = path.last().map(String::as_str).unwrap_or("");
-    if si == key {
-        let tokens: Vec<&str> = key.split('_').collect();
-        return match tokens.iter().skip(1).position(|t| SI_TOKENS.contains(t)) {
-            Some(i) => tokens[i + 1..].join("_"),
-            None => String::new(),
-        };
-    }
-    let common = si
-        .char_indices()
-        .zip(key.chars())
-        .take_while(|((_, a), b)| a == b)
-        .filter(|((_, a), _)| *a == '_')
-        .map(|((i, _), _)| i + 1)
-        .last()
-        .unwrap_or(0);
-    key.get(common..).unwrap_or("").to_string()
-}
-
-/// The other fields that hold the same quantity as `path`: the surface's σ is held by its heights
+/// The other fields that hold the same quantity as `field`: the surface's σ is held by its heights
 /// and, for Rice-maxima peaks, by the peak law, one value unless the scene says they differ on
 /// purpose (`surface.independent_peak_sigma`, which its validation enforces); freeing either sets
 /// both.
-fn linked_fields(base: &Value, path: &[String]) -> Vec<Vec<String>> {
-    let height = ["surface", "height_sigma_m"];
-    let peak = ["surface", "peaks", "sigma_m"];
-    let as_path = |p: &[&str]| p.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+fn linked_fields(base: &Value, field: &FieldPath) -> Vec<FieldPath> {
+    const HEIGHT: &str = "surface.height_sigma_m";
+    const PEAK: &str = "surface.peaks.sigma_m";
     let independent = base
         .pointer("/surface/independent_peak_sigma")
         .and_then(Value::as_bool)
         .unwrap_or(false);
-    let other = if path == height {
-        as_path(&peak)
-    } else if path == peak {
-        as_path(&height)
-    } else {
-        return Vec::new();
+    let other = match field.keys().join(".").as_str() {
+        HEIGHT => PEAK,
+        PEAK => HEIGHT,
+        _ => return Vec::new(),
     };
-    if independent || get(base, &other).is_none() {
+    if independent {
         return Vec::new();
     }
-    vec![other]
+    FieldPath::at(base, other)
+        .ok()
+        .filter(|f| f.get(base).is_some())
+        .into_iter()
+        .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    use crate::scene::Scene;
+
     fn paper() -> Value {
         serde_json::to_value(Scene::paper()).unwrap()
+    }
+
+    fn keys(r: &Resolved) -> Vec<&str> {
+        r.field.keys().iter().map(String::as_str).collect()
     }
 
     #[test]
     fn engineering_names_resolve_through_the_scene_reader() {
         let base = paper();
         let r = resolve(&base, &FreeParameter::new("height_sigma_nm")).unwrap();
-        assert_eq!(r.path, ["surface", "height_sigma_m"]);
-        assert!((r.factor - 1e-9).abs() < 1e-24 && (r.start - 0.7).abs() < 1e-12);
-        assert_eq!(r.unit, "nm");
-        assert_eq!(r.linked, vec![vec!["surface", "peaks", "sigma_m"]]);
+        assert_eq!(keys(&r), ["surface", "height_sigma_m"]);
+        assert!((r.field.factor() - 1e-9).abs() < 1e-24 && (r.start - 0.7).abs() < 1e-12);
+        assert_eq!(r.field.unit(), "nm");
+        assert_eq!(r.linked.len(), 1);
+        assert_eq!(r.linked[0].keys(), ["surface", "peaks", "sigma_m"]);
         // σ of the peaks set apart on purpose: freeing one σ leaves the other alone.
         let mut apart = Scene::paper();
         apart.surface.independent_peak_sigma = true;
@@ -445,14 +328,18 @@ mod tests {
         let r = resolve(&apart, &FreeParameter::new("height_sigma_nm")).unwrap();
         assert!(r.linked.is_empty(), "{:?}", r.linked);
         let r = resolve(&base, &FreeParameter::new("efficiency_nm_per_mw")).unwrap();
-        assert_eq!(r.path, ["heater", "efficiency_m_per_w"]);
+        assert_eq!(keys(&r), ["heater", "efficiency_m_per_w"]);
         assert!((r.start - 0.1).abs() < 1e-12, "{}", r.start);
-        assert_eq!(r.unit, "nm_per_mw");
+        assert_eq!(r.field.unit(), "nm_per_mw");
         let r = resolve(&base, &FreeParameter::new("hamaker_attractive_j")).unwrap();
-        assert_eq!((r.factor, r.start), (1.0, 1e-19));
+        assert_eq!((r.field.factor(), r.start), (1.0, 1e-19));
         let r = resolve(&base, &FreeParameter::new("stiffness_n_per_m")).unwrap();
-        assert_eq!(r.path, ["air_bearing", "stiffness_n_per_m"]);
-        assert_eq!(r.unit, "n_per_m");
+        assert_eq!(keys(&r), ["air_bearing", "stiffness_n_per_m"]);
+        assert_eq!(r.field.unit(), "n_per_m");
+        // a unit in which 1 would be refused as a value (σ = 1 µm) names the field all the same
+        let r = resolve(&base, &FreeParameter::new("height_sigma_um")).unwrap();
+        assert_eq!(keys(&r), ["surface", "height_sigma_m"]);
+        assert_eq!((r.field.factor(), r.field.unit()), (1e-6, "um"));
         let r = resolve(&base, &FreeParameter::new("contact_potential_v")).unwrap();
         assert_eq!(r.transform, Transform::Free { x0: 0.0, s: 1.0 });
     }
@@ -474,7 +361,7 @@ mod tests {
             &FreeParameter::new("contact.footprint.radius_of_curvature_mm"),
         )
         .unwrap();
-        assert_eq!(r.path, ["contact", "footprint", "radius_of_curvature_m"]);
+        assert_eq!(keys(&r), ["contact", "footprint", "radius_of_curvature_m"]);
         let e = resolve(
             &base,
             &FreeParameter::new("height_sigma_nm").bounded(2.0, 1.0),

@@ -14,8 +14,8 @@ use super::model::{weighted, weights, Evaluator, Predicted, Sets};
 use super::params::{resolve, FreeParameter, Resolved};
 use super::FitError;
 use crate::analysis::sweep::Refinement;
+use crate::numerics::rng::Xoshiro256;
 use crate::scene::Scene;
-use crate::surface::Xoshiro256;
 use crate::Error;
 
 /// Settings of a fit.
@@ -581,10 +581,13 @@ pub fn fit(
         .map(|p| resolve(&base, p))
         .collect::<crate::Result<Vec<_>>>()?;
     for (i, p) in params.iter().enumerate() {
-        if let Some(q) = params[..i].iter().find(|q| q.path == p.path) {
+        if let Some(q) = params[..i]
+            .iter()
+            .find(|q| q.field.keys() == p.field.keys())
+        {
             return Err(Error::invalid(
-                format!("--free {}", p.name),
-                format!("sets the same field as `{}`", q.name),
+                format!("--free {}", p.name()),
+                format!("sets the same field as `{}`", q.name()),
             )
             .into());
         }
@@ -789,7 +792,7 @@ fn analyse(
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by(|&a, &b| sv[b].total_cmp(&sv[a]));
     let tol = opts.undetermined_rel_error;
-    let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+    let names: Vec<&str> = params.iter().map(Resolved::name).collect();
     let directions: Vec<Direction> = order
         .iter()
         .map(|&k| {
@@ -847,9 +850,9 @@ fn analyse(
                 .flatten()
                 .any(|b| (x[j] - b).abs() <= 1e-3 * width);
             FittedParameter {
-                name: p.name.clone(),
-                unit: p.unit.clone(),
-                field: p.path.join("."),
+                name: p.name().to_string(),
+                unit: p.field.unit().to_string(),
+                field: p.field.keys().join("."),
                 value: x[j],
                 start: start[j],
                 standard_error: determined.then_some(rel * p.scale),
@@ -1048,7 +1051,7 @@ fn identifiability_words(
     tol: f64,
 ) -> Vec<String> {
     let scale_word = |name: &str| {
-        let p = params.iter().find(|p| p.name == name);
+        let p = params.iter().find(|p| p.name() == name);
         match p {
             Some(p) if p.lower.is_some_and(|lo| lo >= 0.0) && p.start > 0.0 => "its value",
             _ => "its scale",

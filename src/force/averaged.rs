@@ -6,7 +6,9 @@ use std::f64::consts::PI;
 use statrs::function::erf::erfc;
 
 use super::term::finite_eval;
-use super::{Coupling, Footprint, GapReference, InterfaceTerm, PressureLaw, TermForce, TermKind};
+use super::{
+    Coupling, Footprint, GapReference, InterfaceTerm, PressureLaw, Scaled, TermForce, TermKind,
+};
 use crate::error::check_positive;
 use crate::quadrature::{integrate_with_breaks, QuadOptions};
 use crate::surface::GaussianHeights;
@@ -232,23 +234,18 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
         self.gap
     }
     fn force(&self, d: f64) -> Result<TermForce> {
-        let r = (|| -> Result<(f64, f64)> {
-            if !d.is_finite() {
-                return Err(Error::invalid("d", format!("must be finite, got {d}")));
-            }
-            match self.footprint {
-                Footprint::Flat { area_m2 } => Ok((
-                    area_m2 * self.mean_pressure(d)?,
-                    area_m2 * self.mean_pressure_slope(d)?,
-                )),
-                Footprint::Paraboloid {
-                    radius_of_curvature_m,
-                    ..
-                } => {
-                    let c = 2.0 * PI * radius_of_curvature_m;
-                    let delta = self.footprint.derjaguin_depth();
+        finite_eval(self.name(), "force", d, || {
+            self.footprint.reduce(
+                1.0,
+                || {
+                    Ok((
+                        self.mean_pressure(d)?.into(),
+                        self.mean_pressure_slope(d)?.into(),
+                    ))
+                },
+                |delta| {
                     if delta.is_infinite() {
-                        Ok((c * self.mean_energy(d)?, -c * self.mean_pressure(d)?))
+                        Ok((self.mean_energy(d)?.into(), self.mean_pressure(d)?.into()))
                     } else if self.sigma > 0.0 && delta < 0.1 * self.sigma {
                         // A band much thinner than σ: I(d) − I(d + Δ) would cancel; p̄ is smooth on
                         // the scale σ, so 8-point Gauss–Legendre over the band is exact to
@@ -261,16 +258,16 @@ impl<L: PressureLaw> InterfaceTerm for AveragedTerm<L> {
                                     + self.mean_pressure(mid + half * x)?);
                         }
                         let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
-                        Ok((c * half * f, -c * df))
+                        Ok((Scaled::new(half, f), df.into()))
                     } else {
                         let f = self.mean_energy(d)? - self.mean_energy(d + delta)?;
                         let df = self.mean_pressure(d)? - self.mean_pressure(d + delta)?;
-                        Ok((c * f, -c * df))
+                        Ok((f.into(), df.into()))
                     }
-                }
-            }
-        })()?;
-        finite_eval(self.name(), "force", d, r).map(TermForce::from)
+                },
+            )
+        })
+        .map(TermForce::from)
     }
     fn kinks(&self) -> Vec<f64> {
         // With roughness the cutoff is smeared over σ and the force is smooth on the scale of the
@@ -333,3 +330,69 @@ macro_rules! forward_term {
     };
 }
 pub(crate) use forward_term;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::force::LennardJones39;
+
+    /// The footprint reduction as each term wrote it out before [`Footprint::reduce`] held it.
+    fn written_out<L: PressureLaw>(t: &AveragedTerm<L>, d: f64) -> (f64, f64) {
+        let (p, e) = (
+            |s: f64| t.mean_pressure(s).unwrap(),
+            |s: f64| t.mean_energy(s).unwrap(),
+        );
+        match t.footprint {
+            Footprint::Flat { area_m2 } => {
+                (area_m2 * p(d), area_m2 * t.mean_pressure_slope(d).unwrap())
+            }
+            Footprint::Paraboloid {
+                radius_of_curvature_m,
+                ..
+            } => {
+                let c = 2.0 * PI * radius_of_curvature_m;
+                let delta = t.footprint.derjaguin_depth();
+                if delta.is_infinite() {
+                    (c * e(d), -c * p(d))
+                } else if t.sigma > 0.0 && delta < 0.1 * t.sigma {
+                    let (mid, half) = (d + 0.5 * delta, 0.5 * delta);
+                    let mut f = 0.0;
+                    for (x, w) in GAUSS_LEGENDRE_8 {
+                        f += w * (p(mid - half * x) + p(mid + half * x));
+                    }
+                    (c * half * f, -c * (p(d) - p(d + delta)))
+                } else {
+                    (c * (e(d) - e(d + delta)), -c * (p(d) - p(d + delta)))
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_footprint_reduction_gives_the_written_out_numbers_to_the_bit() {
+        for sigma in [0.0, 0.7e-9] {
+            for footprint in Footprint::samples() {
+                let t = AveragedTerm::new(
+                    "lj",
+                    TermKind::Intermolecular,
+                    Coupling::Static,
+                    LennardJones39::new(1e-19, 1e-76).unwrap(),
+                    2e-10,
+                    GaussianHeights::new(sigma).unwrap(),
+                    footprint,
+                    GapReference::Bulge,
+                )
+                .unwrap();
+                for d in [1e-10, 4e-10, 1.3e-9, 5e-9] {
+                    let f = t.force(d).unwrap();
+                    let (value, slope) = written_out(&t, d);
+                    assert_eq!(
+                        (f.value.to_bits(), f.slope.to_bits()),
+                        (value.to_bits(), slope.to_bits()),
+                        "σ = {sigma}, {footprint:?}, d = {d}"
+                    );
+                }
+            }
+        }
+    }
+}

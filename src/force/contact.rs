@@ -4,7 +4,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use super::term::finite_eval;
-use super::{Coupling, Footprint, GapReference, InterfaceTerm, TermForce, TermKind};
+use super::{Coupling, Footprint, GapReference, InterfaceTerm, Scaled, TermForce, TermKind};
 use crate::error::check_positive;
 use crate::surface::PeakDistribution;
 use crate::{Error, Result};
@@ -118,6 +118,27 @@ impl GreenwoodWilliamson {
             Ok(m - self.moment(d + delta, p)?)
         }
     }
+
+    /// `k M_p` per nominal area (the pressure for `p = 3/2`, the real contact area for `p = 1`)
+    /// over the footprint, with its slope: `dM_p/dd = −p M_{p−1}` and
+    /// `∫_d^∞ M_p = M_{p+1}/(p + 1)`.
+    fn over_footprint(&self, d: f64, k: f64, p: f64) -> Result<(f64, f64)> {
+        self.footprint.reduce(
+            k,
+            || {
+                Ok((
+                    self.moment(d, p)?.into(),
+                    Scaled::new(-p, self.moment(d, p - 1.0)?),
+                ))
+            },
+            |delta| {
+                Ok((
+                    Scaled::new(1.0 / (p + 1.0), self.moment_band(d, p + 1.0, delta)?),
+                    self.moment_band(d, p, delta)?.into(),
+                ))
+            },
+        )
+    }
 }
 
 impl InterfaceTerm for GreenwoodWilliamson {
@@ -134,30 +155,11 @@ impl InterfaceTerm for GreenwoodWilliamson {
         self.gap
     }
     fn force(&self, d: f64) -> Result<TermForce> {
-        let r = (|| -> Result<(f64, f64)> {
-            if !d.is_finite() {
-                return Err(Error::invalid("d", format!("must be finite, got {d}")));
-            }
+        finite_eval(self.name(), "force", d, || {
             let k = 4.0 / 3.0 * self.modulus * self.radius.sqrt() * self.density;
-            match self.footprint {
-                Footprint::Flat { area_m2 } => Ok((
-                    area_m2 * k * self.moment(d, 1.5)?,
-                    -area_m2 * k * 1.5 * self.moment(d, 0.5)?,
-                )),
-                Footprint::Paraboloid {
-                    radius_of_curvature_m,
-                    ..
-                } => {
-                    let c = 2.0 * PI * radius_of_curvature_m * k;
-                    let delta = self.footprint.derjaguin_depth();
-                    Ok((
-                        c * 0.4 * self.moment_band(d, 2.5, delta)?,
-                        -c * self.moment_band(d, 1.5, delta)?,
-                    ))
-                }
-            }
-        })()?;
-        finite_eval(self.name(), "force", d, r).map(TermForce::from)
+            self.over_footprint(d, k, 1.5)
+        })
+        .map(TermForce::from)
     }
     fn real_contact_area(&self, d: f64) -> Result<f64> {
         Ok(self.real_contact_area_and_slope(d)?.0)
@@ -169,29 +171,71 @@ impl InterfaceTerm for GreenwoodWilliamson {
         }
     }
     fn real_contact_area_and_slope(&self, d: f64) -> Result<(f64, f64)> {
-        let r = (|| -> Result<(f64, f64)> {
-            if !d.is_finite() {
-                return Err(Error::invalid("d", format!("must be finite, got {d}")));
+        finite_eval(self.name(), "real contact area", d, || {
+            self.over_footprint(d, PI * self.radius * self.density, 1.0)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::Gaussian;
+
+    /// Force and real contact area with their slopes, as the term wrote the footprint reduction
+    /// out before [`Footprint::reduce`] held it.
+    fn written_out(gw: &GreenwoodWilliamson, d: f64) -> [(f64, f64); 2] {
+        let m = |s: f64, p: f64| gw.moment(s, p).unwrap();
+        let band = |p: f64, delta: f64| gw.moment_band(d, p, delta).unwrap();
+        let kf = 4.0 / 3.0 * gw.modulus * gw.radius.sqrt() * gw.density;
+        let ka = PI * gw.radius * gw.density;
+        match gw.footprint {
+            Footprint::Flat { area_m2 } => [
+                (area_m2 * kf * m(d, 1.5), -area_m2 * kf * 1.5 * m(d, 0.5)),
+                (area_m2 * ka * m(d, 1.0), -area_m2 * ka * m(d, 0.0)),
+            ],
+            Footprint::Paraboloid {
+                radius_of_curvature_m,
+                ..
+            } => {
+                let delta = gw.footprint.derjaguin_depth();
+                let (cf, ca) = (
+                    2.0 * PI * radius_of_curvature_m * kf,
+                    2.0 * PI * radius_of_curvature_m * ka,
+                );
+                [
+                    (cf * 0.4 * band(2.5, delta), -cf * band(1.5, delta)),
+                    (ca * 0.5 * band(2.0, delta), -ca * band(1.0, delta)),
+                ]
             }
-            let k = PI * self.radius * self.density;
-            match self.footprint {
-                Footprint::Flat { area_m2 } => Ok((
-                    area_m2 * k * self.moment(d, 1.0)?,
-                    -area_m2 * k * self.moment(d, 0.0)?,
-                )),
-                Footprint::Paraboloid {
-                    radius_of_curvature_m,
-                    ..
-                } => {
-                    let c = 2.0 * PI * radius_of_curvature_m * k;
-                    let delta = self.footprint.derjaguin_depth();
-                    Ok((
-                        c * 0.5 * self.moment_band(d, 2.0, delta)?,
-                        -c * self.moment_band(d, 1.0, delta)?,
-                    ))
-                }
+        }
+    }
+
+    #[test]
+    fn the_footprint_reduction_gives_the_written_out_numbers_to_the_bit() {
+        let peaks = Arc::new(Gaussian::new(2e-10, 6e-10).unwrap());
+        for footprint in Footprint::samples() {
+            let gw = GreenwoodWilliamson::new(
+                1.1e11,
+                1.3e-7,
+                1.7e14,
+                peaks.clone(),
+                footprint,
+                GapReference::Bulge,
+            )
+            .unwrap();
+            for d in [-1e-9, 0.0, 7e-10, 2.1e-9] {
+                let f = gw.force(d).unwrap();
+                let area = gw.real_contact_area_and_slope(d).unwrap();
+                let bits = |(v, s): (f64, f64)| (v.to_bits(), s.to_bits());
+                let [force, contact] = written_out(&gw, d);
+                assert_eq!(
+                    bits((f.value, f.slope)),
+                    bits(force),
+                    "{footprint:?}, d = {d}"
+                );
+                assert_eq!(bits(area), bits(contact), "{footprint:?}, d = {d}");
             }
-        })()?;
-        finite_eval(self.name(), "real contact area", d, r)
+        }
     }
 }

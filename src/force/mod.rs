@@ -39,7 +39,7 @@ pub use air_bearing::{AirBearing, AirBearingModel, CubicBearing, LinearBearing, 
 pub use averaged::AveragedTerm;
 pub use contact::{composite_modulus, GreenwoodWilliamson};
 pub use electrostatic::Electrostatic;
-pub use footprint::Footprint;
+pub use footprint::{Footprint, Scaled};
 pub(crate) use interface::by_coupling;
 pub use interface::{Breakdown, ForceEval, Gaps, HotForces, HotValues, InterfaceForces};
 pub use intermolecular::Intermolecular;

@@ -133,9 +133,22 @@ pub trait InterfaceTerm: Debug + Send + Sync {
     }
 }
 
-/// A term's value and slope at `d`, or an error when parameters too large for `f64` made them
-/// overflow (±∞ or NaN): no term returns a non-finite result as `Ok`.
-pub(crate) fn finite_eval(name: &str, what: &str, d: f64, r: (f64, f64)) -> Result<(f64, f64)> {
+/// A term's value and slope at `d`, computed by `eval`: an error when `d` is not finite, or when
+/// parameters too large for `f64` made them overflow (±∞ or NaN): no term returns a non-finite
+/// result as `Ok`.
+pub(crate) fn finite_eval(
+    name: &str,
+    what: &str,
+    d: f64,
+    eval: impl FnOnce() -> Result<(f64, f64)>,
+) -> Result<(f64, f64)> {
+    if !d.is_finite() {
+        return Err(crate::Error::invalid(
+            "d",
+            format!("must be finite, got {d}"),
+        ));
+    }
+    let r = eval()?;
     if r.0.is_finite() && r.1.is_finite() {
         Ok(r)
     } else {

@@ -57,17 +57,25 @@
 //! assert!(err.contains("surface.height_sigma_nm: must be finite and >= 0, got -0.5 nm"), "{err}");
 //! # Ok(()) }
 //! ```
+//!
+//! # Fields by name
+//!
+//! [`FieldPath`] resolves a field named as a user writes it, in SI or in an engineering unit
+//! (`surface.height_sigma_nm`), on the scene's serde form: `hdi fit --free` and the Python
+//! `scene[...]` and `Scene.with_values` go through it.
 
 mod build;
 mod eng_units;
 mod io;
 mod paper;
+mod path;
 mod spec;
 mod structure;
 mod toml_text;
 mod validate;
 
 pub use eng_units::engineering_unit;
+pub use path::{FieldPath, PathError};
 
 pub use spec::{
     ContactSpec, DetectorSpec, ElectrostaticSpec, FrictionSpec, HeaterSpec, IntermolecularSpec,

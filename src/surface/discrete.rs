@@ -2,8 +2,8 @@
 //! peaks"), given or drawn reproducibly from a continuous law.
 
 use super::empirical::MAX_INPUT_LEN;
-use super::rng::Xoshiro256;
 use super::PeakDistribution;
+use crate::numerics::rng::Xoshiro256;
 use crate::quadrature::{Table, TableOptions};
 use crate::{Error, Result};
 

@@ -27,9 +27,9 @@ mod moments;
 mod peak_model;
 mod rice_maxima;
 mod rician;
-mod rng;
 pub mod special;
 
+pub use crate::numerics::rng::Xoshiro256;
 pub use discrete::Discrete;
 pub use empirical::Empirical;
 pub use gaussian::Gaussian;
@@ -37,7 +37,6 @@ pub use heights::GaussianHeights;
 pub use peak_model::PeakModel;
 pub use rice_maxima::RiceMaxima;
 pub use rician::Rician;
-pub use rng::Xoshiro256;
 
 /// Asperity peak-height distribution, heights z (m) from the surface mean plane.
 pub trait PeakDistribution: std::fmt::Debug + Send + Sync {
