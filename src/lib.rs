@@ -97,6 +97,7 @@ pub mod ode;
 pub mod quadrature;
 pub mod report;
 pub mod scene;
+pub mod sim;
 pub mod surface;
 pub mod units;
 

@@ -12,11 +12,10 @@ use super::equilibrium::{flying_equilibrium, ScanGrid};
 use super::roots::brent;
 use crate::error::{check_positive, Error, Result};
 use crate::heater::Programme;
-use crate::model::{SliderModel, SliderSystem, StateLayout};
-use crate::ode::{self, Integrator, Method, Options, Stats, StepStatus};
-use nalgebra::{
-    allocator::Allocator, DefaultAllocator, DimName, OVector, U10, U4, U5, U6, U7, U8, U9,
-};
+use crate::model::{SliderModel, SliderSystem};
+use crate::ode::{self, Integrator, Method, Stats, StepStatus};
+use crate::sim::{Problem, SizedRun};
+use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -30,13 +29,6 @@ const STEP_PACE_ALLOWANCE: f64 = 0.1;
 /// The start allowance of the step pace taken afresh from a cycle's first step below the force
 /// tables, as a fraction of `max_steps` ([`CycleOptions::stop_outside_tables`]).
 const BELOW_TABLES_ALLOWANCE: f64 = 0.01;
-
-/// `Auto` starts with the stiff method when the explicit method's stability limit alone would
-/// take more steps than this over the programme (the rigid paper scene needs about 1.3e3; a bulge
-/// ringing at hundreds of MHz, or a nanosecond interface lag, 1e6 and more). Auto would switch
-/// after its first stiffness checks anyway, but its explicit trial steps on the way throw the
-/// state out of the force tables, where every force is an exact quadrature.
-const EXPLICIT_STEPS_FOR_STIFF: f64 = 1e5;
 
 /// The heater programme of a cycle.
 #[derive(Clone, Debug, PartialEq)]
@@ -304,22 +296,117 @@ pub fn simulate_cycle(
 ) -> Result<CycleResult> {
     opts.validate()?;
     super::equilibrium::check_heater(model)?;
-    // Dispatch on the state size to stack vectors: a step allocates nothing, and a scene pays
-    // only for the coordinates and lags it uses.
-    let layout = StateLayout::of(model, true);
-    match layout.len() {
-        4 => run::<U4>(model, programme, opts),
-        5 => run::<U5>(model, programme, opts),
-        6 => run::<U6>(model, programme, opts),
-        7 => run::<U7>(model, programme, opts),
-        8 => run::<U8>(model, programme, opts),
-        9 => run::<U9>(model, programme, opts),
-        10 => run::<U10>(model, programme, opts),
-        n => Err(crate::error::AnalysisError::Internal {
-            stage: crate::error::Stage::Cycle,
-            detail: format!("unexpected state size {n}"),
-        }
-        .into()),
+    let clock = Instant::now();
+    let start = Start::of(model, programme)?;
+    let t0 = start.programme.start_time();
+    let eq = flying_equilibrium(
+        model,
+        start.programme.power(t0),
+        model.voltage().squared(t0),
+        &ScanGrid::default(),
+    )?;
+    // The fixed programme's knots are kinks of the right-hand side; the triggered programme's
+    // only interior knot, its turning point, is where the programme is replaced (a restart).
+    let kinks = match start.triggered {
+        None => start.programme.knots().iter().map(|k| k.0).collect(),
+        Some(_) => Vec::new(),
+    };
+    let s = opts.solver;
+    let end = start.programme.end_time();
+    // The integrals only need the accuracy the detector and the mean temperature use.
+    let problem = Problem::builder(model, model.inputs(start.programme.clone()), true)
+        .rtol(s.rtol)
+        .tolerances(
+            s.atol_displacement,
+            s.rtol * opts.detector.contact_threshold * opts.detector.window,
+            s.rtol * opts.detector.window,
+        )
+        .max_step(s.max_step)
+        .max_steps(s.max_steps)
+        .stops(kinks)
+        .dense()
+        .method_for_span(s.method, end - t0)
+        .build()?;
+    // On a state vector sized at compile time: a step allocates nothing, and a scene pays only
+    // for the coordinates, lags and term states it uses.
+    problem.dispatch(
+        crate::error::Stage::Cycle,
+        CycleRun {
+            model,
+            opts,
+            start,
+            rest: eq.rest(),
+            clock,
+        },
+    )
+}
+
+/// The programme a cycle starts on: the fixed one, or the triggered protocol's ramp (whose
+/// turning point the detector fixes), with the triggered protocol's settings.
+struct Start {
+    programme: Programme,
+    /// `(start power, ramp rate, overshoot)` of the triggered protocol.
+    triggered: Option<(f64, f64, f64)>,
+}
+
+impl Start {
+    fn of(model: &SliderModel, programme: &HeaterProgramme) -> Result<Self> {
+        Ok(match programme {
+            HeaterProgramme::Fixed(p) => Start {
+                programme: p.clone(),
+                triggered: None,
+            },
+            &HeaterProgramme::Triggered {
+                start_power,
+                ramp_rate,
+                overshoot,
+            } => {
+                check_positive("programme.ramp_rate", ramp_rate)?;
+                check_positive("programme.overshoot", overshoot)?;
+                crate::error::check_non_negative("programme.start_power", start_power)?;
+                // Search up to the power whose protrusion is twice the nominal clearance.
+                let span = 2.0 * model.nominal_clearance() / model.efficiency();
+                // Bound the search, in overshoots, so that a heater too weak to ever reach
+                // touchdown fails at once instead of running for ever.
+                let segments = span / overshoot;
+                if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
+                    return Err(crate::error::AnalysisError::TooManySegments {
+                        span_mw: crate::units::to_mw(span),
+                        overshoot_mw: crate::units::to_mw(overshoot),
+                        segments,
+                        max_segments: MAX_TRIGGERED_SEGMENTS,
+                    }
+                    .into());
+                }
+                let ramp = Programme::new(vec![
+                    (0.0, start_power),
+                    (span / ramp_rate, start_power + span),
+                ])?;
+                Start {
+                    programme: ramp,
+                    triggered: Some((start_power, ramp_rate, overshoot)),
+                }
+            }
+        })
+    }
+}
+
+/// The cycle's integration on a [`Problem`], at the state size of its layout.
+struct CycleRun<'m> {
+    model: &'m SliderModel,
+    opts: &'m CycleOptions,
+    start: Start,
+    rest: crate::model::Rest,
+    clock: Instant,
+}
+
+impl SizedRun for CycleRun<'_> {
+    type Output = CycleResult;
+    fn run<D: DimName>(self, problem: Problem) -> Result<CycleResult>
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        run::<D>(self, problem)
     }
 }
 
@@ -491,8 +578,8 @@ where
             .it
             .step()
             .map_err(|e| explain_ode_error(model, opts, e))?;
-        let p = &self.it.poly;
-        self.rec.push_step(p.t0, p.h, p.n, &p.coeffs, self.it.t());
+        let p = self.it.last_step();
+        self.rec.push_step(p.t0, p.h, p.n, p.coeffs, self.it.t());
         let st = self.it.stats();
         let (t0, span) = self.span;
         let max = opts.solver.max_steps as f64;
@@ -549,72 +636,29 @@ where
     }
 }
 
-fn run<D: DimName>(
-    model: &SliderModel,
-    programme: &HeaterProgramme,
-    opts: &CycleOptions,
-) -> Result<CycleResult>
+fn run<D: DimName>(job: CycleRun<'_>, problem: Problem) -> Result<CycleResult>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    let clock = Instant::now();
-    let det = opts.detector;
-    // The ramp that the triggered protocol follows until touchdown fixes its turning point.
-    let (initial_programme, triggered) = match programme {
-        HeaterProgramme::Fixed(p) => (p.clone(), None),
-        &HeaterProgramme::Triggered {
-            start_power,
-            ramp_rate,
-            overshoot,
-        } => {
-            check_positive("programme.ramp_rate", ramp_rate)?;
-            check_positive("programme.overshoot", overshoot)?;
-            crate::error::check_non_negative("programme.start_power", start_power)?;
-            // Search up to the power whose protrusion is twice the nominal clearance.
-            let span = 2.0 * model.nominal_clearance() / model.efficiency();
-            // Bound the search, in overshoots, so that a heater too weak to ever reach touchdown
-            // fails at once instead of running for ever.
-            let segments = span / overshoot;
-            if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
-                return Err(crate::error::AnalysisError::TooManySegments {
-                    span_mw: crate::units::to_mw(span),
-                    overshoot_mw: crate::units::to_mw(overshoot),
-                    segments,
-                    max_segments: MAX_TRIGGERED_SEGMENTS,
-                }
-                .into());
-            }
-            let ramp = Programme::new(vec![
-                (0.0, start_power),
-                (span / ramp_rate, start_power + span),
-            ])?;
-            (ramp, Some((start_power, ramp_rate, overshoot)))
-        }
-    };
-
-    let t0 = initial_programme.start_time();
-    let volt2_0 = model.voltage().squared(t0);
-    let eq = flying_equilibrium(
+    let CycleRun {
         model,
-        initial_programme.power(t0),
-        volt2_0,
-        &ScanGrid::default(),
-    )?;
-    let sys = SliderSystem::new(model, model.inputs(initial_programme.clone()), true);
-    let layout = sys.layout();
+        opts,
+        start,
+        rest,
+        clock,
+    } = job;
+    let det = opts.detector;
+    let Start {
+        programme: initial_programme,
+        triggered,
+    } = start;
+    let t0 = initial_programme.start_time();
+    let layout = problem.system().layout();
     let q = layout
         .contact_impulse
         .ok_or_else(|| internal("no impulse state"))?;
     let heat = layout.heat.ok_or_else(|| internal("no heat state"))?;
-    let y0: OVector<f64, D> = sys.initial_state(D::name(), &eq.rest());
-
-    // The fixed programme's knots are kinks of the right-hand side; the triggered programme's
-    // only interior knot, its turning point, is where the programme is replaced (a restart).
-    let kinks = match triggered {
-        None => initial_programme.knots().iter().map(|k| k.0).collect(),
-        Some(_) => Vec::new(),
-    };
-    let ode_opts = ode_options(&sys, opts, kinks)?;
+    let y0: OVector<f64, D> = problem.initial_state(D::name(), &rest);
     // Stop where the lumped model ends: the pad gap h0 + y reaching zero puts the slider body
     // into the disk (no pad contact is modelled; a power-law bearing is singular there).
     let h0 = model.nominal_clearance();
@@ -622,8 +666,8 @@ where
         .direction(ode::Direction::Falling)
         .terminal(true);
     let end = initial_programme.end_time();
-    let method = cycle_method(model, &opts.solver, end - t0);
-    let it = Integrator::new(sys, t0, y0.clone(), end, method, &ode_opts)
+    let it = problem
+        .integrator(t0, y0.clone(), end)
         .map_err(|e| explain_ode_error(model, opts, e))?
         .events([guard]);
     let mut run = Run {
@@ -743,44 +787,6 @@ where
         wall_seconds: clock.elapsed().as_secs_f64(),
         series,
     })
-}
-
-/// The method of a cycle: as asked, except that `Auto` on a slider whose fastest rate no explicit
-/// step can follow over `span` is its stiff method from the start (Radau5 or Rodas5P by the
-/// tolerance, as `Auto` would choose).
-fn cycle_method(model: &SliderModel, s: &SolverSettings, span: f64) -> Method {
-    let explicit_steps = span * model.fastest_rate() / ode::EXPLICIT_STABILITY_BOUNDARY;
-    match s.method {
-        Method::Auto if explicit_steps > EXPLICIT_STEPS_FOR_STIFF => {
-            if s.rtol < ode::AUTO_RADAU_BELOW_RTOL {
-                Method::Radau5
-            } else {
-                Method::Rodas5P
-            }
-        }
-        m => m,
-    }
-}
-
-fn ode_options(sys: &SliderSystem, opts: &CycleOptions, kinks: Vec<f64>) -> Result<Options> {
-    let s = opts.solver;
-    // The integrals only need the accuracy the detector and the mean temperature use.
-    let atol = sys.tolerances(
-        s.atol_displacement,
-        s.rtol * opts.detector.contact_threshold * opts.detector.window,
-        s.rtol * opts.detector.window,
-    );
-    let n = atol.len();
-    let o = Options::default()
-        .rtol(s.rtol)
-        .atol_per_component(atol)
-        .h_max(sys.max_step(s.max_step))
-        .max_steps(s.max_steps)
-        .t_stops(kinks)
-        .dense(true);
-    o.validate(n)
-        .map_err(|e| Error::invalid("solver", e.to_string()))?;
-    Ok(o)
 }
 
 /// The error for a trajectory that left the lumped model (the pad gap reached zero), with the

@@ -8,10 +8,10 @@
 
 use super::equilibrium::{flying_equilibrium, Equilibrium, ScanGrid};
 use crate::error::{AnalysisError, Error, Result, Stage};
-use crate::heater::Programme;
-use crate::model::{SliderModel, SliderSystem, Voltage};
+use crate::model::{Heater, SliderModel, SliderSystem, Voltage};
 use crate::ode::OdeSystem;
 use crate::scene::MAX_DOF;
+use crate::sim::Problem;
 use nalgebra::{DMatrix, DVector, Dyn};
 use num_complex::Complex64;
 use serde::Serialize;
@@ -178,16 +178,13 @@ pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse
     let mean_volt2 = v.mean_squared();
     let eq = flying_equilibrium(model, power, mean_volt2, &ScanGrid::default())?;
     // Freeze the voltage at its mean square: a DC voltage with the same V².
-    let frozen = model.with_voltage(Voltage {
+    let mut inputs = model.inputs(Heater::Power(power));
+    inputs.voltage = Voltage {
         dc: v.contact_potential + mean_volt2.sqrt(),
         ac_amplitude: 0.0,
         ..v
-    });
-    let sys = SliderSystem::new(
-        &frozen,
-        frozen.inputs(Programme::constant(power, 1.0)?),
-        false,
-    );
+    };
+    let sys = SliderSystem::new(model, inputs, false);
     let layout = sys.layout();
     let n = layout.len();
     let state = sys.initial_state(Dyn(n), &eq.rest());
@@ -281,7 +278,7 @@ pub fn simulated_dither(
     settle: usize,
     periods: usize,
 ) -> Result<f64> {
-    use crate::ode::{solve, Options, SaveAt};
+    use crate::ode::SaveAt;
     let v = model.voltage();
     if !v.is_time_dependent() {
         return Err(AnalysisError::NoAcVoltage.into());
@@ -292,25 +289,23 @@ pub fn simulated_dither(
     let period = 1.0 / (2.0 * v.frequency.abs());
     let t_end = (settle + periods) as f64 * period;
     let eq = flying_equilibrium(model, power, v.squared(0.0), &ScanGrid::default())?;
-    let sys = SliderSystem::new(
-        model,
-        model.inputs(Programme::constant(power, t_end)?),
-        false,
-    );
-    let y0 = sys.initial_state(Dyn(sys.layout().len()), &eq.rest());
     let t_start = settle as f64 * period;
     let samples = 400 * periods;
     let times: Vec<f64> = (0..=samples)
         .map(|i| t_start + (t_end - t_start) * i as f64 / samples as f64)
         .collect();
     let s = opts.solver;
-    let o = Options::default()
+    let problem = Problem::builder(model, model.inputs(Heater::Power(power)), false)
         .rtol(s.rtol)
-        .atol_per_component(sys.tolerances(s.atol_displacement, 0.0, 0.0))
-        .h_max(sys.max_step(None))
+        .tolerances(s.atol_displacement, 0.0, 0.0)
+        .max_step(None)
         .max_steps(s.max_steps)
-        .save(SaveAt::Times(times));
-    let sol = solve(&sys, 0.0, y0, t_end, s.method, &o, &mut [])?;
+        .save(SaveAt::Times(times))
+        .method(s.method)
+        .build()?;
+    let sys = problem.system();
+    let y0 = problem.initial_state(Dyn(sys.layout().len()), &eq.rest());
+    let sol = problem.solve(0.0, y0, t_end)?;
     let (lo, hi) = sol
         .y
         .iter()

@@ -6,9 +6,10 @@ use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
 use crate::error::{check_finite, check_non_negative, Error, Result};
 use crate::model::{Heater, Inputs, Rest, SliderModel, SliderSystem, StateLayout, Voltage};
-use crate::ode::{Integrator, Method, Options, Stats};
+use crate::ode::{Integrator, Method, Stats};
 use crate::scene::Scene;
-use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector, U10, U4, U5, U6, U7, U8, U9};
+use crate::sim::{with_sized, Problem, SizedIntegrator};
+use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -281,8 +282,9 @@ pub fn scene_zone(scene: &Scene, radius: f64) -> Result<Zone> {
 /// ```
 #[derive(Clone)]
 pub struct Plant {
-    /// The slider under the start's inputs, the disk's motion among them.
-    system: SliderSystem,
+    /// The slider under the start's inputs (the disk's motion among them), with its
+    /// tolerances and method.
+    problem: Problem,
     /// The disk surface (its motion is in the system's inputs).
     disk: Arc<Disk>,
     base: SliderModel,
@@ -291,8 +293,6 @@ pub struct Plant {
     start_sensors: Physical,
     sensors: SensorSpec,
     ambient: Ambient,
-    method: Method,
-    ode: Options,
     /// How each period's displacement tolerance is chosen.
     tol: TolRule,
     /// See `Span::rebase`.
@@ -430,14 +430,13 @@ impl Plant {
             clearance_offset: 0.0,
             base_motion: base_motion(&disk),
         };
-        let system = SliderSystem::new(&base, start_inputs, true);
-        let probe = &system;
+        let builder = Problem::builder(&base, start_inputs, true);
+        let probe = builder.system();
         let layout = probe.layout();
         // The period means of the contact force and flash temperature: 0.1 µN and 0.1 K over
         // 50 µs (the contact sensor resolves about 0.2 µN of contact force per period in
         // contact; the flash temperature is a truth value only, hundreds of kelvin in contact).
         let (impulse, heat) = (3e-8 * 5e-5, 0.1 * 5e-5);
-        let atol = probe.tolerances(opts.atol_displacement, impulse, heat);
         let tol = TolRule::new(
             &probe.tolerances(1.0, 0.0, 0.0),
             &probe.tolerances(0.0, impulse, heat),
@@ -446,16 +445,17 @@ impl Plant {
         );
         // Beyond these the relative tolerance allows ten times the absolute one.
         let rebase = [10.0 * impulse / opts.rtol, 10.0 * heat / opts.rtol];
-        let ode = Options::default()
+        let problem = builder
             .rtol(opts.rtol)
-            .atol_per_component(atol)
+            .tolerances(opts.atol_displacement, impulse, heat)
+            // The voltage changes with the commands: no step limit of its own.
             .h_max(opts.max_step.unwrap_or(f64::INFINITY))
             // Bounded per period in `Drive::step`; the integrator lives as long as the drive.
             .max_steps(usize::MAX)
             // The sensors are read on the interpolant of a step that spans the period's end.
-            .dense(true);
-        ode.validate(layout.len())
-            .map_err(|e| Error::invalid("solver", e.to_string()))?;
+            .dense()
+            .method(opts.method)
+            .build()?;
         let friction = base.friction().coefficient * zone.disk_speed;
         let start_sensors = Physical {
             gap: eq.d,
@@ -472,7 +472,7 @@ impl Plant {
             }
         }
         Ok(Plant {
-            system,
+            problem,
             disk,
             base,
             layout,
@@ -480,8 +480,6 @@ impl Plant {
             start_sensors,
             sensors: opts.sensors,
             ambient: opts.ambient,
-            method: opts.method,
-            ode,
             tol,
             rebase,
             max_steps,
@@ -500,9 +498,9 @@ impl Plant {
     pub fn with_seed(&self, seed: u64) -> Result<Plant> {
         let mut p = self.clone();
         p.disk = Arc::new(Disk::new(&self.disk_spec, self.rpm, seed)?);
-        let mut inputs = p.system.inputs().clone();
+        let mut inputs = p.problem.system().inputs().clone();
         inputs.base_motion = base_motion(&p.disk);
-        p.system.set_inputs(inputs);
+        p.problem.set_inputs(inputs);
         p.seed = seed;
         Ok(p)
     }
@@ -546,33 +544,6 @@ impl Plant {
     }
 }
 
-/// The integrator, on a state sized at compile time for the layouts a scene can have.
-// One per drive, built once and never moved per step: the size difference costs nothing.
-#[allow(clippy::large_enum_variant)]
-enum Integ {
-    S4(Integrator<'static, U4, SliderSystem>),
-    S5(Integrator<'static, U5, SliderSystem>),
-    S6(Integrator<'static, U6, SliderSystem>),
-    S7(Integrator<'static, U7, SliderSystem>),
-    S8(Integrator<'static, U8, SliderSystem>),
-    S9(Integrator<'static, U9, SliderSystem>),
-    S10(Integrator<'static, U10, SliderSystem>),
-}
-
-macro_rules! with_integ {
-    ($integ:expr, $it:ident => $body:expr) => {
-        match $integ {
-            Integ::S4($it) => $body,
-            Integ::S5($it) => $body,
-            Integ::S6($it) => $body,
-            Integ::S7($it) => $body,
-            Integ::S8($it) => $body,
-            Integ::S9($it) => $body,
-            Integ::S10($it) => $body,
-        }
-    };
-}
-
 /// A simulated drive: the slider of a [`Plant`] flying over its wavy disk, with a heater, a
 /// head–disk voltage and the sensors firmware reads, stepped at the controller's rate.
 ///
@@ -586,7 +557,7 @@ macro_rules! with_integ {
 /// bit. A `Drive` owns its plant (`Arc<Plant>`): no borrow, `'static`.
 pub struct Drive {
     plant: Arc<Plant>,
-    integ: Integ,
+    integ: SizedIntegrator,
     sensors: SensorState,
     t: f64,
     /// The command and ambient clearance the integrator's system holds (`None` before the first
@@ -611,13 +582,10 @@ struct TermStates {
 }
 
 impl TermStates {
-    fn of<D: Dim>(layout: &StateLayout, y: &OVector<f64, D>) -> Self
-    where
-        DefaultAllocator: Allocator<D>,
-    {
+    fn of(layout: &StateLayout, y: &[f64]) -> Self {
         let (first, n) = layout.term_states;
         let mut x = [0.0; crate::force::MAX_TERM_STATES];
-        x[..n].copy_from_slice(&y.as_slice()[first..first + n]);
+        x[..n].copy_from_slice(&y[first..first + n]);
         TermStates { x, n }
     }
 }
@@ -642,38 +610,21 @@ impl Drive {
     /// # Errors
     /// A state size the drive has no fixed-size vector for; integrator set-up failures.
     pub fn new(plant: Arc<Plant>) -> Result<Self> {
-        let sys = plant.system.clone();
-        let (m, o) = (plant.method, &plant.ode);
-        let terms;
-        let rest = plant.start;
+        let mut terms = TermStates::default();
         let mut tol = TolState {
             atol: plant.tol.range.0,
             y0: [0.0; MAX_STATE],
         };
-        macro_rules! start {
-            ($variant:ident, $dim:expr) => {{
-                let y0 = sys.initial_state($dim, &rest);
-                tol.y0[..y0.len()].copy_from_slice(y0.as_slice());
-                terms = TermStates::of(&plant.layout, &y0);
-                Integ::$variant(Integrator::new(sys, 0.0, y0, HORIZON, m, o)?)
-            }};
-        }
-        let integ = match plant.layout.len() {
-            4 => start!(S4, U4),
-            5 => start!(S5, U5),
-            6 => start!(S6, U6),
-            7 => start!(S7, U7),
-            8 => start!(S8, U8),
-            9 => start!(S9, U9),
-            10 => start!(S10, U10),
-            n => {
-                return Err(crate::error::AnalysisError::Internal {
-                    stage: crate::error::Stage::Drive,
-                    detail: format!("no fixed-size state of {n} components"),
-                }
-                .into())
-            }
-        };
+        let integ = plant.problem.clone().start(
+            crate::error::Stage::Drive,
+            0.0,
+            &plant.start,
+            HORIZON,
+            |y0| {
+                tol.y0[..y0.len()].copy_from_slice(y0);
+                terms = TermStates::of(&plant.layout, y0);
+            },
+        )?;
         Ok(Drive {
             sensors: SensorState::new(plant.sensors, plant.seed, &plant.start_sensors),
             plant,
@@ -721,9 +672,9 @@ impl Drive {
             contact_potential: plant.base.voltage().contact_potential,
         });
         let tol = plant.tol.adapts().then_some((&plant.tol, &mut self.tol));
-        let (truth, integrals, terms) = with_integ!(&mut self.integ, it => {
+        let (truth, integrals, terms) = with_sized!(&mut self.integ, it => {
             let y1 = advance(it, &layout, set, &mut self.integrals0, span, tol)?;
-            let terms = TermStates::of(&layout, &y1);
+            let terms = TermStates::of(&layout, y1.as_slice());
             let s = it.system();
             let integrals = (
                 layout.contact_impulse.map_or(0.0, |i| y1[i]),
@@ -784,7 +735,7 @@ impl Drive {
 
     /// Solver work so far.
     pub fn stats(&self) -> Stats {
-        with_integ!(&self.integ, it => it.stats())
+        with_sized!(&self.integ, it => it.stats())
     }
 
     /// The plant.

@@ -15,7 +15,46 @@ pub(crate) struct StepPoly {
     pub coeffs: Vec<f64>,
 }
 
+/// The interpolant of the last accepted step of an [`super::Integrator`]
+/// ([`super::Integrator::last_step`]): `y(t0 + θh) = Σ_m a_m θ^m` on `θ ∈ [0, 1]`, with
+/// `coeffs[m * n + i]` component `i` of `a_m`.
+///
+/// ```
+/// use hdi_tribology::ode::{FnSystem, Integrator, Method, Options};
+/// use nalgebra::Vector1;
+/// let sys = FnSystem::new(|_t, y: &Vector1<f64>, dy: &mut Vector1<f64>| dy[0] = -y[0]);
+/// let o = Options::default().rtol(1e-10).atol(1e-12).dense(true);
+/// let mut it = Integrator::new(sys, 0.0, Vector1::new(1.0), 1.0, Method::Tsit5, &o)?;
+/// it.step()?;
+/// let p = it.last_step();
+/// let theta = 0.5;
+/// let y: f64 = (0..p.coeffs.len() / p.n).rev().fold(0.0, |acc, m| acc * theta + p.coeffs[m * p.n]);
+/// assert!((y - (-(p.t0 + theta * p.h)).exp()).abs() < 1e-8);
+/// # Ok::<(), hdi_tribology::ode::OdeError>(())
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct StepPolynomial<'a> {
+    /// Start of the step.
+    pub t0: f64,
+    /// Length of the step.
+    pub h: f64,
+    /// Number of components.
+    pub n: usize,
+    /// Monomial coefficients, component-major within each power.
+    pub coeffs: &'a [f64],
+}
+
 impl StepPoly {
+    /// This interpolant, as the public view.
+    pub(crate) fn view(&self) -> StepPolynomial<'_> {
+        StepPolynomial {
+            t0: self.t0,
+            h: self.h,
+            n: self.n,
+            coeffs: &self.coeffs,
+        }
+    }
+
     pub fn new(n: usize) -> Self {
         StepPoly {
             t0: 0.0,

@@ -514,6 +514,12 @@ where
         &self.hits
     }
 
+    /// The interpolant of the last accepted step (its coefficients are kept only with dense
+    /// output or events; meaningless before the first step).
+    pub fn last_step(&self) -> super::StepPolynomial<'_> {
+        self.poly.view()
+    }
+
     /// The state at `t` on the interpolant of the last accepted step, `t` in
     /// `[t_prev(), t()]`.
     ///

@@ -44,11 +44,9 @@ mod stepper;
 mod system;
 mod tsit5;
 
-pub use dense::DenseOutput;
+pub use dense::{DenseOutput, StepPolynomial};
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
-/// What `Auto` is made of, for callers that know their problem is stiff from the start.
-pub(crate) use integrator::AUTO_RADAU_BELOW_RTOL;
 pub use integrator::{Integrator, StepStatus};
 pub use options::{Method, Options, SaveAt, Tolerance};
 pub use problem::OdeProblem;
@@ -56,7 +54,6 @@ pub use solution::{Solution, Stats};
 pub use system::{
     complex_step_jacobian, finite_difference_jacobian, FnSystem, NoJacobian, OdeSystem,
 };
-pub(crate) use tsit5::STABILITY_BOUNDARY as EXPLICIT_STABILITY_BOUNDARY;
 
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
