@@ -67,9 +67,17 @@
 //!   dotted name ([`scene::FieldPath`]);
 //! - [`ode`]: a generic ODE stepper that knows no physics;
 //! - [`heater`]: heater power programmes;
-//! - [`model`] and [`analysis`]: the slider model and the analyses (touchdown, take-off,
-//!   hysteresis, pull-in, temperature rise) that join physics and ODE;
-//! - [`report`]: CSV tables and SVG charts.
+//! - [`model`]: the slider model of a scene (never rewritten), the [`model::Inputs`] that drive
+//!   it, and the two as an ODE system ([`model::SliderSystem`]);
+//! - [`sim`]: the one simulation path: a problem built from a model and its inputs (tolerances,
+//!   method, options, fixed-size state);
+//! - [`analysis`]: the analyses (touchdown, take-off, hysteresis, pull-in, temperature rise,
+//!   cycles, sweeps, the linear response);
+//! - [`error`]: the crate's error type, with typed kinds per analysis;
+//! - [`drive`]: a simulated drive that firmware code can step;
+//! - [`clearance`]: firmware clearance calibration on the simulated drive;
+//! - [`fit`]: fitting a scene's parameters to measured curves;
+//! - [`report`]: CSV tables and SVG charts; [`units`]: engineering units at the edges.
 //!
 //! All quantities are SI inside the crate; [`units`] has helpers for the engineering units
 //! used at the edges (nm, mW, kHz, GPa).
