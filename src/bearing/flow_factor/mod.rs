@@ -1,0 +1,2 @@
+//! Rarefied-gas Poiseuille flow factor.
+mod kinetic;
