@@ -119,6 +119,7 @@ fn t_minus1_series(y: f64) -> f64 {
 /// `T_n(y)` for `y > 0` by the trapezoidal rule after `c = e^τ`:
 /// `T_n(y) = ∫ exp((n+1)τ − e^{2τ} − y e^{−τ}) dτ`, whose integrand is analytic in a strip
 /// and decays double-exponentially, so the rule converges geometrically in the step.
+#[cfg(test)]
 pub(crate) fn abramowitz_trapezoid(n: i32, y: f64) -> f64 {
     abramowitz_trapezoid_scaled(n, y, 0.0)
 }
@@ -465,20 +466,9 @@ fn add_near(
 /// Panels closer than this many half-widths (centre to singular point) get the product rules.
 const NEAR: f64 = 3.0;
 
-/// The solution of the discretised integral equation.
-pub(crate) struct Solution {
-    /// Nodes in `[0, D/2]` (mean free paths).
-    pub nodes: Vec<f64>,
-    /// Quadrature weights of the nodes.
-    pub weights: Vec<f64>,
-    /// `φ` at the nodes.
-    pub phi: Vec<f64>,
-    /// `Q_P = D⁻² ∫₀ᴰ φ dt`.
-    pub flow_rate: f64,
-}
-
-/// Solves the Poiseuille integral equation for the inverse Knudsen number `d > 0`.
-pub(crate) fn solve(d: f64, res: &Resolution) -> Solution {
+/// Solves the Poiseuille integral equation for the inverse Knudsen number `d > 0` and
+/// returns `Q_P = D⁻² ∫₀ᴰ φ dt`.
+pub(crate) fn solve(d: f64, res: &Resolution) -> f64 {
     let h = 0.5 * d;
     let (gx, gw) = gauss_legendre(res.order);
     // Barycentric weights of the Gauss nodes (independent of the panel up to a factor).
@@ -543,12 +533,7 @@ pub(crate) fn solve(d: f64, res: &Resolution) -> Solution {
         .solve(&rhs)
         .expect("the Poiseuille operator I − K is invertible for D > 0");
     let integral: f64 = phi.iter().zip(&weights).map(|(f, w)| f * w).sum();
-    Solution {
-        flow_rate: 2.0 * integral / (d * d),
-        nodes,
-        weights,
-        phi: phi.iter().copied().collect(),
-    }
+    2.0 * integral / (d * d)
 }
 
 #[cfg(test)]

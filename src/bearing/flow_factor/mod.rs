@@ -88,7 +88,7 @@ pub fn poiseuille_flow_rate(d: f64, resolution: &Resolution) -> crate::Result<f6
             format!("must be in (0, 1e4], got {d}"),
         ));
     }
-    Ok(kinetic::solve(d, resolution).flow_rate)
+    Ok(kinetic::solve(d, resolution))
 }
 
 /// Smallest inverse Knudsen number of the database's table (`10⁻³`, i.e. `Kn ≈ 886`).
@@ -497,10 +497,13 @@ mod tests {
         let mut a = 0.0;
         let mut b = 1e-12;
         while a < 300.0 {
-            let pts: Vec<f64> = x.iter().map(|xi| {
-                // s = a + (b − a)·((xi+1)/2)^4 on the first piece only.
-                0.5 * (xi + 1.0)
-            }).collect();
+            let pts: Vec<f64> = x
+                .iter()
+                .map(|xi| {
+                    // s = a + (b − a)·((xi+1)/2)^4 on the first piece only.
+                    0.5 * (xi + 1.0)
+                })
+                .collect();
             for (v, wi) in pts.iter().zip(&w) {
                 let (s, ds) = if a == 0.0 {
                     (b * v.powi(6), b * 6.0 * v.powi(5) * 0.5 * wi)
