@@ -1,0 +1,373 @@
+//! The attitude solve: the fly height, pitch and roll at which the air bearing's force and
+//! moments about the pivot balance the preload and the static torques; and what follows from
+//! the equilibrium (spacings, stiffness, damping, a force–spacing curve).
+//!
+//! Newton's method on the three balances, with the Jacobian from the pressure's sensitivities
+//! (one linear solve per attitude coordinate with the factored Jacobian of the converged
+//! pressure), on a sequence of grids from coarse to fine: each grid starts from the coarser
+//! one's attitude and interpolated pressure.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::geometry::Bearing;
+use super::grid::nudged;
+use super::reynolds::{Attitude, Factored, Reynolds, REFERENCE_SPACING};
+use crate::error::AnalysisError;
+use crate::{Error, Result};
+
+/// The smallest spacing the attitude solve lets the slider reach, m: a bearing that does not
+/// carry its preload above it does not fly.
+pub const SPACING_FLOOR: f64 = 0.5e-9;
+/// The coarsest grid of the sequence has at least this many control volumes along a side.
+const COARSEST: usize = 24;
+/// Relative tolerance of the force and moment balances on the coarser grids.
+const COARSE_TOLERANCE: f64 = 1e-4;
+/// Largest fraction of the smallest spacing one Newton step may take away.
+const MAX_CLOSING: f64 = 0.6;
+
+/// Options of the attitude solve.
+///
+/// ```
+/// use hdi_tribology::bearing::AttitudeOptions;
+/// let o = AttitudeOptions::default();
+/// assert!(o.tolerance < 1e-6);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct AttitudeOptions {
+    /// Where Newton starts on the coarsest grid.
+    pub start: Attitude,
+    /// Relative tolerance of the balances (force over the preload; moments over preload × L).
+    pub tolerance: f64,
+    /// Newton steps allowed per grid.
+    pub max_iterations: usize,
+    /// Solve on coarser grids first.
+    pub coarse_to_fine: bool,
+}
+
+impl Default for AttitudeOptions {
+    fn default() -> Self {
+        AttitudeOptions {
+            start: Attitude {
+                fly_height: 15e-9,
+                pitch: 150e-6,
+                roll: 0.0,
+            },
+            tolerance: 1e-9,
+            max_iterations: 40,
+            coarse_to_fine: true,
+        }
+    }
+}
+
+/// How the solve went on one grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelReport {
+    /// Control volumes `(nx, ny)`.
+    pub cells: (usize, usize),
+    /// Newton steps of the attitude.
+    pub iterations: usize,
+    /// Newton steps of the pressure, summed over the attitude's steps.
+    pub pressure_iterations: usize,
+    /// GMRES iterations, summed (pressure and sensitivities).
+    pub krylov_iterations: usize,
+    /// Largest relative imbalance at the end.
+    pub imbalance: f64,
+}
+
+/// The equilibrium attitude and what follows from it.
+#[derive(Clone, Debug)]
+pub struct Equilibrium {
+    /// The attitude.
+    pub attitude: Attitude,
+    /// The bearing's force (N) and moments about the pivot (N m), pitch and roll.
+    pub loads: [f64; 3],
+    /// Pressure `p/p_a` per control volume, index `j nx + i`.
+    pub pressure: Vec<f64>,
+    /// The equation on the final grid.
+    pub reynolds: Reynolds,
+    /// The solve on each grid, coarse to fine.
+    pub levels: Vec<LevelReport>,
+    /// Jacobian of the loads in the attitude at the equilibrium: `[i][j] = ∂load_i/∂q_j`.
+    pub load_jacobian: [[f64; 3]; 3],
+    spacing: Vec<f64>,
+    factored: Factored,
+    dps: [Vec<f64>; 3],
+}
+
+fn imbalance(b: &Bearing, loads: [f64; 3]) -> Vector3<f64> {
+    let f = b.preload;
+    Vector3::new(
+        (loads[0] - f) / f,
+        (loads[1] - b.pitch_torque) / (f * b.length),
+        (loads[2] - b.roll_torque) / (f * b.length),
+    )
+}
+
+/// One Newton solve of the attitude on one grid; `p` is the start and the result.
+fn solve_level(
+    r: &Reynolds,
+    start: Attitude,
+    p: &mut [f64],
+    tol: f64,
+    max_iterations: usize,
+) -> Result<(
+    Attitude,
+    LevelReport,
+    Factored,
+    [Vec<f64>; 3],
+    [[f64; 3]; 3],
+    Vec<f64>,
+)> {
+    let b = &r.bearing;
+    let mut att = start;
+    let mut report = LevelReport {
+        cells: r.size(),
+        iterations: 0,
+        pressure_iterations: 0,
+        krylov_iterations: 0,
+        imbalance: f64::INFINITY,
+    };
+    loop {
+        let h = r.spacing(&att);
+        let (stats, fac) = r.solve_spacing(&h, p)?;
+        report.pressure_iterations += stats.iterations;
+        report.krylov_iterations += stats.krylov_iterations;
+        let loads = r.loads(p);
+        let f = imbalance(b, loads);
+        report.imbalance = f.amax();
+        let (k, dps) = r.sensitivities(p, &h, &fac)?;
+        if report.imbalance <= tol {
+            return Ok((att, report, fac, dps, k, h));
+        }
+        if report.iterations >= max_iterations {
+            return Err(Error::no_convergence(
+                "air-bearing attitude",
+                format!(
+                    "{} Newton steps on {}×{} control volumes, relative imbalance {:.3e}",
+                    report.iterations, report.cells.0, report.cells.1, report.imbalance
+                ),
+            ));
+        }
+        report.iterations += 1;
+        // Jacobian of the scaled imbalance.
+        let fl = b.preload * b.length;
+        let jm = Matrix3::from_fn(|i, j| k[i][j] / if i == 0 { b.preload } else { fl });
+        let step = jm.lu().solve(&(-f)).ok_or_else(|| {
+            Error::no_convergence(
+                "air-bearing attitude",
+                "the bearing's stiffness matrix is singular",
+            )
+        })?;
+        let q = att.to_array();
+        let hmin = r.min_spacing(&att);
+        let mut t = 1.0;
+        let mut next = att;
+        for _ in 0..60 {
+            next =
+                Attitude::from_array([q[0] + t * step[0], q[1] + t * step[1], q[2] + t * step[2]]);
+            let m = r.min_spacing(&next);
+            if m >= (1.0 - MAX_CLOSING) * hmin && m >= SPACING_FLOOR {
+                break;
+            }
+            if hmin <= SPACING_FLOOR * (1.0 + 1e-6) && loads[0] < b.preload {
+                return Err(AnalysisError::DoesNotFly {
+                    preload_mn: b.preload * 1e3,
+                    load_mn: loads[0] * 1e3,
+                    min_spacing_nm: hmin * 1e9,
+                }
+                .into());
+            }
+            t *= 0.5;
+            if r.min_spacing(&Attitude::from_array([
+                q[0] + t * step[0],
+                q[1] + t * step[1],
+                q[2] + t * step[2],
+            ])) < SPACING_FLOOR
+                && t < 1e-3
+            {
+                // Close in on the floor along the step.
+                let (mut lo, mut hi) = (0.0, t);
+                for _ in 0..50 {
+                    let mid = 0.5 * (lo + hi);
+                    let m = r.min_spacing(&Attitude::from_array([
+                        q[0] + mid * step[0],
+                        q[1] + mid * step[1],
+                        q[2] + mid * step[2],
+                    ]));
+                    if m >= SPACING_FLOOR {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                t = lo;
+                next = Attitude::from_array([
+                    q[0] + t * step[0],
+                    q[1] + t * step[1],
+                    q[2] + t * step[2],
+                ]);
+                break;
+            }
+        }
+        // First-order predictor of the pressure at the new attitude.
+        let dq = [
+            next.fly_height - att.fly_height,
+            next.pitch - att.pitch,
+            next.roll - att.roll,
+        ];
+        for c in 0..p.len() {
+            let v = p[c] + dps[0][c] * dq[0] + dps[1][c] * dq[1] + dps[2][c] * dq[2];
+            p[c] = v.max(0.5 * p[c]);
+        }
+        att = next;
+    }
+}
+
+/// Solves for the equilibrium attitude of `bearing` on its grid (`bearing.grid`).
+///
+/// A bearing that cannot carry the preload above [`SPACING_FLOOR`] gives
+/// [`AnalysisError::DoesNotFly`].
+///
+/// ```
+/// use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec};
+/// let spec = BearingSpec::from_path(concat!(
+///     env!("CARGO_MANIFEST_DIR"),
+///     "/scenes/bearing/two_rail_taper_flat.toml"
+/// ))?;
+/// let mut spec = spec;
+/// spec.grid.nx = 65;
+/// spec.grid.ny = 65;
+/// let eq = solve_attitude(&spec.build()?, &AttitudeOptions::default())?;
+/// assert!(eq.attitude.fly_height > 1e-9 && eq.attitude.pitch > 0.0);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn solve_attitude(bearing: &Bearing, opts: &AttitudeOptions) -> Result<Equilibrium> {
+    let (nx, ny) = (bearing.grid.nx, bearing.grid.ny);
+    let mut sizes = vec![(nx, ny)];
+    if opts.coarse_to_fine {
+        let (mut a, mut c) = (nx, ny);
+        while a.min(c) / 2 >= COARSEST {
+            a = a / 2 + 1;
+            c = c / 2 + 1;
+            sizes.push((a, c));
+        }
+    }
+    sizes.reverse();
+    let mut att = opts.start;
+    let mut prev: Option<(Reynolds, Vec<f64>)> = None;
+    let mut levels = Vec::new();
+    let last = sizes.len() - 1;
+    for (k, &(a, c)) in sizes.iter().enumerate() {
+        let r = Reynolds::new(bearing, a, c);
+        let mut p = match &prev {
+            Some((rc, pc)) => r.interpolate_from(rc, pc),
+            None => r.ambient(),
+        };
+        let tol = if k == last {
+            opts.tolerance
+        } else {
+            COARSE_TOLERANCE.max(opts.tolerance)
+        };
+        let (next, report, fac, dps, kmat, h) =
+            solve_level(&r, att, &mut p, tol, opts.max_iterations)?;
+        att = next;
+        levels.push(report);
+        if k == last {
+            let loads = r.loads(&p);
+            return Ok(Equilibrium {
+                attitude: att,
+                loads,
+                pressure: p,
+                reynolds: r,
+                levels,
+                load_jacobian: kmat,
+                spacing: h,
+                factored: fac,
+                dps,
+            });
+        }
+        prev = Some((r, p));
+    }
+    unreachable!("the grid sequence is never empty")
+}
+
+impl Equilibrium {
+    /// Spacing at a point `(x, y)` (m), the surface's depth included.
+    pub fn spacing_at(&self, x: f64, y: f64) -> f64 {
+        let b = &self.reynolds.bearing;
+        let (xi, yi) = nudged(b, x, y);
+        self.attitude.spacing_at(x, y, b.length, b.width) + b.depth_at(xi, yi)
+    }
+
+    /// Spacing at the trailing edge's centre (m).
+    pub fn trailing_edge_spacing(&self) -> f64 {
+        let b = &self.reynolds.bearing;
+        self.spacing_at(b.length, 0.5 * b.width)
+    }
+
+    /// Spacing at the bulge (m).
+    pub fn bulge_spacing(&self) -> f64 {
+        let [x, y] = self.reynolds.bearing.bulge;
+        self.spacing_at(x, y)
+    }
+
+    /// Smallest spacing over the grid's nodes (m).
+    pub fn min_spacing(&self) -> f64 {
+        self.reynolds.min_spacing(&self.attitude)
+    }
+
+    /// Stiffness matrix about the equilibrium, `K = −∂(force, pitch moment, roll moment) /
+    /// ∂(fly height, pitch, roll)`: N/m, N/rad; N m/m, N m/rad.
+    pub fn stiffness(&self) -> [[f64; 3]; 3] {
+        let mut k = self.load_jacobian;
+        for row in k.iter_mut() {
+            for v in row.iter_mut() {
+                *v = -*v;
+            }
+        }
+        k
+    }
+
+    /// Low-frequency squeeze-film damping matrix about the equilibrium (same units as
+    /// [`Equilibrium::stiffness`] times s).
+    pub fn damping(&self) -> Result<[[f64; 3]; 3]> {
+        self.reynolds
+            .damping(&self.pressure, &self.spacing, &self.factored, &self.dps)
+    }
+
+    /// Pressure `p` (Pa) per control volume.
+    pub fn pressure_pa(&self) -> Vec<f64> {
+        let pa = self.reynolds.bearing.ambient_pressure;
+        self.pressure.iter().map(|v| v * pa).collect()
+    }
+
+    /// The bearing's force (N) against the bulge's spacing (m), with pitch and roll held at
+    /// the equilibrium's and the fly height moved by each of `offsets` (m).
+    pub fn force_spacing(&self, offsets: &[f64]) -> Result<Vec<(f64, f64)>> {
+        let r = &self.reynolds;
+        let mut out = Vec::with_capacity(offsets.len());
+        let mut sorted: Vec<f64> = offsets.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        for &d in &sorted {
+            let mut att = self.attitude;
+            att.fly_height += d;
+            let mut p = self.pressure.clone();
+            for c in 0..p.len() {
+                p[c] = (p[c] + self.dps[0][c] * d).max(0.5 * p[c]);
+            }
+            r.solve(&att, &mut p)?;
+            out.push((self.bulge_spacing() + d, r.loads(&p)[0]));
+        }
+        Ok(out)
+    }
+
+    /// The bearing number at the reference spacing (10 nm).
+    pub fn bearing_number(&self) -> f64 {
+        self.reynolds.bearing_number()
+    }
+
+    /// The reference spacing of the bearing number, m.
+    pub fn reference_spacing(&self) -> f64 {
+        REFERENCE_SPACING
+    }
+}
