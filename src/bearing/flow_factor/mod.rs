@@ -284,7 +284,7 @@ impl FlowFactor {
 
     /// `g = Q_P − D/6` and `dg/dD`.
     fn smooth_part(&self, d: f64) -> (f64, f64) {
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return (f64::NAN, f64::NAN);
         }
         if d.is_infinite() {
@@ -346,7 +346,7 @@ impl FlowFactor {
         if knudsen == 0.0 {
             return (1.0, 12.0 * SLIP_COEFFICIENT / SQRT_PI);
         }
-        if !(knudsen > 0.0) {
+        if knudsen.is_nan() || knudsen < 0.0 {
             return (f64::NAN, f64::NAN);
         }
         let d = 0.5 * SQRT_PI / knudsen;
@@ -544,7 +544,7 @@ mod generate {
         eprintln!("generated in {:?}", t0.elapsed());
         let mut s = String::new();
         for q in v {
-            s.push_str(&format!("    {q:.17e},\n"));
+            s.push_str(&format!("    {q:?},\n"));
         }
         println!("BEGIN\n{s}END");
     }
