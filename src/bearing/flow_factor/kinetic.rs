@@ -277,8 +277,13 @@ pub struct Resolution {
 }
 
 impl Resolution {
-    /// The resolution the database is built with: `Q_P` to about 3e-11 (relative) against
-    /// [`Resolution::REFINED`] for `10⁻³ ≤ D ≤ 300`.
+    /// The resolution the database is built with: `Q_P` to about 1e-10 (relative) against
+    /// [`Resolution::REFINED`] for `10⁻³ ≤ D ≤ 100`.
+    ///
+    /// ```
+    /// use hdi_tribology::bearing::flow_factor::Resolution;
+    /// assert_eq!(Resolution::STANDARD.order, 10);
+    /// ```
     pub const STANDARD: Resolution = Resolution {
         order: 10,
         grading: 0.2,
@@ -288,6 +293,14 @@ impl Resolution {
     };
 
     /// A finer resolution for checking [`Resolution::STANDARD`].
+    ///
+    /// ```
+    /// use hdi_tribology::bearing::flow_factor::{poiseuille_flow_rate, Resolution};
+    /// let fine = poiseuille_flow_rate(10.0, &Resolution::REFINED)?;
+    /// let standard = poiseuille_flow_rate(10.0, &Resolution::STANDARD)?;
+    /// assert!((standard / fine - 1.0).abs() < 1e-10);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     pub const REFINED: Resolution = Resolution {
         order: 16,
         grading: 0.15,
@@ -297,6 +310,13 @@ impl Resolution {
     };
 
     /// A coarse resolution (about 1e-9), the first step of a convergence study.
+    ///
+    /// ```
+    /// use hdi_tribology::bearing::flow_factor::{poiseuille_flow_rate, Resolution};
+    /// let q = poiseuille_flow_rate(0.1, &Resolution::COARSE)?;
+    /// assert!((q - 2.032714285).abs() < 1e-8);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     pub const COARSE: Resolution = Resolution {
         order: 8,
         grading: 0.2,
@@ -306,6 +326,12 @@ impl Resolution {
     };
 
     /// Checks every field's range; errors name the field as `resolution.<field>`.
+    ///
+    /// ```
+    /// use hdi_tribology::bearing::flow_factor::Resolution;
+    /// let err = Resolution { near_points: 4, ..Resolution::STANDARD }.validate().unwrap_err();
+    /// assert!(err.to_string().contains("resolution.near_points"));
+    /// ```
     pub fn validate(&self) -> crate::Result<()> {
         let bad = |field: &str, reason: String| {
             Err(crate::Error::invalid(format!("resolution.{field}"), reason))
@@ -345,7 +371,7 @@ struct Panel {
     first: usize,
 }
 
-/// `(nodes, weights, panels)` of the discretisation of `[0, h]`.
+/// Panel ends `(a, b)` of the discretisation of the half channel `[0, h]`.
 fn panels(h: f64, res: &Resolution) -> Vec<(f64, f64)> {
     let mut bounds = vec![0.0];
     let graded = h.min(1.0);

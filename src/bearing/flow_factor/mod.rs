@@ -92,8 +92,20 @@ pub fn poiseuille_flow_rate(d: f64, resolution: &Resolution) -> crate::Result<f6
 }
 
 /// Smallest inverse Knudsen number of the database's table (`10⁻³`, i.e. `Kn ≈ 886`).
+///
+/// ```
+/// use hdi_tribology::bearing::flow_factor::{inverse_knudsen, TABLE_D_MIN};
+/// // A 0.05 nm gap in air (λ ≈ 65 nm) is below the table: the free-molecular tail applies.
+/// assert!(inverse_knudsen(0.05e-9, 65e-9) < TABLE_D_MIN);
+/// ```
 pub const TABLE_D_MIN: f64 = 1e-3;
 /// Largest inverse Knudsen number of the database's table (`10^2.5 ≈ 316`, `Kn ≈ 0.0028`).
+///
+/// ```
+/// use hdi_tribology::bearing::flow_factor::{inverse_knudsen, TABLE_D_MAX};
+/// // A 30 µm gap in air is above the table: the slip expansion applies.
+/// assert!(inverse_knudsen(30e-6, 65e-9) > TABLE_D_MAX);
+/// ```
 pub const TABLE_D_MAX: f64 = 316.227_766_016_837_94;
 
 /// The inverse Knudsen numbers of the database's table: `10^(−3 + k/24)`, `k = 0..=132`.
