@@ -24,6 +24,12 @@ const COARSEST: usize = 24;
 const COARSE_TOLERANCE: f64 = 1e-4;
 /// Largest fraction of the smallest spacing one Newton step may take away.
 const MAX_CLOSING: f64 = 0.6;
+/// Relative tolerance of the linear solves for the sensitivities that steer Newton's steps.
+const STEP_SENSITIVITY_RTOL: f64 = 1e-6;
+/// Relative tolerance of the linear solves for the stiffness at the equilibrium.
+const FINAL_SENSITIVITY_RTOL: f64 = 1e-10;
+/// The Jacobian in use is kept while each step cuts the imbalance by at least this factor.
+const FAST_CONVERGENCE: f64 = 0.2;
 
 /// Options of the attitude solve.
 ///
@@ -103,21 +109,28 @@ fn imbalance(b: &Bearing, loads: [f64; 3]) -> Vector3<f64> {
     )
 }
 
-/// One Newton solve of the attitude on one grid; `p` is the start and the result.
+/// What one grid's solve hands on.
+struct LevelResult {
+    attitude: Attitude,
+    report: LevelReport,
+    factored: Factored,
+    dps: [Vec<f64>; 3],
+    jacobian: [[f64; 3]; 3],
+    spacing: Vec<f64>,
+}
+
+/// One Newton solve of the attitude on one grid; `p` is the start and the result. `jacobian`
+/// is the load Jacobian of a coarser grid, if any: it steers the steps until they stop
+/// converging fast, when the sensitivities on this grid replace it.
 fn solve_level(
     r: &Reynolds,
     start: Attitude,
     p: &mut [f64],
     tol: f64,
     max_iterations: usize,
-) -> Result<(
-    Attitude,
-    LevelReport,
-    Factored,
-    [Vec<f64>; 3],
-    [[f64; 3]; 3],
-    Vec<f64>,
-)> {
+    final_level: bool,
+    jacobian: Option<[[f64; 3]; 3]>,
+) -> Result<LevelResult> {
     let b = &r.bearing;
     let mut att = start;
     let mut report = LevelReport {
@@ -127,6 +140,9 @@ fn solve_level(
         krylov_iterations: 0,
         imbalance: f64::INFINITY,
     };
+    let mut jac = jacobian;
+    let mut dps: Option<[Vec<f64>; 3]> = None;
+    let mut last = f64::INFINITY;
     loop {
         let h = r.spacing(&att);
         let (stats, fac) = r.solve_spacing(&h, p)?;
@@ -135,9 +151,22 @@ fn solve_level(
         let loads = r.loads(p);
         let f = imbalance(b, loads);
         report.imbalance = f.amax();
-        let (k, dps) = r.sensitivities(p, &h, &fac)?;
         if report.imbalance <= tol {
-            return Ok((att, report, fac, dps, k, h));
+            let rtol = if final_level {
+                FINAL_SENSITIVITY_RTOL
+            } else {
+                STEP_SENSITIVITY_RTOL
+            };
+            let (k, d, its) = r.sensitivities(p, &h, &fac, rtol)?;
+            report.krylov_iterations += its;
+            return Ok(LevelResult {
+                attitude: att,
+                report,
+                factored: fac,
+                dps: d,
+                jacobian: k,
+                spacing: h,
+            });
         }
         if report.iterations >= max_iterations {
             return Err(Error::no_convergence(
@@ -148,6 +177,14 @@ fn solve_level(
                 ),
             ));
         }
+        if jac.is_none() || report.imbalance > FAST_CONVERGENCE * last {
+            let (k, d, its) = r.sensitivities(p, &h, &fac, STEP_SENSITIVITY_RTOL)?;
+            report.krylov_iterations += its;
+            jac = Some(k);
+            dps = Some(d);
+        }
+        last = report.imbalance;
+        let k = jac.expect("the Jacobian is set above");
         report.iterations += 1;
         // Jacobian of the scaled imbalance.
         let fl = b.preload * b.length;
@@ -159,12 +196,14 @@ fn solve_level(
             )
         })?;
         let q = att.to_array();
+        let at = |t: f64| {
+            Attitude::from_array([q[0] + t * step[0], q[1] + t * step[1], q[2] + t * step[2]])
+        };
         let hmin = r.min_spacing(&att);
         let mut t = 1.0;
-        let mut next = att;
+        let mut next = at(t);
         for _ in 0..60 {
-            next =
-                Attitude::from_array([q[0] + t * step[0], q[1] + t * step[1], q[2] + t * step[2]]);
+            next = at(t);
             let m = r.min_spacing(&next);
             if m >= (1.0 - MAX_CLOSING) * hmin && m >= SPACING_FLOOR {
                 break;
@@ -178,46 +217,32 @@ fn solve_level(
                 .into());
             }
             t *= 0.5;
-            if r.min_spacing(&Attitude::from_array([
-                q[0] + t * step[0],
-                q[1] + t * step[1],
-                q[2] + t * step[2],
-            ])) < SPACING_FLOOR
-                && t < 1e-3
-            {
+            if r.min_spacing(&at(t)) < SPACING_FLOOR && t < 1e-3 {
                 // Close in on the floor along the step.
                 let (mut lo, mut hi) = (0.0, t);
                 for _ in 0..50 {
                     let mid = 0.5 * (lo + hi);
-                    let m = r.min_spacing(&Attitude::from_array([
-                        q[0] + mid * step[0],
-                        q[1] + mid * step[1],
-                        q[2] + mid * step[2],
-                    ]));
-                    if m >= SPACING_FLOOR {
+                    if r.min_spacing(&at(mid)) >= SPACING_FLOOR {
                         lo = mid;
                     } else {
                         hi = mid;
                     }
                 }
-                t = lo;
-                next = Attitude::from_array([
-                    q[0] + t * step[0],
-                    q[1] + t * step[1],
-                    q[2] + t * step[2],
-                ]);
+                next = at(lo);
                 break;
             }
         }
         // First-order predictor of the pressure at the new attitude.
-        let dq = [
-            next.fly_height - att.fly_height,
-            next.pitch - att.pitch,
-            next.roll - att.roll,
-        ];
-        for c in 0..p.len() {
-            let v = p[c] + dps[0][c] * dq[0] + dps[1][c] * dq[1] + dps[2][c] * dq[2];
-            p[c] = v.max(0.5 * p[c]);
+        if let Some(d) = &dps {
+            let dq = [
+                next.fly_height - att.fly_height,
+                next.pitch - att.pitch,
+                next.roll - att.roll,
+            ];
+            for c in 0..p.len() {
+                let v = p[c] + d[0][c] * dq[0] + d[1][c] * dq[1] + d[2][c] * dq[2];
+                p[c] = v.max(0.5 * p[c]);
+            }
         }
         att = next;
     }
@@ -255,6 +280,7 @@ pub fn solve_attitude(bearing: &Bearing, opts: &AttitudeOptions) -> Result<Equil
     sizes.reverse();
     let mut att = opts.start;
     let mut prev: Option<(Reynolds, Vec<f64>)> = None;
+    let mut jac = None;
     let mut levels = Vec::new();
     let last = sizes.len() - 1;
     for (k, &(a, c)) in sizes.iter().enumerate() {
@@ -268,10 +294,10 @@ pub fn solve_attitude(bearing: &Bearing, opts: &AttitudeOptions) -> Result<Equil
         } else {
             COARSE_TOLERANCE.max(opts.tolerance)
         };
-        let (next, report, fac, dps, kmat, h) =
-            solve_level(&r, att, &mut p, tol, opts.max_iterations)?;
-        att = next;
-        levels.push(report);
+        let res = solve_level(&r, att, &mut p, tol, opts.max_iterations, k == last, jac)?;
+        att = res.attitude;
+        jac = Some(res.jacobian);
+        levels.push(res.report);
         if k == last {
             let loads = r.loads(&p);
             return Ok(Equilibrium {
@@ -280,10 +306,10 @@ pub fn solve_attitude(bearing: &Bearing, opts: &AttitudeOptions) -> Result<Equil
                 pressure: p,
                 reynolds: r,
                 levels,
-                load_jacobian: kmat,
-                spacing: h,
-                factored: fac,
-                dps,
+                load_jacobian: res.jacobian,
+                spacing: res.spacing,
+                factored: res.factored,
+                dps: res.dps,
             });
         }
         prev = Some((r, p));

@@ -20,7 +20,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::flow::FlowModel;
+use super::flow_factor::FlowModel;
 use crate::error::{check_finite, check_non_negative, check_positive};
 use crate::{Error, Result};
 

@@ -8,7 +8,8 @@
 //! Raithby 1986). Merging keeps the five-point structure and the flux balance of each merged
 //! volume, so it copes with the jumps of the conductance `Q P H³` by many orders of magnitude
 //! between a rail and a deep recess, where a single-level preconditioner stalls. ILU(0) smooths
-//! on every level; the coarsest is solved by dense LU.
+//! on every level, each coarser level is visited twice (a W-cycle), and the coarsest is solved
+//! by dense LU.
 
 use nalgebra::DMatrix;
 
@@ -190,7 +191,7 @@ struct Level {
     ilu: Ilu0,
 }
 
-/// Additive-correction multigrid V-cycle on a [`FivePoint`] matrix, a preconditioner for
+/// Additive-correction multigrid W-cycle on a [`FivePoint`] matrix, a preconditioner for
 /// [`gmres`].
 ///
 /// ```
@@ -350,6 +351,20 @@ impl Multigrid {
         }
         let mut ec = vec![0.0; mx * my];
         self.cycle(l + 1, &rc, &mut ec);
+        if l + 2 < self.levels.len() {
+            // Second visit of the coarse level (W-cycle) on its own residual.
+            let mut rr = vec![0.0; mx * my];
+            c.apply(&ec, &mut rr);
+            for k in 0..mx * my {
+                rr[k] = rc[k] - rr[k];
+            }
+            let mut e2 = vec![0.0; mx * my];
+            self.cycle(l + 1, &rr, &mut e2);
+            for k in 0..mx * my {
+                ec[k] += e2[k];
+            }
+        }
+        // Prolongation: each merged volume's correction to all its volumes.
         for j in 0..a.ny {
             let jc = agg(j, my);
             for i in 0..a.nx {
@@ -392,8 +407,9 @@ fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// Solves `A x = b` by GMRES(`restart`) with `m` as right preconditioner, from the start `x`,
-/// until `‖b − A x‖ ≤ rtol ‖b‖` or `max_iter` iterations.
+/// Solves `A x = b` by flexible GMRES(`restart`) with `m` as right preconditioner (which may
+/// vary from one application to the next), from the start `x`, until `‖b − A x‖ ≤ rtol ‖b‖`
+/// or `max_iter` iterations.
 ///
 /// ```
 /// use hdi_tribology::bearing::linear::{gmres, FivePoint, Ilu0};
@@ -425,7 +441,8 @@ pub fn gmres(
     let ilu = m;
     let m = restart.max(1);
     let mut v: Vec<Vec<f64>> = vec![vec![0.0; n]; m + 1];
-    let mut z = vec![0.0; n];
+    // Flexible GMRES: the preconditioned vectors are kept, so the preconditioner may vary.
+    let mut zs: Vec<Vec<f64>> = vec![vec![0.0; n]; m];
     let mut w = vec![0.0; n];
     let mut h = vec![vec![0.0; m]; m + 1];
     let (mut cs, mut sn, mut g) = (vec![0.0; m], vec![0.0; m], vec![0.0; m + 1]);
@@ -448,9 +465,9 @@ pub fn gmres(
         g[0] = beta;
         let mut used = 0;
         for j in 0..m {
-            z.copy_from_slice(&v[j]);
-            ilu.apply(&mut z);
-            a.apply(&z, &mut w);
+            zs[j].copy_from_slice(&v[j]);
+            ilu.apply(&mut zs[j]);
+            a.apply(&zs[j], &mut w);
             iters += 1;
             // Modified Gram–Schmidt.
             for i in 0..=j {
@@ -498,15 +515,10 @@ pub fn gmres(
             }
             y[i] = s / h[i][i];
         }
-        w.iter_mut().for_each(|x| *x = 0.0);
         for (i, yi) in y.iter().enumerate() {
-            for (wk, vk) in w.iter_mut().zip(&v[i]) {
-                *wk += yi * vk;
+            for (xk, zk) in x.iter_mut().zip(&zs[i]) {
+                *xk += yi * zk;
             }
-        }
-        ilu.apply(&mut w);
-        for k in 0..n {
-            x[k] += w[k];
         }
     }
     KrylovStats {

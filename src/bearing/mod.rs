@@ -14,7 +14,6 @@
 //! - [`attitude`]: the attitude solve and its outputs.
 
 pub mod attitude;
-pub mod flow;
 pub mod flow_factor;
 pub mod geometry;
 pub mod grid;
@@ -22,7 +21,7 @@ pub mod linear;
 pub mod reynolds;
 
 pub use attitude::{solve_attitude, AttitudeOptions, Equilibrium};
-pub use flow::FlowModel;
+pub use flow_factor::FlowModel;
 pub use geometry::{
     Bearing, BearingSpec, GridSpec, OperatingConditions, Polygon, Region, SliderGeometry, Taper,
 };

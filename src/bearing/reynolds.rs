@@ -14,7 +14,7 @@
 //! any bearing number. The Jacobian of the residual is exact (analytic), and each Newton step
 //! is a GMRES solve preconditioned by the incomplete LU factors of that Jacobian.
 
-use super::flow::FlowModel;
+use super::flow_factor::FlowModel;
 use super::geometry::Bearing;
 use super::grid::Grid;
 use super::linear::{gmres, FivePoint, KrylovStats, Multigrid};
@@ -23,7 +23,7 @@ use crate::{Error, Result};
 /// The reference spacing `h_m` of the non-dimensional variables, m.
 pub const REFERENCE_SPACING: f64 = 10e-9;
 /// Restart length of GMRES.
-const RESTART: usize = 60;
+const RESTART: usize = 30;
 /// Iteration budget of one GMRES solve.
 const MAX_KRYLOV: usize = 3000;
 /// Smallest fraction of the current pressure a Newton step may leave.
@@ -644,14 +644,16 @@ impl Reynolds {
 
     /// Derivatives of the loads ([`Reynolds::loads`]) with respect to the attitude, at the
     /// converged pressure `p` and spacing `h` with the factored Jacobian `f`: `k[i][j] =
-    /// ∂load_i/∂attitude_j` (N/m, N, N m/m, N m), and the pressure's derivatives
-    /// `∂P/∂attitude_j`.
+    /// ∂load_i/∂attitude_j` (N/m, N, N m/m, N m), the pressure's derivatives
+    /// `∂P/∂attitude_j`, and the GMRES iterations spent; each linear solve to the relative
+    /// tolerance `rtol`.
     pub fn sensitivities(
         &self,
         p: &[f64],
         h: &[f64],
         f: &Factored,
-    ) -> Result<([[f64; 3]; 3], [Vec<f64>; 3])> {
+        rtol: f64,
+    ) -> Result<([[f64; 3]; 3], [Vec<f64>; 3], usize)> {
         let dh = self.spacing_derivatives();
         let n = p.len();
         let mut rp = vec![0.0; n];
@@ -660,6 +662,7 @@ impl Reynolds {
         let hmax = h.iter().cloned().fold(0.0, f64::max);
         let mut dps: [Vec<f64>; 3] = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         let mut k = [[0.0; 3]; 3];
+        let mut iterations = 0;
         let w = self.weights();
         let l = self.bearing.length;
         let pa = self.bearing.ambient_pressure;
@@ -680,11 +683,12 @@ impl Reynolds {
                 &f.ilu,
                 &rhs,
                 &mut dps[q],
-                1e-10,
+                rtol,
                 RESTART,
                 MAX_KRYLOV,
             );
-            if stats.relative_residual > 1e-6 {
+            iterations += stats.iterations;
+            if stats.relative_residual > 10.0 * rtol {
                 return Err(Error::no_convergence(
                     "air-bearing sensitivity",
                     format!(
@@ -697,7 +701,7 @@ impl Reynolds {
                 k[i][q] = dps[q].iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>() * pa * l * l;
             }
         }
-        Ok((k, dps))
+        Ok((k, dps, iterations))
     }
 
     /// Low-frequency squeeze-film damping (the term of first order in the frequency of a
