@@ -516,12 +516,6 @@ fn validate_region(r: &Region, index: usize, length: f64, width: f64) -> Result<
             ));
         }
     }
-    if area2.abs() <= tol * scale {
-        return Err(Error::invalid(
-            format!("{field}.polygon_um"),
-            "the polygon encloses no area",
-        ));
-    }
     for i in 0..n {
         for j in i + 1..n {
             // Adjacent edges share a vertex; skip them.
@@ -539,6 +533,12 @@ fn validate_region(r: &Region, index: usize, length: f64, width: f64) -> Result<
                 ));
             }
         }
+    }
+    if area2.abs() <= tol * scale {
+        return Err(Error::invalid(
+            format!("{field}.polygon_um"),
+            "the polygon encloses no area",
+        ));
     }
     Ok(Polygon {
         label,

@@ -310,7 +310,7 @@ impl Reynolds {
         for j in 0..ny {
             let area = self.dy[j];
             for i in 0..=nx {
-                let (cl, cr) = (j * nx + i.wrapping_sub(1), j * nx + i);
+                let (cl, cr) = ((j * nx + i).wrapping_sub(1), j * nx + i);
                 let left = i > 0;
                 let right = i < nx;
                 let (pl, hl, gl, dgl, al) = if left {
