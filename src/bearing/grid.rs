@@ -18,7 +18,9 @@ const SUB_ROWS: usize = 8;
 /// Samples of the grid density per final cell when the mapping is inverted.
 const MAP_SAMPLES: usize = 16;
 
-/// A tensor grid over the slider and the surface depth on it.
+/// A tensor grid over the slider and the surface depth on it. The face nearest each vertex
+/// coordinate of a region (and the taper's end) is moved onto it, so that rails with edges
+/// along the grid lines step exactly at a face.
 ///
 /// ```
 /// use hdi_tribology::bearing::{BearingSpec, Grid};
@@ -50,7 +52,9 @@ pub struct Grid {
 /// `1 + (r − 1) max_k exp(−((s − s_k)/w)²)`, so the grids of one slider differ only in `n`.
 fn faces(n: usize, len: f64, marks: &[f64], refinement: f64) -> Vec<f64> {
     if refinement <= 1.0 || marks.is_empty() {
-        return (0..=n).map(|i| len * i as f64 / n as f64).collect();
+        let mut out: Vec<f64> = (0..=n).map(|i| len * i as f64 / n as f64).collect();
+        snap(&mut out, marks);
+        return out;
     }
     let m = (n * MAP_SAMPLES).max(4096);
     let density = |s: f64| {
@@ -84,7 +88,34 @@ fn faces(n: usize, len: f64, marks: &[f64], refinement: f64) -> Vec<f64> {
     }
     out[0] = 0.0;
     out[n] = len;
+    snap(&mut out, marks);
     out
+}
+
+/// Moves the face nearest to each mark onto it, where that keeps the faces in order, so that
+/// a step along a grid line falls on a face and no control volume straddles it.
+fn snap(faces: &mut [f64], marks: &[f64]) {
+    let n = faces.len() - 1;
+    for &m in marks {
+        let k = faces.partition_point(|&f| f < m);
+        if k == 0 || k > n {
+            continue;
+        }
+        let near = if k < n && (faces[k] - m).abs() <= (m - faces[k - 1]).abs() {
+            k
+        } else {
+            k - 1
+        };
+        if near == 0 || near == n {
+            continue;
+        }
+        // Keep at least a quarter of the neighbouring widths on either side.
+        let lo = faces[near - 1] + 0.25 * (faces[near] - faces[near - 1]);
+        let hi = faces[near + 1] - 0.25 * (faces[near + 1] - faces[near]);
+        if m > lo && m < hi {
+            faces[near] = m;
+        }
+    }
 }
 
 /// Paints `[a, b]` at depth `d` over the sorted, disjoint segments `(x0, x1, depth)`.

@@ -8,8 +8,9 @@
 //!
 //! Each control volume balances the fluxes through its four faces. Across a face, the
 //! conductance `Q P H³` of the two neighbours is combined in series (the harmonic mean, which
-//! keeps the flux continuous where a rail steps), the convected mass `P H` is taken from the
-//! upstream cell, and Patankar's power-law scheme weighs the two by the face's Péclet number:
+//! keeps the flux continuous where a rail steps), the convected mass `P H` takes the spacing on
+//! the face (interpolated where the surface is smooth, the upstream cell's across a step), and
+//! Patankar's power-law scheme weighs the two by the face's Péclet number:
 //! central differences where diffusion dominates, upwinding where convection does, stable at
 //! any bearing number. The Jacobian of the residual is exact (analytic), and each Newton step
 //! is a GMRES solve preconditioned by the incomplete LU factors of that Jacobian.
@@ -146,6 +147,38 @@ fn power_law(z: f64) -> (f64, f64) {
         let t = 1.0 - 0.1 * z;
         let t2 = t * t;
         (t2 * t2 * t, -0.5 * t2 * t2)
+    }
+}
+
+/// Two neighbouring spacings differing by more than this fraction of the smaller one are a
+/// step, not a smooth variation.
+const STEP_RATIO: f64 = 0.5;
+
+/// Spacing on face `k` of a line of cells (`h[m · stride]` the spacing of cell `m`, `w[m]` its
+/// width) for the convected mass `Λ P H`: linear interpolation between the two cells where the
+/// spacing varies smoothly (second order), linear extrapolation from the first two cells on the
+/// slider's edge, and the upstream cell's spacing across a step, where the surface jumps.
+fn face_spacing(h: &[f64], w: &[f64], k: usize, stride: usize, lambda: f64) -> f64 {
+    let n = w.len();
+    let at = |m: usize| h[m * stride];
+    let smooth = |a: f64, b: f64| (a - b).abs() <= STEP_RATIO * a.min(b);
+    if k == 0 || k == n {
+        let (c0, c1) = if k == 0 { (0, 1) } else { (n - 1, n - 2) };
+        let (h0, h1) = (at(c0), at(c1));
+        if n < 2 || !smooth(h0, h1) {
+            return h0;
+        }
+        let t = 0.5 * w[c0] / (0.5 * (w[c0] + w[c1]));
+        return (h0 - t * (h1 - h0)).max(0.5 * h0);
+    }
+    let (hl, hr) = (at(k - 1), at(k));
+    if smooth(hl, hr) {
+        let (wl, wr) = (w[k - 1], w[k]);
+        (hl * wr + hr * wl) / (wl + wr)
+    } else if lambda >= 0.0 {
+        hl
+    } else {
+        hr
     }
 }
 
@@ -323,8 +356,8 @@ impl Reynolds {
                 } else {
                     (1.0, hl, 1.0, 0.0, 0.0)
                 };
-                let hup = if lx >= 0.0 { hl } else { hr };
-                let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, lx * area * hup, area);
+                let hf = self.x_face_spacing(h, i, j, lx);
+                let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, lx * area * hf, area);
                 if left {
                     r[cl] += flux;
                 }
@@ -369,8 +402,8 @@ impl Reynolds {
                 } else {
                     (1.0, hl, 1.0, 0.0, 0.0)
                 };
-                let hup = if ly >= 0.0 { hl } else { hr };
-                let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, ly * area * hup, area);
+                let hf = self.y_face_spacing(h, i, j, ly);
+                let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, ly * area * hf, area);
                 if below {
                     r[cl] += flux;
                 }
@@ -391,6 +424,20 @@ impl Reynolds {
                 }
             }
         }
+    }
+
+    /// Spacing on the face `i` (of `0..=nx`) of row `j` normal to `x`, for the convected mass:
+    /// see [`face_spacing`].
+    fn x_face_spacing(&self, h: &[f64], i: usize, j: usize, lambda: f64) -> f64 {
+        let nx = self.grid.nx();
+        let row = &h[j * nx..(j + 1) * nx];
+        face_spacing(row, &self.dx, i, 1, lambda)
+    }
+
+    /// Spacing on the face `j` (of `0..=ny`) of column `i` normal to `y`.
+    fn y_face_spacing(&self, h: &[f64], i: usize, j: usize, lambda: f64) -> f64 {
+        let nx = self.grid.nx();
+        face_spacing(&h[i..], &self.dy, j, nx, lambda)
     }
 
     /// Total mass flux into and out of the slider through its edges (non-dimensional, per the
@@ -428,7 +475,7 @@ impl Reynolds {
                 g[c0],
                 0.0,
                 dg[c0],
-                lx * area * h[c0],
+                lx * area * self.x_face_spacing(h, 0, j, lx),
                 area,
             );
             add(-f);
@@ -441,7 +488,7 @@ impl Reynolds {
                 1.0,
                 dg[c1],
                 0.0,
-                lx * area * h[c1],
+                lx * area * self.x_face_spacing(h, nx, j, lx),
                 area,
             );
             add(f);
@@ -460,7 +507,7 @@ impl Reynolds {
                     g[c0],
                     0.0,
                     dg[c0],
-                    ly * area * h[c0],
+                    ly * area * self.y_face_spacing(h, i, 0, ly),
                     area,
                 );
                 add(-f);
@@ -473,7 +520,7 @@ impl Reynolds {
                     1.0,
                     dg[c1],
                     0.0,
-                    ly * area * h[c1],
+                    ly * area * self.y_face_spacing(h, i, ny, ly),
                     area,
                 );
                 add(f);
