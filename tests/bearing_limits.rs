@@ -102,7 +102,7 @@ fn incompressible_limit_of_the_wide_inclined_plane() {
     let err = (w / closed - 1.0).abs();
     eprintln!("inclined plane: load error {err:.2e}");
     assert!(err < 2e-3, "load {w} N/m against {closed} N/m: {err:e}");
-    let centre = r.bearing.pivot[0] + moment / load;
+    let centre = r.bearing.pivot[0] - moment / load;
     let cerr = (centre - xcp).abs() / L;
     eprintln!("inclined plane: centre of pressure error {cerr:.2e} L");
     assert!(cerr < 1e-3, "centre of pressure {centre} against {xcp}: {cerr:e}");

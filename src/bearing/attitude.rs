@@ -343,7 +343,8 @@ impl Equilibrium {
     }
 
     /// Stiffness matrix about the equilibrium, `K = −∂(force, pitch moment, roll moment) /
-    /// ∂(fly height, pitch, roll)`: N/m, N/rad; N m/m, N m/rad.
+    /// ∂(fly height, pitch, roll)`: N/m, N/rad; N m/m, N m/rad. The moments are positive in the
+    /// sense that raises their angle, so a stable bearing has a positive diagonal.
     pub fn stiffness(&self) -> [[f64; 3]; 3] {
         let mut k = self.load_jacobian;
         for row in k.iter_mut() {

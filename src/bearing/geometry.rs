@@ -187,11 +187,12 @@ pub struct OperatingConditions {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pivot_um: Option<[f64; 2]>,
     /// Static pitch torque of the suspension about the pivot, µN m: the moment about the pivot
-    /// that the bearing's pressure must make, positive when the pressure's centre lies behind
-    /// the pivot (towards the trailing edge).
+    /// that the bearing's pressure must make at equilibrium, positive when it raises the leading
+    /// edge (the pressure's centre ahead of the pivot).
     #[serde(default)]
     pub pitch_torque_un_m: f64,
-    /// Static roll torque, µN m: positive when the pressure's centre lies on the `+y` side.
+    /// Static roll torque, µN m: positive when it raises the `+y` side (the pressure's centre on
+    /// the `+y` side of the pivot).
     #[serde(default)]
     pub roll_torque_un_m: f64,
     /// The rarefaction model of the Poiseuille flow.

@@ -18,6 +18,7 @@ pub mod flow_factor;
 pub mod geometry;
 pub mod grid;
 pub mod linear;
+pub mod map;
 pub mod reynolds;
 
 pub use attitude::{solve_attitude, AttitudeOptions, Equilibrium};

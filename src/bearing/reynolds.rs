@@ -346,15 +346,15 @@ impl Reynolds {
                 let (cl, cr) = ((j * nx + i).wrapping_sub(1), j * nx + i);
                 let left = i > 0;
                 let right = i < nx;
-                let (pl, hl, gl, dgl, al) = if left {
-                    (p[cl], h[cl], g[cl], dg[cl], 0.5 * self.dx[i - 1])
+                let (pl, gl, dgl, al) = if left {
+                    (p[cl], g[cl], dg[cl], 0.5 * self.dx[i - 1])
                 } else {
-                    (1.0, h[cr], 1.0, 0.0, 0.0)
+                    (1.0, 1.0, 0.0, 0.0)
                 };
-                let (pr, hr, gr, dgr, ar) = if right {
-                    (p[cr], h[cr], g[cr], dg[cr], 0.5 * self.dx[i])
+                let (pr, gr, dgr, ar) = if right {
+                    (p[cr], g[cr], dg[cr], 0.5 * self.dx[i])
                 } else {
-                    (1.0, hl, 1.0, 0.0, 0.0)
+                    (1.0, 1.0, 0.0, 0.0)
                 };
                 let hf = self.x_face_spacing(h, i, j, lx);
                 let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, lx * area * hf, area);
@@ -392,15 +392,15 @@ impl Reynolds {
                     (j.wrapping_sub(1)).wrapping_mul(nx).wrapping_add(i),
                     j * nx + i,
                 );
-                let (pl, hl, gl, dgl, al) = if below {
-                    (p[cl], h[cl], g[cl], dg[cl], 0.5 * self.dy[j - 1])
+                let (pl, gl, dgl, al) = if below {
+                    (p[cl], g[cl], dg[cl], 0.5 * self.dy[j - 1])
                 } else {
-                    (1.0, h[cr], 1.0, 0.0, 0.0)
+                    (1.0, 1.0, 0.0, 0.0)
                 };
-                let (pr, hr, gr, dgr, ar) = if above {
-                    (p[cr], h[cr], g[cr], dg[cr], 0.5 * self.dy[j])
+                let (pr, gr, dgr, ar) = if above {
+                    (p[cr], g[cr], dg[cr], 0.5 * self.dy[j])
                 } else {
-                    (1.0, hl, 1.0, 0.0, 0.0)
+                    (1.0, 1.0, 0.0, 0.0)
                 };
                 let hf = self.y_face_spacing(h, i, j, ly);
                 let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, ly * area * hf, area);
@@ -649,8 +649,9 @@ impl Reynolds {
     }
 
     /// Loads of the pressure `p` (non-dimensional): the force (N, positive away from the disk)
-    /// and its moments about the pivot (N m): pitch (positive when the pressure's centre lies
-    /// behind the pivot) and roll (positive when it lies on the `+y` side).
+    /// and its moments about the pivot (N m), each positive in the sense that raises its angle
+    /// of [`Attitude`]: pitch (positive when the pressure's centre lies ahead of the pivot,
+    /// towards the leading edge) and roll (positive when it lies on the `+y` side).
     pub fn loads(&self, p: &[f64]) -> [f64; 3] {
         let w = self.weights();
         let l = self.bearing.length;
@@ -669,7 +670,8 @@ impl Reynolds {
         ]
     }
 
-    /// Weights of the loads: area, area × lever arm in `x` (m), area × lever arm in `y`.
+    /// Weights of the loads: area, area × lever arm ahead of the pivot (m), area × lever arm to
+    /// its `+y` side.
     fn weights(&self) -> [Vec<f64>; 3] {
         let (nx, ny) = self.size();
         let [px, py] = self.bearing.pivot;
@@ -682,7 +684,7 @@ impl Reynolds {
             for i in 0..nx {
                 let a = self.dx[i] * self.dy[j];
                 w[0].push(a);
-                w[1].push(a * (self.grid.xc[i] - px));
+                w[1].push(a * (px - self.grid.xc[i]));
                 w[2].push(a * (self.grid.yc[j] - py));
             }
         }
