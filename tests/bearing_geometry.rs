@@ -59,8 +59,13 @@ fn an_open_polygon_is_named() {
 fn a_self_intersecting_polygon_is_named() {
     let mut s = example();
     s.slider.regions[0].name = None;
-    s.slider.regions[0].polygon_um =
-        vec![[0.0, 0.0], [2000.0, 400.0], [2000.0, 0.0], [0.0, 400.0], [0.0, 0.0]];
+    s.slider.regions[0].polygon_um = vec![
+        [0.0, 0.0],
+        [2000.0, 400.0],
+        [2000.0, 0.0],
+        [0.0, 400.0],
+        [0.0, 0.0],
+    ];
     let (field, reason) = invalid(&s);
     assert!(field.contains("regions[0] #0"), "{field}");
     assert!(reason.contains("intersects itself"), "{reason}");

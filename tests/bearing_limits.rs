@@ -105,15 +105,17 @@ fn incompressible_limit_of_the_wide_inclined_plane() {
     let centre = r.bearing.pivot[0] - moment / load;
     let cerr = (centre - xcp).abs() / L;
     eprintln!("inclined plane: centre of pressure error {cerr:.2e} L");
-    assert!(cerr < 1e-3, "centre of pressure {centre} against {xcp}: {cerr:e}");
+    assert!(
+        cerr < 1e-3,
+        "centre of pressure {centre} against {xcp}: {cerr:e}"
+    );
 }
 
 #[test]
 fn large_bearing_number_keeps_p_h_constant() {
     let (u, h1, h2) = (20.0, 20e-9, 10e-9);
     let (r, att) = wide_plane(u, h1, h2, 0.0, FlowModel::Continuum, 400);
-    let lambda_phys =
-        6.0 * r.bearing.viscosity * u * L / (r.bearing.ambient_pressure * h2 * h2);
+    let lambda_phys = 6.0 * r.bearing.viscosity * u * L / (r.bearing.ambient_pressure * h2 * h2);
     assert!(lambda_phys > 1e5, "{lambda_phys}");
     let mut p = r.ambient();
     r.solve(&att, &mut p).unwrap();
@@ -144,7 +146,10 @@ fn slip_case(model: FlowModel) -> f64 {
     });
     let err = (w / want - 1.0).abs();
     eprintln!("{model:?}: load {w:.6e} N/m, error {err:.2e}");
-    assert!(err < 3e-3, "{model:?}: load {w} N/m against {want} N/m: {err:e}");
+    assert!(
+        err < 3e-3,
+        "{model:?}: load {w} N/m against {want} N/m: {err:e}"
+    );
     w
 }
 

@@ -27,7 +27,10 @@ fn a_symmetric_slider_without_skew_does_not_roll() {
     let b = &eq.reynolds.bearing;
     // Roll over the width: the spacing difference across the slider, against the fly height.
     let tilt = eq.attitude.roll * b.width / eq.attitude.fly_height;
-    eprintln!("symmetry: roll {:.3e} rad, roll x width / fly height {tilt:.2e}", eq.attitude.roll);
+    eprintln!(
+        "symmetry: roll {:.3e} rad, roll x width / fly height {tilt:.2e}",
+        eq.attitude.roll
+    );
     assert!(tilt.abs() < 1e-9, "{tilt:e}");
     assert!(eq.attitude.pitch > 0.0);
     // Balanced: force against preload, moments against the static torques (zero).
@@ -107,7 +110,10 @@ fn a_bearing_that_cannot_carry_the_preload_does_not_fly() {
     match solve_attitude(&spec.build().unwrap(), &AttitudeOptions::default()) {
         Err(Error::Analysis(e @ AnalysisError::DoesNotFly { .. })) => {
             let msg = e.to_string();
-            assert!(msg.starts_with("air bearing: the slider does not fly"), "{msg}");
+            assert!(
+                msg.starts_with("air bearing: the slider does not fly"),
+                "{msg}"
+            );
             assert!(msg.contains("preload 1.0000e6 mN"), "{msg}");
         }
         Ok(eq) => panic!("expected DoesNotFly, it flies at {:?}", eq.attitude),

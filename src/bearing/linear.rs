@@ -11,6 +11,8 @@
 //! on every level, each coarser level is visited twice (a W-cycle), and the coarsest is solved
 //! by dense LU.
 
+use std::cell::RefCell;
+
 use nalgebra::DMatrix;
 
 /// A preconditioner: `x ← M⁻¹ x`.
@@ -184,11 +186,24 @@ impl Preconditioner for Ilu0 {
 /// The coarsest level of the multigrid has fewer control volumes than this along a side.
 const COARSEST_SIDE: usize = 12;
 
-/// One level of the multigrid: the matrix and its ILU(0) smoother.
+/// One level of the multigrid: the matrix, its ILU(0) smoother, and the cycle's work vectors
+/// (allocated once).
 #[derive(Clone, Debug)]
 struct Level {
     a: FivePoint,
     ilu: Ilu0,
+    work: RefCell<Work>,
+}
+
+/// Work vectors of one level: its residual, and the coarser level's residual, correction,
+/// second residual and second correction.
+#[derive(Clone, Debug, Default)]
+struct Work {
+    r: Vec<f64>,
+    rc: Vec<f64>,
+    ec: Vec<f64>,
+    rr: Vec<f64>,
+    e2: Vec<f64>,
 }
 
 /// Additive-correction multigrid W-cycle on a [`FivePoint`] matrix, a preconditioner for
@@ -213,6 +228,8 @@ struct Level {
 #[derive(Clone, Debug)]
 pub struct Multigrid {
     levels: Vec<Level>,
+    /// The right-hand side of the cycle being applied.
+    rhs: RefCell<Vec<f64>>,
     coarsest: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
 }
 
@@ -272,6 +289,7 @@ impl Multigrid {
         let mut levels = vec![Level {
             a: a.clone(),
             ilu: Ilu0::new(a),
+            work: RefCell::default(),
         }];
         loop {
             let last = &levels[levels.len() - 1].a;
@@ -280,7 +298,22 @@ impl Multigrid {
             }
             let c = coarsen(last);
             let ilu = Ilu0::new(&c);
-            levels.push(Level { a: c, ilu });
+            levels.push(Level {
+                a: c,
+                ilu,
+                work: RefCell::default(),
+            });
+        }
+        for k in 0..levels.len() {
+            let n = levels[k].a.diag.len();
+            let m = levels.get(k + 1).map_or(0, |c| c.a.diag.len());
+            levels[k].work = RefCell::new(Work {
+                r: vec![0.0; n],
+                rc: vec![0.0; m],
+                ec: vec![0.0; m],
+                rr: vec![0.0; m],
+                e2: vec![0.0; m],
+            });
         }
         let coarsest = if levels.len() > 1 {
             let a = &levels[levels.len() - 1].a;
@@ -305,7 +338,11 @@ impl Multigrid {
         } else {
             None
         };
-        Multigrid { levels, coarsest }
+        Multigrid {
+            rhs: RefCell::new(Vec::with_capacity(a.diag.len())),
+            levels,
+            coarsest,
+        }
     }
 
     fn cycle(&self, l: usize, b: &[f64], x: &mut [f64]) {
@@ -331,35 +368,33 @@ impl Multigrid {
         }
         let a = &lev.a;
         let n = b.len();
+        let mut guard = lev.work.borrow_mut();
+        let Work { r, rc, ec, rr, e2 } = &mut *guard;
         // Pre-smoothing from zero.
         x.copy_from_slice(b);
         lev.ilu.solve(x);
-        let mut r = vec![0.0; n];
-        a.apply(x, &mut r);
+        a.apply(x, r);
         for k in 0..n {
             r[k] = b[k] - r[k];
         }
         // Restriction: sums over the merged volumes.
         let c = &self.levels[l + 1].a;
         let (mx, my) = (c.nx, c.ny);
-        let mut rc = vec![0.0; mx * my];
+        rc.iter_mut().for_each(|v| *v = 0.0);
         for j in 0..a.ny {
             let jc = agg(j, my);
             for i in 0..a.nx {
                 rc[jc * mx + agg(i, mx)] += r[j * a.nx + i];
             }
         }
-        let mut ec = vec![0.0; mx * my];
-        self.cycle(l + 1, &rc, &mut ec);
+        self.cycle(l + 1, rc, ec);
         if l + 2 < self.levels.len() {
             // Second visit of the coarse level (W-cycle) on its own residual.
-            let mut rr = vec![0.0; mx * my];
-            c.apply(&ec, &mut rr);
+            c.apply(ec, rr);
             for k in 0..mx * my {
                 rr[k] = rc[k] - rr[k];
             }
-            let mut e2 = vec![0.0; mx * my];
-            self.cycle(l + 1, &rr, &mut e2);
+            self.cycle(l + 1, rr, e2);
             for k in 0..mx * my {
                 ec[k] += e2[k];
             }
@@ -372,11 +407,11 @@ impl Multigrid {
             }
         }
         // Post-smoothing.
-        a.apply(x, &mut r);
+        a.apply(x, r);
         for k in 0..n {
             r[k] = b[k] - r[k];
         }
-        lev.ilu.solve(&mut r);
+        lev.ilu.solve(r);
         for k in 0..n {
             x[k] += r[k];
         }
@@ -385,7 +420,9 @@ impl Multigrid {
 
 impl Preconditioner for Multigrid {
     fn apply(&self, x: &mut [f64]) {
-        let b = x.to_vec();
+        let mut b = self.rhs.borrow_mut();
+        b.clear();
+        b.extend_from_slice(x);
         self.cycle(0, &b, x);
     }
 }

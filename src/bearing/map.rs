@@ -40,7 +40,11 @@ fn colour(t: f64) -> [u8; 3] {
 /// A number with a real minus sign.
 fn label(v: f64, decimals: usize) -> String {
     let s = format!("{:.*}", decimals, v);
-    let s = if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+    let s = if s
+        .trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
         s.trim_start_matches('-').to_string()
     } else {
         s
@@ -95,7 +99,11 @@ impl Equilibrium {
         let height = ph + MARGIN[2] + MARGIN[3];
         let (x0, y0) = (MARGIN[0], MARGIN[2]);
         let lo = self.pressure.iter().cloned().fold(f64::INFINITY, f64::min);
-        let hi = self.pressure.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let hi = self
+            .pressure
+            .iter()
+            .cloned()
+            .fold(f64::NEG_INFINITY, f64::max);
         let span = (hi - lo).max(1e-12);
         let level = |p: f64| (((p - lo) / span) * (LEVELS - 1) as f64).round() as usize;
         let mut s = String::new();
@@ -111,7 +119,9 @@ impl Equilibrium {
         let px = 0.5;
         let cols = (pw / px).round() as usize;
         let rows = (ph / px).round() as usize;
-        let cell = |faces: &[f64], v: f64| faces.partition_point(|&f| f <= v).clamp(1, faces.len() - 1) - 1;
+        let cell = |faces: &[f64], v: f64| {
+            faces.partition_point(|&f| f <= v).clamp(1, faces.len() - 1) - 1
+        };
         let ix: Vec<usize> = (0..cols)
             .map(|c| cell(&g.xf, (c as f64 + 0.5) / cols as f64 * b.length))
             .collect();

@@ -553,6 +553,17 @@ impl Reynolds {
     /// [`Reynolds::solve`] at a given non-dimensional spacing per cell; also returns the
     /// Jacobian at the solution and its multigrid preconditioner, for sensitivities.
     pub fn solve_spacing(&self, h: &[f64], p: &mut [f64]) -> Result<(NewtonStats, Factored)> {
+        self.solve_spacing_to(h, p, self.tolerance)
+    }
+
+    /// [`Reynolds::solve_spacing`] to the tolerance `tol` on the largest change of `P` in a
+    /// Newton step instead of [`Reynolds::tolerance`].
+    pub fn solve_spacing_to(
+        &self,
+        h: &[f64],
+        p: &mut [f64],
+        tol: f64,
+    ) -> Result<(NewtonStats, Factored)> {
         let (nx, ny) = self.size();
         let n = nx * ny;
         let mut r = vec![0.0; n];
@@ -585,7 +596,7 @@ impl Reynolds {
             stats.krylov_iterations += ks.iterations;
             stats.iterations += 1;
             let full = dp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if full <= self.tolerance {
+            if full <= tol {
                 for c in 0..n {
                     p[c] += dp[c];
                 }
