@@ -119,11 +119,9 @@ fn large_bearing_number_keeps_p_h_constant() {
     assert!(lambda_phys > 1e5, "{lambda_phys}");
     let mut p = r.ambient();
     r.solve(&att, &mut p).unwrap();
-    let (nx, _) = r.size();
     let mut worst: f64 = 0.0;
-    for i in 0..nx {
-        let x = r.grid.xc[i];
-        if x < 0.05 * L || x > 0.9 * L {
+    for (i, &x) in r.grid.xc.iter().enumerate() {
+        if !(0.05 * L..=0.9 * L).contains(&x) {
             continue;
         }
         let h = att.spacing_at(x, 0.0, L, WIDTH);

@@ -395,8 +395,8 @@ impl Equilibrium {
             let mut att = self.attitude;
             att.fly_height += d;
             let mut p = self.pressure.clone();
-            for c in 0..p.len() {
-                p[c] = (p[c] + self.dps[0][c] * d).max(0.5 * p[c]);
+            for (pc, dc) in p.iter_mut().zip(&self.dps[0]) {
+                *pc = (*pc + dc * d).max(0.5 * *pc);
             }
             r.solve(&att, &mut p)?;
             out.push((self.bulge_spacing() + d, r.loads(&p)[0]));

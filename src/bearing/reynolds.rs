@@ -538,7 +538,7 @@ impl Reynolds {
     /// Newton's method; `p` holds the solution.
     pub fn solve(&self, att: &Attitude, p: &mut [f64]) -> Result<NewtonStats> {
         let h = self.spacing(att);
-        if let Some(c) = h.iter().position(|&v| !(v > 0.0)) {
+        if let Some(c) = h.iter().position(|&v| v.is_nan() || v <= 0.0) {
             return Err(Error::no_convergence(
                 "air-bearing pressure",
                 format!(
@@ -713,7 +713,7 @@ impl Reynolds {
         h: &[f64],
         f: &Factored,
         rtol: f64,
-    ) -> Result<([[f64; 3]; 3], [Vec<f64>; 3], usize)> {
+    ) -> Result<Sensitivities> {
         let dh = self.spacing_derivatives();
         let n = p.len();
         let mut rp = vec![0.0; n];
@@ -853,6 +853,10 @@ impl Reynolds {
         out
     }
 }
+
+/// What [`Reynolds::sensitivities`] gives: `∂load_i/∂attitude_j`, the pressure's derivatives
+/// `∂P/∂attitude_j`, and the GMRES iterations spent.
+pub type Sensitivities = ([[f64; 3]; 3], [Vec<f64>; 3], usize);
 
 /// The Jacobian at a converged pressure and its multigrid preconditioner, reused for sensitivities.
 #[derive(Clone, Debug)]
