@@ -41,7 +41,7 @@ const COORD_TOL: f64 = 1e-9;
 /// ```
 /// use hdi_tribology::bearing::Taper;
 /// let t = Taper { length_um: 200.0, angle_mrad: Some(10.0), height_um: None };
-/// assert!((t.height_m("slider.taper").unwrap() - 2e-6).abs() < 1e-15);
+/// assert!((t.height_m("slider.taper").unwrap() - 200e-6 * 0.01f64.tan()).abs() < 1e-18);
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
