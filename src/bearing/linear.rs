@@ -84,21 +84,28 @@ impl FivePoint {
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
         let nx = self.nx;
         let n = x.len();
-        for c in 0..n {
-            let mut s = self.diag[c] * x[c];
-            if c >= 1 {
-                s += self.west[c] * x[c - 1];
+        for ((yc, d), xc) in y.iter_mut().zip(&self.diag).zip(x) {
+            *yc = d * xc;
+        }
+        if n > 1 {
+            for ((yc, w), xw) in y[1..].iter_mut().zip(&self.west[1..]).zip(&x[..n - 1]) {
+                *yc += w * xw;
             }
-            if c + 1 < n {
-                s += self.east[c] * x[c + 1];
+            for ((yc, e), xe) in y[..n - 1].iter_mut().zip(&self.east[..n - 1]).zip(&x[1..]) {
+                *yc += e * xe;
             }
-            if c >= nx {
-                s += self.south[c] * x[c - nx];
+        }
+        if n > nx {
+            for ((yc, s), xs) in y[nx..].iter_mut().zip(&self.south[nx..]).zip(&x[..n - nx]) {
+                *yc += s * xs;
             }
-            if c + nx < n {
-                s += self.north[c] * x[c + nx];
+            for ((yc, m), xn) in y[..n - nx]
+                .iter_mut()
+                .zip(&self.north[..n - nx])
+                .zip(&x[nx..])
+            {
+                *yc += m * xn;
             }
-            y[c] = s;
         }
     }
 }
@@ -154,25 +161,25 @@ impl Ilu0 {
     pub fn solve(&self, x: &mut [f64]) {
         let nx = self.nx;
         let n = x.len();
-        for c in 0..n {
-            let mut v = x[c];
-            if c >= 1 {
-                v -= self.lw[c] * x[c - 1];
-            }
-            if c >= nx {
-                v -= self.ls[c] * x[c - nx];
-            }
-            x[c] = v;
+        // Forward: the first row has west neighbours only, the rest south ones too.
+        for c in 1..nx.min(n) {
+            x[c] -= self.lw[c] * x[c - 1];
         }
-        for c in (0..n).rev() {
-            let mut v = x[c];
-            if c + 1 < n {
-                v -= self.ue[c] * x[c + 1];
-            }
-            if c + nx < n {
-                v -= self.un[c] * x[c + nx];
-            }
-            x[c] = v / self.pivot[c];
+        for c in nx..n {
+            x[c] -= self.lw[c] * x[c - 1] + self.ls[c] * x[c - nx];
+        }
+        // Backward: the last row has east neighbours only.
+        let top = n.saturating_sub(nx);
+        for c in (top..n).rev() {
+            let east = if c + 1 < n {
+                self.ue[c] * x[c + 1]
+            } else {
+                0.0
+            };
+            x[c] = (x[c] - east) / self.pivot[c];
+        }
+        for c in (0..top).rev() {
+            x[c] = (x[c] - self.ue[c] * x[c + 1] - self.un[c] * x[c + nx]) / self.pivot[c];
         }
     }
 }

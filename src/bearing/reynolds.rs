@@ -32,6 +32,8 @@ const MIN_PRESSURE_FRACTION: f64 = 0.2;
 /// A Newton step this small (in `p/p_a`) that no longer lowers the residual has met the
 /// residual's round-off floor.
 const ROUND_OFF_UPDATE: f64 = 1e-7;
+/// Relative tolerance of the linear solves of the damping.
+const DAMPING_RTOL: f64 = 1e-8;
 
 /// The slider's attitude: spacing at the trailing edge's centre, pitch and roll.
 ///
@@ -797,11 +799,11 @@ impl Reynolds {
                 &f.ilu,
                 &rhs,
                 &mut x,
-                1e-10,
+                DAMPING_RTOL,
                 RESTART,
                 MAX_KRYLOV,
             );
-            if stats.relative_residual > 1e-6 {
+            if stats.relative_residual > 10.0 * DAMPING_RTOL {
                 return Err(Error::no_convergence(
                     "air-bearing damping",
                     format!(
