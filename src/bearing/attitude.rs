@@ -378,6 +378,19 @@ impl Equilibrium {
     }
 
     /// Spacing at the bulge (m).
+    ///
+    /// ```
+    /// # use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec};
+    /// # let mut spec = BearingSpec::from_path(concat!(
+    /// #     env!("CARGO_MANIFEST_DIR"), "/scenes/bearing/two_rail_taper_flat.toml"))?;
+    /// # spec.grid.nx = 33;
+    /// # spec.grid.ny = 33;
+    /// # let eq = solve_attitude(&spec.build()?, &AttitudeOptions::default())?;
+    /// // The example's bulge is the left rail's trailing edge: no roll, so the fly height.
+    /// assert!((eq.bulge_spacing() - eq.attitude.fly_height).abs() < 1e-15);
+    /// assert!(eq.min_spacing() <= eq.bulge_spacing());
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     pub fn bulge_spacing(&self) -> f64 {
         let [x, y] = self.reynolds.bearing.bulge;
         self.spacing_at(x, y)
@@ -388,6 +401,18 @@ impl Equilibrium {
         self.reynolds.min_spacing(&self.attitude)
     }
 
+    /// ```
+    /// # use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec};
+    /// # let mut spec = BearingSpec::from_path(concat!(
+    /// #     env!("CARGO_MANIFEST_DIR"), "/scenes/bearing/two_rail_taper_flat.toml"))?;
+    /// # spec.grid.nx = 33;
+    /// # spec.grid.ny = 33;
+    /// # let eq = solve_attitude(&spec.build()?, &AttitudeOptions::default())?;
+    /// let k = eq.stiffness();
+    /// assert!(k[0][0] > 0.0 && k[1][1] > 0.0 && k[2][2] > 0.0);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
     /// Stiffness matrix about the equilibrium, `K = −∂(force, pitch moment, roll moment) /
     /// ∂(fly height, pitch, roll)`: N/m, N/rad; N m/m, N m/rad. The moments are positive in the
     /// sense that raises their angle, so a stable bearing has a positive diagonal.
@@ -401,6 +426,18 @@ impl Equilibrium {
         k
     }
 
+    /// ```
+    /// # use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec};
+    /// # let mut spec = BearingSpec::from_path(concat!(
+    /// #     env!("CARGO_MANIFEST_DIR"), "/scenes/bearing/two_rail_taper_flat.toml"))?;
+    /// # spec.grid.nx = 33;
+    /// # spec.grid.ny = 33;
+    /// # let eq = solve_attitude(&spec.build()?, &AttitudeOptions::default())?;
+    /// let c = eq.damping()?;
+    /// assert!(c[0][0] > 0.0);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
     /// Low-frequency squeeze-film damping matrix about the equilibrium (same units as
     /// [`Equilibrium::stiffness`] times s).
     pub fn damping(&self) -> Result<[[f64; 3]; 3]> {
@@ -414,6 +451,19 @@ impl Equilibrium {
         self.pressure.iter().map(|v| v * pa).collect()
     }
 
+    /// ```
+    /// # use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec};
+    /// # let mut spec = BearingSpec::from_path(concat!(
+    /// #     env!("CARGO_MANIFEST_DIR"), "/scenes/bearing/two_rail_taper_flat.toml"))?;
+    /// # spec.grid.nx = 33;
+    /// # spec.grid.ny = 33;
+    /// # let eq = solve_attitude(&spec.build()?, &AttitudeOptions::default())?;
+    /// let curve = eq.force_spacing(&[-20e-9, 0.0, 50e-9])?;
+    /// assert!(curve[0].1 > curve[1].1 && curve[1].1 > curve[2].1);
+    /// assert!((curve[1].1 - 49e-3).abs() < 1e-9);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
     /// The bearing's force (N) against the bulge's spacing (m), with pitch and roll held at
     /// the equilibrium's and the fly height moved by each of `offsets` (m).
     pub fn force_spacing(&self, offsets: &[f64]) -> Result<Vec<(f64, f64)>> {

@@ -16,6 +16,19 @@ use std::cell::RefCell;
 use nalgebra::DMatrix;
 
 /// A preconditioner: `x ← M⁻¹ x`.
+///
+/// ```
+/// use hdi_tribology::bearing::linear::Preconditioner;
+/// struct Jacobi(Vec<f64>);
+/// impl Preconditioner for Jacobi {
+///     fn apply(&self, x: &mut [f64]) {
+///         x.iter_mut().zip(&self.0).for_each(|(v, d)| *v /= d);
+///     }
+/// }
+/// let mut x = vec![2.0, 6.0];
+/// Jacobi(vec![2.0, 3.0]).apply(&mut x);
+/// assert_eq!(x, vec![1.0, 2.0]);
+/// ```
 pub trait Preconditioner {
     /// Applies `M⁻¹` in place.
     fn apply(&self, x: &mut [f64]);
@@ -111,6 +124,18 @@ impl FivePoint {
 }
 
 /// ILU(0) of a [`FivePoint`] matrix: `L U` with the sparsity of `A`, `L` unit lower triangular.
+/// On a tridiagonal matrix (one row of cells) it is the exact LU.
+///
+/// ```
+/// use hdi_tribology::bearing::linear::{FivePoint, Ilu0};
+/// let mut a = FivePoint::zeros(3, 1);
+/// a.diag = vec![2.0, 2.0, 2.0];
+/// a.west = vec![0.0, -1.0, -1.0];
+/// a.east = vec![-1.0, -1.0, 0.0];
+/// let mut x = vec![1.0, 0.0, 1.0];
+/// Ilu0::new(&a).solve(&mut x);
+/// assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-15));
+/// ```
 #[derive(Clone, Debug)]
 pub struct Ilu0 {
     nx: usize,

@@ -442,6 +442,19 @@ impl Reynolds {
         face_spacing(&h[i..], &self.dy, j, nx, lambda)
     }
 
+    /// ```
+    /// # use hdi_tribology::bearing::{Attitude, BearingSpec, Reynolds};
+    /// # let b = BearingSpec::from_toml_str("[slider]\nlength_um = 1000\nwidth_um = 800\n\
+    /// #     [operating]\nradius_mm = 20\nrpm = 7200\npreload_mn = 20")?.build()?;
+    /// # let r = Reynolds::new(&b, 24, 24);
+    /// # let att = Attitude { fly_height: 20e-9, pitch: 100e-6, roll: 0.0 };
+    /// let mut p = r.ambient();
+    /// r.solve(&att, &mut p)?;
+    /// let (inflow, outflow) = r.boundary_flux(&p, &r.spacing(&att));
+    /// assert!((inflow - outflow).abs() < 1e-8 * inflow);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
     /// Total mass flux into and out of the slider through its edges (non-dimensional, per the
     /// scale `p_a h_m L`), at the pressure `p` and spacing `h`.
     pub fn boundary_flux(&self, p: &[f64], h: &[f64]) -> (f64, f64) {
@@ -704,6 +717,20 @@ impl Reynolds {
         w
     }
 
+    /// ```
+    /// # use hdi_tribology::bearing::{Attitude, BearingSpec, Reynolds};
+    /// # let b = BearingSpec::from_toml_str("[slider]\nlength_um = 1000\nwidth_um = 800\n\
+    /// #     [operating]\nradius_mm = 20\nrpm = 7200\npreload_mn = 20")?.build()?;
+    /// # let r = Reynolds::new(&b, 24, 24);
+    /// # let att = Attitude { fly_height: 20e-9, pitch: 100e-6, roll: 0.0 };
+    /// let h = r.spacing(&att);
+    /// let mut p = r.ambient();
+    /// let (_, f) = r.solve_spacing(&h, &mut p)?;
+    /// let (k, _, _) = r.sensitivities(&p, &h, &f, 1e-8)?;
+    /// assert!(k[0][0] < 0.0); // the load falls as the slider rises
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
     /// Derivatives of the loads ([`Reynolds::loads`]) with respect to the attitude, at the
     /// converged pressure `p` and spacing `h` with the factored Jacobian `f`: `k[i][j] =
     /// ∂load_i/∂attitude_j` (N/m, N, N m/m, N m), the pressure's derivatives
@@ -822,6 +849,20 @@ impl Reynolds {
         Ok(c)
     }
 
+    /// ```
+    /// # use hdi_tribology::bearing::{Attitude, BearingSpec, Reynolds};
+    /// # let b = BearingSpec::from_toml_str("[slider]\nlength_um = 1000\nwidth_um = 800\n\
+    /// #     [operating]\nradius_mm = 20\nrpm = 7200\npreload_mn = 20")?.build()?;
+    /// # let r = Reynolds::new(&b, 24, 24);
+    /// # let att = Attitude { fly_height: 20e-9, pitch: 100e-6, roll: 0.0 };
+    /// let mut p = r.ambient();
+    /// r.solve(&att, &mut p)?;
+    /// let fine = Reynolds::new(&b, 48, 48);
+    /// let q = fine.interpolate_from(&r, &p);
+    /// assert_eq!(q.len(), 48 * 48);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
     /// Interpolates a pressure field of another grid of the same bearing onto this one
     /// (bilinear between cell centres, constant beyond the outermost centres).
     pub fn interpolate_from(&self, other: &Reynolds, p: &[f64]) -> Vec<f64> {
