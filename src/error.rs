@@ -221,6 +221,8 @@ pub enum Stage {
     PeakSampling,
     /// The first-order shift of a transition power with a parameter.
     TransitionSensitivity,
+    /// The air bearing's attitude (fly height, pitch, roll) from the slider's geometry.
+    AirBearing,
 }
 
 impl Stage {
@@ -242,6 +244,7 @@ impl Stage {
             Stage::ModelCurves => "model curves",
             Stage::PeakSampling => "peak sampling",
             Stage::TransitionSensitivity => "transition sensitivity",
+            Stage::AirBearing => "air bearing",
         }
     }
 }
@@ -496,6 +499,16 @@ pub enum AnalysisError {
         /// The measured point's abscissa, as in the data.
         x: f64,
     },
+    /// Air bearing: the bearing cannot carry the preload; its load stays below it down to the
+    /// smallest spacing the solve allows.
+    DoesNotFly {
+        /// The preload (mN).
+        preload_mn: f64,
+        /// The bearing's load at the lowest attitude reached (mN).
+        load_mn: f64,
+        /// The smallest spacing there (nm).
+        min_spacing_nm: f64,
+    },
     /// A state the code should never reach (a bug, not a property of the scene).
     Internal {
         /// The analysis.
@@ -543,6 +556,7 @@ impl AnalysisError {
             A::NoModelStart { .. } | A::TooFewSettled { .. } => Stage::Fit,
             A::NotDetected { .. } | A::BeyondEquilibria { .. } => Stage::ModelCurves,
             A::NoSensitivity { .. } => Stage::TransitionSensitivity,
+            A::DoesNotFly { .. } => Stage::AirBearing,
             A::NoTouchdown { stage, .. }
             | A::TableTooNarrow { stage, .. }
             | A::NotFinite { stage, .. }
@@ -579,6 +593,7 @@ impl AnalysisError {
             A::BeyondEquilibria { .. } => "BeyondEquilibria",
             A::TooFewSettled { .. } => "TooFewSettled",
             A::NotDetected { .. } => "NotDetected",
+            A::DoesNotFly { .. } => "DoesNotFly",
             A::Internal { .. } => "Internal",
         }
     }
@@ -786,6 +801,17 @@ impl AnalysisError {
                 num(*start_power_mw)
             ),
             A::NotFinite { quantity, .. } => format!("non-finite {quantity}"),
+            A::DoesNotFly {
+                preload_mn,
+                load_mn,
+                min_spacing_nm,
+            } => format!(
+                "the slider does not fly: the bearing carries {} mN at a smallest spacing of {} \
+                 nm, short of the preload {} mN",
+                num(*load_mn),
+                num(*min_spacing_nm),
+                num(*preload_mn)
+            ),
             A::NoSensitivity { gap_nm, why } => format!("{why} at d = {} nm", num(*gap_nm)),
             A::BeyondEquilibria {
                 origin,

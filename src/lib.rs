@@ -63,6 +63,8 @@
 //! - [`surface`]: surface-height and asperity-peak-height statistics;
 //! - [`quadrature`]: adaptive integration and precomputed tables;
 //! - [`force`]: interface terms (trait based), footprints and air bearings;
+//! - [`bearing`]: the air bearing from the slider's geometry (the Reynolds equation with
+//!   rarefaction, the attitude solve, stiffness and damping);
 //! - [`scene`]: a serde description of a whole scene, validated into parts, and its fields by
 //!   dotted name ([`scene::FieldPath`]);
 //! - [`ode`]: a generic ODE stepper that knows no physics;
@@ -93,6 +95,7 @@
 #![cfg_attr(docsrs, feature(doc_cfg))]
 
 pub mod analysis;
+pub mod bearing;
 pub mod clearance;
 pub mod drive;
 pub mod error;

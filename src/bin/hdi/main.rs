@@ -7,6 +7,7 @@
 //! Exit codes: 0 success, 1 a bad scene or a failed computation (one line on stderr), 2 a bad
 //! command line (clap's usage message).
 
+mod bearing;
 mod calibrate;
 mod common;
 mod cycle;
@@ -51,6 +52,9 @@ enum Command {
     /// A command file (time, heater power, voltage) replayed through the simulated drive; the
     /// sensor CSV written.
     Drive(drive::Args),
+    /// The air bearing of a slider's geometry: attitude, stiffness and damping as JSON, and the
+    /// pressure map.
+    Bearing(bearing::Args),
 }
 
 fn main() -> ExitCode {
@@ -65,6 +69,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => fit::run(a),
         Command::Scene(a) => scene::run(a),
         Command::Drive(a) => drive::run(a),
+        Command::Bearing(a) => bearing::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

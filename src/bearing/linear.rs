@@ -1,0 +1,597 @@
+//! Linear algebra of the five-point finite-volume stencil: the matrix in diagonal storage, its
+//! incomplete LU factorisation without fill (ILU(0)), an additive-correction multigrid built on
+//! it, and restarted GMRES.
+//!
+//! The multigrid merges 2 × 2 control volumes into one on each coarser level, and its coarse
+//! matrices are the sums of the fine couplings between the merged volumes (the Galerkin product
+//! with piecewise-constant prolongation: additive-correction multigrid after Hutchinson &
+//! Raithby 1986). Merging keeps the five-point structure and the flux balance of each merged
+//! volume, so it copes with the jumps of the conductance `Q P H³` by many orders of magnitude
+//! between a rail and a deep recess, where a single-level preconditioner stalls. ILU(0) smooths
+//! on every level, each coarser level is visited twice (a W-cycle), and the coarsest is solved
+//! by dense LU.
+
+use std::cell::RefCell;
+
+use nalgebra::DMatrix;
+
+/// A preconditioner: `x ← M⁻¹ x`.
+///
+/// ```
+/// use hdi_tribology::bearing::linear::Preconditioner;
+/// struct Jacobi(Vec<f64>);
+/// impl Preconditioner for Jacobi {
+///     fn apply(&self, x: &mut [f64]) {
+///         x.iter_mut().zip(&self.0).for_each(|(v, d)| *v /= d);
+///     }
+/// }
+/// let mut x = vec![2.0, 6.0];
+/// Jacobi(vec![2.0, 3.0]).apply(&mut x);
+/// assert_eq!(x, vec![1.0, 2.0]);
+/// ```
+pub trait Preconditioner {
+    /// Applies `M⁻¹` in place.
+    fn apply(&self, x: &mut [f64]);
+}
+
+/// A matrix on an `nx × ny` tensor grid with the five-point stencil, unknown `c = j nx + i`:
+/// row `c` holds `diag[c]` and the coefficients of its west (`c − 1`), east (`c + 1`), south
+/// (`c − nx`) and north (`c + nx`) neighbours, zero where the neighbour is outside the grid.
+///
+/// ```
+/// use hdi_tribology::bearing::linear::FivePoint;
+/// let mut a = FivePoint::zeros(2, 1);
+/// a.diag = vec![2.0, 2.0];
+/// a.east[0] = -1.0;
+/// let mut y = vec![0.0; 2];
+/// a.apply(&[1.0, 1.0], &mut y);
+/// assert_eq!(y, vec![1.0, 2.0]);
+/// ```
+#[derive(Clone, Debug)]
+pub struct FivePoint {
+    /// Cells along `x`.
+    pub nx: usize,
+    /// Cells along `y`.
+    pub ny: usize,
+    /// Diagonal.
+    pub diag: Vec<f64>,
+    /// West neighbour.
+    pub west: Vec<f64>,
+    /// East neighbour.
+    pub east: Vec<f64>,
+    /// South neighbour.
+    pub south: Vec<f64>,
+    /// North neighbour.
+    pub north: Vec<f64>,
+}
+
+impl FivePoint {
+    /// The zero matrix.
+    pub fn zeros(nx: usize, ny: usize) -> Self {
+        let n = nx * ny;
+        FivePoint {
+            nx,
+            ny,
+            diag: vec![0.0; n],
+            west: vec![0.0; n],
+            east: vec![0.0; n],
+            south: vec![0.0; n],
+            north: vec![0.0; n],
+        }
+    }
+
+    /// Sets every coefficient to zero.
+    pub fn clear(&mut self) {
+        for v in [
+            &mut self.diag,
+            &mut self.west,
+            &mut self.east,
+            &mut self.south,
+            &mut self.north,
+        ] {
+            v.iter_mut().for_each(|x| *x = 0.0);
+        }
+    }
+
+    /// `y = A x`.
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        let nx = self.nx;
+        let n = x.len();
+        for ((yc, d), xc) in y.iter_mut().zip(&self.diag).zip(x) {
+            *yc = d * xc;
+        }
+        if n > 1 {
+            for ((yc, w), xw) in y[1..].iter_mut().zip(&self.west[1..]).zip(&x[..n - 1]) {
+                *yc += w * xw;
+            }
+            for ((yc, e), xe) in y[..n - 1].iter_mut().zip(&self.east[..n - 1]).zip(&x[1..]) {
+                *yc += e * xe;
+            }
+        }
+        if n > nx {
+            for ((yc, s), xs) in y[nx..].iter_mut().zip(&self.south[nx..]).zip(&x[..n - nx]) {
+                *yc += s * xs;
+            }
+            for ((yc, m), xn) in y[..n - nx]
+                .iter_mut()
+                .zip(&self.north[..n - nx])
+                .zip(&x[nx..])
+            {
+                *yc += m * xn;
+            }
+        }
+    }
+}
+
+/// ILU(0) of a [`FivePoint`] matrix: `L U` with the sparsity of `A`, `L` unit lower triangular.
+/// On a tridiagonal matrix (one row of cells) it is the exact LU.
+///
+/// ```
+/// use hdi_tribology::bearing::linear::{FivePoint, Ilu0};
+/// let mut a = FivePoint::zeros(3, 1);
+/// a.diag = vec![2.0, 2.0, 2.0];
+/// a.west = vec![0.0, -1.0, -1.0];
+/// a.east = vec![-1.0, -1.0, 0.0];
+/// let mut x = vec![1.0, 0.0, 1.0];
+/// Ilu0::new(&a).solve(&mut x);
+/// assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-15));
+/// ```
+#[derive(Clone, Debug)]
+pub struct Ilu0 {
+    nx: usize,
+    /// Pivots of `U`.
+    pivot: Vec<f64>,
+    /// Multipliers of `L` (west, south).
+    lw: Vec<f64>,
+    ls: Vec<f64>,
+    /// Off-diagonals of `U` (east, north), those of `A`.
+    ue: Vec<f64>,
+    un: Vec<f64>,
+}
+
+impl Ilu0 {
+    /// Factorises `a`; a vanishing pivot is replaced by a small one of the row's scale.
+    pub fn new(a: &FivePoint) -> Ilu0 {
+        let nx = a.nx;
+        let n = a.diag.len();
+        let mut pivot = vec![0.0; n];
+        let mut lw = vec![0.0; n];
+        let mut ls = vec![0.0; n];
+        for c in 0..n {
+            let mut d = a.diag[c];
+            if c >= 1 && a.west[c] != 0.0 {
+                lw[c] = a.west[c] / pivot[c - 1];
+                d -= lw[c] * a.east[c - 1];
+            }
+            if c >= nx && a.south[c] != 0.0 {
+                ls[c] = a.south[c] / pivot[c - nx];
+                d -= ls[c] * a.north[c - nx];
+            }
+            if d.abs() < 1e-14 * a.diag[c].abs().max(f64::MIN_POSITIVE) {
+                d = 1e-14 * a.diag[c].abs().max(1.0);
+            }
+            pivot[c] = d;
+        }
+        Ilu0 {
+            nx,
+            pivot,
+            lw,
+            ls,
+            ue: a.east.clone(),
+            un: a.north.clone(),
+        }
+    }
+
+    /// `x = (L U)⁻¹ x`, in place.
+    pub fn solve(&self, x: &mut [f64]) {
+        let nx = self.nx;
+        let n = x.len();
+        // Forward: the first row has west neighbours only, the rest south ones too.
+        for c in 1..nx.min(n) {
+            x[c] -= self.lw[c] * x[c - 1];
+        }
+        for c in nx..n {
+            x[c] -= self.lw[c] * x[c - 1] + self.ls[c] * x[c - nx];
+        }
+        // Backward: the last row has east neighbours only.
+        let top = n.saturating_sub(nx);
+        for c in (top..n).rev() {
+            let east = if c + 1 < n {
+                self.ue[c] * x[c + 1]
+            } else {
+                0.0
+            };
+            x[c] = (x[c] - east) / self.pivot[c];
+        }
+        for c in (0..top).rev() {
+            x[c] = (x[c] - self.ue[c] * x[c + 1] - self.un[c] * x[c + nx]) / self.pivot[c];
+        }
+    }
+}
+
+impl Preconditioner for Ilu0 {
+    fn apply(&self, x: &mut [f64]) {
+        self.solve(x);
+    }
+}
+
+/// The coarsest level of the multigrid has fewer control volumes than this along a side.
+const COARSEST_SIDE: usize = 12;
+
+/// One level of the multigrid: the matrix, its ILU(0) smoother, and the cycle's work vectors
+/// (allocated once).
+#[derive(Clone, Debug)]
+struct Level {
+    a: FivePoint,
+    ilu: Ilu0,
+    work: RefCell<Work>,
+}
+
+/// Work vectors of one level: its residual, and the coarser level's residual, correction,
+/// second residual and second correction.
+#[derive(Clone, Debug, Default)]
+struct Work {
+    r: Vec<f64>,
+    rc: Vec<f64>,
+    ec: Vec<f64>,
+    rr: Vec<f64>,
+    e2: Vec<f64>,
+}
+
+/// Additive-correction multigrid W-cycle on a [`FivePoint`] matrix, a preconditioner for
+/// [`gmres`].
+///
+/// ```
+/// use hdi_tribology::bearing::linear::{gmres, FivePoint, Multigrid};
+/// let (nx, ny) = (64, 64);
+/// let mut a = FivePoint::zeros(nx, ny);
+/// for c in 0..nx * ny {
+///     a.diag[c] = 4.0;
+///     if c % nx > 0 { a.west[c] = -1.0; }
+///     if c % nx + 1 < nx { a.east[c] = -1.0; }
+///     if c >= nx { a.south[c] = -1.0; }
+///     if c + nx < nx * ny { a.north[c] = -1.0; }
+/// }
+/// let b = vec![1.0; nx * ny];
+/// let mut x = vec![0.0; nx * ny];
+/// let stats = gmres(&a, &Multigrid::new(&a), &b, &mut x, 1e-10, 30, 200);
+/// assert!(stats.relative_residual <= 1e-10 && stats.iterations < 40);
+/// ```
+#[derive(Clone, Debug)]
+pub struct Multigrid {
+    levels: Vec<Level>,
+    /// The right-hand side of the cycle being applied.
+    rhs: RefCell<Vec<f64>>,
+    coarsest: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+}
+
+/// Aggregate of fine index `i` on a side of `n` cells coarsened to `n / 2`.
+#[inline]
+fn agg(i: usize, nc: usize) -> usize {
+    (i / 2).min(nc - 1)
+}
+
+fn coarsen(a: &FivePoint) -> FivePoint {
+    let (nx, ny) = (a.nx, a.ny);
+    let (mx, my) = (nx / 2, ny / 2);
+    let mut c = FivePoint::zeros(mx, my);
+    for j in 0..ny {
+        let jc = agg(j, my);
+        for i in 0..nx {
+            let ic = agg(i, mx);
+            let k = j * nx + i;
+            let kc = jc * mx + ic;
+            c.diag[kc] += a.diag[k];
+            if i > 0 {
+                if agg(i - 1, mx) == ic {
+                    c.diag[kc] += a.west[k];
+                } else {
+                    c.west[kc] += a.west[k];
+                }
+            }
+            if i + 1 < nx {
+                if agg(i + 1, mx) == ic {
+                    c.diag[kc] += a.east[k];
+                } else {
+                    c.east[kc] += a.east[k];
+                }
+            }
+            if j > 0 {
+                if agg(j - 1, my) == jc {
+                    c.diag[kc] += a.south[k];
+                } else {
+                    c.south[kc] += a.south[k];
+                }
+            }
+            if j + 1 < ny {
+                if agg(j + 1, my) == jc {
+                    c.diag[kc] += a.north[k];
+                } else {
+                    c.north[kc] += a.north[k];
+                }
+            }
+        }
+    }
+    c
+}
+
+impl Multigrid {
+    /// Builds the levels of `a`.
+    pub fn new(a: &FivePoint) -> Multigrid {
+        let mut levels = vec![Level {
+            a: a.clone(),
+            ilu: Ilu0::new(a),
+            work: RefCell::default(),
+        }];
+        loop {
+            let last = &levels[levels.len() - 1].a;
+            if last.nx.min(last.ny) < COARSEST_SIDE || last.nx < 2 || last.ny < 2 {
+                break;
+            }
+            let c = coarsen(last);
+            let ilu = Ilu0::new(&c);
+            levels.push(Level {
+                a: c,
+                ilu,
+                work: RefCell::default(),
+            });
+        }
+        for k in 0..levels.len() {
+            let n = levels[k].a.diag.len();
+            let m = levels.get(k + 1).map_or(0, |c| c.a.diag.len());
+            levels[k].work = RefCell::new(Work {
+                r: vec![0.0; n],
+                rc: vec![0.0; m],
+                ec: vec![0.0; m],
+                rr: vec![0.0; m],
+                e2: vec![0.0; m],
+            });
+        }
+        let coarsest = if levels.len() > 1 {
+            let a = &levels[levels.len() - 1].a;
+            let n = a.nx * a.ny;
+            let mut m = DMatrix::<f64>::zeros(n, n);
+            for k in 0..n {
+                m[(k, k)] = a.diag[k];
+                if k >= 1 {
+                    m[(k, k - 1)] = a.west[k];
+                }
+                if k + 1 < n {
+                    m[(k, k + 1)] = a.east[k];
+                }
+                if k >= a.nx {
+                    m[(k, k - a.nx)] = a.south[k];
+                }
+                if k + a.nx < n {
+                    m[(k, k + a.nx)] = a.north[k];
+                }
+            }
+            Some(m.lu())
+        } else {
+            None
+        };
+        Multigrid {
+            rhs: RefCell::new(Vec::with_capacity(a.diag.len())),
+            levels,
+            coarsest,
+        }
+    }
+
+    fn cycle(&self, l: usize, b: &[f64], x: &mut [f64]) {
+        let lev = &self.levels[l];
+        if l + 1 == self.levels.len() {
+            match &self.coarsest {
+                Some(lu) => {
+                    let v = nalgebra::DVector::from_column_slice(b);
+                    match lu.solve(&v) {
+                        Some(s) => x.copy_from_slice(s.as_slice()),
+                        None => {
+                            x.copy_from_slice(b);
+                            lev.ilu.solve(x);
+                        }
+                    }
+                }
+                None => {
+                    x.copy_from_slice(b);
+                    lev.ilu.solve(x);
+                }
+            }
+            return;
+        }
+        let a = &lev.a;
+        let n = b.len();
+        let mut guard = lev.work.borrow_mut();
+        let Work { r, rc, ec, rr, e2 } = &mut *guard;
+        // Pre-smoothing from zero.
+        x.copy_from_slice(b);
+        lev.ilu.solve(x);
+        a.apply(x, r);
+        for k in 0..n {
+            r[k] = b[k] - r[k];
+        }
+        // Restriction: sums over the merged volumes.
+        let c = &self.levels[l + 1].a;
+        let (mx, my) = (c.nx, c.ny);
+        rc.iter_mut().for_each(|v| *v = 0.0);
+        for j in 0..a.ny {
+            let jc = agg(j, my);
+            for i in 0..a.nx {
+                rc[jc * mx + agg(i, mx)] += r[j * a.nx + i];
+            }
+        }
+        self.cycle(l + 1, rc, ec);
+        if l + 2 < self.levels.len() {
+            // Second visit of the coarse level (W-cycle) on its own residual.
+            c.apply(ec, rr);
+            for k in 0..mx * my {
+                rr[k] = rc[k] - rr[k];
+            }
+            self.cycle(l + 1, rr, e2);
+            for k in 0..mx * my {
+                ec[k] += e2[k];
+            }
+        }
+        // Prolongation: each merged volume's correction to all its volumes.
+        for j in 0..a.ny {
+            let jc = agg(j, my);
+            for i in 0..a.nx {
+                x[j * a.nx + i] += ec[jc * mx + agg(i, mx)];
+            }
+        }
+        // Post-smoothing.
+        a.apply(x, r);
+        for k in 0..n {
+            r[k] = b[k] - r[k];
+        }
+        lev.ilu.solve(r);
+        for k in 0..n {
+            x[k] += r[k];
+        }
+    }
+}
+
+impl Preconditioner for Multigrid {
+    fn apply(&self, x: &mut [f64]) {
+        let mut b = self.rhs.borrow_mut();
+        b.clear();
+        b.extend_from_slice(x);
+        self.cycle(0, &b, x);
+    }
+}
+
+/// What a GMRES solve did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KrylovStats {
+    /// Iterations (matrix–vector products).
+    pub iterations: usize,
+    /// Final residual norm relative to the right-hand side's.
+    pub relative_residual: f64,
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm(a: &[f64]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Solves `A x = b` by flexible GMRES(`restart`) with `m` as right preconditioner (which may
+/// vary from one application to the next), from the start `x`, until `‖b − A x‖ ≤ rtol ‖b‖`
+/// or `max_iter` iterations.
+///
+/// ```
+/// use hdi_tribology::bearing::linear::{gmres, FivePoint, Ilu0};
+/// let (nx, ny) = (8, 8);
+/// let mut a = FivePoint::zeros(nx, ny);
+/// for c in 0..nx * ny {
+///     a.diag[c] = 4.0;
+///     if c % nx > 0 { a.west[c] = -1.0; }
+///     if c % nx + 1 < nx { a.east[c] = -1.0; }
+///     if c >= nx { a.south[c] = -1.0; }
+///     if c + nx < nx * ny { a.north[c] = -1.0; }
+/// }
+/// let b = vec![1.0; nx * ny];
+/// let mut x = vec![0.0; nx * ny];
+/// let stats = gmres(&a, &Ilu0::new(&a), &b, &mut x, 1e-10, 30, 200);
+/// assert!(stats.relative_residual <= 1e-10);
+/// ```
+pub fn gmres(
+    a: &FivePoint,
+    m: &impl Preconditioner,
+    b: &[f64],
+    x: &mut [f64],
+    rtol: f64,
+    restart: usize,
+    max_iter: usize,
+) -> KrylovStats {
+    let n = b.len();
+    let bnorm = norm(b).max(f64::MIN_POSITIVE);
+    let ilu = m;
+    let m = restart.max(1);
+    let mut v: Vec<Vec<f64>> = vec![vec![0.0; n]; m + 1];
+    // Flexible GMRES: the preconditioned vectors are kept, so the preconditioner may vary.
+    let mut zs: Vec<Vec<f64>> = vec![vec![0.0; n]; m];
+    let mut w = vec![0.0; n];
+    let mut h = vec![vec![0.0; m]; m + 1];
+    let (mut cs, mut sn, mut g) = (vec![0.0; m], vec![0.0; m], vec![0.0; m + 1]);
+    let mut iters = 0;
+    let mut rel;
+    loop {
+        a.apply(x, &mut w);
+        for k in 0..n {
+            w[k] = b[k] - w[k];
+        }
+        let beta = norm(&w);
+        rel = beta / bnorm;
+        if rel <= rtol || iters >= max_iter {
+            break;
+        }
+        for k in 0..n {
+            v[0][k] = w[k] / beta;
+        }
+        g.iter_mut().for_each(|x| *x = 0.0);
+        g[0] = beta;
+        let mut used = 0;
+        for j in 0..m {
+            zs[j].copy_from_slice(&v[j]);
+            ilu.apply(&mut zs[j]);
+            a.apply(&zs[j], &mut w);
+            iters += 1;
+            // Modified Gram–Schmidt.
+            for i in 0..=j {
+                let hij = dot(&w, &v[i]);
+                h[i][j] = hij;
+                for (wk, vk) in w.iter_mut().zip(&v[i]) {
+                    *wk -= hij * vk;
+                }
+            }
+            let hn = norm(&w);
+            h[j + 1][j] = hn;
+            if hn > 0.0 {
+                for k in 0..n {
+                    v[j + 1][k] = w[k] / hn;
+                }
+            }
+            for i in 0..j {
+                let t = cs[i] * h[i][j] + sn[i] * h[i + 1][j];
+                h[i + 1][j] = -sn[i] * h[i][j] + cs[i] * h[i + 1][j];
+                h[i][j] = t;
+            }
+            let r = h[j][j].hypot(h[j + 1][j]);
+            if r == 0.0 {
+                cs[j] = 1.0;
+                sn[j] = 0.0;
+            } else {
+                cs[j] = h[j][j] / r;
+                sn[j] = h[j + 1][j] / r;
+            }
+            h[j][j] = r;
+            h[j + 1][j] = 0.0;
+            g[j + 1] = -sn[j] * g[j];
+            g[j] *= cs[j];
+            used = j + 1;
+            if g[j + 1].abs() / bnorm <= rtol || iters >= max_iter || hn == 0.0 {
+                break;
+            }
+        }
+        // Back substitution for y, then x += M⁻¹ V y.
+        let mut y = vec![0.0; used];
+        for i in (0..used).rev() {
+            let mut s = g[i];
+            for k in i + 1..used {
+                s -= h[i][k] * y[k];
+            }
+            y[i] = s / h[i][i];
+        }
+        for (i, yi) in y.iter().enumerate() {
+            for (xk, zk) in x.iter_mut().zip(&zs[i]) {
+                *xk += yi * zk;
+            }
+        }
+    }
+    KrylovStats {
+        iterations: iters,
+        relative_residual: rel,
+    }
+}

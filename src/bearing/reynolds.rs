@@ -1,0 +1,915 @@
+//! The steady compressible Reynolds equation with rarefaction, discretised by control volumes
+//! and solved by Newton's method.
+//!
+//! In the variables `X = x/L`, `Y = y/L`, `P = p/p_a`, `H = h/h_m` the mass flux per unit width
+//! is `J = Λ e P H − Q P H³ ∇P` (`e` the unit vector of the disk's velocity, `Λ = 6 μ U L /
+//! (p_a h_m²)` the bearing number, `Q(Kn)` the Poiseuille flow factor at `Kn = λ_a/(P H h_m)`),
+//! and the steady equation is `∇·J = 0`, with `P = 1` on the slider's edges.
+//!
+//! Each control volume balances the fluxes through its four faces. Across a face, the
+//! conductance `Q P H³` of the two neighbours is combined in series (the harmonic mean, which
+//! keeps the flux continuous where a rail steps), the convected mass `P H` takes the spacing on
+//! the face (interpolated where the surface is smooth, the upstream cell's across a step), and
+//! Patankar's power-law scheme weighs the two by the face's Péclet number:
+//! central differences where diffusion dominates, upwinding where convection does, stable at
+//! any bearing number. The Jacobian of the residual is exact (analytic), and each Newton step
+//! is a GMRES solve preconditioned by the incomplete LU factors of that Jacobian.
+
+use super::flow_factor::FlowModel;
+use super::geometry::Bearing;
+use super::grid::Grid;
+use super::linear::{gmres, FivePoint, KrylovStats, Multigrid};
+use crate::{Error, Result};
+
+/// The reference spacing `h_m` of the non-dimensional variables, m.
+pub const REFERENCE_SPACING: f64 = 10e-9;
+/// Restart length of GMRES.
+const RESTART: usize = 30;
+/// Iteration budget of one GMRES solve.
+const MAX_KRYLOV: usize = 3000;
+/// Smallest fraction of the current pressure a Newton step may leave.
+const MIN_PRESSURE_FRACTION: f64 = 0.2;
+/// A Newton step this small (in `p/p_a`) that no longer lowers the residual has met the
+/// residual's round-off floor.
+const ROUND_OFF_UPDATE: f64 = 1e-7;
+/// Relative tolerance of the linear solves of the damping.
+const DAMPING_RTOL: f64 = 1e-8;
+
+/// The slider's attitude: spacing at the trailing edge's centre, pitch and roll.
+///
+/// The spacing of the air-bearing surface (depth 0) at `(x, y)` is
+/// `h = fly_height + pitch (L − x) + roll (y − W/2)`; positive pitch raises the leading edge,
+/// positive roll the `+y` side. The surface's depth adds to it.
+///
+/// ```
+/// use hdi_tribology::bearing::Attitude;
+/// let a = Attitude { fly_height: 10e-9, pitch: 100e-6, roll: 0.0 };
+/// assert!((a.spacing_at(0.0, 0.5e-3, 1e-3, 1e-3) - 110e-9).abs() < 1e-18);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attitude {
+    /// Spacing at the trailing edge's centre (surface depth 0), m.
+    pub fly_height: f64,
+    /// Pitch, rad.
+    pub pitch: f64,
+    /// Roll, rad.
+    pub roll: f64,
+}
+
+impl Attitude {
+    /// Spacing of the plane of depth 0 at `(x, y)` on a slider of length `l` and width `w`, m.
+    pub fn spacing_at(&self, x: f64, y: f64, l: f64, w: f64) -> f64 {
+        self.fly_height + self.pitch * (l - x) + self.roll * (y - 0.5 * w)
+    }
+
+    /// As an array `[fly_height, pitch, roll]`.
+    pub fn to_array(self) -> [f64; 3] {
+        [self.fly_height, self.pitch, self.roll]
+    }
+
+    /// From an array `[fly_height, pitch, roll]`.
+    pub fn from_array(a: [f64; 3]) -> Self {
+        Attitude {
+            fly_height: a[0],
+            pitch: a[1],
+            roll: a[2],
+        }
+    }
+}
+
+/// What happens at the slider's sides `y = 0` and `y = W`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Sides {
+    /// Ambient pressure (a real slider).
+    #[default]
+    Ambient,
+    /// No flux through the sides: with no skew, the infinitely wide slider.
+    Closed,
+}
+
+/// How a Newton solve of the pressure went.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NewtonStats {
+    /// Newton steps.
+    pub iterations: usize,
+    /// GMRES iterations over all steps.
+    pub krylov_iterations: usize,
+    /// Largest change of `P` in the last step.
+    pub last_update: f64,
+    /// 2-norm of the residual at the solution, relative to the convective flux scale `Λ`
+    /// times the slider's width over its length.
+    pub residual: f64,
+}
+
+/// The Reynolds equation of one bearing on one grid.
+///
+/// ```
+/// use hdi_tribology::bearing::{Attitude, BearingSpec, Reynolds};
+/// let b = BearingSpec::from_toml_str("[slider]\nlength_um = 1000\nwidth_um = 800\n\
+///     [operating]\nradius_mm = 20\nrpm = 7200\npreload_mn = 20")?.build()?;
+/// let r = Reynolds::new(&b, 32, 32);
+/// let att = Attitude { fly_height: 20e-9, pitch: 100e-6, roll: 0.0 };
+/// let mut p = r.ambient();
+/// r.solve(&att, &mut p)?;
+/// let [load, _, _] = r.loads(&p);
+/// assert!(load > 0.0);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Reynolds {
+    /// The bearing.
+    pub bearing: Bearing,
+    /// The grid.
+    pub grid: Grid,
+    /// Side boundaries.
+    pub sides: Sides,
+    /// Bearing number components along `x` and `y`.
+    lambda: [f64; 2],
+    /// `λ_a / h_m`.
+    kn0: f64,
+    model: FlowModel,
+    /// Non-dimensional cell widths.
+    dx: Vec<f64>,
+    dy: Vec<f64>,
+    /// Non-dimensional cell centres.
+    xc: Vec<f64>,
+    yc: Vec<f64>,
+    /// Tolerance on the largest change of `P` in a Newton step.
+    pub tolerance: f64,
+    /// Newton steps allowed.
+    pub max_newton: usize,
+}
+
+/// Patankar's power-law weight `A(|Pe|) = max(0, (1 − 0.1 |Pe|)⁵)` and its derivative.
+#[inline]
+fn power_law(z: f64) -> (f64, f64) {
+    if z >= 10.0 {
+        (0.0, 0.0)
+    } else {
+        let t = 1.0 - 0.1 * z;
+        let t2 = t * t;
+        (t2 * t2 * t, -0.5 * t2 * t2)
+    }
+}
+
+/// Two neighbouring spacings differing by more than this fraction of the smaller one are a
+/// step, not a smooth variation.
+const STEP_RATIO: f64 = 0.5;
+
+/// Spacing on face `k` of a line of cells (`h[m · stride]` the spacing of cell `m`, `w[m]` its
+/// width) for the convected mass `Λ P H`: linear interpolation between the two cells where the
+/// spacing varies smoothly (second order), linear extrapolation from the first two cells on the
+/// slider's edge, and the upstream cell's spacing across a step, where the surface jumps.
+fn face_spacing(h: &[f64], w: &[f64], k: usize, stride: usize, lambda: f64) -> f64 {
+    let n = w.len();
+    let at = |m: usize| h[m * stride];
+    let smooth = |a: f64, b: f64| (a - b).abs() <= STEP_RATIO * a.min(b);
+    if k == 0 || k == n {
+        let (c0, c1) = if k == 0 { (0, 1) } else { (n - 1, n - 2) };
+        let (h0, h1) = (at(c0), at(c1));
+        if n < 2 || !smooth(h0, h1) {
+            return h0;
+        }
+        let t = 0.5 * w[c0] / (0.5 * (w[c0] + w[c1]));
+        return (h0 - t * (h1 - h0)).max(0.5 * h0);
+    }
+    let (hl, hr) = (at(k - 1), at(k));
+    if smooth(hl, hr) {
+        let (wl, wr) = (w[k - 1], w[k]);
+        (hl * wr + hr * wl) / (wl + wr)
+    } else if lambda >= 0.0 {
+        hl
+    } else {
+        hr
+    }
+}
+
+/// One face: flux from the left cell to the right one and its derivatives with respect to the
+/// two pressures. `a_l`, `a_r`: distances of the centres from the face (0 for a boundary);
+/// `gl`, `gr`: conductances `Q P H³`, `dgl`, `dgr` their derivatives in `P`; `f`: convective
+/// strength `Λ_d × face length × H_upwind`; `area`: face length.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn face(
+    pl: f64,
+    pr: f64,
+    a_l: f64,
+    a_r: f64,
+    gl: f64,
+    gr: f64,
+    dgl: f64,
+    dgr: f64,
+    f: f64,
+    area: f64,
+) -> (f64, f64, f64) {
+    let rl = a_l / gl;
+    let rr = a_r / gr;
+    let g = 1.0 / (rl + rr);
+    let d = g * area;
+    let pe = (f / d).abs();
+    let (a, da) = power_law(pe);
+    let j = d * a * (pl - pr) + f.max(0.0) * pl - (-f).max(0.0) * pr;
+    let djdd = (pl - pr) * (a - da * pe);
+    let ddl = area * g * g * rl / gl * dgl;
+    let ddr = area * g * g * rr / gr * dgr;
+    let jl = djdd * ddl + d * a + f.max(0.0);
+    let jr = djdd * ddr - d * a - (-f).max(0.0);
+    (j, jl, jr)
+}
+
+impl Reynolds {
+    /// The equation of `bearing` on the grid of `nx × ny` control volumes at the bearing's
+    /// refinement.
+    pub fn new(bearing: &Bearing, nx: usize, ny: usize) -> Reynolds {
+        let grid = Grid::new(bearing, nx, ny, bearing.grid.refinement);
+        Self::on_grid(bearing, grid)
+    }
+
+    /// The equation on a given grid.
+    pub fn on_grid(bearing: &Bearing, grid: Grid) -> Reynolds {
+        let l = bearing.length;
+        let lam = bearing.bearing_number(REFERENCE_SPACING);
+        let dx = grid.xf.windows(2).map(|w| (w[1] - w[0]) / l).collect();
+        let dy = grid.yf.windows(2).map(|w| (w[1] - w[0]) / l).collect();
+        let xc = grid.xc.iter().map(|x| x / l).collect();
+        let yc = grid.yc.iter().map(|y| y / l).collect();
+        Reynolds {
+            lambda: [lam * bearing.skew.cos(), lam * bearing.skew.sin()],
+            kn0: bearing.mean_free_path / REFERENCE_SPACING,
+            model: bearing.flow_model,
+            bearing: bearing.clone(),
+            grid,
+            sides: Sides::Ambient,
+            dx,
+            dy,
+            xc,
+            yc,
+            tolerance: 1e-10,
+            max_newton: 60,
+        }
+    }
+
+    /// Control volumes `(nx, ny)`.
+    pub fn size(&self) -> (usize, usize) {
+        (self.grid.nx(), self.grid.ny())
+    }
+
+    /// The bearing number `Λ` at the reference spacing.
+    pub fn bearing_number(&self) -> f64 {
+        self.lambda[0].hypot(self.lambda[1])
+    }
+
+    /// Ambient pressure everywhere (`P = 1`), a start for [`Reynolds::solve`].
+    pub fn ambient(&self) -> Vec<f64> {
+        vec![1.0; self.grid.depth.len()]
+    }
+
+    /// Spacing of each control volume (area average), non-dimensional (`h / h_m`).
+    pub fn spacing(&self, att: &Attitude) -> Vec<f64> {
+        let (nx, ny) = self.size();
+        let (l, w) = (self.bearing.length, self.bearing.width);
+        let mut h = Vec::with_capacity(nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let s = att.spacing_at(self.grid.xc[i], self.grid.yc[j], l, w)
+                    + self.grid.depth[j * nx + i];
+                h.push(s / REFERENCE_SPACING);
+            }
+        }
+        h
+    }
+
+    /// How the non-dimensional spacing of each control volume changes with the attitude's
+    /// fly height (per m), pitch and roll (per rad).
+    pub fn spacing_derivatives(&self) -> [Vec<f64>; 3] {
+        let (nx, ny) = self.size();
+        let (l, w) = (self.bearing.length, self.bearing.width);
+        let mut d = [
+            Vec::with_capacity(nx * ny),
+            Vec::with_capacity(nx * ny),
+            Vec::with_capacity(nx * ny),
+        ];
+        for j in 0..ny {
+            for i in 0..nx {
+                d[0].push(1.0 / REFERENCE_SPACING);
+                d[1].push((l - self.grid.xc[i]) / REFERENCE_SPACING);
+                d[2].push((self.grid.yc[j] - 0.5 * w) / REFERENCE_SPACING);
+            }
+        }
+        d
+    }
+
+    /// Smallest spacing over the grid's nodes (surface depth included), m.
+    pub fn min_spacing(&self, att: &Attitude) -> f64 {
+        let (l, w) = (self.bearing.length, self.bearing.width);
+        let nxn = self.grid.xf.len();
+        let mut m = f64::INFINITY;
+        for (j, &y) in self.grid.yf.iter().enumerate() {
+            for (i, &x) in self.grid.xf.iter().enumerate() {
+                m = m.min(att.spacing_at(x, y, l, w) + self.grid.node_depth[j * nxn + i]);
+            }
+        }
+        m
+    }
+
+    /// Conductance `Q P H³` of each cell and its derivative in `P`.
+    fn conductances(&self, p: &[f64], h: &[f64], g: &mut [f64], dg: &mut [f64]) {
+        for c in 0..p.len() {
+            let (pc, hc) = (p[c], h[c]);
+            let h3 = hc * hc * hc;
+            if self.kn0 == 0.0 || self.model == FlowModel::Continuum {
+                g[c] = pc * h3;
+                dg[c] = h3;
+            } else {
+                let kn = self.kn0 / (pc * hc);
+                let (q, dq) = self.model.factor_and_derivative(kn);
+                g[c] = q * pc * h3;
+                dg[c] = h3 * (q - dq * kn);
+            }
+        }
+    }
+
+    /// The residual `r` (net mass outflow of each control volume) and, if asked, its Jacobian.
+    pub fn residual(&self, p: &[f64], h: &[f64], r: &mut [f64], mut jac: Option<&mut FivePoint>) {
+        let (nx, ny) = self.size();
+        let n = nx * ny;
+        let mut g = vec![0.0; n];
+        let mut dg = vec![0.0; n];
+        self.conductances(p, h, &mut g, &mut dg);
+        r.iter_mut().for_each(|x| *x = 0.0);
+        if let Some(a) = jac.as_deref_mut() {
+            a.clear();
+        }
+        let [lx, ly] = self.lambda;
+        // Faces normal to x.
+        for j in 0..ny {
+            let area = self.dy[j];
+            for i in 0..=nx {
+                let (cl, cr) = ((j * nx + i).wrapping_sub(1), j * nx + i);
+                let left = i > 0;
+                let right = i < nx;
+                let (pl, gl, dgl, al) = if left {
+                    (p[cl], g[cl], dg[cl], 0.5 * self.dx[i - 1])
+                } else {
+                    (1.0, 1.0, 0.0, 0.0)
+                };
+                let (pr, gr, dgr, ar) = if right {
+                    (p[cr], g[cr], dg[cr], 0.5 * self.dx[i])
+                } else {
+                    (1.0, 1.0, 0.0, 0.0)
+                };
+                let hf = self.x_face_spacing(h, i, j, lx);
+                let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, lx * area * hf, area);
+                if left {
+                    r[cl] += flux;
+                }
+                if right {
+                    r[cr] -= flux;
+                }
+                if let Some(a) = jac.as_deref_mut() {
+                    if left {
+                        a.diag[cl] += jl;
+                        if right {
+                            a.east[cl] += jr;
+                            a.west[cr] -= jl;
+                        }
+                    }
+                    if right {
+                        a.diag[cr] -= jr;
+                    }
+                }
+            }
+        }
+        // Faces normal to y.
+        let closed = self.sides == Sides::Closed;
+        for j in 0..=ny {
+            let below = j > 0;
+            let above = j < ny;
+            if closed && !(below && above) {
+                continue;
+            }
+            for i in 0..nx {
+                let area = self.dx[i];
+                let (cl, cr) = (
+                    (j.wrapping_sub(1)).wrapping_mul(nx).wrapping_add(i),
+                    j * nx + i,
+                );
+                let (pl, gl, dgl, al) = if below {
+                    (p[cl], g[cl], dg[cl], 0.5 * self.dy[j - 1])
+                } else {
+                    (1.0, 1.0, 0.0, 0.0)
+                };
+                let (pr, gr, dgr, ar) = if above {
+                    (p[cr], g[cr], dg[cr], 0.5 * self.dy[j])
+                } else {
+                    (1.0, 1.0, 0.0, 0.0)
+                };
+                let hf = self.y_face_spacing(h, i, j, ly);
+                let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, ly * area * hf, area);
+                if below {
+                    r[cl] += flux;
+                }
+                if above {
+                    r[cr] -= flux;
+                }
+                if let Some(a) = jac.as_deref_mut() {
+                    if below {
+                        a.diag[cl] += jl;
+                        if above {
+                            a.north[cl] += jr;
+                            a.south[cr] -= jl;
+                        }
+                    }
+                    if above {
+                        a.diag[cr] -= jr;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Spacing on the face `i` (of `0..=nx`) of row `j` normal to `x`, for the convected mass:
+    /// see [`face_spacing`].
+    fn x_face_spacing(&self, h: &[f64], i: usize, j: usize, lambda: f64) -> f64 {
+        let nx = self.grid.nx();
+        let row = &h[j * nx..(j + 1) * nx];
+        face_spacing(row, &self.dx, i, 1, lambda)
+    }
+
+    /// Spacing on the face `j` (of `0..=ny`) of column `i` normal to `y`.
+    fn y_face_spacing(&self, h: &[f64], i: usize, j: usize, lambda: f64) -> f64 {
+        let nx = self.grid.nx();
+        face_spacing(&h[i..], &self.dy, j, nx, lambda)
+    }
+
+    /// ```
+    /// # use hdi_tribology::bearing::{Attitude, BearingSpec, Reynolds};
+    /// # let b = BearingSpec::from_toml_str("[slider]\nlength_um = 1000\nwidth_um = 800\n\
+    /// #     [operating]\nradius_mm = 20\nrpm = 7200\npreload_mn = 20")?.build()?;
+    /// # let r = Reynolds::new(&b, 24, 24);
+    /// # let att = Attitude { fly_height: 20e-9, pitch: 100e-6, roll: 0.0 };
+    /// let mut p = r.ambient();
+    /// r.solve(&att, &mut p)?;
+    /// let (inflow, outflow) = r.boundary_flux(&p, &r.spacing(&att));
+    /// assert!((inflow - outflow).abs() < 1e-8 * inflow);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
+    /// Total mass flux into and out of the slider through its edges (non-dimensional, per the
+    /// scale `p_a h_m L`), at the pressure `p` and spacing `h`.
+    pub fn boundary_flux(&self, p: &[f64], h: &[f64]) -> (f64, f64) {
+        // The flux through a boundary face is the residual of a solve with that face alone;
+        // evaluate it directly: the net outflow of all cells is the boundary outflow, split by
+        // sign face by face from the one-cell residual of each edge cell.
+        let (nx, ny) = self.size();
+        let mut inflow = 0.0;
+        let mut outflow = 0.0;
+        let n = nx * ny;
+        let mut g = vec![0.0; n];
+        let mut dg = vec![0.0; n];
+        self.conductances(p, h, &mut g, &mut dg);
+        let [lx, ly] = self.lambda;
+        let mut add = |f: f64| {
+            if f > 0.0 {
+                outflow += f;
+            } else {
+                inflow -= f;
+            }
+        };
+        for j in 0..ny {
+            let area = self.dy[j];
+            let c0 = j * nx;
+            let c1 = j * nx + nx - 1;
+            // Leading edge: flux from the boundary into cell c0 (positive = into the slider).
+            let (f, _, _) = face(
+                1.0,
+                p[c0],
+                0.0,
+                0.5 * self.dx[0],
+                1.0,
+                g[c0],
+                0.0,
+                dg[c0],
+                lx * area * self.x_face_spacing(h, 0, j, lx),
+                area,
+            );
+            add(-f);
+            let (f, _, _) = face(
+                p[c1],
+                1.0,
+                0.5 * self.dx[nx - 1],
+                0.0,
+                g[c1],
+                1.0,
+                dg[c1],
+                0.0,
+                lx * area * self.x_face_spacing(h, nx, j, lx),
+                area,
+            );
+            add(f);
+        }
+        if self.sides == Sides::Ambient {
+            for i in 0..nx {
+                let area = self.dx[i];
+                let c0 = i;
+                let c1 = (ny - 1) * nx + i;
+                let (f, _, _) = face(
+                    1.0,
+                    p[c0],
+                    0.0,
+                    0.5 * self.dy[0],
+                    1.0,
+                    g[c0],
+                    0.0,
+                    dg[c0],
+                    ly * area * self.y_face_spacing(h, i, 0, ly),
+                    area,
+                );
+                add(-f);
+                let (f, _, _) = face(
+                    p[c1],
+                    1.0,
+                    0.5 * self.dy[ny - 1],
+                    0.0,
+                    g[c1],
+                    1.0,
+                    dg[c1],
+                    0.0,
+                    ly * area * self.y_face_spacing(h, i, ny, ly),
+                    area,
+                );
+                add(f);
+            }
+        }
+        (inflow, outflow)
+    }
+
+    /// Scale of the residual: the convective flux `Λ` across the slider's width.
+    fn residual_scale(&self) -> f64 {
+        self.bearing_number().max(1.0) * self.dy.iter().sum::<f64>()
+    }
+
+    /// Solves for the pressure at the attitude `att`, from the start `p` (non-dimensional), by
+    /// Newton's method; `p` holds the solution.
+    pub fn solve(&self, att: &Attitude, p: &mut [f64]) -> Result<NewtonStats> {
+        let h = self.spacing(att);
+        if let Some(c) = h.iter().position(|&v| v.is_nan() || v <= 0.0) {
+            return Err(Error::no_convergence(
+                "air-bearing pressure",
+                format!(
+                    "the slider touches the disk at control volume {c} (spacing {:.3} nm)",
+                    h[c] * REFERENCE_SPACING * 1e9
+                ),
+            ));
+        }
+        self.solve_spacing(&h, p).map(|(s, _)| s)
+    }
+
+    /// [`Reynolds::solve`] at a given non-dimensional spacing per cell; also returns the
+    /// Jacobian at the solution and its multigrid preconditioner, for sensitivities.
+    pub fn solve_spacing(&self, h: &[f64], p: &mut [f64]) -> Result<(NewtonStats, Factored)> {
+        self.solve_spacing_to(h, p, self.tolerance)
+    }
+
+    /// [`Reynolds::solve_spacing`] to the tolerance `tol` on the largest change of `P` in a
+    /// Newton step instead of [`Reynolds::tolerance`].
+    pub fn solve_spacing_to(
+        &self,
+        h: &[f64],
+        p: &mut [f64],
+        tol: f64,
+    ) -> Result<(NewtonStats, Factored)> {
+        let (nx, ny) = self.size();
+        let n = nx * ny;
+        let mut r = vec![0.0; n];
+        let mut trial_r = vec![0.0; n];
+        let mut a = FivePoint::zeros(nx, ny);
+        let mut dp = vec![0.0; n];
+        let mut trial = vec![0.0; n];
+        let scale = self.residual_scale();
+        let mut stats = NewtonStats::default();
+        self.residual(p, h, &mut r, Some(&mut a));
+        let mut rnorm = norm(&r);
+        let mut prev_ratio: f64 = 1.0;
+        loop {
+            if stats.iterations >= self.max_newton {
+                return Err(Error::no_convergence(
+                    "air-bearing pressure",
+                    format!(
+                        "{} Newton steps, last change of p/p_a {:.3e}, residual {:.3e}",
+                        stats.iterations,
+                        stats.last_update,
+                        rnorm / scale
+                    ),
+                ));
+            }
+            let ilu = Multigrid::new(&a);
+            let eta = (0.1 * prev_ratio * prev_ratio).clamp(1e-10, 1e-3);
+            dp.iter_mut().for_each(|x| *x = 0.0);
+            let neg: Vec<f64> = r.iter().map(|v| -v).collect();
+            let ks: KrylovStats = gmres(&a, &ilu, &neg, &mut dp, eta, RESTART, MAX_KRYLOV);
+            stats.krylov_iterations += ks.iterations;
+            stats.iterations += 1;
+            let full = dp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            if full <= tol {
+                for c in 0..n {
+                    p[c] += dp[c];
+                }
+                stats.last_update = full;
+                self.residual(p, h, &mut r, Some(&mut a));
+                rnorm = norm(&r);
+                break;
+            }
+            // Keep the pressure positive, then backtrack on the residual's norm.
+            let mut t: f64 = 1.0;
+            for c in 0..n {
+                if dp[c] < 0.0 {
+                    t = t.min((MIN_PRESSURE_FRACTION - 1.0) * p[c] / dp[c]);
+                }
+            }
+            let mut accepted = false;
+            let mut tnorm = rnorm;
+            for _ in 0..12 {
+                for c in 0..n {
+                    trial[c] = p[c] + t * dp[c];
+                }
+                self.residual(&trial, h, &mut trial_r, None);
+                tnorm = norm(&trial_r);
+                if tnorm.is_finite() && tnorm <= (1.0 - 1e-4 * t) * rnorm {
+                    accepted = true;
+                    break;
+                }
+                t *= 0.5;
+            }
+            if !accepted {
+                if full <= ROUND_OFF_UPDATE {
+                    // The residual is at its round-off floor: the full step is the answer.
+                    for c in 0..n {
+                        p[c] += dp[c];
+                    }
+                    stats.last_update = full;
+                    self.residual(p, h, &mut r, Some(&mut a));
+                    rnorm = norm(&r);
+                    break;
+                }
+                if !tnorm.is_finite() {
+                    return Err(Error::no_convergence(
+                        "air-bearing pressure",
+                        "the Newton step gives a non-finite residual",
+                    ));
+                }
+            }
+            let mut upd: f64 = 0.0;
+            for c in 0..n {
+                upd = upd.max((trial[c] - p[c]).abs());
+            }
+            p.copy_from_slice(&trial);
+            stats.last_update = upd;
+            prev_ratio = (tnorm / rnorm).min(1.0);
+            rnorm = tnorm;
+            self.residual(p, h, &mut r, Some(&mut a));
+        }
+        stats.residual = rnorm / scale;
+        let ilu = Multigrid::new(&a);
+        Ok((stats, Factored { jacobian: a, ilu }))
+    }
+
+    /// Loads of the pressure `p` (non-dimensional): the force (N, positive away from the disk)
+    /// and its moments about the pivot (N m), each positive in the sense that raises its angle
+    /// of [`Attitude`]: pitch (positive when the pressure's centre lies ahead of the pivot,
+    /// towards the leading edge) and roll (positive when it lies on the `+y` side).
+    pub fn loads(&self, p: &[f64]) -> [f64; 3] {
+        let w = self.weights();
+        let l = self.bearing.length;
+        let pa = self.bearing.ambient_pressure;
+        let mut out = [0.0; 3];
+        for (c, &pc) in p.iter().enumerate() {
+            let e = pc - 1.0;
+            out[0] += e * w[0][c];
+            out[1] += e * w[1][c];
+            out[2] += e * w[2][c];
+        }
+        [
+            out[0] * pa * l * l,
+            out[1] * pa * l * l,
+            out[2] * pa * l * l,
+        ]
+    }
+
+    /// Weights of the loads: area, area × lever arm ahead of the pivot (m), area × lever arm to
+    /// its `+y` side.
+    fn weights(&self) -> [Vec<f64>; 3] {
+        let (nx, ny) = self.size();
+        let [px, py] = self.bearing.pivot;
+        let mut w = [
+            Vec::with_capacity(nx * ny),
+            Vec::with_capacity(nx * ny),
+            Vec::with_capacity(nx * ny),
+        ];
+        for j in 0..ny {
+            for i in 0..nx {
+                let a = self.dx[i] * self.dy[j];
+                w[0].push(a);
+                w[1].push(a * (px - self.grid.xc[i]));
+                w[2].push(a * (self.grid.yc[j] - py));
+            }
+        }
+        w
+    }
+
+    /// ```
+    /// # use hdi_tribology::bearing::{Attitude, BearingSpec, Reynolds};
+    /// # let b = BearingSpec::from_toml_str("[slider]\nlength_um = 1000\nwidth_um = 800\n\
+    /// #     [operating]\nradius_mm = 20\nrpm = 7200\npreload_mn = 20")?.build()?;
+    /// # let r = Reynolds::new(&b, 24, 24);
+    /// # let att = Attitude { fly_height: 20e-9, pitch: 100e-6, roll: 0.0 };
+    /// let h = r.spacing(&att);
+    /// let mut p = r.ambient();
+    /// let (_, f) = r.solve_spacing(&h, &mut p)?;
+    /// let (k, _, _) = r.sensitivities(&p, &h, &f, 1e-8)?;
+    /// assert!(k[0][0] < 0.0); // the load falls as the slider rises
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
+    /// Derivatives of the loads ([`Reynolds::loads`]) with respect to the attitude, at the
+    /// converged pressure `p` and spacing `h` with the factored Jacobian `f`: `k[i][j] =
+    /// ∂load_i/∂attitude_j` (N/m, N, N m/m, N m), the pressure's derivatives
+    /// `∂P/∂attitude_j`, and the GMRES iterations spent; each linear solve to the relative
+    /// tolerance `rtol`.
+    pub fn sensitivities(
+        &self,
+        p: &[f64],
+        h: &[f64],
+        f: &Factored,
+        rtol: f64,
+    ) -> Result<Sensitivities> {
+        let dh = self.spacing_derivatives();
+        let n = p.len();
+        let mut rp = vec![0.0; n];
+        let mut rm = vec![0.0; n];
+        let mut hs = h.to_vec();
+        let hmax = h.iter().cloned().fold(0.0, f64::max);
+        let mut dps: [Vec<f64>; 3] = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let mut k = [[0.0; 3]; 3];
+        let mut iterations = 0;
+        let w = self.weights();
+        let l = self.bearing.length;
+        let pa = self.bearing.ambient_pressure;
+        for q in 0..3 {
+            let dmax = dh[q].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let eps = 1e-6 * hmax / dmax;
+            for c in 0..n {
+                hs[c] = h[c] + eps * dh[q][c];
+            }
+            self.residual(p, &hs, &mut rp, None);
+            for c in 0..n {
+                hs[c] = h[c] - eps * dh[q][c];
+            }
+            self.residual(p, &hs, &mut rm, None);
+            let rhs: Vec<f64> = (0..n).map(|c| -(rp[c] - rm[c]) / (2.0 * eps)).collect();
+            let stats = gmres(
+                &f.jacobian,
+                &f.ilu,
+                &rhs,
+                &mut dps[q],
+                rtol,
+                RESTART,
+                MAX_KRYLOV,
+            );
+            iterations += stats.iterations;
+            if stats.relative_residual > 10.0 * rtol {
+                return Err(Error::no_convergence(
+                    "air-bearing sensitivity",
+                    format!(
+                        "GMRES reached {:.3e} in {} iterations",
+                        stats.relative_residual, stats.iterations
+                    ),
+                ));
+            }
+            for i in 0..3 {
+                k[i][q] = dps[q].iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>() * pa * l * l;
+            }
+        }
+        Ok((k, dps, iterations))
+    }
+
+    /// Low-frequency squeeze-film damping (the term of first order in the frequency of a
+    /// small harmonic motion of the attitude): `c[i][j] = −∂load_i/∂(d attitude_j/dt)`.
+    /// `dps` are the pressure's derivatives from [`Reynolds::sensitivities`].
+    pub fn damping(
+        &self,
+        p: &[f64],
+        h: &[f64],
+        f: &Factored,
+        dps: &[Vec<f64>; 3],
+    ) -> Result<[[f64; 3]; 3]> {
+        let b = &self.bearing;
+        let sigma = 12.0 * b.viscosity * b.length * b.length
+            / (b.ambient_pressure * REFERENCE_SPACING.powi(2));
+        let dh = self.spacing_derivatives();
+        let w = self.weights();
+        let (nx, ny) = self.size();
+        let n = p.len();
+        let mut c = [[0.0; 3]; 3];
+        for q in 0..3 {
+            let mut rhs = vec![0.0; n];
+            for j in 0..ny {
+                for i in 0..nx {
+                    let k = j * nx + i;
+                    let area = self.dx[i] * self.dy[j];
+                    rhs[k] = -sigma * area * (h[k] * dps[q][k] + p[k] * dh[q][k]);
+                }
+            }
+            let mut x = vec![0.0; n];
+            let stats = gmres(
+                &f.jacobian,
+                &f.ilu,
+                &rhs,
+                &mut x,
+                DAMPING_RTOL,
+                RESTART,
+                MAX_KRYLOV,
+            );
+            if stats.relative_residual > 10.0 * DAMPING_RTOL {
+                return Err(Error::no_convergence(
+                    "air-bearing damping",
+                    format!(
+                        "GMRES reached {:.3e} in {} iterations",
+                        stats.relative_residual, stats.iterations
+                    ),
+                ));
+            }
+            for i in 0..3 {
+                c[i][q] = -x.iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>()
+                    * b.ambient_pressure
+                    * b.length
+                    * b.length;
+            }
+        }
+        Ok(c)
+    }
+
+    /// ```
+    /// # use hdi_tribology::bearing::{Attitude, BearingSpec, Reynolds};
+    /// # let b = BearingSpec::from_toml_str("[slider]\nlength_um = 1000\nwidth_um = 800\n\
+    /// #     [operating]\nradius_mm = 20\nrpm = 7200\npreload_mn = 20")?.build()?;
+    /// # let r = Reynolds::new(&b, 24, 24);
+    /// # let att = Attitude { fly_height: 20e-9, pitch: 100e-6, roll: 0.0 };
+    /// let mut p = r.ambient();
+    /// r.solve(&att, &mut p)?;
+    /// let fine = Reynolds::new(&b, 48, 48);
+    /// let q = fine.interpolate_from(&r, &p);
+    /// assert_eq!(q.len(), 48 * 48);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
+    /// Interpolates a pressure field of another grid of the same bearing onto this one
+    /// (bilinear between cell centres, constant beyond the outermost centres).
+    pub fn interpolate_from(&self, other: &Reynolds, p: &[f64]) -> Vec<f64> {
+        let (nx, ny) = self.size();
+        let (mx, _) = other.size();
+        let locate = |centres: &[f64], x: f64| -> (usize, f64) {
+            let m = centres.len();
+            if x <= centres[0] {
+                return (0, 0.0);
+            }
+            if x >= centres[m - 1] {
+                return (m - 2, 1.0);
+            }
+            let k = centres.partition_point(|&c| c <= x) - 1;
+            (k, (x - centres[k]) / (centres[k + 1] - centres[k]))
+        };
+        let ix: Vec<(usize, f64)> = self.xc.iter().map(|&x| locate(&other.xc, x)).collect();
+        let mut out = Vec::with_capacity(nx * ny);
+        for &y in &self.yc {
+            let (j, ty) = locate(&other.yc, y);
+            for &(i, tx) in &ix {
+                let v00 = p[j * mx + i];
+                let v10 = p[j * mx + i + 1];
+                let v01 = p[(j + 1) * mx + i];
+                let v11 = p[(j + 1) * mx + i + 1];
+                out.push(
+                    (1.0 - ty) * ((1.0 - tx) * v00 + tx * v10) + ty * ((1.0 - tx) * v01 + tx * v11),
+                );
+            }
+        }
+        out
+    }
+}
+
+/// What [`Reynolds::sensitivities`] gives: `∂load_i/∂attitude_j`, the pressure's derivatives
+/// `∂P/∂attitude_j`, and the GMRES iterations spent.
+pub type Sensitivities = ([[f64; 3]; 3], [Vec<f64>; 3], usize);
+
+/// The Jacobian at a converged pressure and its multigrid preconditioner, reused for sensitivities.
+#[derive(Clone, Debug)]
+pub struct Factored {
+    /// The Jacobian.
+    pub jacobian: FivePoint,
+    /// Its multigrid preconditioner.
+    pub ilu: Multigrid,
+}
+
+fn norm(a: &[f64]) -> f64 {
+    a.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
