@@ -21,6 +21,13 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::flow_factor::FlowModel;
+
+/// Default ratio of the coarsest to the finest cell of the grid.
+pub const DEFAULT_REFINEMENT: f64 = 4.0;
+/// Fewest control volumes along a side.
+pub const MIN_CELLS: usize = 8;
+/// Most control volumes along a side.
+pub const MAX_CELLS: usize = 4097;
 use crate::error::{check_finite, check_non_negative, check_positive};
 use crate::{Error, Result};
 
@@ -261,7 +268,7 @@ fn default_cells() -> usize {
     257
 }
 fn default_refinement() -> f64 {
-    super::grid::DEFAULT_REFINEMENT
+    DEFAULT_REFINEMENT
 }
 
 impl Default for GridSpec {
@@ -626,13 +633,12 @@ impl BearingSpec {
         let roll_torque = check_finite("operating.roll_torque_un_m", o.roll_torque_un_m)? * 1e-6;
         let g = &self.grid;
         for (f, n) in [("grid.nx", g.nx), ("grid.ny", g.ny)] {
-            if !(super::grid::MIN_CELLS..=super::grid::MAX_CELLS).contains(&n) {
+            if !(MIN_CELLS..=MAX_CELLS).contains(&n) {
                 return Err(Error::invalid(
                     f,
                     format!(
                         "must lie within {}..={} control volumes, got {n}",
-                        super::grid::MIN_CELLS,
-                        super::grid::MAX_CELLS
+                        MIN_CELLS, MAX_CELLS
                     ),
                 ));
             }

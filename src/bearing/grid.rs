@@ -3,15 +3,9 @@
 
 use super::geometry::Bearing;
 
-/// Default ratio of the coarsest to the finest cell of the grid.
-pub const DEFAULT_REFINEMENT: f64 = 4.0;
 /// Width of the refined band about a step, as a fraction of the slider's length (along `x`) or
 /// width (along `y`).
 pub const REFINE_WIDTH: f64 = 0.015;
-/// Fewest control volumes along a side.
-pub const MIN_CELLS: usize = 8;
-/// Most control volumes along a side.
-pub const MAX_CELLS: usize = 4097;
 /// Rows per control volume at which the painted regions are sampled across `y` (along `x` the
 /// area average is exact).
 const SUB_ROWS: usize = 8;

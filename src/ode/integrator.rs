@@ -82,6 +82,43 @@ pub(crate) const AUTO_RADAU_BELOW_RTOL: f64 = 1e-6;
 /// small or smaller; at rtol ≥ 1e-8 Tsit5's cheaper steps win on the slider without AC.
 pub(crate) const AUTO_DOP853_BELOW_RTOL: f64 = 1e-8;
 
+/// Auto's choice where the problem is known to be stiff from the start (here, beside the
+/// thresholds Auto itself uses).
+impl Method {
+    /// The method for a problem whose fastest rate is `fastest_rate` (1/s) over `span` (s), at
+    /// relative tolerance `rtol`: as asked, except that `Auto` on a problem that no explicit step
+    /// could follow in fewer than `explicit_step_limit` steps is its stiff method from the start
+    /// (Radau5 or Rodas5P by the tolerance, as `Auto` itself would switch to): the explicit
+    /// phase would only spend steps finding out.
+    ///
+    /// ```
+    /// use hdi_tribology::ode::Method;
+    /// assert_eq!(Method::Auto.for_problem(1e-8, 1e9, 1e-3, 1e5), Method::Radau5);
+    /// assert_eq!(Method::Auto.for_problem(1e-4, 1e9, 1e-3, 1e5), Method::Rodas5P);
+    /// assert_eq!(Method::Auto.for_problem(1e-8, 1e3, 1e-3, 1e5), Method::Auto);
+    /// assert_eq!(Method::Tsit5.for_problem(1e-8, 1e9, 1e-3, 1e5), Method::Tsit5);
+    /// ```
+    pub fn for_problem(
+        self,
+        rtol: f64,
+        fastest_rate: f64,
+        span: f64,
+        explicit_step_limit: f64,
+    ) -> Method {
+        let explicit_steps = span * fastest_rate / super::tsit5::STABILITY_BOUNDARY;
+        match self {
+            Method::Auto if explicit_steps > explicit_step_limit => {
+                if rtol < AUTO_RADAU_BELOW_RTOL {
+                    Method::Radau5
+                } else {
+                    Method::Rodas5P
+                }
+            }
+            m => m,
+        }
+    }
+}
+
 impl<D: Dim> Steppers<D>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,

@@ -54,39 +54,6 @@ impl Method {
         }
     }
 
-    /// The method for a problem whose fastest rate is `fastest_rate` (1/s) over `span` (s), at
-    /// relative tolerance `rtol`: as asked, except that `Auto` on a problem that no explicit step
-    /// could follow in fewer than `explicit_step_limit` steps is its stiff method from the start
-    /// (Radau5 or Rodas5P by the tolerance, as `Auto` itself would switch to): the explicit
-    /// phase would only spend steps finding out.
-    ///
-    /// ```
-    /// use hdi_tribology::ode::Method;
-    /// assert_eq!(Method::Auto.for_problem(1e-8, 1e9, 1e-3, 1e5), Method::Radau5);
-    /// assert_eq!(Method::Auto.for_problem(1e-4, 1e9, 1e-3, 1e5), Method::Rodas5P);
-    /// assert_eq!(Method::Auto.for_problem(1e-8, 1e3, 1e-3, 1e5), Method::Auto);
-    /// assert_eq!(Method::Tsit5.for_problem(1e-8, 1e9, 1e-3, 1e5), Method::Tsit5);
-    /// ```
-    pub fn for_problem(
-        self,
-        rtol: f64,
-        fastest_rate: f64,
-        span: f64,
-        explicit_step_limit: f64,
-    ) -> Method {
-        let explicit_steps = span * fastest_rate / super::tsit5::STABILITY_BOUNDARY;
-        match self {
-            Method::Auto if explicit_steps > explicit_step_limit => {
-                if rtol < super::integrator::AUTO_RADAU_BELOW_RTOL {
-                    Method::Radau5
-                } else {
-                    Method::Rodas5P
-                }
-            }
-            m => m,
-        }
-    }
-
     /// The lowercase name used by `FromStr`, `Display` and serde.
     pub fn name(self) -> &'static str {
         match self {
