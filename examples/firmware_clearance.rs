@@ -14,7 +14,7 @@
 use hdi_tribology::analysis::{
     flying_equilibrium, static_hysteresis, touchdown_power, ScanGrid, StaticOptions,
 };
-use hdi_tribology::clearance::{
+use hdi_tribology::calibration::{
     calibrate, Calibration, CalibrationOptions, ContactForceRms, MeanContactForce, Relative,
     TouchdownDetector, VibrationRms, Zone,
 };

@@ -77,7 +77,7 @@
 //!   cycles, sweeps, the linear response);
 //! - [`error`]: the crate's error type, with typed kinds per analysis;
 //! - [`drive`]: a simulated drive that firmware code can step;
-//! - [`clearance`]: firmware clearance calibration on the simulated drive;
+//! - [`calibration`]: firmware clearance calibration on the simulated drive;
 //! - [`fit`]: fitting a scene's parameters to measured curves;
 //! - [`report`]: CSV tables and SVG charts; [`units`]: engineering units at the edges.
 //!
@@ -96,7 +96,7 @@
 
 pub mod analysis;
 pub mod bearing;
-pub mod clearance;
+pub mod calibration;
 pub mod drive;
 pub mod error;
 pub mod fit;

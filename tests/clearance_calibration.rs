@@ -5,7 +5,7 @@
 use hdi_tribology::analysis::{
     flying_equilibrium, static_hysteresis, touchdown_power, ScanGrid, StaticOptions,
 };
-use hdi_tribology::clearance::{
+use hdi_tribology::calibration::{
     calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Zone,
 };
 use hdi_tribology::error::{AnalysisError, Stage};

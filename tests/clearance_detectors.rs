@@ -2,7 +2,7 @@
 //! calibration loop.
 
 use hdi_tribology::analysis::equilibrium::EquilibriumSolver;
-use hdi_tribology::clearance::{
+use hdi_tribology::calibration::{
     calibrate, CalibrationOptions, HighPass, MeanContactForce, MeanSquare, Relative, Sample,
     TouchdownDetector, VibrationRms,
 };

@@ -14,7 +14,7 @@ use hdi_tribology::analysis::sweep::{self, Flag};
 use hdi_tribology::analysis::{
     self, CycleOptions, CycleResult, HeaterProgramme, Refinement, ScanGrid, StaticOptions,
 };
-use hdi_tribology::clearance::{
+use hdi_tribology::calibration::{
     self, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
     VibrationRms,
 };
@@ -1427,7 +1427,7 @@ fn calibrate(
         }
     };
     let c = py
-        .detach(|| clearance::calibrate(model, det.as_mut(), &opts))
+        .detach(|| calibration::calibrate(model, det.as_mut(), &opts))
         .py()?;
     Ok(Calibration {
         detector: c.detector.clone(),

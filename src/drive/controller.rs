@@ -500,7 +500,7 @@ pub struct StaircaseOutcome {
 }
 
 /// The firmware touchdown calibration as a [`Controller`]: the staircase of
-/// `clearance::calibrate`, driven through [`Drive`], judged by any [`LevelDetector`].
+/// `calibration::calibrate`, driven through [`Drive`], judged by any [`LevelDetector`].
 ///
 /// ```no_run
 /// use hdi_tribology::drive::{run, scene_zone, ContactSensorSlope, DriveOptions, Plant, Staircase, StaircaseSettings};

@@ -336,7 +336,7 @@ impl Plant {
     /// The drive of a model as it is (its clearance, bearing, structure and disk speed), at
     /// `radius` (m, for the disk's rpm); every drive started on it begins at rest in the flying
     /// equilibrium at `opts.initial_power` under the model's own voltage at `t = 0`, which the
-    /// commands should then carry (`clearance::calibrate` runs this way).
+    /// commands should then carry (`calibration::calibrate` runs this way).
     ///
     /// ```
     /// use hdi_tribology::drive::{Command, DiskSpec, DriveOptions, Plant};

@@ -23,8 +23,8 @@
 
 mod cli;
 mod data;
+mod forward;
 pub mod goodness;
-mod model;
 mod params;
 mod solve;
 

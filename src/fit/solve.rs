@@ -9,8 +9,8 @@ use nalgebra_lm::{storage::Owned, DMatrix as LmMatrix, DVector as LmVector, Dyn}
 use serde::Serialize;
 
 use super::data::{DataError, DataSet};
+use super::forward::{weighted, weights, Evaluator, Predicted, Sets};
 use super::goodness::{self, Goodness};
-use super::model::{weighted, weights, Evaluator, Predicted, Sets};
 use super::params::{resolve, FreeParameter, Resolved};
 use super::FitError;
 use crate::analysis::sweep::Refinement;

@@ -1,6 +1,6 @@
 //! `hdi calibrate`: touchdown calibration as drive firmware does it.
 
-use hdi_tribology::clearance::{
+use hdi_tribology::calibration::{
     calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
     VibrationRms, MAX_LEVELS,
 };

@@ -7,7 +7,7 @@
 //! model's own criterion), [`ContactForceRms`] (an acoustic-emission proxy) and [`VibrationRms`].
 //!
 //! ```
-//! use hdi_tribology::clearance::{calibrate, CalibrationOptions, ContactForceRms};
+//! use hdi_tribology::calibration::{calibrate, CalibrationOptions, ContactForceRms};
 //! use hdi_tribology::model::{SliderModel, Voltage};
 //! use hdi_tribology::scene::Scene;
 //! let model = SliderModel::from_scene(&Scene::paper())?;

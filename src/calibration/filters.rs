@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 /// from the actual sample interval (so the filter does not assume a fixed rate).
 ///
 /// ```
-/// use hdi_tribology::clearance::HighPass;
+/// use hdi_tribology::calibration::HighPass;
 /// let mut hp = HighPass::new(1.0e3)?;
 /// // A step of 5 passes at once, then decays as exp(−2π f_c t).
 /// hp.filter(0.0, 0.0);
@@ -69,7 +69,7 @@ impl HighPass {
 /// Exponentially weighted mean square with time constant `τ`; its square root is the running RMS.
 ///
 /// ```
-/// use hdi_tribology::clearance::MeanSquare;
+/// use hdi_tribology::calibration::MeanSquare;
 /// let mut ms = MeanSquare::new(1e-4)?;
 /// let f = 2.0e4;
 /// let mut rms = 0.0;

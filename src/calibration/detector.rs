@@ -32,7 +32,7 @@ pub struct Sample {
 /// `update` returns `true` for any sample of its measurement window.
 ///
 /// ```
-/// use hdi_tribology::clearance::{Sample, TouchdownDetector};
+/// use hdi_tribology::calibration::{Sample, TouchdownDetector};
 /// /// Contact when the gap falls below a fixed value (a detector no drive has: for tests).
 /// #[derive(Debug)]
 /// struct GapBelow(f64);
@@ -60,7 +60,7 @@ pub trait TouchdownDetector: Debug {
 /// trailing window reaches a force threshold (the `F_th` of the static and dynamic analyses).
 ///
 /// ```
-/// use hdi_tribology::clearance::{MeanContactForce, Sample, TouchdownDetector};
+/// use hdi_tribology::calibration::{MeanContactForce, Sample, TouchdownDetector};
 /// let mut d = MeanContactForce::new(5e-5, 1e-5)?;
 /// let mut seen = false;
 /// for i in 0..=20 {
@@ -164,7 +164,7 @@ impl FilteredRms {
 /// frequency: the burst of a jump into contact, and the modulation of the contact by an AC dither.
 ///
 /// ```
-/// use hdi_tribology::clearance::{ContactForceRms, Sample, TouchdownDetector};
+/// use hdi_tribology::calibration::{ContactForceRms, Sample, TouchdownDetector};
 /// let mut d = ContactForceRms::new(1e-5, 5e3, 5e-5)?;
 /// let mut seen = false;
 /// for i in 0..2000 {
@@ -210,7 +210,7 @@ impl TouchdownDetector for ContactForceRms {
 /// stand-in for the readback-modulation or PES-based detectors of drives).
 ///
 /// ```
-/// use hdi_tribology::clearance::{Sample, TouchdownDetector, VibrationRms};
+/// use hdi_tribology::calibration::{Sample, TouchdownDetector, VibrationRms};
 /// let mut d = VibrationRms::new(5e-11, 5e3, 5e-5)?;
 /// // A slow drift of 1 nm over 2 ms leaves slope·τ ≈ 0.016 nm after the filter: not seen.
 /// let mut seen = false;
@@ -266,7 +266,7 @@ impl TouchdownDetector for VibrationRms {
 /// Before the baseline is complete it never fires.
 ///
 /// ```
-/// use hdi_tribology::clearance::{Relative, Sample, TouchdownDetector, VibrationRms};
+/// use hdi_tribology::calibration::{Relative, Sample, TouchdownDetector, VibrationRms};
 /// let inner = VibrationRms::new(1e-11, 5e3, 5e-5)?; // absolute floor 0.01 nm
 /// let mut d = Relative::new(inner, 3.0, 1e-4, 1e-4)?;
 /// let tone = |t: f64, a: f64| a * (2.0 * std::f64::consts::PI * 2.1e4 * t).sin();

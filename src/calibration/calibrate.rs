@@ -80,14 +80,14 @@ impl Staircase {
 /// Upper bound on the number of levels of one search, against runaway loops.
 ///
 /// ```
-/// assert_eq!(hdi_tribology::clearance::MAX_LEVELS, 100_000);
+/// assert_eq!(hdi_tribology::calibration::MAX_LEVELS, 100_000);
 /// ```
 pub const MAX_LEVELS: usize = 100_000;
 
 /// Options of [`calibrate`].
 ///
 /// ```
-/// use hdi_tribology::clearance::CalibrationOptions;
+/// use hdi_tribology::calibration::CalibrationOptions;
 /// let o = CalibrationOptions::new(0.060, 0.0005, 0.120, 0.010);
 /// assert_eq!(o.staircase.step, 0.0005);
 /// assert!(o.find_takeoff);
@@ -140,7 +140,7 @@ impl CalibrationOptions {
     /// them.
     ///
     /// ```
-    /// use hdi_tribology::clearance::CalibrationOptions;
+    /// use hdi_tribology::calibration::CalibrationOptions;
     /// let o = CalibrationOptions::from_mw(60.0, 0.5, 90.0, 5.0);
     /// use hdi_tribology::units::mw;
     /// assert_eq!(o, CalibrationOptions::new(mw(60.0), mw(0.5), mw(90.0), mw(5.0)));
@@ -241,7 +241,7 @@ impl Calibration {
 ///
 /// ```
 /// use hdi_tribology::analysis::{touchdown_power, StaticOptions};
-/// use hdi_tribology::clearance::{calibrate, CalibrationOptions, MeanContactForce};
+/// use hdi_tribology::calibration::{calibrate, CalibrationOptions, MeanContactForce};
 /// use hdi_tribology::{model::SliderModel, scene::Scene};
 /// let scene = Scene::paper();
 /// let model = SliderModel::from_scene(&scene)?;
