@@ -804,8 +804,7 @@ fn probe(setup: &Setup, spec: &MapSpec, points: &[Point]) -> Res<()> {
             let mut o = setup.opts;
             o.keep_series = false;
             o.solver.method = method;
-            o.solver.atol_displacement *= rtol / o.solver.rtol;
-            o.solver.rtol = rtol;
+            o.solver = o.solver.with_rtol(rtol);
             let r = setup
                 .model(spec.axis, p.param, p.v_ac)
                 .map_err(|e| e.to_string())

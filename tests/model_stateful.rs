@@ -127,3 +127,41 @@ fn a_stateful_force_enters_the_statics_at_its_equilibrium() {
     );
     assert!((drive.term_states()[0] - a * eq.d).abs() < 1e-4 * a * eq.d);
 }
+
+/// Pull-in sees a stateful term at its equilibrium too: at the pull-in voltage and gap of a
+/// model with an attracting term, the interface force (the term's included) balances the load
+/// on the bulge and the total stiffness vanishes; the attraction lowers the pull-in voltage.
+#[test]
+fn pull_in_sees_a_stateful_force_at_its_equilibrium() {
+    use hdi_tribology::analysis::{pull_in_voltage, StaticOptions};
+    let plain = paper();
+    let (a, k) = (1e9, -2e-5);
+    let model = plain
+        .with_stateful_term(RelaxingState::new(1e-6, a, k, None).unwrap())
+        .unwrap();
+    let (p, opts) = (0.03, StaticOptions::new(5e-5));
+    let pi = pull_in_voltage(&model, p, &opts).unwrap();
+    let pi0 = pull_in_voltage(&plain, p, &opts).unwrap();
+    assert!(
+        pi.voltage < pi0.voltage - 1e-3,
+        "{} V vs {} V",
+        pi.voltage,
+        pi0.voltage
+    );
+    let delta = model.protrusion(p);
+    let (q, load, k_structure) = model
+        .bulge_load(pi.d - model.nominal_clearance() + delta)
+        .unwrap();
+    let f = model.interface_force(model.gaps(&q, delta), pi.voltage * pi.voltage);
+    assert!(
+        (f.value - load).abs() <= 1e-6 * load.abs(),
+        "balance: {} N vs {} N",
+        f.value,
+        load
+    );
+    let k_total = k_structure - (f.d_bulge + f.d_pad);
+    assert!(
+        k_total.abs() <= 1e-3 * k_structure,
+        "stiffness at pull-in {k_total} N/m of {k_structure} N/m"
+    );
+}

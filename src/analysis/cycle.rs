@@ -14,7 +14,7 @@ use crate::error::{check_positive, Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem};
 use crate::ode::{self, Integrator, Method, Stats, StepStatus};
-use crate::sim::{Problem, SizedRun};
+use crate::sim::{self, Flow, Observer, Problem, SizedRun};
 use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector};
 use serde::Serialize;
 use std::time::Instant;
@@ -73,6 +73,27 @@ pub struct SolverSettings {
     /// (after a tenth of the limit as a start allowance): a contact that bounces without bound
     /// would otherwise use the whole limit on its first microseconds.
     pub max_steps: usize,
+}
+
+impl SolverSettings {
+    /// The settings at relative tolerance `rtol`, the displacement's absolute tolerance scaled
+    /// with it (`atol · rtol / rtol₀`): the one rule by which a new rtol tightens or loosens
+    /// the whole error control, as `hdi cycle --rtol` and Python's `rtol=` apply it.
+    ///
+    /// ```
+    /// use hdi_tribology::{analysis::CycleOptions, scene::Scene};
+    /// let s = CycleOptions::from_scene(&Scene::paper())?.solver;
+    /// let tight = s.with_rtol(s.rtol / 10.0);
+    /// assert!((tight.atol_displacement - s.atol_displacement / 10.0).abs() < 1e-30);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn with_rtol(self, rtol: f64) -> Self {
+        SolverSettings {
+            atol_displacement: self.atol_displacement * (rtol / self.rtol),
+            rtol,
+            ..self
+        }
+    }
 }
 
 /// Options of a cycle simulation.
@@ -365,7 +386,7 @@ impl Start {
                 check_positive("programme.overshoot", overshoot)?;
                 crate::error::check_non_negative("programme.start_power", start_power)?;
                 // Search up to the power whose protrusion is twice the nominal clearance.
-                let span = 2.0 * model.nominal_clearance() / model.efficiency();
+                let span = model.power_for(2.0 * model.nominal_clearance());
                 // Bound the search, in overshoots, so that a heater too weak to ever reach
                 // touchdown fails at once instead of running for ever.
                 let segments = span / overshoot;
@@ -551,13 +572,62 @@ where
     }
 }
 
-/// The one integration of a cycle, with what the detector and the time series need.
-struct Run<'m, D: DimName>
+/// The recorder of a cycle's run: every accepted step goes into the [`Record`]; with a watch,
+/// the run stops at the step where the detector first sees touchdown.
+struct Recorder<D: DimName>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    rec: Record<D>,
+    watch: Option<Watch>,
+}
+
+/// The touchdown watch of the triggered programme.
+struct Watch {
+    detector: Detector,
+    /// The detector has been checked up to here.
+    checked: f64,
+    /// The touchdown time, once seen.
+    found: Option<f64>,
+}
+
+impl<D: DimName> Observer<D> for Recorder<D>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    it: Integrator<'static, D, SliderSystem>,
-    rec: Record<D>,
+    fn accepted(
+        &mut self,
+        it: &Integrator<'static, D, SliderSystem>,
+        _: StepStatus,
+    ) -> Result<Flow> {
+        let p = it.last_step();
+        let t = it.t();
+        self.rec.push_step(p.t0, p.h, p.n, p.coeffs, t);
+        self.rec.times.push(t);
+        if let Some(st) = self.rec.states.as_mut() {
+            st.push(it.state().clone());
+        }
+        let Some(w) = self.watch.as_mut() else {
+            return Ok(Flow::Continue);
+        };
+        let found = Detecting {
+            rec: &self.rec,
+            detector: w.detector,
+        }
+        .first_crossing(w.checked, t, true)?;
+        w.checked = t;
+        w.found = found;
+        Ok(if found.is_some() {
+            Flow::Stop
+        } else {
+            Flow::Continue
+        })
+    }
+}
+
+/// The cycle's guards: the step pace, the pad-contact guard and (when asked for) a bounce below
+/// the force tables end the cycle with an error.
+struct Guards<'m> {
     model: &'m SliderModel,
     opts: &'m CycleOptions,
     /// Start and length of the programme, for the step pace.
@@ -566,24 +636,20 @@ where
     below_since: Option<(f64, usize)>,
 }
 
-impl<D: DimName> Run<'_, D>
+impl<D: DimName> Observer<D> for Guards<'_>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    /// One accepted step, recorded; the step pace, the pad-contact guard and (when asked for) a
-    /// bounce below the force tables end the cycle with an error.
-    fn step(&mut self) -> Result<StepStatus> {
+    fn accepted(
+        &mut self,
+        it: &Integrator<'static, D, SliderSystem>,
+        status: StepStatus,
+    ) -> Result<Flow> {
         let (model, opts) = (self.model, self.opts);
-        let status = self
-            .it
-            .step()
-            .map_err(|e| explain_ode_error(model, opts, e))?;
-        let p = self.it.last_step();
-        self.rec.push_step(p.t0, p.h, p.n, p.coeffs, self.it.t());
-        let st = self.it.stats();
+        let st = it.stats();
         let (t0, span) = self.span;
         let max = opts.solver.max_steps as f64;
-        let t = self.it.t();
+        let t = it.t();
         let steps = st.accepted + st.rejected;
         // More than twice the even pace of `max_steps` since `from`, after `allowance` steps.
         let too_fast = |n: usize, from: f64, allowance: f64| {
@@ -593,15 +659,10 @@ where
             return Err(out_of_step_budget(model, opts, t, st, span));
         }
         if let StepStatus::Terminated(_) = status {
-            return Err(left_the_model(
-                model,
-                self.it.system(),
-                self.it.t(),
-                self.it.state(),
-            ));
+            return Err(left_the_model(model, it.system(), t, it.state()));
         }
         if opts.stop_outside_tables {
-            let d = self.it.system().gaps(t, self.it.state()).bulge;
+            let d = it.system().gaps(t, it.state()).bulge;
             let low = model.forces().table_range().0;
             if d < low {
                 let (t1, n1) = *self.below_since.get_or_insert((t, steps));
@@ -622,17 +683,7 @@ where
                 }
             }
         }
-        self.rec.times.push(self.it.t());
-        if let Some(st) = self.rec.states.as_mut() {
-            st.push(self.it.state().clone());
-        }
-        Ok(status)
-    }
-
-    /// Steps until the end time.
-    fn run_to_end(&mut self) -> Result<()> {
-        while self.step()? != StepStatus::ReachedEnd {}
-        Ok(())
+        Ok(Flow::Continue)
     }
 }
 
@@ -670,47 +721,43 @@ where
         .integrator(t0, y0.clone(), end)
         .map_err(|e| explain_ode_error(model, opts, e))?
         .events([guard]);
-    let mut run = Run {
-        it,
+    let mut it = it;
+    let mut recorder = Recorder {
         rec: Record::new(t0, &y0, q, opts.keep_series),
+        watch: None,
+    };
+    let mut guards = Guards {
         model,
         opts,
         span: (t0, end - t0),
         below_since: None,
     };
+    let ode_err = |e| explain_ode_error(model, opts, e);
 
     let final_programme;
     let search_from;
     match triggered {
         None => {
-            run.run_to_end()?;
+            sim::run(&mut it, None, &mut (&mut recorder, &mut guards), ode_err)?;
             final_programme = initial_programme.clone();
             search_from = final_programme.end_of_hold();
         }
         Some((start_power, rate, overshoot)) => {
             // Ramp up, watching the detector step by step.
             let chunk = overshoot / rate;
-            let mut checked = t0;
-            let t_td = loop {
-                let status = run.step()?;
-                let t = run.it.t();
-                let found = Detecting {
-                    rec: &run.rec,
-                    detector: det,
+            recorder.watch = Some(Watch {
+                detector: det,
+                checked: t0,
+                found: None,
+            });
+            sim::run(&mut it, None, &mut (&mut recorder, &mut guards), ode_err)?;
+            let Some(t_td) = recorder.watch.take().and_then(|w| w.found) else {
+                return Err(crate::error::AnalysisError::NoTouchdown {
+                    stage: crate::error::Stage::TriggeredCycle,
+                    max_power_mw: crate::units::to_mw(initial_programme.power(end)),
+                    detector: None,
                 }
-                .first_crossing(checked, t, true)?;
-                if let Some(t_td) = found {
-                    break t_td;
-                }
-                if status == StepStatus::ReachedEnd {
-                    return Err(crate::error::AnalysisError::NoTouchdown {
-                        stage: crate::error::Stage::TriggeredCycle,
-                        max_power_mw: crate::units::to_mw(initial_programme.power(end)),
-                        detector: None,
-                    }
-                    .into());
-                }
-                checked = t;
+                .into());
             };
             // The programme turns `overshoot` after the detection: go on up the ramp to the
             // turning point (or step back to it from a longer step), then ramp down.
@@ -722,34 +769,33 @@ where
                 (t_peak, p_peak),
                 (t_end, start_power),
             ])?;
-            let ode_err = |e| explain_ode_error(model, opts, e);
-            if run.it.t() < t_peak {
-                if t_peak < run.it.tf() {
-                    run.it.set_tf(t_peak).map_err(ode_err)?;
+            if it.t() < t_peak {
+                if t_peak < it.tf() {
+                    it.set_tf(t_peak).map_err(ode_err)?;
                 }
-                run.run_to_end()?;
-            } else if run.it.t() > t_peak {
-                let y = run.it.interpolate(t_peak).map_err(ode_err)?;
-                run.rec.truncate(t_peak);
-                if run.rec.times.last().is_some_and(|&t| t < t_peak) {
-                    run.rec.times.push(t_peak);
-                    if let Some(st) = run.rec.states.as_mut() {
+                sim::run(&mut it, None, &mut (&mut recorder, &mut guards), ode_err)?;
+            } else if it.t() > t_peak {
+                let y = it.interpolate(t_peak).map_err(ode_err)?;
+                let rec = &mut recorder.rec;
+                rec.truncate(t_peak);
+                if rec.times.last().is_some_and(|&t| t < t_peak) {
+                    rec.times.push(t_peak);
+                    if let Some(st) = rec.states.as_mut() {
                         st.push(y.clone());
                     }
                 }
-                run.it.reinit(t_peak, y).map_err(ode_err)?;
+                it.reinit(t_peak, y).map_err(ode_err)?;
             }
-            run.it
-                .system_mut()
+            it.system_mut()
                 .set_inputs(model.inputs(final_programme.clone()));
-            run.it.set_tf(t_end).map_err(ode_err)?;
-            run.run_to_end()?;
+            it.set_tf(t_end).map_err(ode_err)?;
+            sim::run(&mut it, None, &mut (&mut recorder, &mut guards), ode_err)?;
             search_from = t_peak;
         }
     }
 
     let detecting = Detecting {
-        rec: &run.rec,
+        rec: &recorder.rec,
         detector: det,
     };
     let end = final_programme.end_time();
@@ -769,12 +815,12 @@ where
         _ => None,
     };
     let duration = end - t0;
-    let mean_temperature_rise = run.it.state()[heat] / duration;
-    let series = run
+    let mean_temperature_rise = it.state()[heat] / duration;
+    let series = recorder
         .rec
         .states
         .as_ref()
-        .map(|states| series_of(run.it.system(), &run.rec.times, states, &detecting));
+        .map(|states| series_of(it.system(), &recorder.rec.times, states, &detecting));
     Ok(CycleResult {
         v_ac: model.voltage().ac_amplitude,
         touchdown,
@@ -783,7 +829,7 @@ where
         mean_temperature_rise,
         duration,
         programme: final_programme,
-        stats: run.it.stats(),
+        stats: it.stats(),
         wall_seconds: clock.elapsed().as_secs_f64(),
         series,
     })

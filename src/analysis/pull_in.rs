@@ -71,6 +71,9 @@ impl VoltageBalance<'_> {
         } else {
             (m.forces().static_part(g), m.forces().per_volt2_part(g))
         };
+        // Stateful terms (voltage-independent) at their states' equilibrium, as every static
+        // analysis sees them.
+        let s = m.with_stateful(s, g);
         let volt2 = (load - s.value) / e.value;
         let k = k_structure - (s.d_bulge + s.d_pad) - volt2 * (e.d_bulge + e.d_pad);
         Ok((volt2, k, m.contact_force(g)))
@@ -192,22 +195,22 @@ pub fn clearance_change(
     opts: &StaticOptions,
 ) -> Result<Vec<ClearanceChange>> {
     super::equilibrium::check_heater(model)?;
-    let phi = model.voltage().contact_potential;
     let reference = touchdown_at(model, 0.0, opts)?.power;
     dc_voltages
         .iter()
         .enumerate()
         .map(|(i, &v)| {
             check_finite(&format!("dc_voltages[{i}]"), v)?;
-            let m = model.with_voltage(Voltage {
+            let voltage = Voltage {
                 dc: v,
                 ..model.voltage()
-            });
-            let p = touchdown_at(&m, (v - phi).powi(2), opts)?.power;
+            };
+            let m = model.with_voltage(voltage);
+            let p = touchdown_at(&m, voltage.dc_squared(), opts)?.power;
             Ok(ClearanceChange {
                 dc_voltage: v,
                 touchdown_power: p,
-                clearance_change: model.efficiency() * (p - reference),
+                clearance_change: model.protrusion(p - reference),
             })
         })
         .collect()

@@ -6,9 +6,9 @@ use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
 use crate::error::{check_finite, check_non_negative, Error, Result};
 use crate::model::{Heater, Inputs, Rest, SliderModel, SliderSystem, StateLayout, Voltage};
-use crate::ode::{Integrator, Method, Stats};
+use crate::ode::{Integrator, Method, Stats, StepStatus};
 use crate::scene::Scene;
-use crate::sim::{with_sized, Problem, SizedIntegrator};
+use crate::sim::{with_sized, Flow, Observer, Problem, SizedIntegrator};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -1004,23 +1004,69 @@ where
     if (land && it.tf() != t1) || (!land && it.tf() < t1 + 0.5 * HORIZON) {
         it.set_tf(tf)?;
     }
-    let mut n = 0usize;
-    let mut slope = None;
-    while it.t() < t1 {
-        if n >= max_steps {
+    let mut budget = PeriodBudget {
+        steps: 0,
+        max_steps,
+        t0,
+        t1,
+    };
+    if slopes {
+        let mut slope = Slope(None);
+        crate::sim::run(it, Some(t1), &mut (&mut budget, &mut slope), Error::from)?;
+        Ok(slope.0)
+    } else {
+        crate::sim::run(it, Some(t1), &mut budget, Error::from)?;
+        Ok(None)
+    }
+}
+
+/// A period's step budget: more than `max_steps` steps short of `t1` end the drive's step.
+struct PeriodBudget {
+    steps: usize,
+    max_steps: usize,
+    t0: f64,
+    t1: f64,
+}
+
+impl<D: Dim> Observer<D> for PeriodBudget
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn accepted(
+        &mut self,
+        it: &Integrator<'static, D, SliderSystem>,
+        _: StepStatus,
+    ) -> Result<Flow> {
+        self.steps += 1;
+        let Self {
+            max_steps, t0, t1, ..
+        } = *self;
+        if self.steps >= max_steps && it.t() < t1 {
             return Err(Error::no_convergence(
                 "drive period",
                 format!("more than {max_steps} steps (solver.max_steps) in [{t0}, {t1}] s"),
             ));
         }
-        it.step()?;
-        if slopes {
-            let s = contact_slope(it.system(), it.t(), it.state());
-            slope = Some(slope.map_or(s, |m: f64| m.max(s)));
-        }
-        n += 1;
+        Ok(Flow::Continue)
     }
-    Ok(slope)
+}
+
+/// The largest contact-force slope at the step ends of a period.
+struct Slope(Option<f64>);
+
+impl<D: Dim> Observer<D> for Slope
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn accepted(
+        &mut self,
+        it: &Integrator<'static, D, SliderSystem>,
+        _: StepStatus,
+    ) -> Result<Flow> {
+        let s = contact_slope(it.system(), it.t(), it.state());
+        self.0 = Some(self.0.map_or(s, |m: f64| m.max(s)));
+        Ok(Flow::Continue)
+    }
 }
 
 /// The state at `t1`, on the interpolant of the last step when it ran past.

@@ -74,7 +74,7 @@ pub fn touchdown_roc<D: LevelDetector>(
     let model = plant.model();
     let p_td = touchdown_power(model, &StaticOptions::new(threshold))?.power;
     let grid = ScanGrid::default();
-    let dc2 = model.voltage().effective_dc().powi(2);
+    let dc2 = model.voltage().dc_squared();
     let clearance = |p: f64| flying_equilibrium(model, p.max(0.0), dc2, &grid).map(|e| e.d);
     let d_ref = clearance(p_td - st.margin)?;
     let (mut runs, mut fa, mut early, mut missed, mut fired) = (0, 0, 0, 0, 0);

@@ -480,7 +480,7 @@ impl SliderModel {
     /// the total derivatives along the gaps (through the equilibrium's own slope,
     /// `∂x/∂d = −(∂ẋ/∂x)⁻¹ ∂ẋ/∂d`): what a static analysis sees of a term with memory. `f` as
     /// it is when the model has no such terms.
-    fn with_stateful(&self, mut f: ForceEval, g: Gaps) -> ForceEval {
+    pub(crate) fn with_stateful(&self, mut f: ForceEval, g: Gaps) -> ForceEval {
         use crate::force::MAX_TERM_STATES;
         use nalgebra::{SMatrix, SVector};
         for term in self.stateful.iter() {

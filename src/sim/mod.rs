@@ -5,6 +5,10 @@
 //! `sim` joins the physics ([`crate::model`]) and the stepper ([`crate::ode`]), which know
 //! nothing of each other.
 
+mod run;
+
+pub use run::{run, Ended, Flow, Observer};
+
 use crate::error::{AnalysisError, Error, Result, Stage};
 use crate::model::{Inputs, Rest, SliderModel, SliderSystem};
 use crate::ode::{Integrator, Method, OdeError, Options, SaveAt, Solution};

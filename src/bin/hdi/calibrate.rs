@@ -74,9 +74,10 @@ struct Report {
 
 pub fn run(a: Args) -> Result<(), CliError> {
     let scene = a.scene.load()?;
-    let start_mw = a.start_mw.unwrap_or_else(|| {
-        1e3 * ((scene.nominal_clearance_m - 5e-9) / scene.heater.efficiency_m_per_w).max(0.0)
-    });
+    let mut model = SliderModel::from_scene(&scene)?;
+    let start_mw = a
+        .start_mw
+        .unwrap_or_else(|| 1e3 * model.power_for(model.nominal_clearance() - 5e-9).max(0.0));
     let start_shown = match a.start_mw {
         Some(_) => format!("--start-mw {}", fmt_short(start_mw)),
         None => format!("the default --start-mw {}", fmt_short(start_mw)),
@@ -98,7 +99,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
             fmt_short(levels.floor()),
         )));
     }
-    let mut model = SliderModel::from_scene(&scene)?;
     let mut opts = CalibrationOptions::from_mw(start_mw, a.step_mw, max_mw, a.margin_mw);
     opts.find_takeoff = !a.no_takeoff;
     if let Some(v) = a.dither_v {

@@ -94,8 +94,7 @@ impl CycleArgs {
             })?;
         }
         if let Some(r) = self.rtol {
-            opts.solver.atol_displacement *= r / opts.solver.rtol;
-            opts.solver.rtol = r;
+            opts.solver = opts.solver.with_rtol(r);
         }
         if let Some(a) = self.atol_nm {
             opts.solver.atol_displacement = from_nm(a);
