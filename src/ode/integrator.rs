@@ -39,6 +39,16 @@ const STIFF_CHECKS_TO_SWITCH: usize = 2;
 const RETURN_FRACTION: f64 = 0.3;
 const STEPS_TO_RETURN: usize = 5;
 
+/// An accepted trial step: its size, error norm, the method's error order, whether the
+/// method is stiff and whether the step ends on the stop time.
+struct Accepted {
+    h: f64,
+    err: f64,
+    order: f64,
+    stiff: bool,
+    hit_stop: bool,
+}
+
 /// What one call of [`Integrator::step`] (or [`Integrator::advance_to`]) ended with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StepStatus {
@@ -778,6 +788,67 @@ where
             self.init_events(events);
             self.events_stale = false;
         }
+        let (kink, stop) = self.next_stop();
+        let h_max = self.h_max_opt.min(self.tf - self.t_span0);
+        let t = self.t;
+        let Some(Accepted {
+            h,
+            err,
+            order: k,
+            stiff,
+            hit_stop,
+        }) = self.attempt_until_accepted(stop)?
+        else {
+            // Rodas5P's rounding floor: the same step again with the method that took over.
+            return self.step_with(events);
+        };
+        self.fails.0 = 0;
+        self.accepted_run += 1;
+        if self.accepted_run >= 50 {
+            self.recent_nonfinite = 0;
+        }
+        self.ctx.stats.accepted += 1;
+        if stiff {
+            self.ctx.stats.stiff_steps += 1;
+        }
+        let stepper = self.steppers.get::<S>(self.active);
+        stepper.accept(
+            &self.sys,
+            t,
+            &self.y,
+            h,
+            &self.y_new,
+            &mut self.poly,
+            &mut self.ctx,
+        );
+        self.have_poly = self.ctx.need_poly;
+        let t_new = if hit_stop { stop } else { t + h };
+
+        let (cut_by, terminal) = self.locate_events(events, t, t_new);
+        self.set_next_step(h, err, k, stiff, h_max);
+
+        if let Some(i) = cut_by {
+            return self.act_on_cut(events, i, terminal);
+        }
+        if hit_stop && kink == Some(stop) {
+            // The right-hand side may have a kink here: no derivative carries over.
+            self.kink_idx += 1;
+            self.restart()?;
+        }
+        if self.t >= self.tf {
+            return Ok(StepStatus::ReachedEnd);
+        }
+        // Stiffness switching.
+        if self.steppers.count() > 1 {
+            self.switch_check(stiff, h);
+        }
+        Ok(StepStatus::Accepted)
+    }
+
+    /// The next kink of the right-hand side before the end time (skipping those passed), and
+    /// where the coming step must stop: that kink, the end time or the time asked for.
+    #[inline]
+    fn next_stop(&mut self) -> (Option<f64>, f64) {
         while self.kink_idx < self.kinks.len() && self.kinks[self.kink_idx] <= self.t {
             self.kink_idx += 1;
         }
@@ -790,11 +861,18 @@ where
         if let Some(tg) = self.target {
             stop = stop.min(tg);
         }
-        let h_max = self.h_max_opt.min(self.tf - self.t_span0);
+        (kink, stop)
+    }
+
+    /// Trial steps from `(t, y)` until one is accepted (its end state in `y_new`); `None` when
+    /// Rodas5P refused a step for its rounding floor and another method took over (the step is
+    /// to be taken again).
+    #[inline]
+    fn attempt_until_accepted(&mut self, stop: f64) -> Result<Option<Accepted>, OdeError> {
         let sys = &self.sys;
         let t = self.t;
         let mut h = self.h;
-        let (err, k, stiff, hit_stop) = loop {
+        loop {
             let attempts = self.ctx.stats.accepted + self.ctx.stats.rejected;
             if attempts >= self.max_steps {
                 return Err(OdeError::TooManySteps {
@@ -842,7 +920,7 @@ where
                 } => {
                     self.ctx.stats.rejected += 1;
                     self.rounding_floor_fallback(t, h)?;
-                    return self.step_with(events);
+                    return Ok(None);
                 }
                 Trial::Failed { factor, kind } => {
                     if kind == FailKind::NonFinite {
@@ -864,34 +942,28 @@ where
                 self.last_rejected = true;
                 continue;
             }
-            break (err, k, stiff, hit_stop);
-        };
-
-        // Accepted.
-        let h_acc = h;
-        self.fails.0 = 0;
-        self.accepted_run += 1;
-        if self.accepted_run >= 50 {
-            self.recent_nonfinite = 0;
+            return Ok(Some(Accepted {
+                h,
+                err,
+                order: k,
+                stiff,
+                hit_stop,
+            }));
         }
-        self.ctx.stats.accepted += 1;
-        if stiff {
-            self.ctx.stats.stiff_steps += 1;
-        }
-        let stepper = self.steppers.get::<S>(self.active);
-        stepper.accept(
-            sys,
-            t,
-            &self.y,
-            h,
-            &self.y_new,
-            &mut self.poly,
-            &mut self.ctx,
-        );
-        self.have_poly = self.ctx.need_poly;
-        let t_new = if hit_stop { stop } else { t + h };
+    }
 
-        // Events: sign changes between the ends of the step, located on the interpolant.
+    /// The events' sign changes between the ends of the accepted step `[t, t_new]`, located
+    /// on the interpolant and appended to `self.hits`; the first event that stops or acts cuts
+    /// the step there (later roots are dropped: those of acting events are found again after
+    /// the restart). Sets the time and state to the step's (or the cut's) end, and returns the
+    /// cutting event and whether a terminal one cut.
+    #[inline]
+    fn locate_events(
+        &mut self,
+        events: &mut [Event<'_, D>],
+        t: f64,
+        t_new: f64,
+    ) -> (Option<usize>, bool) {
         self.step_hits.clear();
         for (i, ev) in events.iter_mut().enumerate() {
             let g_new = ev.eval(t_new, &self.y_new);
@@ -933,8 +1005,6 @@ where
             self.g_old[i] = g_new;
         }
         self.step_hits.sort_by(|a, b| a.1.total_cmp(&b.1));
-        // The first event that stops or acts cuts the step; later roots are dropped (those of
-        // acting events are found again after the restart).
         let mut t_cut = None;
         let mut cut_by = None;
         let mut terminal = false;
@@ -965,8 +1035,13 @@ where
         }
         self.t = t_reach;
         std::mem::swap(&mut self.y, &mut self.y_new);
+        (cut_by, terminal)
+    }
 
-        // Next step size.
+    /// The size of the next step after an accepted one of size `h` with error `err` (method of
+    /// error order `k`): the PI controller, capped by the method's hint and `h_max`.
+    #[inline]
+    fn set_next_step(&mut self, h: f64, err: f64, k: f64, stiff: bool, h_max: f64) {
         let (alpha, beta) = (0.7 / k, 0.4 / k);
         let e = err.max(1e-10);
         let mut fac = SAFETY * e.powf(-alpha) * self.err_prev.powf(beta);
@@ -982,62 +1057,54 @@ where
         if let Some(hint) = stepper.step_hint() {
             fac = fac.min(hint);
         }
+        let mut h_next = h;
         if self.adaptive {
-            h = stepper
+            h_next = stepper
                 .propose(h, h * fac.clamp(FAC_MIN, fac_max))
                 .min(h_max);
         } else if let Some(h0) = self.h_init {
-            h = h0.min(h_max);
+            h_next = h0.min(h_max);
         }
-        self.h = h;
+        self.h = h_next;
         self.err_prev = e;
         self.last_rejected = false;
+    }
 
-        if let Some(i) = cut_by {
-            // Actions of every event cut at the same time, in index order.
-            let tc = self.t;
-            let mut acted = false;
-            let mut acting: Vec<usize> = self
-                .step_hits
-                .iter()
-                .filter(|&&(j, te, _)| te == tc && events[j].acts())
-                .map(|&(j, _, _)| j)
-                .collect();
-            acting.sort_unstable();
-            for j in acting {
-                events[j].apply(tc, &mut self.y);
-                acted = true;
-            }
-            if acted {
-                check_finite_state(&self.y).map_err(|_| OdeError::NonFinite {
-                    t: tc,
-                    what: format!("state set by the action of event {i}"),
-                })?;
-            }
-            // The method's carried-over data belong to the uncut step end.
-            self.needs_restart = true;
-            self.init_events(events);
-            return Ok(if terminal {
-                StepStatus::Terminated(i)
-            } else {
-                StepStatus::Acted(i)
-            });
+    /// The step was cut by event `i`: the actions of every event cut at the same time, in
+    /// index order, and a restart of the method from the cut.
+    fn act_on_cut(
+        &mut self,
+        events: &mut [Event<'_, D>],
+        i: usize,
+        terminal: bool,
+    ) -> Result<StepStatus, OdeError> {
+        let tc = self.t;
+        let mut acted = false;
+        let mut acting: Vec<usize> = self
+            .step_hits
+            .iter()
+            .filter(|&&(j, te, _)| te == tc && events[j].acts())
+            .map(|&(j, _, _)| j)
+            .collect();
+        acting.sort_unstable();
+        for j in acting {
+            events[j].apply(tc, &mut self.y);
+            acted = true;
         }
-
-        if hit_stop && kink == Some(stop) {
-            // The right-hand side may have a kink here: no derivative carries over.
-            self.kink_idx += 1;
-            self.restart()?;
+        if acted {
+            check_finite_state(&self.y).map_err(|_| OdeError::NonFinite {
+                t: tc,
+                what: format!("state set by the action of event {i}"),
+            })?;
         }
-
-        if self.t >= self.tf {
-            return Ok(StepStatus::ReachedEnd);
-        }
-        // Stiffness switching.
-        if self.steppers.count() > 1 {
-            self.switch_check(stiff, h_acc);
-        }
-        Ok(StepStatus::Accepted)
+        // The method's carried-over data belong to the uncut step end.
+        self.needs_restart = true;
+        self.init_events(events);
+        Ok(if terminal {
+            StepStatus::Terminated(i)
+        } else {
+            StepStatus::Acted(i)
+        })
     }
 
     /// Rodas5P refused a step of size `h` at `t` for its rounding floor (see

@@ -188,6 +188,55 @@ struct Pending {
     mids: Vec<[f64; 2]>,
 }
 
+impl Pending {
+    /// Whether the cubic Hermite interpolant meets the tolerance at every interval's
+    /// midpoint, relative to the largest magnitude on the interval (so that a sign change
+    /// inside it does not demand absolute accuracy near zero).
+    fn accurate(&self, opts: &TableOptions) -> bool {
+        (0..self.xs.len() - 1).all(|i| {
+            let h = self.xs[i + 1] - self.xs[i];
+            let [y0, m0] = self.nodes[i];
+            let [y1, m1] = self.nodes[i + 1];
+            let (v, _) = cubic(y0, h * m0, y1, h * m1, 0.5);
+            let exact = self.mids[i][0];
+            let scale = exact.abs().max(y0.abs()).max(y1.abs());
+            (v - exact).abs() <= (opts.rel_tol * scale).max(opts.abs_tol)
+        })
+    }
+}
+
+/// The checks of [`Table::build`]'s range and options.
+fn check_build(lo: f64, hi: f64, opts: &TableOptions) -> Result<()> {
+    crate::error::check_finite("table.lo", lo)?;
+    crate::error::check_finite("table.hi", hi)?;
+    // Both are finite here, so the comparison is total.
+    if hi <= lo {
+        return Err(Error::invalid(
+            "table.hi",
+            format!("must be > table.lo = {lo}, got {hi}"),
+        ));
+    }
+    crate::error::check_non_negative("table.rel_tol", opts.rel_tol)?;
+    crate::error::check_non_negative("table.abs_tol", opts.abs_tol)?;
+    if opts.rel_tol == 0.0 && opts.abs_tol == 0.0 {
+        // Refinement would go on down to rounding-level spacing: ~1e16 nodes.
+        return Err(Error::invalid(
+            "table.rel_tol",
+            "rel_tol and abs_tol are both 0; at least one must be > 0",
+        ));
+    }
+    if opts.max_nodes > MAX_NODES {
+        return Err(Error::invalid(
+            "table.max_nodes",
+            format!(
+                "must be at most {MAX_NODES} (about 40 bytes each while building), got {}",
+                opts.max_nodes
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Cubic Hermite interpolant on one interval in the local variable t ∈ [0, 1],
 /// from values y and scaled slopes hm = h·f' at both ends: returns the value and
 /// the t-derivative (divide by h for d/dx). Written as linear interpolation plus
@@ -231,33 +280,7 @@ impl Table {
         hi: f64,
         opts: &TableOptions,
     ) -> Result<Table> {
-        crate::error::check_finite("table.lo", lo)?;
-        crate::error::check_finite("table.hi", hi)?;
-        // Both are finite here, so the comparison is total.
-        if hi <= lo {
-            return Err(Error::invalid(
-                "table.hi",
-                format!("must be > table.lo = {lo}, got {hi}"),
-            ));
-        }
-        crate::error::check_non_negative("table.rel_tol", opts.rel_tol)?;
-        crate::error::check_non_negative("table.abs_tol", opts.abs_tol)?;
-        if opts.rel_tol == 0.0 && opts.abs_tol == 0.0 {
-            // Refinement would go on down to rounding-level spacing: ~1e16 nodes.
-            return Err(Error::invalid(
-                "table.rel_tol",
-                "rel_tol and abs_tol are both 0; at least one must be > 0",
-            ));
-        }
-        if opts.max_nodes > MAX_NODES {
-            return Err(Error::invalid(
-                "table.max_nodes",
-                format!(
-                    "must be at most {MAX_NODES} (about 40 bytes each while building), got {}",
-                    opts.max_nodes
-                ),
-            ));
-        }
+        check_build(lo, hi, opts)?;
 
         let mut eval = |x: f64| -> Result<[f64; 2]> {
             let (v, d) = f(x)?;
@@ -329,18 +352,7 @@ impl Table {
         let mut done: Vec<Pending> = Vec::new();
         while let Some(p) = stack.pop() {
             let n = p.xs.len() - 1;
-            let ok = (0..n).all(|i| {
-                let h = p.xs[i + 1] - p.xs[i];
-                let [y0, m0] = p.nodes[i];
-                let [y1, m1] = p.nodes[i + 1];
-                let (v, _) = cubic(y0, h * m0, y1, h * m1, 0.5);
-                let exact = p.mids[i][0];
-                // Relative to the largest magnitude on the interval, so that a sign
-                // change inside it does not demand absolute accuracy near zero.
-                let scale = exact.abs().max(y0.abs()).max(y1.abs());
-                (v - exact).abs() <= (opts.rel_tol * scale).max(opts.abs_tol)
-            });
-            if ok {
+            if p.accurate(opts) {
                 done.push(p);
                 continue;
             }
@@ -409,13 +421,19 @@ impl Table {
             }
         }
 
+        if node_count > u32::MAX as usize {
+            return Err(too_many(node_count));
+        }
+        Ok(Table::assemble(lo, hi, done, node_count))
+    }
+
+    /// The table of the accepted panels `done` (which tile `[lo, hi]`), holding `node_count`
+    /// nodes: cells of the finest panel width, each pointing at its panel.
+    fn assemble(lo: f64, hi: f64, mut done: Vec<Pending>, node_count: usize) -> Table {
         let max_depth = done.iter().map(|p| p.depth).max().unwrap_or(INITIAL_DEPTH);
         // Order by first covered cell of the finest grid (panels tile the range).
         done.sort_by_key(|p| p.pos << (max_depth - p.depth));
         let ncells = 1usize << max_depth;
-        if node_count > u32::MAX as usize {
-            return Err(too_many(node_count));
-        }
         let mut cells = Vec::with_capacity(ncells);
         let mut nodes = Vec::with_capacity(node_count);
         for p in &done {
@@ -433,14 +451,14 @@ impl Table {
             let span = 1usize << (max_depth - p.depth);
             cells.extend(std::iter::repeat_n(panel, span));
         }
-        Ok(Table {
+        Table {
             lo,
             hi,
-            inv_cell: ncells as f64 / width,
+            inv_cell: ncells as f64 / (hi - lo),
             cells,
             panel_count: done.len(),
             nodes,
-        })
+        }
     }
 
     /// `(value, derivative)` at `d`, or `None` outside `[lo, hi]` (or for NaN).
