@@ -13,8 +13,8 @@ use super::roots::brent;
 use crate::error::{check_positive, Error, Result};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem};
-use crate::ode::{self, Integrator, Method, Stats, StepStatus};
-use crate::sim::{self, Flow, Observer, Problem, SizedRun};
+use crate::ode::{self, Method, Stats, StepStatus};
+use crate::sim::{self, Flow, Observer, Problem, SizedRun, StepView};
 use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector};
 use serde::Serialize;
 use std::time::Instant;
@@ -591,21 +591,17 @@ struct Watch {
     found: Option<f64>,
 }
 
-impl<D: DimName> Observer<D> for Recorder<D>
+impl<D: DimName> Observer for Recorder<D>
 where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    DefaultAllocator: Allocator<D>,
 {
-    fn accepted(
-        &mut self,
-        it: &Integrator<'static, D, SliderSystem>,
-        _: StepStatus,
-    ) -> Result<Flow> {
-        let p = it.last_step();
-        let t = it.t();
+    fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow> {
+        let p = step.last_step;
+        let t = step.t;
         self.rec.push_step(p.t0, p.h, p.n, p.coeffs, t);
         self.rec.times.push(t);
         if let Some(st) = self.rec.states.as_mut() {
-            st.push(it.state().clone());
+            st.push(OVector::<f64, D>::from_column_slice(step.state));
         }
         let Some(w) = self.watch.as_mut() else {
             return Ok(Flow::Continue);
@@ -636,20 +632,13 @@ struct Guards<'m> {
     below_since: Option<(f64, usize)>,
 }
 
-impl<D: DimName> Observer<D> for Guards<'_>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    fn accepted(
-        &mut self,
-        it: &Integrator<'static, D, SliderSystem>,
-        status: StepStatus,
-    ) -> Result<Flow> {
+impl Observer for Guards<'_> {
+    fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow> {
         let (model, opts) = (self.model, self.opts);
-        let st = it.stats();
+        let st = step.stats;
         let (t0, span) = self.span;
         let max = opts.solver.max_steps as f64;
-        let t = it.t();
+        let t = step.t;
         let steps = st.accepted + st.rejected;
         // More than twice the even pace of `max_steps` since `from`, after `allowance` steps.
         let too_fast = |n: usize, from: f64, allowance: f64| {
@@ -658,11 +647,11 @@ where
         if too_fast(steps, t0, STEP_PACE_ALLOWANCE) && t < t0 + span {
             return Err(out_of_step_budget(model, opts, t, st, span));
         }
-        if let StepStatus::Terminated(_) = status {
-            return Err(left_the_model(model, it.system(), t, it.state()));
+        if let StepStatus::Terminated(_) = step.status {
+            return Err(left_the_model(model, step.system, t, step.state));
         }
         if opts.stop_outside_tables {
-            let d = it.system().gaps(t, it.state()).bulge;
+            let d = step.system.gaps(t, step.state).bulge;
             let low = model.forces().table_range().0;
             if d < low {
                 let (t1, n1) = *self.below_since.get_or_insert((t, steps));
@@ -837,15 +826,7 @@ where
 
 /// The error for a trajectory that left the lumped model (the pad gap reached zero), with the
 /// likely cause when an interface lag makes the contact branch self-excited.
-fn left_the_model<D: DimName>(
-    model: &SliderModel,
-    sys: &SliderSystem,
-    t: f64,
-    s: &OVector<f64, D>,
-) -> Error
-where
-    DefaultAllocator: Allocator<D>,
-{
+fn left_the_model(model: &SliderModel, sys: &SliderSystem, t: f64, s: &[f64]) -> Error {
     let g = sys.gaps(t, s);
     let mut self_excited = None;
     if model.interface_lag() > 0.0 {

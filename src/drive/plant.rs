@@ -6,9 +6,9 @@ use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
 use crate::error::{check_finite, check_non_negative, Error, Result};
 use crate::model::{Heater, Inputs, Rest, SliderModel, SliderSystem, StateLayout, Voltage};
-use crate::ode::{Integrator, Method, Stats, StepStatus};
+use crate::ode::{Integrator, Method, Stats};
 use crate::scene::Scene;
-use crate::sim::{with_sized, Flow, Observer, Problem, SizedIntegrator};
+use crate::sim::{with_sized, Flow, Observer, Problem, SizedIntegrator, StepView};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -855,10 +855,7 @@ struct TolState {
 }
 
 /// Largest slope of the contact force at a state (N/m), on either gap.
-fn contact_slope<D: Dim>(sys: &SliderSystem, t: f64, y: &OVector<f64, D>) -> f64
-where
-    DefaultAllocator: Allocator<D>,
-{
+fn contact_slope(sys: &SliderSystem, t: f64, y: &[f64]) -> f64 {
     let c = sys.model().forces().contact(sys.gaps(t, y));
     c.d_bulge.abs().max(c.d_pad.abs())
 }
@@ -1028,20 +1025,13 @@ struct PeriodBudget {
     t1: f64,
 }
 
-impl<D: Dim> Observer<D> for PeriodBudget
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    fn accepted(
-        &mut self,
-        it: &Integrator<'static, D, SliderSystem>,
-        _: StepStatus,
-    ) -> Result<Flow> {
+impl Observer for PeriodBudget {
+    fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow> {
         self.steps += 1;
         let Self {
             max_steps, t0, t1, ..
         } = *self;
-        if self.steps >= max_steps && it.t() < t1 {
+        if self.steps >= max_steps && step.t < t1 {
             return Err(Error::no_convergence(
                 "drive period",
                 format!("more than {max_steps} steps (solver.max_steps) in [{t0}, {t1}] s"),
@@ -1054,16 +1044,9 @@ where
 /// The largest contact-force slope at the step ends of a period.
 struct Slope(Option<f64>);
 
-impl<D: Dim> Observer<D> for Slope
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    fn accepted(
-        &mut self,
-        it: &Integrator<'static, D, SliderSystem>,
-        _: StepStatus,
-    ) -> Result<Flow> {
-        let s = contact_slope(it.system(), it.t(), it.state());
+impl Observer for Slope {
+    fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow> {
+        let s = contact_slope(step.system, step.t, step.state);
         self.0 = Some(self.0.map_or(s, |m: f64| m.max(s)));
         Ok(Flow::Continue)
     }

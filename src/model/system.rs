@@ -5,6 +5,7 @@ use crate::force::{Gaps, MAX_TERM_STATES};
 use crate::ode::OdeSystem;
 use crate::scene::MAX_DOF;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
+use std::ops::Index;
 use std::sync::Arc;
 
 /// Where each quantity sits in the state vector. Only what the scene needs is there: one position
@@ -260,28 +261,19 @@ impl SliderSystem {
 
     /// The coordinates `q` of state `s`.
     #[inline]
-    pub fn coordinates<D: Dim>(&self, s: &OVector<f64, D>) -> Dofs
-    where
-        DefaultAllocator: Allocator<D>,
-    {
+    pub fn coordinates<S: Index<usize, Output = f64> + ?Sized>(&self, s: &S) -> Dofs {
         self.block(s, 0)
     }
 
     /// The velocities `q̇` of state `s`.
     #[inline]
-    pub fn velocities<D: Dim>(&self, s: &OVector<f64, D>) -> Dofs
-    where
-        DefaultAllocator: Allocator<D>,
-    {
+    pub fn velocities<S: Index<usize, Output = f64> + ?Sized>(&self, s: &S) -> Dofs {
         self.block(s, self.layout.velocity(0))
     }
 
     /// `dofs` entries of `s` from `start`, as coordinates.
     #[inline]
-    fn block<D: Dim>(&self, s: &OVector<f64, D>, start: usize) -> Dofs
-    where
-        DefaultAllocator: Allocator<D>,
-    {
+    fn block<S: Index<usize, Output = f64> + ?Sized>(&self, s: &S, start: usize) -> Dofs {
         let mut q = super::structure::zero_dofs();
         for i in 0..self.layout.dofs {
             q[i] = s[start + i];
@@ -290,10 +282,7 @@ impl SliderSystem {
     }
 
     /// Protrusion at time `t` and state `s`.
-    pub fn protrusion<D: Dim>(&self, t: f64, s: &OVector<f64, D>) -> f64
-    where
-        DefaultAllocator: Allocator<D>,
-    {
+    pub fn protrusion<S: Index<usize, Output = f64> + ?Sized>(&self, t: f64, s: &S) -> f64 {
         match self.layout.delta {
             Some(i) => s[i],
             None => self.model.protrusion(self.inputs.heater.power(t)),
@@ -301,10 +290,7 @@ impl SliderSystem {
     }
 
     /// Gaps at time `t` and state `s`.
-    pub fn gaps<D: Dim>(&self, t: f64, s: &OVector<f64, D>) -> Gaps
-    where
-        DefaultAllocator: Allocator<D>,
-    {
+    pub fn gaps<S: Index<usize, Output = f64> + ?Sized>(&self, t: f64, s: &S) -> Gaps {
         self.model.gaps_offset(
             &self.coordinates(s),
             self.protrusion(t, s),

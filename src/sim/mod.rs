@@ -7,7 +7,7 @@
 
 mod run;
 
-pub use run::{run, Ended, Flow, Observer};
+pub use run::{run, Ended, Flow, Observer, StepView};
 
 use crate::error::{AnalysisError, Error, Result, Stage};
 use crate::model::{Inputs, Rest, SliderModel, SliderSystem};

@@ -7,7 +7,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::SliderSystem;
-use crate::ode::{Integrator, OdeError, StepStatus};
+use crate::ode::{Integrator, OdeError, Stats, StepPolynomial, StepStatus};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim};
 
 /// What an observer wants after a step.
@@ -30,6 +30,23 @@ pub enum Ended {
     Stopped,
 }
 
+/// One accepted step as an observer sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct StepView<'a> {
+    /// The time the step ended at.
+    pub t: f64,
+    /// The state there.
+    pub state: &'a [f64],
+    /// What the integrator reported of the step.
+    pub status: StepStatus,
+    /// The integrator's counts so far.
+    pub stats: Stats,
+    /// The step's interpolant.
+    pub last_step: StepPolynomial<'a>,
+    /// The slider and its inputs.
+    pub system: &'a SliderSystem,
+}
+
 /// Something that sees every accepted step of a run: a recorder, a detector, a guard.
 ///
 /// It returns [`Flow::Stop`] to end the run, or an error to end it with that error.
@@ -37,22 +54,16 @@ pub enum Ended {
 /// ```
 /// use hdi_tribology::analysis::{flying_equilibrium, ScanGrid};
 /// use hdi_tribology::heater::Programme;
-/// use hdi_tribology::model::{SliderModel, SliderSystem};
-/// use hdi_tribology::ode::{Integrator, StepStatus};
+/// use hdi_tribology::model::SliderModel;
 /// use hdi_tribology::scene::Scene;
-/// use hdi_tribology::sim::{run, Flow, Observer, Problem};
-/// use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, Dyn};
+/// use hdi_tribology::sim::{run, Flow, Observer, Problem, StepView};
 ///
 /// /// Counts the steps and keeps the smallest bulge gap.
 /// struct Closest { steps: usize, gap: f64 }
-/// impl<D: Dim> Observer<D> for Closest
-/// where
-///     DefaultAllocator: Allocator<D> + Allocator<D, D>,
-/// {
-///     fn accepted(&mut self, it: &Integrator<'static, D, SliderSystem>, _: StepStatus)
-///         -> hdi_tribology::Result<Flow> {
+/// impl Observer for Closest {
+///     fn accepted(&mut self, step: &StepView<'_>) -> hdi_tribology::Result<Flow> {
 ///         self.steps += 1;
-///         self.gap = self.gap.min(it.system().gaps(it.t(), it.state()).bulge);
+///         self.gap = self.gap.min(step.system.gaps(step.t, step.state).bulge);
 ///         Ok(Flow::Continue)
 ///     }
 /// }
@@ -62,49 +73,28 @@ pub enum Ended {
 /// let problem = Problem::builder(&model, model.inputs(Programme::constant(0.06, 1e-4)?), true)
 ///     .build()?;
 /// let n = problem.system().layout().len();
-/// let y0 = problem.initial_state(Dyn(n), &rest);
+/// let y0 = problem.initial_state(nalgebra::Dyn(n), &rest);
 /// let mut it = problem.integrator(0.0, y0, 1e-4)?;
 /// let mut closest = Closest { steps: 0, gap: f64::INFINITY };
 /// run(&mut it, None, &mut closest, Into::into)?;
 /// assert!(closest.steps > 0 && closest.gap > 0.0);
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
-pub trait Observer<D: Dim>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    /// Sees the step just accepted (`status` as the integrator reported it).
-    fn accepted(
-        &mut self,
-        it: &Integrator<'static, D, SliderSystem>,
-        status: StepStatus,
-    ) -> Result<Flow>;
+pub trait Observer {
+    /// Sees the step just accepted.
+    fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow>;
 }
 
 /// No observer.
-impl<D: Dim> Observer<D> for ()
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    fn accepted(
-        &mut self,
-        _: &Integrator<'static, D, SliderSystem>,
-        _: StepStatus,
-    ) -> Result<Flow> {
+impl Observer for () {
+    fn accepted(&mut self, _: &StepView<'_>) -> Result<Flow> {
         Ok(Flow::Continue)
     }
 }
 
-impl<D: Dim, O: Observer<D> + ?Sized> Observer<D> for &mut O
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    fn accepted(
-        &mut self,
-        it: &Integrator<'static, D, SliderSystem>,
-        status: StepStatus,
-    ) -> Result<Flow> {
-        (**self).accepted(it, status)
+impl<O: Observer + ?Sized> Observer for &mut O {
+    fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow> {
+        (**self).accepted(step)
     }
 }
 
@@ -112,20 +102,13 @@ where
 /// stops after the step when any of them says stop (all of them have seen it).
 macro_rules! tuple_observer {
     ($($o:ident),+) => {
-        impl<D: Dim, $($o: Observer<D>),+> Observer<D> for ($($o,)+)
-        where
-            DefaultAllocator: Allocator<D> + Allocator<D, D>,
-        {
+        impl<$($o: Observer),+> Observer for ($($o,)+) {
             #[allow(non_snake_case)]
-            fn accepted(
-                &mut self,
-                it: &Integrator<'static, D, SliderSystem>,
-                status: StepStatus,
-            ) -> Result<Flow> {
+            fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow> {
                 let ($($o,)+) = self;
                 let mut flow = Flow::Continue;
                 $(
-                    if $o.accepted(it, status)? == Flow::Stop {
+                    if $o.accepted(step)? == Flow::Stop {
                         flow = Flow::Stop;
                     }
                 )+
@@ -147,7 +130,7 @@ tuple_observer!(A, B, C, E);
 ///
 /// # Errors
 /// The first error of the stepper (through `ode_error`) or of an observer.
-pub fn run<D: Dim, O: Observer<D>>(
+pub fn run<D: Dim, O: Observer>(
     it: &mut Integrator<'static, D, SliderSystem>,
     until: Option<f64>,
     observer: &mut O,
@@ -161,7 +144,14 @@ where
             return Ok(Ended::Time);
         }
         let status = it.step().map_err(&ode_error)?;
-        let flow = observer.accepted(it, status)?;
+        let flow = observer.accepted(&StepView {
+            t: it.t(),
+            state: it.state().as_slice(),
+            status,
+            stats: it.stats(),
+            last_step: it.last_step(),
+            system: it.system(),
+        })?;
         if flow == Flow::Stop {
             return Ok(Ended::Stopped);
         }
