@@ -258,8 +258,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .pop()
         .ok_or_else(|| CliError::Failed("the cycle gave no result".into()))?;
     if let (Some(out), Some(series)) = (out, cycle.series) {
-        series.write_csv(out.tmp_path())?;
-        out.commit()?;
+        out.write_via_path(|p| Ok(series.write_csv(p)?))?;
     }
     common::print_json(&report)
 }

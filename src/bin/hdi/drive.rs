@@ -84,21 +84,18 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let dt = 1e-3 / a.rate_khz;
     match out {
         Some(out) => {
-            let file = std::fs::File::create(out.tmp_path())
-                .map_err(|e| CliError::Failed(format!("--out: {e}")))?;
-            let summary = replay(&plant, &rows, dt, std::io::BufWriter::new(file))?;
-            out.commit()?;
+            let mut summary = None;
+            out.write_with(|w| {
+                summary = Some(replay(&plant, &rows, dt, w)?);
+                Ok(())
+            })?;
             common::print_json(&summary)
         }
         None => {
             // Whole or nothing on standard output too: the run finishes before anything is printed.
             let mut buf = Vec::new();
             replay(&plant, &rows, dt, &mut buf)?;
-            use std::io::Write;
-            std::io::stdout()
-                .lock()
-                .write_all(&buf)
-                .map_err(|e| CliError::Failed(format!("cannot write output: {e}")))
+            common::write_stdout(&buf)
         }
     }
 }

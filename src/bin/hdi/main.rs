@@ -72,7 +72,7 @@ fn main() -> ExitCode {
         Command::Bearing(a) => bearing::run(a),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) | Err(CliError::ClosedPipe) => ExitCode::SUCCESS,
         Err(CliError::Usage(msg)) => {
             eprintln!("error: {msg}\n\nFor more information, try '--help'.");
             ExitCode::from(2)
