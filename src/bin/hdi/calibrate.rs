@@ -8,7 +8,7 @@ use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::units::fmt_short;
 use serde::Serialize;
 
-use crate::common::{self, non_negative, positive, CliError, SceneArgs};
+use crate::common::{self, non_negative, positive, volts, CliError, SceneArgs};
 
 /// Heater steps of --step-mw from --start-mw up to --max-mw until the detector fires, then back
 /// down to take-off; the heater is then set --margin-mw below touchdown. JSON: detector,
@@ -43,7 +43,7 @@ pub struct Args {
     detector: DetectorKind,
     /// AC dither amplitude (V) at the scene's frequency while calibrating [default: the scene's
     /// voltage.ac_amplitude_v].
-    #[arg(long, value_name = "V", value_parser = non_negative, allow_hyphen_values = true)]
+    #[arg(long, value_name = "V", value_parser = volts, allow_hyphen_values = true)]
     dither_v: Option<f64>,
     /// Stop at touchdown: do not step back down to take-off.
     #[arg(long)]

@@ -103,13 +103,32 @@ pub fn non_negative(s: &str) -> Result<f64, String> {
     }
 }
 
-/// A number in (0, 1).
-pub fn fraction(s: &str) -> Result<f64, String> {
+/// A relative tolerance of the ODE solver, in [`MIN_RTOL`](hdi_tribology::ode::MIN_RTOL), 1):
+/// the range scenes and the solver take.
+pub fn rtol(s: &str) -> Result<f64, String> {
     let x = number(s)?;
-    if x > 0.0 && x < 1.0 {
+    let min = hdi_tribology::ode::MIN_RTOL;
+    if (min..1.0).contains(&x) {
         Ok(x)
     } else {
-        Err("must lie strictly between 0 and 1".into())
+        Err(format!("must lie in [{min:.1e}, 1) (100 ε up to 1)"))
+    }
+}
+
+/// A voltage amplitude (V), at least 0 and at most the scenes' bound
+/// [`MAX_VOLTAGE_V`](hdi_tribology::scene::MAX_VOLTAGE_V).
+pub fn volts(s: &str) -> Result<f64, String> {
+    let x = non_negative(s)?;
+    check_volts(x)?;
+    Ok(x)
+}
+
+fn check_volts(x: f64) -> Result<(), String> {
+    let max = hdi_tribology::scene::MAX_VOLTAGE_V;
+    if x <= max {
+        Ok(())
+    } else {
+        Err(format!("must be at most {} V, as in a scene", fmt_short(max)))
     }
 }
 
@@ -132,13 +151,16 @@ pub fn list(s: &str) -> Result<List, String> {
         .map(List)
 }
 
-/// A comma-separated list of finite numbers ≥ 0.
-pub fn list_non_negative(s: &str) -> Result<List, String> {
+/// A comma-separated list of voltage amplitudes (V), each as [`volts`].
+pub fn list_volts(s: &str) -> Result<List, String> {
     let l = list(s)?;
-    match l.0.iter().position(|&x| x < 0.0) {
-        Some(i) => Err(format!("entry {} is negative: must be >= 0", i + 1)),
-        None => Ok(l),
+    if let Some(i) = l.0.iter().position(|&x| x < 0.0) {
+        return Err(format!("entry {} is negative: must be >= 0", i + 1));
     }
+    for (i, &x) in l.0.iter().enumerate() {
+        check_volts(x).map_err(|e| format!("entry {}: {e}", i + 1))?;
+    }
+    Ok(l)
 }
 
 /// An output file, checked before any computation and written whole or not at all.
