@@ -126,12 +126,7 @@ fn a_link_loop_is_refused_before_the_computation() {
     let dir = scratch("loop");
     std::os::unix::fs::symlink("b.csv", dir.join("a.csv")).unwrap();
     std::os::unix::fs::symlink("a.csv", dir.join("b.csv")).unwrap();
-    let e = failure(&hdi(&[
-        "cycle",
-        "--paper",
-        "--csv",
-        s(&dir.join("a.csv")),
-    ]));
+    let e = failure(&hdi(&["cycle", "--paper", "--csv", s(&dir.join("a.csv"))]));
     assert!(e.contains("--csv") && e.contains("symbolic links"), "{e}");
 }
 
@@ -182,7 +177,10 @@ fn a_fifo_as_output_is_written_into_not_replaced() {
     let dir = scratch("fifo");
     let fifo = dir.join("pipe.csv");
     mkfifo(&fifo);
-    let (out, got) = through_fifo(&fifo, &["cycle", "--paper", "--no-refine", "--csv", s(&fifo)]);
+    let (out, got) = through_fifo(
+        &fifo,
+        &["cycle", "--paper", "--no-refine", "--csv", s(&fifo)],
+    );
     assert_ok(&out);
     assert!(std::fs::symlink_metadata(&fifo)
         .unwrap()
@@ -268,9 +266,7 @@ fn one_permission_rule_for_every_output() {
         &["cycle", "--paper", "--no-refine", "--csv", s(&kept)],
     ));
     assert_eq!(mode(&kept), 0o640);
-    assert!(std::fs::read_to_string(&kept)
-        .unwrap()
-        .starts_with("t_s,"));
+    assert!(std::fs::read_to_string(&kept).unwrap().starts_with("t_s,"));
 }
 
 #[test]
@@ -327,4 +323,212 @@ fn a_closed_pipe_ends_quietly() {
         assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stderr(&out));
         assert_eq!(stderr(&out), "", "{args:?}");
     }
+}
+
+/// The shipped paper scene with `key = …` (the first line that starts so) set to `value`.
+fn paper_with(key: &str, value: &str) -> String {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/paper.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut done = false;
+    let lines: Vec<String> = text
+        .lines()
+        .map(|l| {
+            if !done && l.starts_with(&format!("{key} = ")) {
+                done = true;
+                value.to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    assert!(done, "no {key} in the paper scene");
+    lines.join("\n")
+}
+
+#[test]
+fn absurd_scene_values_are_refused_naming_the_field_as_written() {
+    let dir = scratch("scenes");
+    let cases = [
+        (
+            "stiffness_n_per_m",
+            "stiffness_n_per_m = 1e300",
+            "static",
+            "air_bearing.stiffness_n_per_m: is 1e300 N/m, above 1e10 N/m",
+        ),
+        (
+            "nominal_clearance_m",
+            "nominal_clearance_m = 1e300",
+            "static",
+            "nominal_clearance_m: must lie between 1e-10 m and 1e-6 m, got 1e300 m",
+        ),
+        (
+            "nominal_clearance_m",
+            "nominal_clearance_nm = 1e-8",
+            "static",
+            "nominal_clearance_nm: must lie between 0.1 nm and 1000 nm, got 1e-8 nm",
+        ),
+        (
+            "rtol",
+            "rtol = 1e-20",
+            "static",
+            "solver.rtol: must lie in [2.2e-14, 1)",
+        ),
+        (
+            "method",
+            "method = \"euler\"",
+            "scene",
+            "solver.method: unknown method \"euler\", expected one of",
+        ),
+    ];
+    for (i, (key, line, cmd, want)) in cases.into_iter().enumerate() {
+        let path = dir.join(format!("bad{i}.toml"));
+        std::fs::write(&path, paper_with(key, line)).unwrap();
+        let e = failure(&hdi(&[cmd, s(&path)]));
+        assert!(e.contains(want), "{line}: {e}");
+    }
+}
+
+#[test]
+fn command_line_values_have_the_bounds_of_scenes() {
+    let cases = [
+        (
+            &["cycle", "--paper", "--v-ac", "1e6"][..],
+            "'--v-ac <V>': must be at most 1000 V",
+        ),
+        (
+            &["sweep", "--paper", "--v-ac", "0,2000"][..],
+            "entry 2: must be at most 1000 V",
+        ),
+        (
+            &["calibrate", "--paper", "--dither-v", "1001"][..],
+            "'--dither-v <V>': must be at most 1000 V",
+        ),
+        // a range error, as for --step-mw -1, not a parse error
+        (
+            &["cycle", "--paper", "--rtol", "-1"][..],
+            "invalid value '-1' for '--rtol <R>': must lie in [2.2e-14, 1)",
+        ),
+        (
+            &["calibrate", "--paper", "--step-mw", "-1"][..],
+            "invalid value '-1' for '--step-mw <MW>': must be > 0",
+        ),
+        // the refined runs tighten tenfold: the last one must stay in range too
+        (
+            &["cycle", "--paper", "--rtol", "1e-11"][..],
+            "--rtol 1e-11 with --max-runs 5 tightens to rtol 1e-15 in the last run",
+        ),
+    ];
+    for (args, want) in cases {
+        let out = hdi(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(want), "{args:?}: {}", stderr(&out));
+    }
+    // --help states the same range
+    let help = String::from_utf8(hdi(&["cycle", "--help"]).stdout).unwrap();
+    assert!(help.contains("in [2.2e-14, 1)"), "{help}");
+}
+
+#[test]
+fn bad_command_files_are_refused_naming_file_line_and_column() {
+    let dir = scratch("commands");
+    let cases = [
+        (
+            "time_s,heater_mw,voltage_dc_v,voltage_ac\n0,60,0,1\n0.001,60,0,1\n",
+            "line 1, column 4 `voltage_ac`: is not a command column",
+        ),
+        (
+            "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,1065,0\n0.002,60,0\n",
+            "line 3, heater_mw: must be in [0, 1000] mW (far above any fly-height heater), got \
+             1065 mW",
+        ),
+        (
+            "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,x,0\n",
+            "line 3, heater_mw: `x` is not a number (mW)",
+        ),
+        (
+            "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,60\n",
+            "line 3: has 2 fields, the header 3",
+        ),
+        (
+            "time_s,heater_mw\n0,60\n0.001,60\n",
+            "line 1: the column voltage_dc_v (V) is missing",
+        ),
+        (
+            "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,,0\n",
+            "line 3, heater_mw: is empty (mW)",
+        ),
+        (
+            "time_s,heater_mw,voltage_dc_v,voltage_ac_v\n0,60,0,2000\n0.001,60,0,0\n",
+            "line 2, voltage_ac_v: must be in [0, 1000] V",
+        ),
+        (
+            "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.00102,60,0\n",
+            "the last row's time_s: 0.00102 s is 20.4 periods of 50 µs, not a whole number: end \
+             at 0.001 s or 0.00105 s",
+        ),
+    ];
+    for (i, (text, want)) in cases.into_iter().enumerate() {
+        let path = dir.join(format!("c{i}.csv"));
+        std::fs::write(&path, text).unwrap();
+        let e = failure(&hdi(&["drive", "--paper", "--commands", s(&path)]));
+        assert!(
+            e.contains(&format!("c{i}.csv")) && e.contains(want),
+            "{text:?}: {e}"
+        );
+        assert!(!e.contains("CSV") && !e.contains("deserialize"), "{e}");
+    }
+}
+
+#[test]
+fn a_high_pass_take_off_without_dither_is_flagged() {
+    let flags = |dither: &str, detector: &str| {
+        let out = hdi(&[
+            "calibrate",
+            "--paper",
+            "--detector",
+            detector,
+            "--dither-v",
+            dither,
+        ]);
+        assert_ok(&out);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (v["flags"].clone(), stderr(&out))
+    };
+    let (f, e) = flags("0", "ae");
+    assert_eq!(f, serde_json::json!(["takeoff_without_dither"]), "{e}");
+    assert!(
+        e.contains("is not a take-off") && e.contains("--detector mean"),
+        "{e}"
+    );
+    // with a dither, and with the mean detector, nothing to flag
+    assert_eq!(flags("0.5", "ae").0, serde_json::json!([]));
+    assert_eq!(flags("0", "mean").0, serde_json::json!([]));
+}
+
+#[test]
+fn static_without_take_off_reports_touchdown_and_a_null_take_off() {
+    let dir = scratch("no_takeoff");
+    // Ten times the paper's Hamaker constant: adhesion holds the head down to zero power.
+    let path = dir.join("sticky.toml");
+    std::fs::write(
+        &path,
+        paper_with("hamaker_attractive_j", "hamaker_attractive_j = 1e-18"),
+    )
+    .unwrap();
+    let out = hdi(&["static", s(&path)]);
+    assert_ok(&out);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let td = v["touchdown_power"].as_f64().unwrap();
+    assert!(td > 0.0 && td < 0.1, "{td}");
+    assert!(
+        v["takeoff_power"].is_null() && v["hysteresis"].is_null(),
+        "{v}"
+    );
+    assert_eq!(v["status"], "converged");
+    assert_eq!(v["flags"], serde_json::json!(["no_takeoff"]));
+    assert!(
+        stderr(&out).contains("adhesion holds it"),
+        "{}",
+        stderr(&out)
+    );
 }

@@ -272,10 +272,7 @@ impl Scene {
         if k > MAX_AIR_BEARING_STIFFNESS_N_PER_M {
             let what = match self.air_bearing {
                 AirBearingModel::PowerLaw { .. } => {
-                    format!(
-                        "gives a stiffness n F0 / h0 of {} N/m",
-                        fmt_short(k)
-                    )
+                    format!("gives a stiffness n F0 / h0 of {} N/m", fmt_short(k))
                 }
                 _ => format!("is {} N/m", fmt_short(k)),
             };
@@ -296,7 +293,11 @@ impl Scene {
             let names: Vec<&str> = crate::ode::Method::ALL.iter().map(|m| m.name()).collect();
             return Err(Error::invalid(
                 "solver.method",
-                format!("unknown method {:?}, expected one of {}", s.method, names.join(", ")),
+                format!(
+                    "unknown method {:?}, expected one of {}",
+                    s.method,
+                    names.join(", ")
+                ),
             ));
         }
         let min = crate::ode::MIN_RTOL;

@@ -14,8 +14,10 @@ use crate::common::{self, non_negative, positive, volts, CliError, SceneArgs};
 /// down to take-off; the heater is then set --margin-mw below touchdown. JSON: detector,
 /// touchdown_power, takeoff_power, hysteresis, set_power (W), clearance (m, static model at the
 /// set power without dither), contrast (detector level at touchdown over the level before),
-/// levels, simulated_time, wall_seconds (s), and flags (no_takeoff). A detector that fires at
-/// the start power already is an error: there is no touchdown to find.
+/// levels, simulated_time, wall_seconds (s), and flags: no_takeoff; takeoff_without_dither when
+/// a high-pass detector (ae, vibration) ran without a dither, whose take-off is then only the
+/// first step down (docs/clearance.md). A detector that fires at the start power already is an
+/// error: there is no touchdown to find.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -55,6 +57,17 @@ enum DetectorKind {
     Mean,
     Ae,
     Vibration,
+}
+
+impl DetectorKind {
+    /// The name as given on the command line.
+    fn name(self) -> &'static str {
+        match self {
+            DetectorKind::Mean => "mean",
+            DetectorKind::Ae => "ae",
+            DetectorKind::Vibration => "vibration",
+        }
+    }
 }
 
 #[derive(Serialize)]
@@ -136,6 +149,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
         })
     })?;
     let mut flags = Vec::new();
+    if c.takeoff_power.is_some() && detector.high_pass() && model.voltage().ac_amplitude == 0.0 {
+        flags.push("takeoff_without_dither");
+        common::warn(&format!(
+            "the take-off {} is not a take-off: the {} detector hears only changes, and without \
+             a dither it hears nothing in steady contact, so it stops firing at the first step \
+             down (docs/clearance.md); give --dither-v or use --detector mean",
+            common::mw(c.takeoff_power.unwrap_or(f64::NAN)),
+            a.detector.name(),
+        ));
+    }
     if opts.find_takeoff && c.takeoff_power.is_none() {
         flags.push("no_takeoff");
         common::warn(&format!(

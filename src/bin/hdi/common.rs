@@ -128,7 +128,10 @@ fn check_volts(x: f64) -> Result<(), String> {
     if x <= max {
         Ok(())
     } else {
-        Err(format!("must be at most {} V, as in a scene", fmt_short(max)))
+        Err(format!(
+            "must be at most {} V, as in a scene",
+            fmt_short(max)
+        ))
     }
 }
 
@@ -327,7 +330,10 @@ impl Output {
 
     /// Writes `bytes` as the whole content.
     pub fn write(self, bytes: &[u8]) -> Result<(), CliError> {
-        self.write_with(|w| w.write_all(bytes).map_err(|e| CliError::Failed(e.to_string())))
+        self.write_with(|w| {
+            w.write_all(bytes)
+                .map_err(|e| CliError::Failed(e.to_string()))
+        })
     }
 
     /// Writes what `fill` writes as the whole content: streamed into the temporary file for a

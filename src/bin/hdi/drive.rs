@@ -2,7 +2,9 @@
 
 use std::path::PathBuf;
 
-use hdi_tribology::drive::{read_commands, replay, scene_zone, DiskSpec, DriveOptions, Plant};
+use hdi_tribology::drive::{
+    read_commands, replay, scene_zone, whole_periods, DiskSpec, DriveOptions, Plant,
+};
 
 use crate::common::{self, positive, CliError, Output, SceneArgs};
 
@@ -70,6 +72,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let file = std::fs::File::open(&a.commands)
         .map_err(|e| CliError::Failed(format!("--commands {shown}: {e}")))?;
     let rows = read_commands(std::io::BufReader::new(file), &shown)?;
+    let dt = 1e-3 / a.rate_khz;
+    // A run ends on a period boundary: an end between two is refused, not cut.
+    whole_periods(&rows, dt, &shown)?;
     let out = a
         .out
         .as_deref()
@@ -81,7 +86,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
         a.seed,
         opts,
     )?;
-    let dt = 1e-3 / a.rate_khz;
     match out {
         Some(out) => {
             let mut summary = None;
