@@ -532,3 +532,67 @@ fn static_without_take_off_reports_touchdown_and_a_null_take_off() {
         stderr(&out)
     );
 }
+
+/// A command file of 2 s: 40000 periods at 20 kHz over a wavy disk, a few seconds of
+/// `hdi drive`.
+fn long_commands(dir: &Path) -> PathBuf {
+    let p = dir.join("long.csv");
+    std::fs::write(&p, "time_s,heater_mw,voltage_dc_v\n0,60,0\n2,65,0\n").unwrap();
+    p
+}
+
+#[test]
+fn no_progress_when_stderr_is_not_a_terminal() {
+    let dir = scratch("progress_pipe");
+    let cmds = long_commands(&dir);
+    let t = Instant::now();
+    let out = hdi(&[
+        "drive",
+        "--paper",
+        "--commands",
+        s(&cmds),
+        "--out",
+        s(&dir.join("d.csv")),
+    ]);
+    assert_ok(&out);
+    assert!(
+        t.elapsed() > Duration::from_secs(1),
+        "the run is long enough to show progress"
+    );
+    assert_eq!(stderr(&out), "");
+}
+
+/// `hdi args` on a pseudo-terminal made by script(1); what the terminal showed, or None when
+/// script(1) is not installed.
+fn on_a_terminal(dir: &Path, args: &[&str]) -> Option<String> {
+    let log = dir.join("terminal.txt");
+    let line = std::iter::once(HDI)
+        .chain(args.iter().copied())
+        .map(|a| format!("'{a}'"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let status = Command::new("script")
+        .args(["-q", "-e", "-c", &format!("{line} >/dev/null"), s(&log)])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .status()
+        .ok()?;
+    assert!(status.success());
+    Some(String::from_utf8_lossy(&std::fs::read(&log).unwrap()).into_owned())
+}
+
+#[test]
+fn progress_on_a_terminal_and_quiet_silences_it() {
+    let dir = scratch("progress_tty");
+    let cmds = long_commands(&dir);
+    let out = dir.join("d.csv");
+    let args = ["drive", "--paper", "--commands", s(&cmds), "--out", s(&out)];
+    let Some(shown) = on_a_terminal(&dir, &args) else {
+        eprintln!("script(1) is not installed: the terminal case is not checked");
+        return;
+    };
+    assert!(shown.contains("/40001 lines"), "{shown}");
+    let quiet: Vec<&str> = args.iter().copied().chain(["--quiet"]).collect();
+    let shown = on_a_terminal(&dir, &quiet).unwrap();
+    assert!(!shown.contains("lines"), "{shown}");
+}

@@ -182,8 +182,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
         (None, Some(f)) => Some((Output::prepare(f, "--svg")?, None)),
         (None, None) => None,
     };
+    let progress = common::Progress::spinner("bearing: attitude, stiffness and damping");
     let eq = solve_attitude(&bearing, &AttitudeOptions::default())?;
     let rep = report(&eq)?;
+    drop(progress);
     if let Some((svg, csv)) = files {
         svg.write(eq.pressure_map_svg().as_bytes())?;
         if let Some(csv) = csv {

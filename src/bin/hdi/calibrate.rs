@@ -132,6 +132,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )?),
     };
     let clock = std::time::Instant::now();
+    let progress = common::Progress::spinner("calibrate: heater staircase");
     let c = calibrate(&model, detector.as_mut(), &opts).map_err(|e| {
         CliError::Failed(match e {
             hdi_tribology::Error::InvalidInput { ref field, .. } if field == "margin" => {
@@ -148,6 +149,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             }
         })
     })?;
+    drop(progress);
     let mut flags = Vec::new();
     if c.takeoff_power.is_some() && detector.high_pass() && model.voltage().ac_amplitude == 0.0 {
         flags.push("takeoff_without_dither");

@@ -432,3 +432,99 @@ pub fn nm(x: f64) -> String {
 pub fn mw(x: f64) -> String {
     format!("{} mW", fmt_short(to_mw(x)))
 }
+
+/// `--quiet`: no progress on the terminal.
+static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Sets `--quiet` for the whole run.
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// How long a run goes before its progress shows.
+const PROGRESS_AFTER: std::time::Duration = std::time::Duration::from_secs(1);
+
+/// Progress on standard error while a run lasts: shown only on a terminal, only once the run has
+/// gone on for [`PROGRESS_AFTER`], never with `--quiet`; cleared when dropped. Results and
+/// warnings are unaffected.
+pub struct Progress {
+    bar: indicatif::ProgressBar,
+}
+
+impl Progress {
+    /// A spinner with the elapsed time and `what` (a run whose length is not known ahead).
+    pub fn spinner(what: &str) -> Progress {
+        let bar =
+            indicatif::ProgressBar::with_draw_target(None, indicatif::ProgressDrawTarget::hidden());
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+        );
+        bar.set_message(what.to_string());
+        Progress::start(bar)
+    }
+
+    /// A bar of `total` units named `unit` (e.g. periods), with `what` and the time left.
+    pub fn bar(what: &str, total: u64, unit: &str) -> Progress {
+        let bar = indicatif::ProgressBar::with_draw_target(
+            Some(total),
+            indicatif::ProgressDrawTarget::hidden(),
+        );
+        let template =
+            format!("{{bar:30}} {{pos}}/{{len}} {unit}, {{elapsed}} (~{{eta}} left) {{msg}}");
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(&template)
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_message(what.to_string());
+        Progress::start(bar)
+    }
+
+    /// Shows `bar` after [`PROGRESS_AFTER`] unless the run has ended, `--quiet` was given or
+    /// standard error is not a terminal.
+    fn start(bar: indicatif::ProgressBar) -> Progress {
+        use std::io::IsTerminal;
+        if !QUIET.load(std::sync::atomic::Ordering::Relaxed) && std::io::stderr().is_terminal() {
+            let shown = bar.clone();
+            std::thread::spawn(move || {
+                std::thread::sleep(PROGRESS_AFTER);
+                if !shown.is_finished() {
+                    shown.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+                    shown.enable_steady_tick(std::time::Duration::from_millis(120));
+                }
+            });
+        }
+        Progress { bar }
+    }
+
+    /// Counts `n` more units done.
+    pub fn inc(&self, n: u64) {
+        self.bar.inc(n);
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// A writer that counts the lines passing through it on a [`Progress`] bar.
+pub struct CountLines<'a, W: Write> {
+    /// Where the bytes go.
+    pub inner: W,
+    /// The bar that counts them.
+    pub progress: &'a Progress,
+}
+
+impl<W: Write> Write for CountLines<'_, W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        let lines = buf[..n].iter().filter(|&&b| b == b'\n').count();
+        self.progress.inc(lines as u64);
+        Ok(n)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}

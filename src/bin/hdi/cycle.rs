@@ -268,11 +268,13 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let (model, programme, mut opts) = a.cycle.setup(&scene)?;
     opts.keep_series = out.is_some();
     let v_ac = a.v_ac.unwrap_or(model.voltage().ac_amplitude);
+    let progress = common::Progress::spinner("cycle: refining until converged");
     let (report, cycle) = a
         .cycle
         .run(&model, &programme, &opts, &[v_ac])?
         .pop()
         .ok_or_else(|| CliError::Failed("the cycle gave no result".into()))?;
+    drop(progress);
     if let (Some(out), Some(series)) = (out, cycle.series) {
         out.write_via_path(|p| Ok(series.write_csv(p)?))?;
     }

@@ -6,7 +6,7 @@ use hdi_tribology::drive::{
     read_commands, replay, scene_zone, whole_periods, DiskSpec, DriveOptions, Plant,
 };
 
-use crate::common::{self, positive, CliError, Output, SceneArgs};
+use crate::common::{self, positive, CliError, CountLines, Output, SceneArgs};
 
 /// Replays --commands (CSV: time_s, heater_mw, voltage_dc_v and optionally voltage_ac_v,
 /// ac_frequency_khz; each row holds until the next, the last row's time ends the run) through the
@@ -74,7 +74,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let rows = read_commands(std::io::BufReader::new(file), &shown)?;
     let dt = 1e-3 / a.rate_khz;
     // A run ends on a period boundary: an end between two is refused, not cut.
-    whole_periods(&rows, dt, &shown)?;
+    let periods = whole_periods(&rows, dt, &shown)?;
     let out = a
         .out
         .as_deref()
@@ -86,19 +86,31 @@ pub fn run(a: Args) -> Result<(), CliError> {
         a.seed,
         opts,
     )?;
+    // One line per period, and the header.
+    let progress = common::Progress::bar("drive", periods as u64 + 1, "lines");
     match out {
         Some(out) => {
             let mut summary = None;
             out.write_with(|w| {
+                let w = CountLines {
+                    inner: w,
+                    progress: &progress,
+                };
                 summary = Some(replay(&plant, &rows, dt, w)?);
                 Ok(())
             })?;
+            drop(progress);
             common::print_json(&summary)
         }
         None => {
             // Whole or nothing on standard output too: the run finishes before anything is printed.
             let mut buf = Vec::new();
-            replay(&plant, &rows, dt, &mut buf)?;
+            let w = CountLines {
+                inner: &mut buf,
+                progress: &progress,
+            };
+            replay(&plant, &rows, dt, w)?;
+            drop(progress);
             common::write_stdout(&buf)
         }
     }

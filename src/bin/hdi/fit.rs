@@ -108,7 +108,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
         },
         plot: scratch.as_ref().map(|d| d.path().to_path_buf()),
     };
+    let progress = common::Progress::spinner("fit: least squares");
     let json = run_cli(&args).map_err(|e: FitError| CliError::Failed(e.to_string()))?;
+    drop(progress);
     if let (Some(scratch), Some(dir)) = (&scratch, &a.plot) {
         deliver_plots(scratch.path(), dir)?;
     }

@@ -42,6 +42,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let scene = a.scene.load()?;
     let model = SliderModel::from_scene(&scene)?;
     let opts = StaticOptions::new(scene.detector.contact_threshold_n);
+    let progress = common::Progress::spinner("static: touchdown, take-off, pull-in, folds");
     let touchdown = touchdown_power(&model, &opts)?;
     let mut flags = Vec::new();
     let takeoff = match takeoff_power(&model, touchdown.power + opts.takeoff_start_excess, &opts) {
@@ -62,6 +63,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         None
     };
     let curve = s_curve(&model, None, &ScanGrid::default())?;
+    drop(progress);
     if let Some(h) = hysteresis.filter(|&h| h < 0.0) {
         flags.push("negative_hysteresis");
         common::warn(&format!(

@@ -29,6 +29,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "no amplitudes: give --v-ac or a sweep.ac_amplitudes_v list in the scene".into(),
         ));
     }
+    let _progress = common::Progress::spinner(&format!(
+        "sweep: {} amplitudes, each refined until converged",
+        amplitudes.len()
+    ));
     let rows: Vec<_> = a
         .cycle
         .run(&model, &programme, &opts, &amplitudes)?
