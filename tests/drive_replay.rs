@@ -68,7 +68,10 @@ fn bad_command_files_name_line_and_column() {
             "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.1,60,0,1,-2\n",
             "line 3",
         ),
-        ("time_s,heater_mw\n0,60\n0.1,60\n", "line 2"),
+        (
+            "time_s,heater_mw\n0,60\n0.1,60\n",
+            "line 1: the column voltage_dc_v (V) is missing",
+        ),
         (
             "time_s,heater_mw,voltage_dc_v\n0,60,0\n",
             "at least two rows",

@@ -54,6 +54,19 @@ pub trait TouchdownDetector: Debug {
     fn update(&mut self, sample: &Sample) -> bool;
     /// The quantity compared with the threshold, after the last update (detector's own unit).
     fn level(&self) -> f64;
+    /// `true` for a detector that hears only changes (a high-pass filter before its RMS): in
+    /// steady contact without an AC dither it hears nothing, so its take-off without a dither is
+    /// the first step down, not a take-off (docs/clearance.md). `false` by default.
+    ///
+    /// ```
+    /// use hdi_tribology::calibration::{ContactForceRms, MeanContactForce, TouchdownDetector};
+    /// assert!(ContactForceRms::new(1e-5, 5e3, 5e-5)?.high_pass());
+    /// assert!(!MeanContactForce::new(5e-5, 1e-5)?.high_pass());
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    fn high_pass(&self) -> bool {
+        false
+    }
 }
 
 /// The reference detector of the static model: the running mean of the contact force over a
@@ -195,6 +208,9 @@ impl TouchdownDetector for ContactForceRms {
     fn name(&self) -> &str {
         "AE proxy (HPF contact-force RMS)"
     }
+    fn high_pass(&self) -> bool {
+        true
+    }
     fn reset(&mut self) {
         self.0.reset();
     }
@@ -246,6 +262,9 @@ impl VibrationRms {
 impl TouchdownDetector for VibrationRms {
     fn name(&self) -> &str {
         "vibration (HPF displacement RMS)"
+    }
+    fn high_pass(&self) -> bool {
+        true
     }
     fn reset(&mut self) {
         self.0.reset();
@@ -327,6 +346,9 @@ impl<D: TouchdownDetector> Relative<D> {
 impl<D: TouchdownDetector> TouchdownDetector for Relative<D> {
     fn name(&self) -> &str {
         &self.name
+    }
+    fn high_pass(&self) -> bool {
+        self.inner.high_pass()
     }
 
     fn reset(&mut self) {

@@ -46,8 +46,8 @@ pub use controller::{
 pub use disk::{DiskSpec, Harmonic};
 pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions, Plant};
 pub use replay::{
-    check_commands, read_commands, replay, replay_each, sensor_row, CommandRow, ReplaySummary,
-    MAX_REPLAY_PERIODS, SENSOR_COLUMNS,
+    check_commands, read_commands, replay, replay_each, sensor_row, whole_periods, CommandRow,
+    ReplaySummary, MAX_REPLAY_PERIODS, SENSOR_COLUMNS,
 };
 pub use roc::{touchdown_roc, RocPoint};
 pub use sensors::{

@@ -71,7 +71,7 @@ impl Command {
 }
 
 /// Largest heater power a command may ask for (W): far above any thermal fly-height heater.
-const MAX_HEATER_POWER: f64 = 1.0;
+pub const MAX_HEATER_POWER: f64 = 1.0;
 
 /// Ambient temperature drift and what it does to the clearance.
 ///

@@ -41,12 +41,24 @@ pub const SENSOR_COLUMNS: [&str; 12] = [
 /// Most periods one replay may run.
 pub const MAX_REPLAY_PERIODS: f64 = 1e7;
 
+/// The columns of a command file: name, unit, and whether it may be left out.
+const COMMAND_COLUMNS: [(&str, &str, bool); 5] = [
+    ("time_s", "s", false),
+    ("heater_mw", "mW", false),
+    ("voltage_dc_v", "V", false),
+    ("voltage_ac_v", "V", true),
+    ("ac_frequency_khz", "kHz", true),
+];
+
 /// Reads a command file (CSV with a header naming the columns of [`CommandRow`]; the AC columns
-/// may be left out). `origin` names the file in errors.
+/// may be left out, no other column may be there). `origin` names the file in errors.
 ///
 /// # Errors
-/// A row that does not parse, a value out of range, times that are not strictly increasing
-/// from 0: an [`Error::InvalidInput`] naming the file, the line and the column.
+/// A column that is not a command column (a misspelt `voltage_ac` would otherwise run with no
+/// dither), a column missing or given twice, a row of the wrong length, a value that is not a
+/// number or out of range (heater above 1000 mW, a voltage beyond ±1000 V, an AC frequency
+/// above 10 MHz), times that are not strictly increasing from 0: an [`Error::InvalidInput`]
+/// naming the file, the line and the column.
 ///
 /// ```
 /// use hdi_tribology::drive::read_commands;
@@ -57,24 +69,138 @@ pub const MAX_REPLAY_PERIODS: f64 = 1e7;
 /// let bad = "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,-5,0\n";
 /// let e = read_commands(bad.as_bytes(), "commands.csv").unwrap_err();
 /// assert!(e.to_string().contains("commands.csv line 3, heater_mw"), "{e}");
+/// let typo = "time_s,heater_mw,voltage_dc_v,voltage_ac\n0,60,0,1\n0.001,60,0,1\n";
+/// let e = read_commands(typo.as_bytes(), "commands.csv").unwrap_err();
+/// assert!(e.to_string().contains("`voltage_ac`"), "{e}");
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 pub fn read_commands<R: Read>(input: R, origin: &str) -> Result<Vec<CommandRow>> {
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
+        .flexible(true)
         .from_reader(input);
+    let header = rdr.headers().map_err(|e| csv_error(origin, e))?.clone();
+    // Where each command column sits in the file.
+    let mut at: [Option<usize>; 5] = [None; 5];
+    let known = || {
+        COMMAND_COLUMNS
+            .iter()
+            .map(|c| c.0)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    for (j, name) in header.iter().enumerate() {
+        let field = || format!("{origin} line 1, column {} `{name}`", j + 1);
+        match COMMAND_COLUMNS.iter().position(|c| c.0 == name) {
+            Some(k) if at[k].is_some() => {
+                return Err(Error::invalid(field(), "is given twice"));
+            }
+            Some(k) => at[k] = Some(j),
+            None => {
+                return Err(Error::invalid(
+                    field(),
+                    format!(
+                        "is not a command column; the columns are {} (the last two may be left \
+                         out)",
+                        known()
+                    ),
+                ))
+            }
+        }
+    }
+    if let Some(k) = (0..5).find(|&k| at[k].is_none() && !COMMAND_COLUMNS[k].2) {
+        let (name, unit, _) = COMMAND_COLUMNS[k];
+        return Err(Error::invalid(
+            format!("{origin} line 1"),
+            format!(
+                "the column {name} ({unit}) is missing; the columns are {}",
+                known()
+            ),
+        ));
+    }
     let mut rows: Vec<CommandRow> = Vec::new();
-    for (i, rec) in rdr.deserialize::<CommandRow>().enumerate() {
-        let line = i + 2;
-        let row =
-            rec.map_err(|e| Error::invalid(format!("{origin} line {line}"), e.to_string()))?;
-        check_row(&row, rows.last(), |name| {
-            format!("{origin} line {line}, {name}")
-        })?;
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| csv_error(origin, e))?;
+        let line = rec.position().map_or(rows.len() + 2, |p| p.line() as usize);
+        let field = |name: &str| format!("{origin} line {line}, {name}");
+        if rec.len() != header.len() {
+            return Err(Error::invalid(
+                format!("{origin} line {line}"),
+                format!("has {} fields, the header {}", rec.len(), header.len()),
+            ));
+        }
+        let mut v = [0.0; 5];
+        for (k, &(name, unit, _)) in COMMAND_COLUMNS.iter().enumerate() {
+            let Some(j) = at[k] else { continue };
+            let text = rec.get(j).unwrap_or("");
+            v[k] = match text.parse::<f64>() {
+                _ if text.is_empty() => {
+                    return Err(Error::invalid(field(name), format!("is empty ({unit})")))
+                }
+                Ok(x) => x,
+                Err(_) => {
+                    return Err(Error::invalid(
+                        field(name),
+                        format!("`{text}` is not a number ({unit})"),
+                    ))
+                }
+            };
+        }
+        let row = CommandRow {
+            time_s: v[0],
+            heater_mw: v[1],
+            voltage_dc_v: v[2],
+            voltage_ac_v: v[3],
+            ac_frequency_khz: v[4],
+        };
+        check_row(&row, rows.last(), field)?;
         rows.push(row);
     }
     check_count(&rows, origin)?;
     Ok(rows)
+}
+
+/// A reading error of the csv crate in words, with the file and line.
+fn csv_error(origin: &str, e: csv::Error) -> Error {
+    let line = e.position().map(|p| p.line());
+    let at = line.map_or_else(|| origin.to_string(), |l| format!("{origin} line {l}"));
+    match e.kind() {
+        csv::ErrorKind::Io(err) => Error::invalid(origin, format!("cannot read: {err}")),
+        csv::ErrorKind::Utf8 { .. } => Error::invalid(at, "is not UTF-8 text"),
+        _ => Error::invalid(at, e.to_string()),
+    }
+}
+
+/// The last row's time as a whole number of periods `dt` (s), or an error naming `origin`:
+/// a replay runs whole periods, and an end between two would be cut without a word.
+///
+/// ```
+/// use hdi_tribology::drive::{read_commands, whole_periods};
+/// let rows = read_commands("time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,60,0\n".as_bytes(), "c.csv")?;
+/// assert_eq!(whole_periods(&rows, 50e-6, "c.csv")?, 20);
+/// assert!(whole_periods(&rows, 30e-6, "c.csv").is_err());
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+pub fn whole_periods(rows: &[CommandRow], dt: f64, origin: &str) -> Result<usize> {
+    crate::error::check_positive("dt", dt)?;
+    let end = rows.last().map_or(0.0, |r| r.time_s);
+    let n = end / dt;
+    let whole = n.round();
+    if (n - whole).abs() > 1e-9 * whole.max(1.0) {
+        let (below, above) = (n.floor() * dt, n.ceil() * dt);
+        return Err(Error::invalid(
+            format!("{origin}, the last row's time_s"),
+            format!(
+                "{} s is {} periods of {} µs, not a whole number: end at {} s or {} s",
+                crate::units::fmt_short(end),
+                crate::units::fmt_short(n),
+                crate::units::fmt_short(dt * 1e6),
+                crate::units::fmt_short(below),
+                crate::units::fmt_short(above),
+            ),
+        ));
+    }
+    Ok(whole as usize)
 }
 
 /// Checks command rows given as columns rather than read from a file (for bindings and
@@ -102,6 +228,14 @@ pub fn check_commands(
     check_count(rows, origin)
 }
 
+/// The unit of a command column.
+fn unit_of(name: &str) -> &'static str {
+    COMMAND_COLUMNS
+        .iter()
+        .find(|c| c.0 == name)
+        .map_or("", |c| c.1)
+}
+
 /// One row's values and its time against the row before.
 fn check_row(
     row: &CommandRow,
@@ -114,19 +248,37 @@ fn check_row(
         } else {
             Err(Error::invalid(
                 field(name),
-                format!("must be {want}, got {v}"),
+                format!("must be {want}, got {v} {}", unit_of(name)),
             ))
         }
     };
+    let max_mw = super::plant::MAX_HEATER_POWER * 1e3;
+    let max_v = crate::scene::MAX_VOLTAGE_V;
+    let max_khz = crate::scene::MAX_AC_FREQUENCY_HZ * 1e-3;
     check("time_s", row.time_s, row.time_s >= 0.0, "≥ 0 s")?;
-    check("heater_mw", row.heater_mw, row.heater_mw >= 0.0, "≥ 0 mW")?;
-    check("voltage_dc_v", row.voltage_dc_v, true, "finite (V)")?;
-    check("voltage_ac_v", row.voltage_ac_v, true, "finite (V)")?;
+    check(
+        "heater_mw",
+        row.heater_mw,
+        (0.0..=max_mw).contains(&row.heater_mw),
+        &format!("in [0, {max_mw}] mW (far above any fly-height heater)"),
+    )?;
+    check(
+        "voltage_dc_v",
+        row.voltage_dc_v,
+        row.voltage_dc_v.abs() <= max_v,
+        &format!("within ±{max_v} V, as in a scene"),
+    )?;
+    check(
+        "voltage_ac_v",
+        row.voltage_ac_v,
+        (0.0..=max_v).contains(&row.voltage_ac_v),
+        &format!("in [0, {max_v}] V, as in a scene"),
+    )?;
     check(
         "ac_frequency_khz",
         row.ac_frequency_khz,
-        row.ac_frequency_khz >= 0.0,
-        "≥ 0 kHz",
+        (0.0..=max_khz).contains(&row.ac_frequency_khz),
+        &format!("in [0, {max_khz}] kHz, as in a scene"),
     )?;
     match prev {
         None if row.time_s != 0.0 => Err(Error::invalid(

@@ -48,7 +48,7 @@ pub use dense::{DenseOutput, StepPolynomial};
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
 pub use integrator::{Integrator, StepStatus};
-pub use options::{Method, Options, SaveAt, Tolerance};
+pub use options::{Method, Options, SaveAt, Tolerance, MIN_RTOL};
 pub use problem::OdeProblem;
 pub use solution::{Solution, Stats};
 pub use system::{

@@ -72,6 +72,16 @@ impl fmt::Display for Method {
     }
 }
 
+/// Smallest relative tolerance, 100 ε (≈ 2.2e-14): below it the error estimates are rounding
+/// noise. Scenes and the command line take `rtol` in `[MIN_RTOL, 1)`.
+///
+/// ```
+/// use hdi_tribology::ode::{Options, MIN_RTOL};
+/// assert!(Options::default().rtol(MIN_RTOL).validate(1).is_ok());
+/// assert!(Options::default().rtol(MIN_RTOL / 2.0).validate(1).is_err());
+/// ```
+pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
+
 impl FromStr for Method {
     type Err = OdeError;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
@@ -269,10 +279,13 @@ impl Options {
 
     /// Checks every option for a state of dimension `n`.
     pub fn validate(&self, n: usize) -> Result<(), OdeError> {
-        if !(self.rtol.is_finite() && self.rtol >= 100.0 * f64::EPSILON && self.rtol < 1.0) {
+        if !(self.rtol.is_finite() && self.rtol >= MIN_RTOL && self.rtol < 1.0) {
             return Err(OdeError::invalid(
                 "options.rtol",
-                format!("must be finite, in [100 ε, 1), got {}", self.rtol),
+                format!(
+                    "must be finite, in [{MIN_RTOL:.1e}, 1) (100 ε), got {}",
+                    self.rtol
+                ),
             ));
         }
         match &self.atol {

@@ -82,3 +82,7 @@ pub use spec::{
     Scene, SliderSpec, SolverSpec, SurfaceSpec, SweepSpec, TableSpec, TriggeredSpec, VoltageSpec,
 };
 pub use structure::{StructureSpec, MAX_DOF};
+pub use validate::{
+    MAX_AC_FREQUENCY_HZ, MAX_AIR_BEARING_STIFFNESS_N_PER_M, MAX_NOMINAL_CLEARANCE_M, MAX_STEPS,
+    MAX_VOLTAGE_V, MIN_NOMINAL_CLEARANCE_M,
+};

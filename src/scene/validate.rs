@@ -22,6 +22,36 @@ pub const MAX_STEPS: usize = 100_000_000;
 /// meaning (and, far beyond, overflow).
 pub const MAX_SIGMA_OVER_CLEARANCE: f64 = 10.0;
 
+/// Smallest nominal clearance (m): 0.1 nm, about an atom's size; below it the continuum forces
+/// of the model lose meaning.
+pub const MIN_NOMINAL_CLEARANCE_M: f64 = 1e-10;
+
+/// Largest nominal clearance (m): 1 µm, a hundred times the clearance of any drive with thermal
+/// fly-height control; the force tables and the lumped model are built for gaps of nanometres.
+pub const MAX_NOMINAL_CLEARANCE_M: f64 = 1e-6;
+
+/// Largest air-bearing stiffness (N/m) at the flying gap: 1e10, a thousand times that of any
+/// slider's air bearing (1e5 to 1e7 N/m; the paper's scene has 3e5). Far beyond it the pull-in
+/// voltage and the settling times lose meaning.
+pub const MAX_AIR_BEARING_STIFFNESS_N_PER_M: f64 = 1e10;
+
+/// Checks `lo ≤ value ≤ hi`, naming `field` and the unit.
+fn check_range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<()> {
+    check_finite(field, value)?;
+    if !(lo..=hi).contains(&value) {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must lie between {} {unit} and {} {unit}, got {} {unit}",
+                fmt_short(lo),
+                fmt_short(hi),
+                fmt_short(value)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Checks `|value| ≤ bound`, naming `field` and the unit.
 fn check_magnitude(field: &str, value: f64, bound: f64, unit: &str) -> Result<()> {
     check_finite(field, value)?;
@@ -50,6 +80,13 @@ impl Scene {
             return Err(Error::invalid("name", "must not be empty"));
         }
         check_positive("nominal_clearance_m", self.nominal_clearance_m)?;
+        check_range(
+            "nominal_clearance_m",
+            self.nominal_clearance_m,
+            MIN_NOMINAL_CLEARANCE_M,
+            MAX_NOMINAL_CLEARANCE_M,
+            "m",
+        )?;
         check_non_negative("surface.height_sigma_m", self.surface.height_sigma_m)?;
         self.validate_sigma()?;
         if let Some(m) = &self.intermolecular {
@@ -97,7 +134,7 @@ impl Scene {
             check_positive("contact.asperity_density_per_m2", c.asperity_density_per_m2)?;
             c.footprint.validate("contact.footprint")?;
         }
-        self.air_bearing.build()?;
+        self.validate_air_bearing()?;
         check_positive("slider.mass_kg", self.slider.mass_kg)?;
         check_non_negative("slider.interface_lag_s", self.slider.interface_lag_s)?;
         self.validate_structure()?;
@@ -221,15 +258,56 @@ impl Scene {
         Ok(())
     }
 
+    /// The air bearing's own fields, and its stiffness at the flying gap within
+    /// [`MAX_AIR_BEARING_STIFFNESS_N_PER_M`].
+    fn validate_air_bearing(&self) -> Result<()> {
+        use crate::force::AirBearingModel;
+        let k = self.air_bearing.build()?.stiffness(0.0);
+        let field = match self.air_bearing {
+            AirBearingModel::Linear { .. } | AirBearingModel::Cubic { .. } => {
+                "air_bearing.stiffness_n_per_m"
+            }
+            AirBearingModel::PowerLaw { .. } => "air_bearing.preload_n",
+        };
+        if k > MAX_AIR_BEARING_STIFFNESS_N_PER_M {
+            let what = match self.air_bearing {
+                AirBearingModel::PowerLaw { .. } => {
+                    format!("gives a stiffness n F0 / h0 of {} N/m", fmt_short(k))
+                }
+                _ => format!("is {} N/m", fmt_short(k)),
+            };
+            return Err(Error::invalid(
+                field,
+                format!(
+                    "{what}, above {} N/m, a thousand times the stiffest slider air bearing",
+                    fmt_short(MAX_AIR_BEARING_STIFFNESS_N_PER_M)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     fn validate_solver(&self) -> Result<()> {
         let s = &self.solver;
-        if s.method.trim().is_empty() {
-            return Err(Error::invalid("solver.method", "must not be empty"));
+        if s.method.parse::<crate::ode::Method>().is_err() {
+            let names: Vec<&str> = crate::ode::Method::ALL.iter().map(|m| m.name()).collect();
+            return Err(Error::invalid(
+                "solver.method",
+                format!(
+                    "unknown method {:?}, expected one of {}",
+                    s.method,
+                    names.join(", ")
+                ),
+            ));
         }
-        if !(s.rtol > 0.0 && s.rtol < 1.0) {
+        let min = crate::ode::MIN_RTOL;
+        if !(s.rtol >= min && s.rtol < 1.0) {
             return Err(Error::invalid(
                 "solver.rtol",
-                format!("must lie in (0, 1), got {}", fmt_short(s.rtol)),
+                format!(
+                    "must lie in [{min:.1e}, 1) (100 ε up to 1), got {}",
+                    fmt_short(s.rtol)
+                ),
             ));
         }
         check_positive("solver.atol_m", s.atol_m)?;

@@ -158,12 +158,6 @@ fn pressure_csv(eq: &Equilibrium) -> String {
     s
 }
 
-fn write(out: Output, text: &str) -> Result<(), CliError> {
-    std::fs::write(out.tmp_path(), text)
-        .map_err(|e| CliError::Failed(format!("cannot write: {e}")))?;
-    out.commit()
-}
-
 pub fn run(a: Args) -> Result<(), CliError> {
     let mut spec = BearingSpec::from_path(&a.geometry)?;
     if let Some(n) = a.cells {
@@ -188,12 +182,14 @@ pub fn run(a: Args) -> Result<(), CliError> {
         (None, Some(f)) => Some((Output::prepare(f, "--svg")?, None)),
         (None, None) => None,
     };
+    let progress = common::Progress::spinner("bearing: attitude, stiffness and damping");
     let eq = solve_attitude(&bearing, &AttitudeOptions::default())?;
     let rep = report(&eq)?;
+    drop(progress);
     if let Some((svg, csv)) = files {
-        write(svg, &eq.pressure_map_svg())?;
+        svg.write(eq.pressure_map_svg().as_bytes())?;
         if let Some(csv) = csv {
-            write(csv, &pressure_csv(&eq))?;
+            csv.write(pressure_csv(&eq).as_bytes())?;
         }
     }
     common::print_json(&rep)

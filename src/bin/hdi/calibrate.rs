@@ -8,14 +8,16 @@ use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::units::fmt_short;
 use serde::Serialize;
 
-use crate::common::{self, non_negative, positive, CliError, SceneArgs};
+use crate::common::{self, non_negative, positive, volts, CliError, SceneArgs};
 
 /// Heater steps of --step-mw from --start-mw up to --max-mw until the detector fires, then back
 /// down to take-off; the heater is then set --margin-mw below touchdown. JSON: detector,
 /// touchdown_power, takeoff_power, hysteresis, set_power (W), clearance (m, static model at the
 /// set power without dither), contrast (detector level at touchdown over the level before),
-/// levels, simulated_time, wall_seconds (s), and flags (no_takeoff). A detector that fires at
-/// the start power already is an error: there is no touchdown to find.
+/// levels, simulated_time, wall_seconds (s), and flags: no_takeoff; takeoff_without_dither when
+/// a high-pass detector (ae, vibration) ran without a dither, whose take-off is then only the
+/// first step down (docs/clearance.md). A detector that fires at the start power already is an
+/// error: there is no touchdown to find.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -43,7 +45,7 @@ pub struct Args {
     detector: DetectorKind,
     /// AC dither amplitude (V) at the scene's frequency while calibrating [default: the scene's
     /// voltage.ac_amplitude_v].
-    #[arg(long, value_name = "V", value_parser = non_negative, allow_hyphen_values = true)]
+    #[arg(long, value_name = "V", value_parser = volts, allow_hyphen_values = true)]
     dither_v: Option<f64>,
     /// Stop at touchdown: do not step back down to take-off.
     #[arg(long)]
@@ -55,6 +57,17 @@ enum DetectorKind {
     Mean,
     Ae,
     Vibration,
+}
+
+impl DetectorKind {
+    /// The name as given on the command line.
+    fn name(self) -> &'static str {
+        match self {
+            DetectorKind::Mean => "mean",
+            DetectorKind::Ae => "ae",
+            DetectorKind::Vibration => "vibration",
+        }
+    }
 }
 
 #[derive(Serialize)]
@@ -119,6 +132,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )?),
     };
     let clock = std::time::Instant::now();
+    let progress = common::Progress::spinner("calibrate: heater staircase");
     let c = calibrate(&model, detector.as_mut(), &opts).map_err(|e| {
         CliError::Failed(match e {
             hdi_tribology::Error::InvalidInput { ref field, .. } if field == "margin" => {
@@ -135,7 +149,18 @@ pub fn run(a: Args) -> Result<(), CliError> {
             }
         })
     })?;
+    drop(progress);
     let mut flags = Vec::new();
+    if c.takeoff_power.is_some() && detector.high_pass() && model.voltage().ac_amplitude == 0.0 {
+        flags.push("takeoff_without_dither");
+        common::warn(&format!(
+            "the take-off {} is not a take-off: the {} detector hears only changes, and without \
+             a dither it hears nothing in steady contact, so it stops firing at the first step \
+             down (docs/clearance.md); give --dither-v or use --detector mean",
+            common::mw(c.takeoff_power.unwrap_or(f64::NAN)),
+            a.detector.name(),
+        ));
+    }
     if opts.find_takeoff && c.takeoff_power.is_none() {
         flags.push("no_takeoff");
         common::warn(&format!(

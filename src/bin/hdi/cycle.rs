@@ -12,7 +12,7 @@ use hdi_tribology::scene::Scene;
 use hdi_tribology::units::{fmt_short, mw as from_mw, nm as from_nm};
 use serde::Serialize;
 
-use crate::common::{self, fraction, non_negative, positive, CliError, Output, SceneArgs};
+use crate::common::{self, positive, rtol, volts, CliError, Output, SceneArgs};
 
 /// One touchdown/take-off cycle under the scene's fixed heater programme (or the
 /// touchdown-triggered protocol), JSON: v_ac (V), touchdown_power, takeoff_power, hysteresis
@@ -29,7 +29,7 @@ pub struct Args {
     #[command(flatten)]
     scene: SceneArgs,
     /// AC amplitude (V) [default: the scene's voltage.ac_amplitude_v].
-    #[arg(long, value_name = "V", value_parser = non_negative, allow_hyphen_values = true)]
+    #[arg(long, value_name = "V", value_parser = volts, allow_hyphen_values = true)]
     v_ac: Option<f64>,
     /// Write the time series of spacing and forces of the final run as CSV to FILE.
     #[arg(long, value_name = "FILE")]
@@ -48,9 +48,10 @@ pub struct CycleArgs {
     /// ODE method (auto, rodas5p, radau5, tsit5, dop853) [default: the scene's solver.method].
     #[arg(long, value_name = "M")]
     method: Option<String>,
-    /// Relative tolerance of the first run, in (0, 1) [default: the scene's solver.rtol]. Without
-    /// --atol-nm the absolute tolerance is scaled with it.
-    #[arg(long, value_name = "R", value_parser = fraction)]
+    /// Relative tolerance of the first run, in [2.2e-14, 1) (100 ε up to 1, as in a scene; the
+    /// refined runs must stay in it too) [default: the scene's solver.rtol]. Without --atol-nm the
+    /// absolute tolerance is scaled with it.
+    #[arg(long, value_name = "R", value_parser = rtol, allow_hyphen_values = true)]
     rtol: Option<f64>,
     /// Absolute tolerance on the displacement of the first run (nm) [default: the scene's
     /// solver.atol_m, scaled with --rtol].
@@ -134,6 +135,21 @@ impl CycleArgs {
                 agreeing_runs: usize::from(self.agree),
                 ..Refinement::new(from_mw(self.refine_mw))
             };
+            // The last run must stay in the solver's range too: checked before the first.
+            let last = opts.solver.rtol * refine.factor.powi(i32::from(self.max_runs) - 1);
+            let min = hdi_tribology::ode::MIN_RTOL;
+            if last < min {
+                let from = match self.rtol {
+                    Some(r) => format!("--rtol {}", fmt_short(r)),
+                    None => format!("the scene's solver.rtol {}", fmt_short(opts.solver.rtol)),
+                };
+                return Err(CliError::Usage(format!(
+                    "{from} with --max-runs {} tightens to rtol {} in the last run, below the \
+                     solver's {min:.1e} (100 ε): raise --rtol or lower --max-runs",
+                    self.max_runs,
+                    fmt_short(last)
+                )));
+            }
             ac_sweep_refined(model, programme, opts, amplitudes, &refine)?
                 .into_iter()
                 .map(|r| (Report::refined(&r), r.cycle))
@@ -251,14 +267,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let (model, programme, mut opts) = a.cycle.setup(&scene)?;
     opts.keep_series = out.is_some();
     let v_ac = a.v_ac.unwrap_or(model.voltage().ac_amplitude);
+    let progress = common::Progress::spinner("cycle: refining until converged");
     let (report, cycle) = a
         .cycle
         .run(&model, &programme, &opts, &[v_ac])?
         .pop()
         .ok_or_else(|| CliError::Failed("the cycle gave no result".into()))?;
+    drop(progress);
     if let (Some(out), Some(series)) = (out, cycle.series) {
-        series.write_csv(out.tmp_path())?;
-        out.commit()?;
+        out.write_via_path(|p| Ok(series.write_csv(p)?))?;
     }
     common::print_json(&report)
 }

@@ -2,9 +2,11 @@
 
 use std::path::PathBuf;
 
-use hdi_tribology::drive::{read_commands, replay, scene_zone, DiskSpec, DriveOptions, Plant};
+use hdi_tribology::drive::{
+    read_commands, replay, scene_zone, whole_periods, DiskSpec, DriveOptions, Plant,
+};
 
-use crate::common::{self, positive, CliError, Output, SceneArgs};
+use crate::common::{self, positive, CliError, CountLines, Output, SceneArgs};
 
 /// Replays --commands (CSV: time_s, heater_mw, voltage_dc_v and optionally voltage_ac_v,
 /// ac_frequency_khz; each row holds until the next, the last row's time ends the run) through the
@@ -70,6 +72,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let file = std::fs::File::open(&a.commands)
         .map_err(|e| CliError::Failed(format!("--commands {shown}: {e}")))?;
     let rows = read_commands(std::io::BufReader::new(file), &shown)?;
+    let dt = 1e-3 / a.rate_khz;
+    // A run ends on a period boundary: an end between two is refused, not cut.
+    let periods = whole_periods(&rows, dt, &shown)?;
     let out = a
         .out
         .as_deref()
@@ -81,24 +86,32 @@ pub fn run(a: Args) -> Result<(), CliError> {
         a.seed,
         opts,
     )?;
-    let dt = 1e-3 / a.rate_khz;
+    // One line per period, and the header.
+    let progress = common::Progress::bar("drive", periods as u64 + 1, "lines");
     match out {
         Some(out) => {
-            let file = std::fs::File::create(out.tmp_path())
-                .map_err(|e| CliError::Failed(format!("--out: {e}")))?;
-            let summary = replay(&plant, &rows, dt, std::io::BufWriter::new(file))?;
-            out.commit()?;
+            let mut summary = None;
+            out.write_with(|w| {
+                let w = CountLines {
+                    inner: w,
+                    progress: &progress,
+                };
+                summary = Some(replay(&plant, &rows, dt, w)?);
+                Ok(())
+            })?;
+            drop(progress);
             common::print_json(&summary)
         }
         None => {
             // Whole or nothing on standard output too: the run finishes before anything is printed.
             let mut buf = Vec::new();
-            replay(&plant, &rows, dt, &mut buf)?;
-            use std::io::Write;
-            std::io::stdout()
-                .lock()
-                .write_all(&buf)
-                .map_err(|e| CliError::Failed(format!("cannot write output: {e}")))
+            let w = CountLines {
+                inner: &mut buf,
+                progress: &progress,
+            };
+            replay(&plant, &rows, dt, w)?;
+            drop(progress);
+            common::write_stdout(&buf)
         }
     }
 }

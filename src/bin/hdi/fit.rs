@@ -1,10 +1,10 @@
 //! `hdi fit`: fit free scene fields to measured curves.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use hdi_tribology::fit::{run_cli, CliArgs, FitError, FitOptions};
 
-use crate::common::{self, CliError, SceneArgs};
+use crate::common::{self, CliError, Output, SceneArgs};
 
 /// Fits scene fields to measured curves and prints JSON: the fitted scene, each parameter with
 /// its standard error (null where the data do not determine it), the correlation matrix, the
@@ -34,8 +34,69 @@ pub struct Args {
     plot: Option<PathBuf>,
 }
 
+/// Checks the --plot folder before the fit: a folder, or a name whose nearest existing
+/// ancestor is a folder (it is then created after the fit).
+fn check_plot_dir(dir: &Path) -> Result<(), CliError> {
+    let shown = format!("--plot {}", dir.display());
+    if !cfg!(feature = "plot") {
+        return Err(CliError::Failed(format!(
+            "{shown}: this build has no `plot` feature"
+        )));
+    }
+    let mut p = dir;
+    loop {
+        match std::fs::metadata(p) {
+            Ok(m) if m.is_dir() => return Ok(()),
+            Ok(_) if p == dir => {
+                return Err(CliError::Failed(format!(
+                    "{shown}: is a file, give a folder for the plots"
+                )))
+            }
+            Ok(_) => {
+                return Err(CliError::Failed(format!(
+                    "{shown}: {} is a file, not a folder",
+                    p.display()
+                )))
+            }
+            Err(_) => match p.parent() {
+                Some(up) if !up.as_os_str().is_empty() => p = up,
+                _ => return Ok(()),
+            },
+        }
+    }
+}
+
+/// Writes the plots `run_cli` drew in `scratch` into `dir`, each through [`Output`].
+fn deliver_plots(scratch: &Path, dir: &Path) -> Result<(), CliError> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::Failed(format!("--plot {}: {e}", dir.display())))?;
+    let read = |e: std::io::Error| CliError::Failed(format!("--plot: {e}"));
+    let mut names: Vec<_> = std::fs::read_dir(scratch)
+        .map_err(read)?
+        .map(|e| e.map(|e| e.file_name()))
+        .collect::<Result<_, _>>()
+        .map_err(read)?;
+    names.sort();
+    for name in names {
+        let bytes = std::fs::read(scratch.join(&name)).map_err(read)?;
+        Output::prepare(&dir.join(&name), "--plot")?.write(&bytes)?;
+    }
+    Ok(())
+}
+
 pub fn run(a: Args) -> Result<(), CliError> {
+    if let Some(dir) = &a.plot {
+        check_plot_dir(dir)?;
+    }
     let scene = a.scene.load()?;
+    // The library draws into a scratch folder; the plots then go through the one writer.
+    let scratch = match a.plot {
+        Some(_) => Some(
+            tempfile::tempdir()
+                .map_err(|e| CliError::Failed(format!("--plot: no scratch folder: {e}")))?,
+        ),
+        None => None,
+    };
     let args = CliArgs {
         scene,
         data: a.data,
@@ -45,9 +106,14 @@ pub fn run(a: Args) -> Result<(), CliError> {
             seed: a.seed,
             ..FitOptions::default()
         },
-        plot: a.plot,
+        plot: scratch.as_ref().map(|d| d.path().to_path_buf()),
     };
+    let progress = common::Progress::spinner("fit: least squares");
     let json = run_cli(&args).map_err(|e: FitError| CliError::Failed(e.to_string()))?;
+    drop(progress);
+    if let (Some(scratch), Some(dir)) = (&scratch, &a.plot) {
+        deliver_plots(scratch.path(), dir)?;
+    }
     let value: serde_json::Value =
         serde_json::from_str(&json).map_err(|e| CliError::Failed(e.to_string()))?;
     if value["trusted"] == serde_json::Value::Bool(false) {

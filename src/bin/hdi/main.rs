@@ -31,6 +31,10 @@ use common::CliError;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// No progress on the terminal (shown for runs over a second when standard error is a
+    /// terminal, never otherwise). Warnings and results are unaffected.
+    #[arg(long, short, global = true)]
+    quiet: bool,
 }
 
 #[derive(Subcommand)]
@@ -60,6 +64,7 @@ enum Command {
 fn main() -> ExitCode {
     // clap prints help and --version on stdout with exit 0, usage errors on stderr with exit 2.
     let cli = Cli::parse();
+    common::set_quiet(cli.quiet);
     let result = match cli.command {
         Command::Forces(a) => forces::run(a),
         Command::Static(a) => static_cmd::run(a),
@@ -72,7 +77,7 @@ fn main() -> ExitCode {
         Command::Bearing(a) => bearing::run(a),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) | Err(CliError::ClosedPipe) => ExitCode::SUCCESS,
         Err(CliError::Usage(msg)) => {
             eprintln!("error: {msg}\n\nFor more information, try '--help'.");
             ExitCode::from(2)

@@ -1,6 +1,6 @@
 //! `hdi sweep`: one cycle per AC amplitude.
 
-use crate::common::{self, list_non_negative, CliError, List, SceneArgs};
+use crate::common::{self, list_volts, CliError, List, SceneArgs};
 use crate::cycle::CycleArgs;
 
 /// One cycle per AC amplitude, JSON list of the objects `hdi cycle` prints (see `hdi cycle
@@ -10,7 +10,7 @@ pub struct Args {
     #[command(flatten)]
     scene: SceneArgs,
     /// AC amplitudes (V), comma-separated [default: the scene's sweep.ac_amplitudes_v].
-    #[arg(long, value_name = "V1,V2,...", value_parser = list_non_negative,
+    #[arg(long, value_name = "V1,V2,...", value_parser = list_volts,
           allow_hyphen_values = true)]
     v_ac: Option<List>,
     #[command(flatten)]
@@ -29,6 +29,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "no amplitudes: give --v-ac or a sweep.ac_amplitudes_v list in the scene".into(),
         ));
     }
+    let _progress = common::Progress::spinner(&format!(
+        "sweep: {} amplitudes, each refined until converged",
+        amplitudes.len()
+    ));
     let rows: Vec<_> = a
         .cycle
         .run(&model, &programme, &opts, &amplitudes)?
