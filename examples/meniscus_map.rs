@@ -157,7 +157,7 @@ impl Setup {
     }
 
     fn cycle(&self, model: &SliderModel, tighter: bool) -> hdi_tribology::Result<CycleResult> {
-        let mut o = self.opts.clone();
+        let mut o = self.opts;
         if tighter {
             o.solver.rtol *= 0.1;
             o.solver.atol_displacement *= 0.1;
@@ -387,7 +387,7 @@ fn write_svg(path: &Path, axis: Axis, values: &[f64], v: &[f64], points: &[Point
     writeln!(
         s,
         "<text x='4' y='{}'>rows: {}; bottom row: no menisci. Grey: moves &gt; 0.05 mW at 10× \
-         tighter tolerance; light grey: not detected.</text>",
+         tighter tolerance; light grey: touchdown or take-off not detected (no take-off before the programme returns to 60 mW).</text>",
         top + ph + 55.0,
         axis.label()
     )?;
