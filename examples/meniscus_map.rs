@@ -14,7 +14,7 @@
 //! `cargo run --release --all-features --example meniscus_map -- --grid 12` writes
 //! `out/meniscus/{thickness,healing}.csv` and `.svg` (three heat maps each, converged points
 //! coloured, others grey), and prints the CPU time of each map and of one cycle with and without
-//! menisci. `--maps thickness` picks one; `--out DIR` writes elsewhere; without `--grid` a 4 × 4
+//! menisci (median of seven). `--maps thickness` picks one (`--maps none`: the timing alone); `--out DIR` writes elsewhere; without `--grid` a 4 × 4
 //! grid runs.
 
 use std::fmt::Write as _;
@@ -27,6 +27,10 @@ use hdi_tribology::model::SliderModel;
 use hdi_tribology::quadrature::TableOptions;
 use hdi_tribology::scene::Scene;
 use rayon::prelude::*;
+
+#[path = "common/colour.rs"]
+mod colour;
+use colour::viridis;
 
 type Res<T> = Result<T, Box<dyn std::error::Error + Send + Sync>>;
 
@@ -247,29 +251,6 @@ fn write_csv(path: &Path, axis: Axis, points: &[Point]) -> Res<()> {
     }
     std::fs::write(path, s)?;
     Ok(())
-}
-
-fn viridis(x: f64) -> (u8, u8, u8) {
-    const A: [(u8, u8, u8); 9] = [
-        (68, 1, 84),
-        (71, 44, 122),
-        (59, 81, 139),
-        (44, 113, 142),
-        (33, 144, 141),
-        (39, 173, 129),
-        (92, 200, 99),
-        (170, 220, 50),
-        (253, 231, 37),
-    ];
-    let x = x.clamp(0.0, 1.0) * (A.len() - 1) as f64;
-    let i = (x.floor() as usize).min(A.len() - 2);
-    let f = x - i as f64;
-    let mix = |a: u8, b: u8| (a as f64 + (b as f64 - a as f64) * f).round() as u8;
-    (
-        mix(A[i].0, A[i + 1].0),
-        mix(A[i].1, A[i + 1].1),
-        mix(A[i].2, A[i + 1].2),
-    )
 }
 
 type Quantity = (&'static str, fn(&Point) -> Option<f64>);
@@ -507,6 +488,7 @@ fn main() -> Res<()> {
                     .next()
                     .ok_or("--maps needs names")?
                     .split(',')
+                    .filter(|m| *m != "none")
                     .map(|m| match m {
                         "thickness" => Ok(Axis::Thickness),
                         "healing" => Ok(Axis::Healing),
@@ -523,7 +505,7 @@ fn main() -> Res<()> {
     }
     std::fs::create_dir_all(&out)?;
     let setup = Setup::new()?;
-    timing(&setup, 3)?;
+    timing(&setup, 7)?;
     for axis in maps {
         run_map(&setup, axis, n, &out)?;
     }
