@@ -41,6 +41,9 @@ use std::f64::consts::PI;
 use std::path::Path;
 use std::time::Instant;
 
+#[path = "common/colour.rs"]
+mod colour;
+
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
 /// Largest change of `P_TD` and `P_TO` between the run at the scene's rtol and ten times tighter
@@ -432,26 +435,8 @@ fn run_map(setup: &Setup, spec: &MapSpec, n: usize, checks: Checks) -> Res<Vec<P
 
 /// Viridis, from its published anchor colours (colour-blind safe, sequential).
 fn viridis(x: f64) -> RGBColor {
-    const A: [(u8, u8, u8); 9] = [
-        (68, 1, 84),
-        (71, 44, 122),
-        (59, 81, 139),
-        (44, 113, 142),
-        (33, 144, 141),
-        (39, 173, 129),
-        (92, 200, 99),
-        (170, 220, 50),
-        (253, 231, 37),
-    ];
-    let x = x.clamp(0.0, 1.0) * (A.len() - 1) as f64;
-    let i = (x.floor() as usize).min(A.len() - 2);
-    let f = x - i as f64;
-    let mix = |a: u8, b: u8| (a as f64 + (b as f64 - a as f64) * f).round() as u8;
-    RGBColor(
-        mix(A[i].0, A[i + 1].0),
-        mix(A[i].1, A[i + 1].1),
-        mix(A[i].2, A[i + 1].2),
-    )
+    let (r, g, b) = colour::viridis(x);
+    RGBColor(r, g, b)
 }
 
 const UNCONVERGED: RGBColor = RGBColor(150, 150, 150);

@@ -6,7 +6,7 @@ use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
 
-/// A 100 ns interface lag on the paper scene (c/K_contact ≈ 0.1 ns) makes the contact branch
+/// A 100 ns interface lag on the paper scene (c/K_contact ≈ 27 ns) makes the contact branch
 /// self-excited: the head bounced ever higher and harder and the integration ended with
 /// `Ode(NonFinite)` at t ≈ 3.67 ms, 26 nm deep in the disk. It now stops where the pad reaches
 /// the disk, with an error that says why.

@@ -240,7 +240,7 @@ impl SliderModel {
             .electrostatic
             .as_ref()
             .map_or(0.0, |e| e.contact_potential_v);
-        Ok(SliderModel {
+        SliderModel {
             forces: Arc::new(forces),
             bearing,
             structure: Structure::from_spec(&scene.structure, scene.slider.mass_kg)?,
@@ -261,7 +261,17 @@ impl SliderModel {
             },
             stateful: Arc::new([]),
             linear_bearing: matches!(scene.air_bearing, AirBearingModel::Linear { .. }),
-        })
+        }
+        .with_scene_terms(scene)
+    }
+
+    /// The model with the stateful terms its scene enables (the lubricant menisci); itself when
+    /// there are none.
+    fn with_scene_terms(self, scene: &Scene) -> Result<Self> {
+        match scene.meniscus()? {
+            Some(m) => self.with_stateful_term(m),
+            None => Ok(self),
+        }
     }
 
     /// The inputs of the scene for a heater: the scene's voltage, no change of clearance, the

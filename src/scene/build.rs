@@ -2,10 +2,10 @@
 
 use std::sync::Arc;
 
-use super::Scene;
+use super::{Scene, WettingSpec};
 use crate::force::{
     lj_zero, AirBearing, Electrostatic, GreenwoodWilliamson, InterfaceForces, InterfaceTerm,
-    Intermolecular,
+    Intermolecular, Meniscus, MeniscusParams, Wetting,
 };
 use crate::quadrature::TableOptions;
 use crate::surface::{Discrete, GaussianHeights, PeakDistribution, PeakModel};
@@ -135,6 +135,46 @@ impl Scene {
             terms.push(Box::new(t));
         }
         Ok(terms)
+    }
+
+    /// The lubricant menisci of the `[lubricant]` section on the asperities of `[contact]`,
+    /// tabulated over [`Scene::table_range`]; `None` when the section is absent or the mobile
+    /// thickness is zero (the model is then exactly that of the scene without it).
+    pub fn meniscus(&self) -> Result<Option<Meniscus>> {
+        self.validate()?;
+        let (Some(l), Some(c)) = (&self.lubricant, &self.contact) else {
+            return Ok(None);
+        };
+        let mobile = l.mobile_thickness_m();
+        if mobile <= 0.0 {
+            return Ok(None);
+        }
+        let params = MeniscusParams {
+            surface_tension: l.surface_tension_n_per_m,
+            contact_angle: l.contact_angle_deg.to_radians(),
+            wetting: match l.wetting {
+                WettingSpec::Disk => Wetting::Disk,
+                WettingSpec::Both => Wetting::Both,
+            },
+            mobile_thickness: mobile,
+            rupture_distance: l.rupture_distance_m,
+            healing_time: l.healing_time_s,
+            formation_time: l.formation_time_s,
+        };
+        let opts = TableOptions {
+            rel_tol: self.table.rel_tol,
+            ..TableOptions::default()
+        };
+        let m = Meniscus::new(
+            params,
+            c.asperity_radius_m,
+            c.asperity_density_per_m2,
+            self.peaks()?,
+            c.footprint,
+        )
+        .map_err(|e| in_field(e, "lubricant."))?
+        .tabulated(self.table_range(), &opts)?;
+        Ok(Some(m))
     }
 
     /// Range of separations `d` (m) that the force tables cover.

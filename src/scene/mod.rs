@@ -79,7 +79,8 @@ pub use path::{FieldPath, PathError};
 
 pub use spec::{
     ContactSpec, DetectorSpec, ElectrostaticSpec, FrictionSpec, HeaterSpec, IntermolecularSpec,
-    Scene, SliderSpec, SolverSpec, SurfaceSpec, SweepSpec, TableSpec, TriggeredSpec, VoltageSpec,
+    LubricantSpec, Scene, SliderSpec, SolverSpec, SurfaceSpec, SweepSpec, TableSpec, TriggeredSpec,
+    VoltageSpec, WettingSpec,
 };
 pub use structure::{StructureSpec, MAX_DOF};
 pub use validate::{

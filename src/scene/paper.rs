@@ -55,6 +55,7 @@ impl Scene {
                 footprint: bulge,
                 gap: GapReference::Bulge,
             }),
+            lubricant: None,
             air_bearing: AirBearingModel::Linear {
                 stiffness_n_per_m: stiffness,
                 damping_n_s_per_m: 2.0 * zeta * (stiffness * mass).sqrt(),

@@ -25,6 +25,9 @@ pub struct Scene {
     /// Greenwood–Williamson contact; absent = off.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact: Option<ContactSpec>,
+    /// Lubricant menisci on the contact term's asperities; absent (or no mobile lubricant) = off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lubricant: Option<LubricantSpec>,
     /// Air-bearing model.
     pub air_bearing: AirBearingModel,
     /// Slider (lumped mass).
@@ -119,6 +122,56 @@ pub struct ContactSpec {
     /// Gap reference (default bulge).
     #[serde(default)]
     pub gap: GapReference,
+}
+
+/// Lubricant menisci (a term with memory, see `docs/analyses.md`): bridges form on the asperity
+/// peaks of the `[contact]` section where the local gap falls below the mobile thickness
+/// `total − bonded`, and break past the rupture distance.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LubricantSpec {
+    /// Total lubricant thickness on the disk, m (≥ 0).
+    pub total_thickness_m: f64,
+    /// Bonded part of it, m (0 ≤ bonded ≤ total); the rest is mobile.
+    pub bonded_thickness_m: f64,
+    /// Surface tension γ, N/m (> 0; PFPE lubricants: about 0.02–0.025).
+    pub surface_tension_n_per_m: f64,
+    /// Contact angle θ of the lubricant on the head, degrees, in [0, 90].
+    pub contact_angle_deg: f64,
+    /// Whether the lubricant wets the disk only (`"disk"`, default) or both surfaces (`"both"`).
+    #[serde(default)]
+    pub wetting: WettingSpec,
+    /// Healing time τ_h (s, > 0): how fast the bridges formed at the closest approach drain.
+    pub healing_time_s: f64,
+    /// Formation time τ_f (s, > 0), default 1e-7 s: how fast bridges form as the gap closes.
+    #[serde(default = "default_formation_time")]
+    pub formation_time_s: f64,
+    /// Rupture distance `s_r` (m, ≥ 0); default the Lian law `(1 + θ/2) V^{1/3}` with the bridge
+    /// volume `V = π R t_m²`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rupture_distance_m: Option<f64>,
+}
+
+fn default_formation_time() -> f64 {
+    1e-7
+}
+
+/// Which surfaces the lubricant wets.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WettingSpec {
+    /// The disk only: `2πRγ(1 + cos θ)` per bridge.
+    #[default]
+    Disk,
+    /// Both surfaces: `4πRγ cos θ` per bridge.
+    Both,
+}
+
+impl LubricantSpec {
+    /// The mobile thickness `total − bonded` (m).
+    pub fn mobile_thickness_m(&self) -> f64 {
+        self.total_thickness_m - self.bonded_thickness_m
+    }
 }
 
 /// Slider.

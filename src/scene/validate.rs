@@ -134,6 +134,7 @@ impl Scene {
             check_positive("contact.asperity_density_per_m2", c.asperity_density_per_m2)?;
             c.footprint.validate("contact.footprint")?;
         }
+        self.validate_lubricant()?;
         self.validate_air_bearing()?;
         check_positive("slider.mass_kg", self.slider.mass_kg)?;
         check_non_negative("slider.interface_lag_s", self.slider.interface_lag_s)?;
@@ -220,6 +221,49 @@ impl Scene {
                     ),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// The lubricant: thicknesses, bonded within total, θ in [0°, 90°], γ > 0, times > 0, and
+    /// the asperities of a `[contact]` section to form on.
+    fn validate_lubricant(&self) -> Result<()> {
+        let Some(l) = &self.lubricant else {
+            return Ok(());
+        };
+        check_non_negative("lubricant.total_thickness_m", l.total_thickness_m)?;
+        check_non_negative("lubricant.bonded_thickness_m", l.bonded_thickness_m)?;
+        if l.bonded_thickness_m > l.total_thickness_m {
+            return Err(Error::invalid(
+                "lubricant.bonded_thickness_m",
+                format!(
+                    "must not exceed the total thickness of {} m, got {} m",
+                    fmt_short(l.total_thickness_m),
+                    fmt_short(l.bonded_thickness_m)
+                ),
+            ));
+        }
+        check_positive(
+            "lubricant.surface_tension_n_per_m",
+            l.surface_tension_n_per_m,
+        )?;
+        let theta = l.contact_angle_deg;
+        if !(theta.is_finite() && (0.0..=90.0).contains(&theta)) {
+            return Err(Error::invalid(
+                "lubricant.contact_angle_deg",
+                format!("must lie in [0, 90] deg, got {} deg", fmt_short(theta)),
+            ));
+        }
+        check_positive("lubricant.healing_time_s", l.healing_time_s)?;
+        check_positive("lubricant.formation_time_s", l.formation_time_s)?;
+        if let Some(s) = l.rupture_distance_m {
+            check_non_negative("lubricant.rupture_distance_m", s)?;
+        }
+        if self.contact.is_none() && l.mobile_thickness_m() > 0.0 {
+            return Err(Error::invalid(
+                "lubricant",
+                "needs a [contact] section: the bridges form on its asperities",
+            ));
         }
         Ok(())
     }

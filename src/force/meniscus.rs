@@ -1,0 +1,335 @@
+//! Lubricant menisci with memory: capillary bridges between the head and the asperity peaks of a
+//! lubricated disk, formed when the local gap falls below the mobile lubricant thickness and
+//! broken only past a larger rupture distance, with the bridge population carried in a state.
+//!
+//! See `docs/analyses.md` (section "Lubricant menisci") for the equations, the parameter ranges
+//! and their sources.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use super::stateful::{RatePartials, StateForce, StatefulTerm, MAX_TERM_STATES};
+use super::{Footprint, ForceEval, Gaps, Scaled};
+use crate::error::{check_non_negative, check_positive};
+use crate::quadrature::{Table, TableOptions};
+use crate::surface::PeakDistribution;
+use crate::{Error, Result};
+
+/// Which surfaces the lubricant wets, which sets the force of one bridge on a sphere of radius
+/// `R` (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed., §17.7, sphere on a flat).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wetting {
+    /// The disk's lubricant wets the disk fully (θ = 0 there) and meets the head at the contact
+    /// angle θ: `2πRγ(1 + cos θ)`.
+    #[default]
+    Disk,
+    /// Both surfaces carry lubricant at the contact angle θ (a head that has picked up
+    /// lubricant): `4πRγ cos θ`.
+    Both,
+}
+
+impl Wetting {
+    /// The force of one bridge (N) on a sphere of radius `radius` (m) for surface tension
+    /// `gamma` (N/m) and contact angle `theta` (rad).
+    ///
+    /// ```
+    /// use hdi_tribology::force::Wetting;
+    /// let (r, g) = (1e-7, 0.025);
+    /// let f = Wetting::Disk.bridge_force(r, g, 0.0);
+    /// assert!((f - 4.0 * std::f64::consts::PI * r * g).abs() < 1e-20);
+    /// assert_eq!(f, Wetting::Both.bridge_force(r, g, 0.0));
+    /// ```
+    pub fn bridge_force(self, radius: f64, gamma: f64, theta: f64) -> f64 {
+        match self {
+            Wetting::Disk => 2.0 * PI * radius * gamma * (1.0 + theta.cos()),
+            Wetting::Both => 4.0 * PI * radius * gamma * theta.cos(),
+        }
+    }
+}
+
+/// The rupture distance of a liquid bridge of volume `volume` (m³) at contact angle `theta`
+/// (rad): `s_r = (1 + θ/2) V^{1/3}` (Lian, Thornton & Adams 1993).
+///
+/// ```
+/// let s = hdi_tribology::force::lian_rupture_distance(1e-24, 0.0);
+/// assert!((s - 1e-8).abs() < 1e-22);
+/// ```
+pub fn lian_rupture_distance(volume: f64, theta: f64) -> f64 {
+    (1.0 + 0.5 * theta) * volume.cbrt()
+}
+
+/// The lubricant and its bridges.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeniscusParams {
+    /// Surface tension γ, N/m.
+    pub surface_tension: f64,
+    /// Contact angle θ, rad, in [0, π/2].
+    pub contact_angle: f64,
+    /// Which surfaces are wet.
+    pub wetting: Wetting,
+    /// Mobile lubricant thickness `t_m` (m, > 0): a bridge forms where the local gap falls below
+    /// it.
+    pub mobile_thickness: f64,
+    /// Rupture distance `s_r` (m); `None`: the Lian law with the bridge volume `π R t_m²`.
+    pub rupture_distance: Option<f64>,
+    /// Healing time τ_h (s, > 0): the closest approach relaxes towards the gap with it.
+    pub healing_time: f64,
+    /// Formation time τ_f (s, > 0): the closest approach follows a closing gap with it.
+    pub formation_time: f64,
+}
+
+/// Lubricant menisci on the asperity peaks, with the closest approach `d*` as their state.
+///
+/// The peaks above `z` carry bridges when `z > max(d* − t_m, d − t_m − s_r)`: a bridge formed at
+/// the closest approach (local gap below `t_m`) and not yet stretched past `t_m + s_r`. With the
+/// per-bridge force `f_b` ([`Wetting::bridge_force`]) and the asperity density `η_s`, the mean
+/// pressure is `−f_b η_s M_0(e)`, `e = d − t_m + max(d* − d, −s_r)`, `M_0` the survival of the
+/// peak heights. Over a paraboloid footprint the bands of `d` and `d*` shift together (the bulge
+/// keeps its shape), so Derjaguin's integral is the partial moment `M_1` in closed form; the
+/// force is tabulated in `e` once.
+///
+/// `d*` obeys `ẋ = (d − x)/τ` with `τ = τ_f` while the gap closes below `x` and `τ_h` while it
+/// is above. At rest `d* = d` (the statics): the branch of bridges formed at the gap itself.
+///
+/// ```
+/// use std::sync::Arc;
+/// use hdi_tribology::force::{Footprint, Gaps, Meniscus, MeniscusParams, StatefulTerm, Wetting};
+/// use hdi_tribology::surface::Gaussian;
+/// # fn main() -> hdi_tribology::Result<()> {
+/// let p = MeniscusParams {
+///     surface_tension: 0.025, contact_angle: 0.0, wetting: Wetting::Disk,
+///     mobile_thickness: 1e-9, rupture_distance: Some(3e-9),
+///     healing_time: 1e-5, formation_time: 1e-7,
+/// };
+/// let peaks = Arc::new(Gaussian::new(0.0, 0.7e-9)?);
+/// let m = Meniscus::new(p, 1e-7, 1.5e14, peaks, Footprint::Flat { area_m2: 1e-8 })?;
+/// // On approach (d* = d) and on separation (d* = d − 1 nm) at the same gap:
+/// let g = Gaps::same(1.5e-9);
+/// let approach = m.force(g, &[1.5e-9]).force.value;
+/// let separation = m.force(g, &[0.5e-9]).force.value;
+/// assert!(separation < approach && approach < 0.0);
+/// # Ok(()) }
+/// ```
+#[derive(Clone, Debug)]
+pub struct Meniscus {
+    params: MeniscusParams,
+    bridge_force: f64,
+    rupture: f64,
+    density: f64,
+    peaks: Arc<dyn PeakDistribution>,
+    footprint: Footprint,
+    /// The force and its slope in `e`, where tabulated.
+    table: Option<Arc<Table>>,
+}
+
+impl Meniscus {
+    /// The menisci on asperities of radius `asperity_radius` (m) and areal density
+    /// `asperity_density` (m⁻²) with heights from `peaks`, over `footprint`. Errors name the
+    /// field of the `[lubricant]` scene section.
+    pub fn new(
+        params: MeniscusParams,
+        asperity_radius: f64,
+        asperity_density: f64,
+        peaks: Arc<dyn PeakDistribution>,
+        footprint: Footprint,
+    ) -> Result<Self> {
+        check_positive("surface_tension_n_per_m", params.surface_tension)?;
+        let theta = params.contact_angle;
+        if !(theta.is_finite() && (0.0..=0.5 * PI).contains(&theta)) {
+            return Err(Error::invalid(
+                "contact_angle_deg",
+                format!(
+                    "must lie in [0, 90] deg, got {} deg",
+                    crate::units::fmt_short(theta.to_degrees())
+                ),
+            ));
+        }
+        check_positive("mobile_thickness_m", params.mobile_thickness)?;
+        if let Some(s) = params.rupture_distance {
+            check_non_negative("rupture_distance_m", s)?;
+        }
+        check_positive("healing_time_s", params.healing_time)?;
+        check_positive("formation_time_s", params.formation_time)?;
+        check_positive("asperity_radius_m", asperity_radius)?;
+        check_positive("asperity_density_per_m2", asperity_density)?;
+        footprint.validate("footprint")?;
+        let rupture = params.rupture_distance.unwrap_or_else(|| {
+            lian_rupture_distance(
+                PI * asperity_radius * params.mobile_thickness.powi(2),
+                theta,
+            )
+        });
+        Ok(Meniscus {
+            bridge_force: params.wetting.bridge_force(
+                asperity_radius,
+                params.surface_tension,
+                theta,
+            ),
+            params,
+            rupture,
+            density: asperity_density,
+            peaks,
+            footprint,
+            table: None,
+        })
+    }
+
+    /// The same term with its force tabulated for bulge gaps in `[lo, hi]` (m); outside, and
+    /// for discrete peak ensembles (whose survival has steps), it evaluates the partial moments
+    /// directly.
+    pub fn tabulated(mut self, (lo, hi): (f64, f64), opts: &TableOptions) -> Result<Self> {
+        if self.peaks.atoms().is_some() {
+            return Ok(self);
+        }
+        let (t_m, s_r) = (self.params.mobile_thickness, self.rupture);
+        let table = Table::build(|e| self.direct(e), lo - t_m - s_r, hi - t_m, opts)?;
+        self.table = Some(Arc::new(table));
+        Ok(self)
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> MeniscusParams {
+        self.params
+    }
+
+    /// The force of one bridge `f_b` (N).
+    pub fn bridge_force(&self) -> f64 {
+        self.bridge_force
+    }
+
+    /// The rupture distance `s_r` in use (m).
+    pub fn rupture_distance(&self) -> f64 {
+        self.rupture
+    }
+
+    /// The force (N, negative: an attraction) and its slope when the peaks above `e` carry
+    /// bridges at the gap `e + t_m`, by direct evaluation of the partial moments.
+    fn direct(&self, e: f64) -> Result<(f64, f64)> {
+        let k = -self.bridge_force * self.density;
+        let m = |z: f64, p: f64| self.peaks.partial_moment(z, p);
+        let band = |p: f64, delta: f64| {
+            if delta.is_infinite() {
+                m(e, p)
+            } else {
+                m(e, p) - m(e + delta, p)
+            }
+        };
+        let (f, df) = self.footprint.reduce(
+            k,
+            || Ok::<_, Error>((m(e, 0.0).into(), Scaled::new(-1.0, self.peaks.pdf(e)))),
+            |delta| Ok((band(1.0, delta).into(), band(0.0, delta).into())),
+        )?;
+        if f.is_finite() && df.is_finite() {
+            Ok((f, df))
+        } else {
+            Err(Error::no_convergence(
+                "meniscus force",
+                format!("at e = {e} m: {f} N, slope {df} N/m"),
+            ))
+        }
+    }
+
+    /// The force and its slope in `e` (0 where the evaluation fails: far outside the peaks).
+    fn at(&self, e: f64) -> (f64, f64) {
+        if let Some((f, df)) = self.table.as_ref().and_then(|t| t.eval(e)) {
+            return (f, df);
+        }
+        self.direct(e).unwrap_or((0.0, 0.0))
+    }
+
+    /// The force at the bulge gap `d` with the closest approach `d_star` (m), and its partial
+    /// derivatives along `d` and `d_star`.
+    pub fn force_at(&self, d: f64, d_star: f64) -> (f64, f64, f64) {
+        let t_m = self.params.mobile_thickness;
+        if d - d_star < self.rupture {
+            let (f, df) = self.at(d_star - t_m);
+            (f, 0.0, df)
+        } else {
+            let (f, df) = self.at(d - t_m - self.rupture);
+            (f, df, 0.0)
+        }
+    }
+
+    fn tau(&self, d: f64, d_star: f64) -> f64 {
+        if d < d_star {
+            self.params.formation_time
+        } else {
+            self.params.healing_time
+        }
+    }
+}
+
+impl StatefulTerm for Meniscus {
+    fn name(&self) -> &str {
+        "meniscus"
+    }
+    fn states(&self) -> usize {
+        1
+    }
+    fn equilibrium(&self, g: Gaps, x: &mut [f64]) {
+        x[0] = g.bulge;
+    }
+    fn rates(&self, g: Gaps, x: &[f64], dx: &mut [f64]) {
+        dx[0] = (g.bulge - x[0]) / self.tau(g.bulge, x[0]);
+    }
+    fn rate_partials(&self, g: Gaps, x: &[f64]) -> RatePartials {
+        let rate = 1.0 / self.tau(g.bulge, x[0]);
+        let mut p = RatePartials::default();
+        p.d_bulge[0] = rate;
+        p.d_state[0][0] = -rate;
+        p
+    }
+    fn force(&self, g: Gaps, x: &[f64]) -> StateForce {
+        let (f, d_bulge, d_star) = self.force_at(g.bulge, x[0]);
+        let mut d_state = [0.0; MAX_TERM_STATES];
+        d_state[0] = d_star;
+        StateForce {
+            force: ForceEval {
+                value: f,
+                d_bulge,
+                d_pad: 0.0,
+            },
+            d_state,
+        }
+    }
+    /// `d*` is a gap: the displacement tolerance.
+    fn tolerances(&self, displacement: f64, atol: &mut [f64]) {
+        atol[0] = displacement;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::Gaussian;
+
+    #[test]
+    fn the_table_agrees_with_direct_evaluation() {
+        let p = MeniscusParams {
+            surface_tension: 0.025,
+            contact_angle: 0.3,
+            wetting: Wetting::Disk,
+            mobile_thickness: 1e-9,
+            rupture_distance: None,
+            healing_time: 1e-5,
+            formation_time: 1e-7,
+        };
+        let peaks = Arc::new(Gaussian::new(0.0, 0.7e-9).unwrap());
+        for footprint in Footprint::samples() {
+            let m = Meniscus::new(p, 1e-7, 1.5e14, peaks.clone(), footprint).unwrap();
+            let t = m
+                .clone()
+                .tabulated((-4e-9, 3e-8), &TableOptions::default())
+                .unwrap();
+            for e in [-3e-9, -1e-9, 0.0, 1.3e-9, 4e-9] {
+                let (a, b) = (m.at(e), t.at(e));
+                // the table's promise: rel_tol of the value, or its abs_tol of 1e-16 N
+                let allowed = (2e-9 * a.0.abs()).max(1e-16);
+                assert!(
+                    (a.0 - b.0).abs() <= allowed,
+                    "{footprint:?} {e}: {a:?} {b:?}"
+                );
+            }
+        }
+    }
+}
