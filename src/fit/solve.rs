@@ -61,6 +61,13 @@ pub struct FitOptions {
     /// evaluation, rebuilding force tables where the parameter changes them) instead of the
     /// static transitions' sensitivities. Slower; kept to check the sensitivities.
     pub finite_difference_jacobian: bool,
+    /// Curves with cycles: from the optimum, this many more starts (in pairs, ± along the least
+    /// determined directions, [`FitOptions::check_distance`] error bars out). A check start that
+    /// ends with a lower χ² shows the first ended in a false minimum: the better one is kept and
+    /// the fit says so. 0 turns the check off.
+    pub cycle_check_starts: usize,
+    /// How far out the check starts begin, in error bars along their direction.
+    pub check_distance: f64,
 }
 
 impl Default for FitOptions {
@@ -76,6 +83,8 @@ impl Default for FitOptions {
             dynamic_power_tol_mw: 1e-3,
             dynamic_rel_step: 1e-2,
             finite_difference_jacobian: false,
+            cycle_check_starts: 2,
+            check_distance: 4.0,
         }
     }
 }
@@ -98,6 +107,7 @@ impl FitOptions {
             ("static_table_rel_tol", self.static_table_rel_tol, 0.01),
             ("dynamic_power_tol_mw", self.dynamic_power_tol_mw, 10.0),
             ("dynamic_rel_step", self.dynamic_rel_step, 0.1),
+            ("check_distance", self.check_distance, 100.0),
         ] {
             if !(v > 0.0 && v <= hi) {
                 return Err(Error::invalid(
@@ -722,6 +732,30 @@ pub fn fit(
         let Some((_, x1, c1, t1)) = end else { break };
         (x, converged, termination) = (x1, c1, t1);
     }
+    // Curves with cycles: the detected powers are not smooth in the parameters, and a single
+    // start can end in a false minimum whose residuals pass every test. Starts from the optimum
+    // moved out along the least determined directions look for a better one.
+    let mut escaped = None;
+    if data.iter().any(DataSet::is_dynamic) && opts.cycle_check_starts > 0 {
+        let best_cost = outcomes
+            .iter()
+            .filter(|o| o.end == x)
+            .map(|o| o.cost)
+            .fold(f64::INFINITY, f64::min);
+        let checks = check_starts(&ev, opts, &x, &active, best_cost)?;
+        for start in checks {
+            let (outcome, end) = run_start(&ev, opts, start, &active);
+            outcomes.push(outcome);
+            if let Some((c, x1, c1, t1)) = end {
+                // Lower by more than the optimiser's tolerance and one unit of χ².
+                if c1 && c < best_cost - 1.0 - opts.tolerance * best_cost {
+                    escaped = Some((best_cost, c));
+                    (x, converged, termination) = (x1, c1, t1);
+                    break;
+                }
+            }
+        }
+    }
     let held: Vec<&str> = held.iter().map(|&j| params[j].name()).collect();
     analyse(
         &ev,
@@ -733,8 +767,67 @@ pub fn fit(
             termination,
             starts: outcomes,
             held: &held,
+            escaped,
         },
     )
+}
+
+/// Check starts around the optimum `x` (cost `chi2`): pairs ± along the least determined
+/// directions of the scaled Jacobian, `check_distance` error bars out, kept inside the bounds.
+fn check_starts(
+    ev: &Evaluator<'_>,
+    opts: &FitOptions,
+    x: &[f64],
+    active: &[usize],
+    chi2: f64,
+) -> Result<Vec<Vec<f64>>, FitError> {
+    let params = ev.params;
+    let cols = jacobian_columns(ev, x, opts, false, active)?;
+    let m = cols.first().map_or(0, Vec::len);
+    let excluded = ev.excluded.iter().filter(|e| **e).count();
+    let dof = (m - excluded).saturating_sub(active.len()).max(1);
+    let s = (chi2 / dof as f64).sqrt();
+    let mut js = DMatrix::<f64>::zeros(m, active.len());
+    for (c, (col, &j)) in cols.iter().zip(active).enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            js[(i, c)] = v * params[j].scale;
+        }
+    }
+    let svd = js.svd(false, true);
+    let Some(v_t) = svd.v_t else {
+        return Ok(Vec::new());
+    };
+    let sv = svd.singular_values;
+    let mut order: Vec<usize> = (0..sv.len()).collect();
+    order.sort_by(|&a, &b| sv[a].total_cmp(&sv[b]));
+    let mut out = Vec::new();
+    for &k in order.iter().take(opts.cycle_check_starts.div_ceil(2)) {
+        // Out to `check_distance` error bars, but at most half the parameters' scale.
+        let reach = (opts.check_distance * s / sv[k].max(f64::MIN_POSITIVE)).min(0.5);
+        for sign in [1.0, -1.0] {
+            if out.len() == opts.cycle_check_starts {
+                break;
+            }
+            let mut p = x.to_vec();
+            for (c, &j) in active.iter().enumerate() {
+                let r = &params[j];
+                let mut v = x[j] + sign * reach * v_t[(k, c)] * r.scale;
+                let room = match (r.lower, r.upper) {
+                    (Some(lo), Some(hi)) => 1e-3 * (hi - lo),
+                    _ => 1e-3 * r.scale,
+                };
+                if let Some(lo) = r.lower {
+                    v = v.max(lo + room);
+                }
+                if let Some(hi) = r.upper {
+                    v = v.min(hi - room);
+                }
+                p[j] = v;
+            }
+            out.push(p);
+        }
+    }
+    Ok(out)
 }
 
 /// Where the optimiser ended, and how.
@@ -746,6 +839,8 @@ struct Optimum<'h> {
     starts: Vec<StartOutcome>,
     /// Parameters no fitted value depended on at the start, held there.
     held: &'h [&'h str],
+    /// A check start found a lower minimum: (χ² of the first, χ² of the better).
+    escaped: Option<(f64, f64)>,
 }
 
 /// A parameter whose Jacobian column (in its scale) is at most this fraction of the largest at
@@ -820,6 +915,7 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
         termination,
         starts,
         held,
+        escaped,
     } = opt;
     let params = ev.params;
     let data = ev.data;
@@ -979,6 +1075,14 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
 
     let residuals = residual_tables(data, &pred, &ev.excluded);
     let mut warnings = Vec::new();
+    if let Some((first, better)) = escaped {
+        warnings.push(format!(
+            "the first start ended in a false minimum (χ² = {first:.1}); a check start from it \
+             found χ² = {better:.1}, which is the fit reported: the cycles' detected powers are \
+             not smooth in the parameters, so give several starts (--starts) or fit the static \
+             curves first"
+        ));
+    }
     if !converged {
         warnings.push(format!("the optimiser did not converge: {termination}"));
     }
@@ -1101,6 +1205,7 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
     let trusted = converged
         && linear
         && strong.is_empty()
+        && escaped.is_none()
         && parameters.iter().all(|p| p.determined && !p.at_bound)
         && clipped == 0
         && integration.as_ref().is_none_or(|i| i.ok)
