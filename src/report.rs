@@ -481,9 +481,10 @@ impl Chart<'_> {
     }
 }
 
-/// Average width of a character over the font size, for sizing the legend panel.
+/// Average width of a character over the font size asked of plotters (which sets glyphs at
+/// 1/1.24 of it), for sizing the legend panel and the tick label areas.
 #[cfg(feature = "plot")]
-const CHAR_EM: f64 = 0.56;
+const CHAR_EM: f64 = 0.46;
 
 /// Charts are drawn on a canvas this many times finer than the SVG's size, which then scales it
 /// down (`viewBox`): plotters rounds coordinates to whole pixels, so curves are placed to a
@@ -938,13 +939,23 @@ impl Chart<'_> {
                         .map_err(|e| err(&e))?;
                 }
             }
-            legend_area
-                .draw(&Text::new(
-                    s.label.to_string(),
-                    (8 * ki + sym, y - (legend_px * 0.5) as i32),
-                    font.clone(),
-                ))
-                .map_err(|e| err(&e))?;
+            // Labels wrap to the panel's width.
+            let room = (legend_w as f64 - (12 * ki + sym) as f64) / (CHAR_EM * legend_px);
+            for (n, line) in wrap(s.label, room.max(6.0) as usize)
+                .into_iter()
+                .enumerate()
+            {
+                if n > 0 {
+                    y += (legend_px * 1.2) as i32;
+                }
+                legend_area
+                    .draw(&Text::new(
+                        line,
+                        (8 * ki + sym, y - (legend_px * 0.5) as i32),
+                        font.clone(),
+                    ))
+                    .map_err(|e| err(&e))?;
+            }
             y += step;
         }
         let note_font = ("sans-serif", note_px)
