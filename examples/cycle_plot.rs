@@ -93,10 +93,10 @@ fn run(args: &[String], out: &Path) -> Res<()> {
     Chart {
         title: &title("contact indicator"),
         x_label: "heater power (mW)",
-        y_label: "running mean of F_c (µN)",
+        y_label: "running mean of F_{c} (µN)",
         series: vec![
             Series::line("contact indicator", indicator).colour(palette::BLUE),
-            Series::line("threshold F_th", vec![(p0, threshold), (p1, threshold)])
+            Series::line("threshold F_{th}", vec![(p0, threshold), (p1, threshold)])
                 .colour(palette::BLACK)
                 .width(1)
                 .dashed(),

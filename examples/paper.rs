@@ -355,7 +355,7 @@ fn rigid_slider(
         fig1.push(r);
     }
     fig1_chart(
-        &[("V_ac = 0 V", &fig1[0]), ("V_ac = 0.6 V", &fig1[1])],
+        &[("V_{ac} = 0 V", &fig1[0]), ("V_{ac} = 0.6 V", &fig1[1])],
         scene.detector.contact_threshold_n,
         options.fig1_absolute,
     )?
@@ -510,7 +510,7 @@ fn summary_cells(r: &RefinedCycle) -> String {
 }
 
 /// Width of the legend panel of Fig. 3(d) and Fig. 4 (px), the same on both panels.
-const LEGEND_WIDTH: u32 = 260;
+const LEGEND_WIDTH: u32 = 300;
 
 /// Gives the panels of one figure (all on the same kind of axes) the same x and y ranges, those
 /// that show every point of every panel, and the same legend width, so that the rigid and bulge
@@ -544,6 +544,9 @@ fn share_ranges(charts: &mut [Chart<'_>]) {
         c.x_range = x;
         c.y_range = y;
         c.legend_width = Some(LEGEND_WIDTH);
+        // Each panel is set for the full two-column width (7 in): at one column its legend and
+        // notes would leave no room for the plot.
+        c.print_width_in = Some(7.0);
     }
 }
 
@@ -744,7 +747,7 @@ fn fig3d_chart<'a>(
     refine: &Refinement,
 ) -> Chart<'a> {
     let mut series = vec![Series::line(
-        "static, V_ac = 0",
+        "static, V_{ac} = 0",
         vec![(0.0, mw(static_hysteresis)), (1.0, mw(static_hysteresis))],
     )
     .colour(palette::BLACK)
@@ -768,8 +771,8 @@ fn fig3d_chart<'a>(
     notes.extend(status_notes(sweeps, refine));
     Chart {
         title,
-        x_label: "V_ac (V)",
-        y_label: "P_TD − P_TO (mW)",
+        x_label: "V_{ac} (V)",
+        y_label: "P_{TD} − P_{TO} (mW)",
         series,
         notes,
         ..Chart::default()
@@ -797,7 +800,7 @@ fn fig4_chart<'a>(title: &'a str, sweeps: &'a [Sweep<'a>], refine: &Refinement) 
     notes.extend(status_notes(sweeps, refine));
     Chart {
         title,
-        x_label: "P_TD − P_TO (mW)",
+        x_label: "P_{TD} − P_{TO} (mW)",
         y_label: "mean ΔT (K)",
         series,
         notes,
@@ -816,7 +819,7 @@ fn fig2b_chart<'a>(volts: &[f64], dfh: &[f64], (a, b, c): (f64, f64, f64)) -> Ch
         .collect();
     Chart {
         title: "Fig. 2(b) clearance change against DC voltage",
-        x_label: "V_dc − φ (V)",
+        x_label: "V_{dc} − φ (V)",
         y_label: "ΔFH (nm)",
         series: vec![
             Series::line("parabolic fit", fit)
@@ -883,30 +886,49 @@ fn fig1_chart<'a>(
             .flatten()
             .map(|d| (x(d.power), y(threshold)))
             .collect();
+        // Nested sizes, so that the cycles' diamonds at one place do not hide each other.
         lines.push(
             Series::markers("", events)
                 .colour(colour)
                 .marker(Marker::Diamond)
-                .width(6)
+                .width(7 - 3 * (k as u32 % 2))
                 .hollow(),
+        );
+    }
+    // The threshold the diamonds sit on, across the curves.
+    let (lo, hi) = lines
+        .iter()
+        .flat_map(|l| l.points.iter().map(|p| p.0))
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+    if lo < hi {
+        let level = if absolute { threshold * 1e6 } else { 1.0 };
+        lines.insert(
+            0,
+            Series::line("threshold F_{th}", vec![(lo, level), (hi, level)])
+                .colour(palette::BLACK)
+                .width(1)
+                .dashed(),
         );
     }
     notes.insert(
         0,
-        "Hollow diamonds: detected touchdown and take-off, where the running mean crosses F_th."
+        "Hollow diamonds: detected touchdown and take-off, where the running mean crosses F_{th}."
             .into(),
     );
     let (title, x_label, y_label) = if absolute {
         (
             "Fig. 1 contact indicator over touchdown-triggered cycles",
             "heater power (mW)",
-            "running mean of F_c (µN)",
+            "running mean of F_{c} (µN)",
         )
     } else {
         (
             "Fig. 1 normalized contact indicator over touchdown-triggered cycles",
             "heater power − touchdown power (mW)",
-            "running mean of F_c / F_th",
+            "running mean of F_{c} / F_{th}",
         )
     };
     Ok(Chart {

@@ -427,6 +427,9 @@ pub struct Chart<'a> {
     /// assert_eq!(a.legend_width, b.legend_width);
     /// ```
     pub legend_width: Option<u32>,
+    /// The width the figure is printed at, in inches, which sets its font sizes (8–9 pt there);
+    /// `None`: one column (3.5 in) below 950 px, two columns (7 in) from there.
+    pub print_width_in: Option<f64>,
 }
 
 /// Whether `(x, y)` can be drawn on axes with the given log flags.
@@ -478,9 +481,93 @@ impl Chart<'_> {
     }
 }
 
-/// Pixels per character of the 13 px legend font, for sizing the legend panel.
+/// Average width of a character over the font size asked of plotters (which sets glyphs at
+/// 1/1.24 of it), for sizing the legend panel and the tick label areas.
 #[cfg(feature = "plot")]
-const CHAR_PX: f64 = 7.0;
+const CHAR_EM: f64 = 0.46;
+
+/// Charts are drawn on a canvas this many times finer than the SVG's size, which then scales it
+/// down (`viewBox`): plotters rounds coordinates to whole pixels, so curves are placed to a
+/// quarter of a pixel of the figure instead of a whole one.
+#[cfg(feature = "plot")]
+const SUPERSAMPLE: u32 = 4;
+
+/// Font sizes, in points at the printed width ([`Chart::print_width_in`]): tick labels, axis
+/// labels, legend, notes. No text is below 8 pt in print.
+#[cfg(feature = "plot")]
+const FONT_PT: (f64, f64, f64, f64) = (8.5, 9.0, 8.5, 8.0);
+
+/// Text set for print: a hyphen-minus before a digit (or a decimal point) becomes a minus sign
+/// (U+2212), `_{…}` a subscript and `^{…}` a superscript (SVG `tspan`s). `text` is the escaped
+/// content of one SVG `text` element.
+///
+/// ```
+/// use hdi_tribology::report::typeset;
+/// assert_eq!(typeset("-0.5"), "\u{2212}0.5");
+/// assert_eq!(typeset("touchdown-power"), "touchdown-power");
+/// assert_eq!(
+///     typeset("V_{ac} (V)"),
+///     "V<tspan baseline-shift=\"sub\" font-size=\"75%\">ac</tspan> (V)"
+/// );
+/// ```
+pub fn typeset(text: &str) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        let next = chars.get(i + 1).copied();
+        let prev = i.checked_sub(1).map(|j| chars[j]);
+        if c == '-'
+            && next.is_some_and(|n| n.is_ascii_digit() || n == '.')
+            && prev.is_none_or(|p| !p.is_alphanumeric())
+        {
+            out.push('\u{2212}');
+            i += 1;
+            continue;
+        }
+        if (c == '_' || c == '^') && next == Some('{') {
+            if let Some(len) = chars[i + 2..].iter().position(|&ch| ch == '}') {
+                let inner: String = chars[i + 2..i + 2 + len].iter().collect();
+                let shift = if c == '_' { "sub" } else { "super" };
+                out.push_str(&format!(
+                    "<tspan baseline-shift=\"{shift}\" font-size=\"75%\">{}</tspan>",
+                    typeset(&inner)
+                ));
+                i += len + 3;
+                continue;
+            }
+        }
+        out.push(c);
+        i += 1;
+    }
+    out
+}
+
+/// The SVG plotters drew at [`SUPERSAMPLE`] times the size, shown at `width × height`, with
+/// every text element [`typeset`].
+#[cfg(feature = "plot")]
+fn finish_svg(svg: &str, width: u32, height: u32) -> String {
+    let k = SUPERSAMPLE;
+    let big = format!(r#"width="{}" height="{}""#, width * k, height * k);
+    let svg = svg.replacen(&big, &format!(r#"width="{width}" height="{height}""#), 1);
+    let mut out = String::with_capacity(svg.len());
+    let mut rest = svg.as_str();
+    while let Some(open) = rest.find("<text") {
+        let Some(gt) = rest[open..].find('>') else {
+            break;
+        };
+        let body_start = open + gt + 1;
+        let Some(end) = rest[body_start..].find("</text>") else {
+            break;
+        };
+        out.push_str(&rest[..body_start]);
+        out.push_str(&typeset(&rest[body_start..body_start + end]));
+        rest = &rest[body_start + end..];
+    }
+    out.push_str(rest);
+    out
+}
 
 /// Splits `text` into lines of at most `width` characters at spaces.
 #[cfg(feature = "plot")]
@@ -510,6 +597,7 @@ struct MarkerElement<C> {
     size: i32,
     colour: plotters::style::RGBColor,
     hollow: bool,
+    stroke: u32,
 }
 
 #[cfg(feature = "plot")]
@@ -523,9 +611,10 @@ fn marker_element<C>(
     MarkerElement {
         at,
         shape,
-        size,
+        size: size * SUPERSAMPLE as i32,
         colour,
         hollow,
+        stroke: 2 * SUPERSAMPLE,
     }
 }
 
@@ -555,7 +644,7 @@ impl<C, DB: plotters_backend::DrawingBackend> plotters::element::Drawable<DB> fo
         let style = if fill {
             self.colour.filled()
         } else {
-            ShapeStyle::from(&self.colour).stroke_width(2)
+            ShapeStyle::from(&self.colour).stroke_width(self.stroke)
         };
         let polygon = |backend: &mut DB, v: Vec<(i32, i32)>| {
             let v: Vec<(i32, i32)> = v.into_iter().map(|(a, b)| (x + a, y + b)).collect();
@@ -610,11 +699,24 @@ impl Chart<'_> {
         let mut svg = String::new();
         self.draw(&mut svg, width, height)
             .map_err(|e| Error::output(format!("chart {:?}", self.title), e))?;
-        write_file(path, &svg)
+        write_file(path, &finish_svg(&svg, width, height))
     }
 
     fn draw(&self, out: &mut String, width: u32, height: u32) -> std::result::Result<(), String> {
         use plotters::prelude::*;
+        let k = SUPERSAMPLE;
+        // Font sizes in the canvas's pixels: points at the printed width.
+        let print_in = self
+            .print_width_in
+            .unwrap_or(if width < 950 { 3.5 } else { 7.0 });
+        // plotters writes a font of size `f` as `font-size = f/1.24` in SVG: ask for 1.24 times
+        // the size wanted.
+        let px_per_pt = 1.24 * (width * k) as f64 / (print_in * 72.0);
+        let tick_px = FONT_PT.0 * px_per_pt;
+        let axis_px = FONT_PT.1 * px_per_pt;
+        let legend_px = FONT_PT.2 * px_per_pt;
+        let note_px = FONT_PT.3 * px_per_pt;
+        let (width, height) = (width * k, height * k);
         let err = |e: &dyn std::fmt::Display| e.to_string();
         let log = self.log;
         let has2 = self.points(true).next().is_some();
@@ -659,25 +761,26 @@ impl Chart<'_> {
             .collect();
         let widest = labelled
             .iter()
-            .map(|&i| self.series[i].label.chars().count() + 6)
+            .map(|&i| self.series[i].label.chars().count() + 4)
             .max()
             .unwrap_or(0);
         let legend_w = if let Some(w) = self.legend_width {
-            w.min(width / 2)
+            (w * k).min(width / 2)
         } else if labelled.is_empty() && self.notes.is_empty() {
             0
         } else {
-            ((widest as f64 * CHAR_PX) as u32 + 24).clamp(170, (width as f64 * 0.32) as u32)
+            ((widest as f64 * CHAR_EM * legend_px) as u32 + 6 * k)
+                .clamp(110 * k, (width as f64 * 0.4) as u32)
         };
         let (plot_area, legend_area) = root.split_horizontally(width - legend_w);
         let mut builder = ChartBuilder::on(&plot_area);
+        // The title is the caption's job, not the plot's.
         builder
-            .caption(self.title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(75);
+            .margin(12 * k)
+            .x_label_area_size((tick_px + axis_px * 1.3) as u32)
+            .y_label_area_size((tick_px * CHAR_EM * 4.5 + axis_px * 1.5) as u32);
         if has2 {
-            builder.right_y_label_area_size(70);
+            builder.right_y_label_area_size((tick_px * CHAR_EM * 4.5 + axis_px * 1.5) as u32);
         }
         let (xs, ys, y2s) = (xr.1 - xr.0, yr.1 - yr.0, y2r.1 - y2r.0);
         let grid = RGBAColor(0, 0, 0, 0.12);
@@ -707,13 +810,13 @@ impl Chart<'_> {
                         )
                         .map_err(|e| err(&e))?;
                 } else {
-                    let style = c.stroke_width(if s.width == 0 { 2 } else { s.width });
+                    let style = c.stroke_width(k * if s.width == 0 { 2 } else { s.width });
                     if s.dashed {
                         $chart
                             .$method(std::iter::once(plotters::element::DashedPathElement::new(
                                 pts.into_iter(),
-                                7,
-                                5,
+                                7 * k,
+                                5 * k,
                                 style,
                             )))
                             .map_err(|e| err(&e))?;
@@ -746,9 +849,13 @@ impl Chart<'_> {
                     .x_label_formatter(&|v| label(*v, log.0, xs))
                     .y_label_formatter(&|v| label(*v, log.1, ys))
                     .max_light_lines(0)
-                    .bold_line_style(grid)
-                    .axis_desc_style(("sans-serif", 15))
-                    .label_style(("sans-serif", 13))
+                    .bold_line_style(grid.stroke_width(k))
+                    .axis_style(BLACK.stroke_width(k))
+                    .set_all_tick_mark_size(3 * k)
+                    .x_labels(6)
+                    .y_labels(6)
+                    .axis_desc_style(("sans-serif", axis_px))
+                    .label_style(("sans-serif", tick_px))
                     .draw()
                     .map_err(|e| err(&e))?;
                 draw_all!($chart.draw_series, false);
@@ -769,8 +876,11 @@ impl Chart<'_> {
                         .configure_secondary_axes()
                         .y_desc(self.y2_label)
                         .y_label_formatter(&|v| snapped_tick_label(*v, y2s))
-                        .axis_desc_style(("sans-serif", 15))
-                        .label_style(("sans-serif", 13))
+                        .axis_style(BLACK.stroke_width(k))
+                        .set_all_tick_mark_size(3 * k)
+                        .y_labels(6)
+                        .axis_desc_style(("sans-serif", axis_px))
+                        .label_style(("sans-serif", tick_px))
                         .draw()
                         .map_err(|e| err(&e))?;
                     draw_all!(chart.draw_secondary_series, true);
@@ -793,22 +903,34 @@ impl Chart<'_> {
         }
 
         // The legend, in its own panel to the right of the plot.
-        let font = ("sans-serif", 13).into_font().color(&BLACK);
-        let mut y = 50;
+        let font = ("sans-serif", legend_px).into_font().color(&BLACK);
+        let ki = k as i32;
+        let step = (legend_px * 1.45) as i32;
+        let mut y = 12 * ki + step / 2;
         for &i in &labelled {
             let (s, c) = (&self.series[i], colours[i]);
+            let sym = (legend_px * 1.8) as i32;
             if s.markers {
                 let size = if s.width == 0 { 4 } else { s.width as i32 };
                 legend_area
-                    .draw(&marker_element(s.marker, (20, y), size, c, s.hollow))
+                    .draw(&marker_element(
+                        s.marker,
+                        (4 * ki + sym / 2, y),
+                        size,
+                        c,
+                        s.hollow,
+                    ))
                     .map_err(|e| err(&e))?;
             } else {
-                let style = c.stroke_width(if s.width == 0 { 2 } else { s.width });
-                let line = vec![(6, y), (34, y)];
+                let style = c.stroke_width(k * if s.width == 0 { 2 } else { s.width });
+                let line = vec![(4 * ki, y), (4 * ki + sym, y)];
                 if s.dashed {
                     legend_area
                         .draw(&plotters::element::DashedPathElement::new(
-                            line, 7, 5, style,
+                            line,
+                            7 * k,
+                            5 * k,
+                            style,
                         ))
                         .map_err(|e| err(&e))?;
                 } else {
@@ -817,22 +939,42 @@ impl Chart<'_> {
                         .map_err(|e| err(&e))?;
                 }
             }
-            legend_area
-                .draw(&Text::new(s.label.to_string(), (42, y - 7), font.clone()))
-                .map_err(|e| err(&e))?;
-            y += 22;
+            // Labels wrap to the panel's width.
+            let room = (legend_w as f64 - (12 * ki + sym) as f64) / (CHAR_EM * legend_px);
+            for (n, line) in wrap(s.label, room.max(6.0) as usize)
+                .into_iter()
+                .enumerate()
+            {
+                if n > 0 {
+                    y += (legend_px * 1.2) as i32;
+                }
+                legend_area
+                    .draw(&Text::new(
+                        line,
+                        (8 * ki + sym, y - (legend_px * 0.5) as i32),
+                        font.clone(),
+                    ))
+                    .map_err(|e| err(&e))?;
+            }
+            y += step;
         }
-        let note_font = ("sans-serif", 12).into_font().color(&RGBColor(60, 60, 60));
-        let chars = ((legend_w as f64 - 12.0) / 6.2).max(10.0) as usize;
-        y += 8;
+        let note_font = ("sans-serif", note_px)
+            .into_font()
+            .color(&RGBColor(60, 60, 60));
+        let chars = ((legend_w as f64 - 8.0 * k as f64) / (CHAR_EM * note_px)).max(10.0) as usize;
+        y += step / 3;
         for note in &self.notes {
             for line in wrap(note, chars) {
                 legend_area
-                    .draw(&Text::new(line, (6, y - 7), note_font.clone()))
+                    .draw(&Text::new(
+                        line,
+                        (4 * ki, y - (note_px * 0.5) as i32),
+                        note_font.clone(),
+                    ))
                     .map_err(|e| err(&e))?;
-                y += 16;
+                y += (note_px * 1.3) as i32;
             }
-            y += 6;
+            y += step / 4;
         }
         root.present().map_err(|e| err(&e))?;
         Ok(())

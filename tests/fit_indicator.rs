@@ -41,7 +41,16 @@ fn indicator_curve_gives_back_the_truth_within_its_error_bars() {
         FreeParameter::new("nominal_clearance_nm").bounded(7.0, 13.0),
     ];
     let r = fit(&start, &[data], &free, &FitOptions::default()).unwrap();
-    assert!(r.converged && r.trusted, "{:?}", r.warnings);
+    // The residuals look like noise, but η and h0 are correlated at ρ ≈ 0.998: the fit is not
+    // trusted for that alone (the indicator's onset fixes h0/η far better than each), and says so.
+    assert!(r.converged && r.goodness.passed(), "{:?}", r.warnings);
+    assert!(!r.trusted);
+    assert_eq!(r.warnings.len(), 1, "{:?}", r.warnings);
+    assert!(
+        r.warnings[0].starts_with("efficiency_nm_per_mw and nominal_clearance_nm are correlated"),
+        "{:?}",
+        r.warnings
+    );
     for (p, t) in r.parameters.iter().zip([0.1, 10.0]) {
         let se = p.standard_error.expect("determined");
         println!("{} = {} ± {se} (truth {t})", p.name, p.value);

@@ -181,4 +181,79 @@ mod charts {
         .unwrap();
         assert!(s.contains("spacing (nm)") && s.contains("force (mN)"));
     }
+
+    /// Font sizes of the text elements, in the SVG's own pixels.
+    fn font_sizes(svg: &str) -> Vec<f64> {
+        svg.split("font-size=\"")
+            .skip(1)
+            .filter_map(|t| t.split('"').next()?.parse().ok())
+            .collect()
+    }
+
+    #[test]
+    fn charts_are_set_for_print() {
+        // A parabola across zero, as Fig. 2(b), drawn 1050 px wide: one column (3.5 in) at
+        // 300 dpi, so 8 pt is 1050/252·8 = 33.3 px of the canvas before it is scaled down.
+        let pts: Vec<(f64, f64)> = (0..=200)
+            .map(|i| {
+                let v = -1.0 + i as f64 * 0.01;
+                (v, 10.0 - 3.0 * (v - 0.1) * (v - 0.1))
+            })
+            .collect();
+        let chart = Chart {
+            title: "a title for the caption only",
+            x_label: "V_{dc} (V)",
+            y_label: "clearance (nm)",
+            series: vec![Series::line("model", pts)],
+            print_width_in: Some(3.5),
+            ..Chart::default()
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.svg");
+        chart.to_svg(&path, 1050, 700).unwrap();
+        if let Ok(keep) = std::env::var("HDI_KEEP_CHART") {
+            std::fs::copy(&path, keep).unwrap();
+        }
+        let s = std::fs::read_to_string(&path).unwrap();
+        // Shown at 1050 × 700, drawn on a canvas four times finer.
+        assert!(
+            s.contains(r#"width="1050" height="700" viewBox="0 0 4200 2800""#),
+            "{}",
+            &s[..200]
+        );
+        let sizes = font_sizes(&s);
+        let eight_pt = 4.0 * 1050.0 / 252.0 * 8.0;
+        assert!(
+            !sizes.is_empty() && sizes.iter().all(|&f| f >= eight_pt - 1e-9),
+            "{sizes:?}"
+        );
+        // No title in the plot; real minus signs on the ticks; a real subscript.
+        assert!(!s.contains("a title for the caption only"));
+        let texts = texts(&s);
+        assert!(
+            texts.iter().any(|(_, t)| t.starts_with('\u{2212}')),
+            "{texts:?}"
+        );
+        assert!(texts.iter().all(|(_, t)| !t.starts_with('-')), "{texts:?}");
+        assert!(s.contains(r#"V<tspan baseline-shift="sub" font-size="75%">dc</tspan> (V)"#));
+        // The curve's points are placed finer than whole pixels of the figure.
+        let ys: Vec<i64> = s
+            .split("<polyline")
+            .skip(1)
+            .map(|poly| {
+                poly.split("points=\"")
+                    .nth(1)
+                    .unwrap()
+                    .split('"')
+                    .next()
+                    .unwrap()
+                    .split_whitespace()
+                    .filter_map(|p| p.split(',').nth(1)?.parse().ok())
+                    .collect::<Vec<i64>>()
+            })
+            .max_by_key(Vec::len)
+            .unwrap();
+        assert!(ys.len() > 100, "{}", ys.len());
+        assert!(ys.iter().any(|y| y % 4 != 0), "points on whole pixels only");
+    }
 }

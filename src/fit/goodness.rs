@@ -3,7 +3,7 @@
 //!
 //! A converged fit can still be wrong: a model that cannot follow the data (a missing physical
 //! effect, a parameter held at a wrong value) converges to the least bad compromise and reports
-//! error bars scaled by its own misfit. Three tests look for that, each at the significance level
+//! error bars scaled by its own misfit. Four tests look for that, each at the significance level
 //! [`ALPHA`]:
 //!
 //! - **χ² against the stated uncertainties**, when the data files give an uncertainty for every
@@ -14,6 +14,15 @@
 //!   mean square against the other columns'.
 //! - **Runs of residual signs** along x in each column (Wald–Wolfowitz, normal approximation,
 //!   from 8 values on): too few runs mean a systematic misfit that the scatter hides.
+//! - **The mean of each column's residuals** against zero, from [`MIN_MEAN_POINTS`] values on:
+//!   residuals that sit on one side of the data (a curve the model cannot reach, a parameter held
+//!   on a bound) are a misfit whatever the weights. With stated uncertainties `z = w̄·√m_k`
+//!   (normal); without, Student's `t = w̄/(s_k/√m_k)` with the column's scatter about its mean
+//!   on `m_k − 1 − n m_k/m` degrees of freedom (the fit's `n` parameters take their share).
+//!   At an exact least-squares optimum the residuals' mean varies less than free noise's, so
+//!   the test errs on the side of passing.
+
+use std::f64::consts::SQRT_2;
 
 use serde::Serialize;
 use statrs::function::{beta::beta_reg, erf::erfc, gamma::gamma_ur};
@@ -27,6 +36,9 @@ pub const ALPHA: f64 = 1e-3;
 /// Fewest values in a column for the runs test (below it the test cannot reject anything at
 /// [`ALPHA`]).
 pub const MIN_RUNS_POINTS: usize = 8;
+
+/// Fewest values in a column for the test of its mean.
+pub const MIN_MEAN_POINTS: usize = 4;
 
 /// The χ² test of the whole fit against the stated uncertainties.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -60,6 +72,11 @@ pub struct ColumnCheck {
     pub runs: Option<usize>,
     /// `p` of so few runs.
     pub runs_p_value: Option<f64>,
+    /// Mean of its weighted residuals.
+    pub mean: f64,
+    /// Two-sided `p` of a mean this far from zero; `None` below [`MIN_MEAN_POINTS`] values or
+    /// without degrees of freedom left.
+    pub mean_p_value: Option<f64>,
 }
 
 /// The goodness-of-fit tests of a fit.
@@ -73,6 +90,13 @@ pub struct Goodness {
     pub columns: Vec<ColumnCheck>,
     /// Each failed test in words (empty: the residuals look like noise).
     pub failures: Vec<String>,
+}
+
+impl ColumnCheck {
+    /// Whether every residual of the column has the same sign (its mean test says how unlikely).
+    pub fn residuals_one_signed(&self) -> bool {
+        self.runs == Some(1)
+    }
 }
 
 impl Goodness {
@@ -98,9 +122,41 @@ fn f_sf(f: f64, nu1: f64, nu2: f64) -> f64 {
     beta_reg(0.5 * nu2, 0.5 * nu1, nu2 / (nu2 + nu1 * f))
 }
 
+/// `P(|T_ν| ≥ t)` of Student's t.
+fn t_two_sided(t: f64, nu: f64) -> f64 {
+    beta_reg(0.5 * nu, 0.5, nu / (nu + t * t))
+}
+
+/// Mean of `w` and the two-sided `p` of a mean this far from zero (see the module's words);
+/// `free_share` is the fit's parameters' share of this column.
+pub fn mean_test(w: &[f64], stated: bool, free_share: f64) -> (f64, Option<f64>) {
+    let m = w.len();
+    if m == 0 {
+        return (0.0, None);
+    }
+    let mean = w.iter().sum::<f64>() / m as f64;
+    if m < MIN_MEAN_POINTS {
+        return (mean, None);
+    }
+    if stated {
+        return (mean, Some(erfc(mean.abs() * (m as f64).sqrt() / SQRT_2)));
+    }
+    let nu = m as f64 - 1.0 - free_share;
+    if nu < 1.0 {
+        return (mean, None);
+    }
+    let ss: f64 = w.iter().map(|v| (v - mean).powi(2)).sum();
+    if ss <= 0.0 {
+        // Every residual the same: no scatter to measure the mean against.
+        return (mean, Some(if mean == 0.0 { 1.0 } else { 0.0 }));
+    }
+    let t = mean / (ss / nu / m as f64).sqrt();
+    (mean, Some(t_two_sided(t, nu)))
+}
+
 /// `P(Z ≤ z)` of the standard normal.
 fn normal_cdf(z: f64) -> f64 {
-    0.5 * erfc(-z / std::f64::consts::SQRT_2)
+    0.5 * erfc(-z / SQRT_2)
 }
 
 /// Runs of signs of `residuals` ordered by `x`, and the probability of so few under random
@@ -219,6 +275,22 @@ pub fn assess(tables: &[ResidualTable], stated: &[bool], free: usize) -> Goodnes
                 t.file, t.column
             ));
         }
+        let share = if m > 0 {
+            free as f64 * mk as f64 / m as f64
+        } else {
+            0.0
+        };
+        let (mean, mean_p) = mean_test(&c.w, is_stated, share);
+        if let Some(p) = mean_p.filter(|&p| p < ALPHA) {
+            let below = c.w.iter().filter(|v| **v < 0.0).count();
+            failures.push(format!(
+                "{} ({}): its residuals average {mean:+.3} (weighted; {below} of {mk} negative, \
+                 p = {p:.1e}): the model curve sits {} the data",
+                t.file,
+                t.column,
+                if mean < 0.0 { "below" } else { "above" }
+            ));
+        }
         columns.push(ColumnCheck {
             file: t.file.clone(),
             column: t.column.clone(),
@@ -228,6 +300,8 @@ pub fn assess(tables: &[ResidualTable], stated: &[bool], free: usize) -> Goodnes
             scale_p_value: scale_p,
             runs: runs.map(|r| r.0),
             runs_p_value: runs.map(|r| r.1),
+            mean,
+            mean_p_value: mean_p,
         });
     }
     Goodness {
@@ -254,6 +328,22 @@ mod tests {
         }
         assert!((normal_cdf(0.0) - 0.5).abs() < 1e-16);
         assert!((normal_cdf(-3.090_232_306_167_813) - 1e-3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn student_t_tails_match_closed_forms() {
+        // ν = 1 is Cauchy: P(|T| ≥ t) = 1 − 2 atan(t)/π; ν = 2: 1 − t/√(2 + t²).
+        for t in [0.3, 1.0, 12.0] {
+            let cauchy = 1.0 - 2.0 * f64::atan(t) / std::f64::consts::PI;
+            assert!((t_two_sided(t, 1.0) - cauchy).abs() < 1e-14);
+            assert!((t_two_sided(t, 2.0) - (1.0 - t / (2.0 + t * t).sqrt())).abs() < 1e-14);
+        }
+        // One-signed residuals far from zero fail; symmetric ones pass.
+        let off = [-58.0, -61.0, -65.0, -59.0, -62.0, -60.0, -64.0, -63.0];
+        assert!(mean_test(&off, false, 2.0).1.unwrap() < 1e-6);
+        let sym = [-1.0, 1.0, -0.5, 0.5, -2.0, 2.0];
+        assert!((mean_test(&sym, false, 1.0).1.unwrap() - 1.0).abs() < 1e-12);
+        assert!(mean_test(&sym[..3], false, 0.0).1.is_none());
     }
 
     #[test]

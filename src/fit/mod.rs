@@ -33,7 +33,7 @@ pub use data::{CurveKind, DataError, DataSet, Observed, Quantity, Unit};
 pub use params::FreeParameter;
 pub use solve::{
     fit, model_curves, Direction, FitOptions, FitResult, FittedParameter, Identifiability,
-    IntegrationCheck, ResidualRow, ResidualTable, StartOutcome,
+    IntegrationCheck, ResidualRow, ResidualTable, StartOutcome, MIN_LINEARITY, STRONG_CORRELATION,
 };
 
 /// Why a fit could not be made.

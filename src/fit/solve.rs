@@ -61,6 +61,13 @@ pub struct FitOptions {
     /// evaluation, rebuilding force tables where the parameter changes them) instead of the
     /// static transitions' sensitivities. Slower; kept to check the sensitivities.
     pub finite_difference_jacobian: bool,
+    /// Curves with cycles: from the optimum, this many more starts (in pairs, ± along the least
+    /// determined directions, [`FitOptions::check_distance`] error bars out). A check start that
+    /// ends with a lower χ² shows the first ended in a false minimum: the better one is kept and
+    /// the fit says so. 0 turns the check off.
+    pub cycle_check_starts: usize,
+    /// How far out the check starts begin, in error bars along their direction.
+    pub check_distance: f64,
 }
 
 impl Default for FitOptions {
@@ -76,6 +83,8 @@ impl Default for FitOptions {
             dynamic_power_tol_mw: 1e-3,
             dynamic_rel_step: 1e-2,
             finite_difference_jacobian: false,
+            cycle_check_starts: 2,
+            check_distance: 4.0,
         }
     }
 }
@@ -98,6 +107,7 @@ impl FitOptions {
             ("static_table_rel_tol", self.static_table_rel_tol, 0.01),
             ("dynamic_power_tol_mw", self.dynamic_power_tol_mw, 10.0),
             ("dynamic_rel_step", self.dynamic_rel_step, 0.1),
+            ("check_distance", self.check_distance, 100.0),
         ] {
             if !(v > 0.0 && v <= hi) {
                 return Err(Error::invalid(
@@ -315,8 +325,10 @@ pub struct FitResult {
     /// Whether the residuals look like noise: χ² against stated uncertainties, the scale of
     /// each curve against the others, runs of residual signs ([`super::goodness`]).
     pub goodness: Goodness,
-    /// Converged, no clipped transition, integration noise small, and every goodness-of-fit
-    /// test passed.
+    /// Converged; every parameter determined and none on a bound; no pair correlated beyond
+    /// [`STRONG_CORRELATION`]; no clipped transition; integration noise small; the error bars
+    /// linear (curves with cycles); and every goodness-of-fit test passed. Each failure is a
+    /// warning.
     pub trusted: bool,
     /// What keeps the fit from being trusted, in words.
     pub warnings: Vec<String>,
@@ -325,7 +337,12 @@ pub struct FitResult {
 /// The least-squares problem in the optimiser's unbounded variables.
 struct Problem<'e, 'a> {
     ev: &'e Evaluator<'a>,
+    /// The optimiser's variables: those of the parameters in `active`.
     u: Vec<f64>,
+    /// Indices of the parameters the optimiser moves; the others are held at `held`.
+    active: &'e [usize],
+    /// The full parameter vector the held values are taken from.
+    held: Vec<f64>,
     opts: &'e FitOptions,
     budget: usize,
     /// Residuals at the last point that could be evaluated.
@@ -336,12 +353,11 @@ struct Problem<'e, 'a> {
 
 impl Problem<'_, '_> {
     fn x(&self, u: &[f64]) -> Vec<f64> {
-        self.ev
-            .params
-            .iter()
-            .zip(u)
-            .map(|(p, &u)| p.transform.x(u))
-            .collect()
+        let mut x = self.held.clone();
+        for (&j, &u) in self.active.iter().zip(u) {
+            x[j] = self.ev.params[j].transform.x(u);
+        }
+        x
     }
 
     fn over_budget(&self) -> bool {
@@ -410,7 +426,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
         }
         let x = self.x(&self.u);
         self.residuals_at(&self.u)?;
-        let cols = match jacobian_columns(self.ev, &x, self.opts, false) {
+        let cols = match jacobian_columns(self.ev, &x, self.opts, false, self.active) {
             Ok(c) => c,
             Err(e) => {
                 *self.error.borrow_mut() = Some(e.to_string());
@@ -419,8 +435,8 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
         };
         let m = cols.first().map_or(0, Vec::len);
         let mut j = LmMatrix::zeros(m, self.u.len());
-        for (c, col) in cols.iter().enumerate() {
-            let d = self.ev.params[c].transform.dx_du(self.u[c]);
+        for (c, (col, &p)) in cols.iter().zip(self.active).enumerate() {
+            let d = self.ev.params[p].transform.dx_du(self.u[c]);
             for (i, v) in col.iter().enumerate() {
                 j[(i, c)] = v * d;
             }
@@ -429,7 +445,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
     }
 }
 
-/// `∂r/∂x_j` of the weighted residuals, one column per parameter.
+/// `∂r/∂x_j` of the weighted residuals, one column per parameter in `which`.
 ///
 /// Static values come from the transitions' first-order shifts ([`Evaluator::static_sensitivities`]:
 /// no rescan and no table build), dynamic values from finite differences of the cycles alone,
@@ -442,6 +458,7 @@ fn jacobian_columns(
     x: &[f64],
     opts: &FitOptions,
     central: bool,
+    which: &[usize],
 ) -> crate::Result<Vec<Vec<f64>>> {
     let n = x.len();
     let pred = ev.predict(x)?;
@@ -484,11 +501,11 @@ fn jacobian_columns(
             #[cfg(feature = "parallel")]
             {
                 use rayon::prelude::*;
-                (0..n).into_par_iter().map(f).collect()
+                which.par_iter().map(|&j| f(j)).collect()
             }
             #[cfg(not(feature = "parallel"))]
             {
-                (0..n).map(f).collect()
+                which.iter().map(|&j| f(j)).collect()
             }
         };
     if opts.finite_difference_jacobian {
@@ -503,11 +520,11 @@ fn jacobian_columns(
     let mut cols = if ev.data.iter().any(|d| !d.is_transitions()) {
         par_map(&|j| fd(j, rel, Sets::NoTransitions))?
     } else {
-        vec![vec![0.0; r0.len()]; n]
+        vec![vec![0.0; r0.len()]; which.len()]
     };
     let steps: Vec<(f64, bool)> = (0..n).map(|j| step(j, opts.rel_step)).collect();
     let sens = ev.static_sensitivities(x, &pred, &steps)?;
-    for (col, s) in cols.iter_mut().zip(&sens) {
+    for (col, s) in cols.iter_mut().zip(which.iter().map(|&j| &sens[j])) {
         for (i, v) in s.iter().enumerate() {
             if let Some(v) = v {
                 col[i] = if ev.excluded.get(i).copied().unwrap_or(false) {
@@ -636,11 +653,36 @@ pub fn fit(
         }
     }
 
+    // Parameters no fitted value depends on at the first start are held there: the optimiser
+    // moves the others (a column of zeros would only stall its trust region), and the error
+    // analysis at the optimum reports them as not determined.
+    let x0: Vec<f64> = params.iter().map(|p| p.start).collect();
+    let all: Vec<usize> = (0..params.len()).collect();
+    let held: Vec<usize> = match jacobian_columns(&ev, &x0, opts, false, &all) {
+        Ok(cols) => {
+            let norms: Vec<f64> = cols
+                .iter()
+                .zip(&params)
+                .map(|(c, p)| p.scale * c.iter().map(|v| v * v).sum::<f64>().sqrt())
+                .collect();
+            let top = norms.iter().copied().fold(0.0, f64::max);
+            (0..params.len())
+                .filter(|&j| top > 0.0 && norms[j] <= UNTOUCHED_COLUMN * top)
+                .collect()
+        }
+        Err(_) => Vec::new(),
+    };
+    let active: Vec<usize> = all.iter().copied().filter(|j| !held.contains(j)).collect();
+    let active = if active.is_empty() { all } else { active };
+
     let mut outcomes = Vec::new();
     let mut best: Option<(f64, Vec<f64>, bool, String)> = None;
     let mut first_error = None;
-    for start in start_points(&params, opts.starts, opts.seed) {
-        let (outcome, end) = run_start(&ev, opts, start);
+    for mut start in start_points(&params, opts.starts, opts.seed) {
+        for &j in &held {
+            start[j] = x0[j];
+        }
+        let (outcome, end) = run_start(&ev, opts, start, &active);
         if end.is_none() {
             first_error.get_or_insert_with(|| outcome.termination.clone());
         }
@@ -685,13 +727,125 @@ pub fn fit(
         for i in newly {
             ev.excluded[i] = true;
         }
-        let (outcome, end) = run_start(&ev, opts, x.clone());
+        let (outcome, end) = run_start(&ev, opts, x.clone(), &active);
         outcomes.push(outcome);
         let Some((_, x1, c1, t1)) = end else { break };
         (x, converged, termination) = (x1, c1, t1);
     }
-    analyse(&ev, opts, x, best_start, converged, termination, outcomes)
+    // Curves with cycles: the detected powers are not smooth in the parameters, and a single
+    // start can end in a false minimum whose residuals pass every test. Starts from the optimum
+    // moved out along the least determined directions look for a better one.
+    let mut escaped = None;
+    if data.iter().any(DataSet::is_dynamic) && opts.cycle_check_starts > 0 {
+        let best_cost = outcomes
+            .iter()
+            .filter(|o| o.end == x)
+            .map(|o| o.cost)
+            .fold(f64::INFINITY, f64::min);
+        let checks = check_starts(&ev, opts, &x, &active, best_cost)?;
+        for start in checks {
+            let (outcome, end) = run_start(&ev, opts, start, &active);
+            outcomes.push(outcome);
+            if let Some((c, x1, c1, t1)) = end {
+                // Lower by more than the optimiser's tolerance and one unit of χ².
+                if c1 && c < best_cost - 1.0 - opts.tolerance * best_cost {
+                    escaped = Some((best_cost, c));
+                    (x, converged, termination) = (x1, c1, t1);
+                    break;
+                }
+            }
+        }
+    }
+    let held: Vec<&str> = held.iter().map(|&j| params[j].name()).collect();
+    analyse(
+        &ev,
+        opts,
+        Optimum {
+            x,
+            start: best_start,
+            converged,
+            termination,
+            starts: outcomes,
+            held: &held,
+            escaped,
+        },
+    )
 }
+
+/// Check starts around the optimum `x` (cost `chi2`): pairs ± along the least determined
+/// directions of the scaled Jacobian, `check_distance` error bars out, kept inside the bounds.
+fn check_starts(
+    ev: &Evaluator<'_>,
+    opts: &FitOptions,
+    x: &[f64],
+    active: &[usize],
+    chi2: f64,
+) -> Result<Vec<Vec<f64>>, FitError> {
+    let params = ev.params;
+    let cols = jacobian_columns(ev, x, opts, false, active)?;
+    let m = cols.first().map_or(0, Vec::len);
+    let excluded = ev.excluded.iter().filter(|e| **e).count();
+    let dof = (m - excluded).saturating_sub(active.len()).max(1);
+    let s = (chi2 / dof as f64).sqrt();
+    let mut js = DMatrix::<f64>::zeros(m, active.len());
+    for (c, (col, &j)) in cols.iter().zip(active).enumerate() {
+        for (i, v) in col.iter().enumerate() {
+            js[(i, c)] = v * params[j].scale;
+        }
+    }
+    let svd = js.svd(false, true);
+    let Some(v_t) = svd.v_t else {
+        return Ok(Vec::new());
+    };
+    let sv = svd.singular_values;
+    let mut order: Vec<usize> = (0..sv.len()).collect();
+    order.sort_by(|&a, &b| sv[a].total_cmp(&sv[b]));
+    let mut out = Vec::new();
+    for &k in order.iter().take(opts.cycle_check_starts.div_ceil(2)) {
+        // Out to `check_distance` error bars, but at most half the parameters' scale.
+        let reach = (opts.check_distance * s / sv[k].max(f64::MIN_POSITIVE)).min(0.5);
+        for sign in [1.0, -1.0] {
+            if out.len() == opts.cycle_check_starts {
+                break;
+            }
+            let mut p = x.to_vec();
+            for (c, &j) in active.iter().enumerate() {
+                let r = &params[j];
+                let mut v = x[j] + sign * reach * v_t[(k, c)] * r.scale;
+                let room = match (r.lower, r.upper) {
+                    (Some(lo), Some(hi)) => 1e-3 * (hi - lo),
+                    _ => 1e-3 * r.scale,
+                };
+                if let Some(lo) = r.lower {
+                    v = v.max(lo + room);
+                }
+                if let Some(hi) = r.upper {
+                    v = v.min(hi - room);
+                }
+                p[j] = v;
+            }
+            out.push(p);
+        }
+    }
+    Ok(out)
+}
+
+/// Where the optimiser ended, and how.
+struct Optimum<'h> {
+    x: Vec<f64>,
+    start: Vec<f64>,
+    converged: bool,
+    termination: String,
+    starts: Vec<StartOutcome>,
+    /// Parameters no fitted value depended on at the start, held there.
+    held: &'h [&'h str],
+    /// A check start found a lower minimum: (χ² of the first, χ² of the better).
+    escaped: Option<(f64, f64)>,
+}
+
+/// A parameter whose Jacobian column (in its scale) is at most this fraction of the largest at
+/// the start is one the data do not touch; it is held at its start.
+const UNTOUCHED_COLUMN: f64 = 1e-12;
 
 /// One start of the optimiser: its outcome, and (cost, end, converged, termination) when the
 /// start could be evaluated.
@@ -700,17 +854,19 @@ fn run_start(
     ev: &Evaluator<'_>,
     opts: &FitOptions,
     start: Vec<f64>,
+    active: &[usize],
 ) -> (StartOutcome, Option<(f64, Vec<f64>, bool, String)>) {
     let params = ev.params;
     let budget = ev.evaluations.load(Ordering::Relaxed) + opts.max_evaluations;
-    let u0: Vec<f64> = params
+    let u0: Vec<f64> = active
         .iter()
-        .zip(&start)
-        .map(|(p, &x)| p.transform.u(x))
+        .map(|&j| params[j].transform.u(start[j]))
         .collect();
     let problem = Problem {
         ev,
         u: u0.clone(),
+        active,
+        held: start.clone(),
         opts,
         budget,
         last: RefCell::new(None),
@@ -751,15 +907,16 @@ fn run_start(
 }
 
 /// Errors, correlations, identifiability and residual tables at the optimum `x`.
-fn analyse(
-    ev: &Evaluator<'_>,
-    opts: &FitOptions,
-    x: Vec<f64>,
-    start: Vec<f64>,
-    converged: bool,
-    termination: String,
-    starts: Vec<StartOutcome>,
-) -> Result<FitResult, FitError> {
+fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<FitResult, FitError> {
+    let Optimum {
+        x,
+        start,
+        converged,
+        termination,
+        starts,
+        held,
+        escaped,
+    } = opt;
     let params = ev.params;
     let data = ev.data;
     let pred = ev.predict(&x)?;
@@ -771,7 +928,8 @@ fn analyse(
     let s = (chi2 / (m - n) as f64).sqrt();
 
     // Central differences, in each parameter's scale: J_s = J · diag(scale).
-    let cols = jacobian_columns(ev, &x, opts, true)?;
+    let all: Vec<usize> = (0..n).collect();
+    let cols = jacobian_columns(ev, &x, opts, true, &all)?;
     let mut js = DMatrix::<f64>::zeros(r0.len(), n);
     for (c, col) in cols.into_iter().enumerate() {
         for (i, v) in col.into_iter().enumerate() {
@@ -901,7 +1059,14 @@ fn analyse(
             if elsewhere.len() == 1 { "it" } else { "them" }
         ));
     }
-    statements.extend(identifiability_words(&parameters, &directions, params, tol));
+    let strong = strongly_correlated(&parameters, &correlation);
+    statements.extend(identifiability_words(
+        &parameters,
+        &directions,
+        params,
+        tol,
+        !strong.is_empty(),
+    ));
     let condition = if sv.iter().any(|&v| v <= 0.0) {
         f64::INFINITY
     } else {
@@ -910,6 +1075,14 @@ fn analyse(
 
     let residuals = residual_tables(data, &pred, &ev.excluded);
     let mut warnings = Vec::new();
+    if let Some((first, better)) = escaped {
+        warnings.push(format!(
+            "the first start ended in a false minimum (χ² = {first:.1}); a check start from it \
+             found χ² = {better:.1}, which is the fit reported: the cycles' detected powers are \
+             not smooth in the parameters, so give several starts (--starts) or fit the static \
+             curves first"
+        ));
+    }
     if !converged {
         warnings.push(format!("the optimiser did not converge: {termination}"));
     }
@@ -926,8 +1099,38 @@ fn analyse(
     }
     for p in parameters.iter().filter(|p| p.at_bound) {
         warnings.push(format!(
-            "{} ended on a bound: its error bar is not meaningful",
+            "{} ended on a bound: the best fit lies beyond it, so the other values are those of a \
+             constrained fit and the error bars (which assume a free minimum) are not meaningful",
             p.name
+        ));
+    }
+    for p in parameters.iter().filter(|p| !p.determined) {
+        warnings.push(if held.contains(&p.name.as_str()) {
+            format!(
+                "{} is not determined: no fitted value depends on it, so it was held at its start \
+                 ({}) while the others were fitted; fix it in the scene or add data that \
+                 depend on it",
+                p.name, p.start
+            )
+        } else {
+            format!(
+                "{} is not determined by these data (no error bar): its value is where the \
+                 optimiser stopped, not a measurement; fix it in the scene or add data that \
+                 determine it",
+                p.name
+            )
+        });
+    }
+    for (a, b, rho) in &strong {
+        warnings.push(format!(
+            "{a} and {b} are correlated at ρ = {rho:+.4} (|ρ| > {STRONG_CORRELATION}): the data \
+             fix a combination of them, along a valley {:.0} times longer than it is wide; \
+             their separate error bars rest on the linearisation along all of it",
+            (1.0 - rho * rho)
+                .max(f64::MIN_POSITIVE)
+                .sqrt()
+                .recip()
+                .min(1e6)
         ));
     }
     let integration = if data.iter().any(DataSet::is_dynamic) {
@@ -951,15 +1154,8 @@ fn analyse(
             }
             let ratio = rise / predicted.max(f64::MIN_POSITIVE);
             p.linearity = Some(ratio);
-            if ratio < 0.25 {
-                warnings.push(format!(
-                    "the error bar of {} is not reliable: moving it by one error bar raises χ² \
-                     by {:.2} of what the linearisation predicts (the error bar is about {:.1} \
-                     times too small)",
-                    p.name,
-                    ratio,
-                    ratio.max(f64::MIN_POSITIVE).sqrt().recip()
-                ));
+            if let Some(w) = linearity_warning(&p.name, ratio) {
+                warnings.push(w);
             }
         }
         let check = integration_check(data, &pred, &ev.excluded, s, opts);
@@ -1005,9 +1201,12 @@ fn analyse(
     warnings.extend(goodness.failures.iter().cloned());
     let linear = parameters
         .iter()
-        .all(|p| p.linearity.is_none_or(|r| r >= 0.25));
+        .all(|p| p.linearity.is_none_or(|r| r >= MIN_LINEARITY));
     let trusted = converged
         && linear
+        && strong.is_empty()
+        && escaped.is_none()
+        && parameters.iter().all(|p| p.determined && !p.at_bound)
         && clipped == 0
         && integration.as_ref().is_none_or(|i| i.ok)
         && goodness.passed();
@@ -1035,6 +1234,59 @@ fn analyse(
     })
 }
 
+/// Correlations beyond this (in magnitude) make a fit untrusted: the pair is then fixed by the
+/// data only as a combination, along a valley more than 7 times (`1/√(1 − ρ²)`) longer than it
+/// is wide, and the separate error bars depend on the linearisation holding along all of it.
+pub const STRONG_CORRELATION: f64 = 0.99;
+
+/// Below this ratio of the χ² rise over one error bar to the linearisation's (curves with
+/// cycles), the error bar is at least twice too small and the fit is not trusted.
+pub const MIN_LINEARITY: f64 = 0.25;
+
+/// Pairs of parameters (both determined) correlated beyond [`STRONG_CORRELATION`].
+fn strongly_correlated(
+    parameters: &[FittedParameter],
+    correlation: &[Vec<f64>],
+) -> Vec<(String, String, f64)> {
+    let mut out = Vec::new();
+    for (a, pa) in parameters.iter().enumerate() {
+        for (b, pb) in parameters.iter().enumerate().skip(a + 1) {
+            let rho = correlation[a][b];
+            if pa.determined && pb.determined && rho.abs() > STRONG_CORRELATION {
+                out.push((pa.name.clone(), pb.name.clone(), rho));
+            }
+        }
+    }
+    out
+}
+
+/// The warning of a linearity ratio below [`MIN_LINEARITY`], its figures bounded: a χ² that does
+/// not rise (or falls) is said in words, not as an astronomically small error bar.
+fn linearity_warning(name: &str, ratio: f64) -> Option<String> {
+    if ratio >= MIN_LINEARITY {
+        return None;
+    }
+    Some(if ratio <= 0.0 {
+        format!(
+            "the error bar of {name} is not reliable: moving it by one error bar does not raise \
+             χ² at all, so the fit did not end at a minimum along it"
+        )
+    } else if ratio < 1e-4 {
+        format!(
+            "the error bar of {name} is not reliable: moving it by one error bar raises χ² by \
+             less than 1e-4 of what the linearisation predicts (the error bar is more than 100 \
+             times too small)"
+        )
+    } else {
+        format!(
+            "the error bar of {name} is not reliable: moving it by one error bar raises χ² by \
+             {ratio:.2} of what the linearisation predicts (the error bar is about {:.1} times \
+             too small)",
+            ratio.sqrt().recip()
+        )
+    })
+}
+
 fn percent(v: f64) -> String {
     if v.is_finite() {
         format!("{:.2} %", 100.0 * v)
@@ -1049,6 +1301,7 @@ fn identifiability_words(
     directions: &[Direction],
     params: &[Resolved],
     tol: f64,
+    strongly_correlated: bool,
 ) -> Vec<String> {
     let scale_word = |name: &str| {
         let p = params.iter().find(|p| p.name() == name);
@@ -1061,10 +1314,13 @@ fn identifiability_words(
     for d in directions.iter().filter(|d| !d.determined) {
         match d.components.as_slice() {
             [] => {}
-            [(name, _)] => out.push(format!(
+            [(name, _)] if d.rel_error.is_finite() => out.push(format!(
                 "{name} is not determined by these data: its 1σ range is {} of {}",
                 percent(d.rel_error),
                 scale_word(name)
+            )),
+            [(name, _)] => out.push(format!(
+                "{name} is not determined by these data: no fitted value depends on it"
             )),
             comps => {
                 let list: Vec<&str> = comps.iter().map(|c| c.0.as_str()).collect();
@@ -1091,7 +1347,14 @@ fn identifiability_words(
         .filter(|p| !p.determined)
         .map(|p| p.name.as_str())
         .collect();
-    if undetermined.is_empty() {
+    if undetermined.is_empty() && strongly_correlated {
+        out.push(format!(
+            "each parameter's error is within the {} limit, but some are strongly correlated \
+             (|ρ| > {STRONG_CORRELATION}, in the warnings): the data determine their \
+             combination better than each alone",
+            percent(tol)
+        ));
+    } else if undetermined.is_empty() {
         let worst = fitted
             .iter()
             .zip(params)
@@ -1199,4 +1462,26 @@ pub fn model_curves(scene: &Scene, data: &[DataSet]) -> Result<Vec<DataSet>, Fit
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_linearity_warning_never_prints_an_absurd_factor() {
+        assert_eq!(linearity_warning("a", MIN_LINEARITY), None);
+        let w = linearity_warning("a", 0.04).unwrap();
+        assert!(w.contains("about 5.0 times too small"), "{w}");
+        // A ratio of 2e-307 once printed "about 6.7e153 times too small".
+        for ratio in [2e-307, 1e-9, 0.0, -3.0, f64::MIN_POSITIVE] {
+            let w = linearity_warning("a", ratio).unwrap();
+            assert!(!w.contains('e') || !w.contains("e1"), "{w}");
+            assert!(
+                w.contains("more than 100 times too small")
+                    || w.contains("did not end at a minimum"),
+                "{ratio}: {w}"
+            );
+        }
+    }
 }
