@@ -484,7 +484,11 @@ fn jacobian_columns(
             #[cfg(feature = "parallel")]
             {
                 use rayon::prelude::*;
-                (0..n).into_par_iter().map(f).collect()
+                let cancel = crate::ode::Cancel::current();
+                (0..n)
+                    .into_par_iter()
+                    .map(|i| crate::ode::Cancel::carry(&cancel, || f(i)))
+                    .collect()
             }
             #[cfg(not(feature = "parallel"))]
             {
@@ -693,6 +697,27 @@ pub fn fit(
     analyse(&ev, opts, x, best_start, converged, termination, outcomes)
 }
 
+/// Why the optimiser stopped, in words (the JSON's `termination`).
+fn termination_text(t: &levenberg_marquardt::TerminationReason) -> String {
+    use levenberg_marquardt::TerminationReason as T;
+    match t {
+        T::Converged { ftol, xtol } => match (ftol, xtol) {
+            (true, true) => "converged: cost and parameters settled".into(),
+            (true, false) => "converged: cost settled".into(),
+            _ => "converged: parameters settled".into(),
+        },
+        T::ResidualsZero => "converged: residuals zero".into(),
+        T::Orthogonal => "converged: gradient zero (residuals orthogonal to the Jacobian)".into(),
+        T::LostPatience => "stopped: the evaluation budget was used up".into(),
+        T::NoImprovementPossible(what) => format!("stopped: no improvement possible ({what})"),
+        T::User(what) => format!("stopped: the model failed ({what})"),
+        T::Numerical(what) => format!("stopped: a non-finite number ({what})"),
+        T::NoParameters => "stopped: no parameters".into(),
+        T::NoResiduals => "stopped: no residuals".into(),
+        T::WrongDimensions(what) => format!("stopped: wrong dimensions ({what})"),
+    }
+}
+
 /// One start of the optimiser: its outcome, and (cost, end, converged, termination) when the
 /// start could be evaluated.
 #[allow(clippy::type_complexity)]
@@ -736,7 +761,7 @@ fn run_start(
     let cost = solved
         .residuals_at(&u)
         .map_or(f64::INFINITY, |r| r.iter().map(|v| v * v).sum());
-    let mut termination = format!("{:?}", report.termination);
+    let mut termination = termination_text(&report.termination);
     if let Some(e) = solved.error.borrow().as_ref() {
         termination.push_str(&format!(" (last model error: {e})"));
     }

@@ -796,6 +796,9 @@ where
         let mut h = self.h;
         let (err, k, stiff, hit_stop) = loop {
             let attempts = self.ctx.stats.accepted + self.ctx.stats.rejected;
+            if super::Cancel::requested() {
+                return Err(OdeError::Cancelled { t });
+            }
             if attempts >= self.max_steps {
                 return Err(OdeError::TooManySteps {
                     t,

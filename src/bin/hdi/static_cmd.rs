@@ -1,18 +1,20 @@
 //! `hdi static`: the static analyses at the scene's DC voltage.
 
+use hdi_tribology::analysis::record::StaticRecord;
 use hdi_tribology::analysis::{
-    pull_in_voltage, s_curve, static_hysteresis, ScanGrid, StaticOptions,
+    pull_in_voltage, s_curve, static_hysteresis, Fold, PullIn, ScanGrid, StaticOptions,
 };
 use hdi_tribology::model::SliderModel;
 use serde::Serialize;
 
 use crate::common::{self, CliError, SceneArgs};
 
-/// Static analyses at the scene's DC voltage, JSON: touchdown_power, takeoff_power, hysteresis
-/// (W), pull_in_voltage (V, at zero heater power; null without voltage terms), folds
-/// [{power, d}], and status: "converged" (each value is a root found to the solver's
-/// tolerance; a root that is not found is an error) with flags ["negative_hysteresis"] when
-/// take-off lies above touchdown.
+/// Static analyses at the scene's DC voltage, JSON, each key with its unit: scene, touchdown and
+/// takeoff ({power_w, at: the equilibrium there, cause}), hysteresis_w, pull_in (at zero heater
+/// power: {voltage_v, d_m, cause}; null without voltage terms), folds [{power_w, d_m,
+/// jump_in}], and status: "converged" (each value is a root found to the solver's tolerance; a
+/// root that is not found is an error) with flags ["negative_hysteresis"] when take-off lies
+/// above touchdown.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -20,20 +22,11 @@ pub struct Args {
 }
 
 #[derive(Serialize)]
-struct Fold {
-    power: f64,
-    d: f64,
-}
-
-#[derive(Serialize)]
 struct Report {
-    touchdown_power: f64,
-    takeoff_power: f64,
-    hysteresis: f64,
-    pull_in_voltage: Option<f64>,
+    #[serde(flatten)]
+    record: StaticRecord,
+    pull_in: Option<PullIn>,
     folds: Vec<Fold>,
-    status: &'static str,
-    flags: Vec<&'static str>,
 }
 
 pub fn run(a: Args) -> Result<(), CliError> {
@@ -41,34 +34,22 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let model = SliderModel::from_scene(&scene)?;
     let opts = StaticOptions::new(scene.detector.contact_threshold_n);
     let h = static_hysteresis(&model, &opts)?;
-    let pull_in_voltage = if model.forces().has_voltage_terms() {
-        Some(pull_in_voltage(&model, 0.0, &opts)?.voltage)
+    let pull_in = if model.forces().has_voltage_terms() {
+        Some(pull_in_voltage(&model, 0.0, &opts)?)
     } else {
         None
     };
     let curve = s_curve(&model, None, &ScanGrid::default())?;
-    let mut flags = Vec::new();
-    if h.hysteresis < 0.0 {
-        flags.push("negative_hysteresis");
+    let record = StaticRecord::new(&scene.name, h);
+    if !record.flags.is_empty() {
         common::warn(&format!(
             "negative static hysteresis {}: take-off lies above touchdown",
             common::mw(h.hysteresis)
         ));
     }
     common::print_json(&Report {
-        touchdown_power: h.touchdown.power,
-        takeoff_power: h.takeoff.power,
-        hysteresis: h.hysteresis,
-        pull_in_voltage,
-        folds: curve
-            .folds
-            .iter()
-            .map(|f| Fold {
-                power: f.power,
-                d: f.d,
-            })
-            .collect(),
-        status: "converged",
-        flags,
+        record,
+        pull_in,
+        folds: curve.folds,
     })
 }
