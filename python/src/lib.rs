@@ -148,19 +148,41 @@ fn equilibrium_value(e: &analysis::Equilibrium, dofs: usize) -> PyResult<Value> 
     Ok(v)
 }
 
-/// Runs `work` without the GIL on a thread of its own, watching a [`Cancel`] flag, while this
-/// thread checks for signals every 50 ms: on Ctrl-C (or any signal handler that raises) the
-/// flag is raised, the work stops at its next integration step, and the handler's exception
-/// (`KeyboardInterrupt`) is raised here.
+/// Runs `work` without the GIL on this thread, watching a [`Cancel`] flag whose check runs
+/// Python's signal handlers (from the integration's steps, at most every 50 ms): on Ctrl-C (or
+/// any handler that raises) the work stops at its next step and the handler's exception
+/// (`KeyboardInterrupt`) is raised here. For work that runs on rayon's threads, see
+/// [`on_own_thread`].
 fn interruptible<T: Send>(
     py: Python<'_>,
     work: impl FnOnce() -> hdi_tribology::Result<T> + Send,
 ) -> PyResult<T> {
-    interruptible_with(py, work, to_py_err)
+    let caught: Arc<std::sync::Mutex<Option<PyErr>>> = Arc::default();
+    let slot = caught.clone();
+    let cancel = Cancel::with_check(move || {
+        Python::attach(|py| match py.check_signals() {
+            Ok(()) => false,
+            Err(e) => {
+                if let Ok(mut s) = slot.lock() {
+                    *s = Some(e);
+                }
+                true
+            }
+        })
+    });
+    let out = py.detach(|| cancel.watch(work));
+    if let Some(e) = caught.lock().ok().and_then(|mut s| s.take()) {
+        return Err(e);
+    }
+    out.map_err(to_py_err)
 }
 
-/// [`interruptible`] for work with an error of its own.
-fn interruptible_with<T: Send, E: Send>(
+/// Runs `work` without the GIL on a thread of its own, watching a [`Cancel`] flag, while this
+/// thread checks for signals every 50 ms: on Ctrl-C (or any signal handler that raises) the
+/// flag is raised, the work stops at its next integration step, and the handler's exception
+/// (`KeyboardInterrupt`) is raised here. For work on rayon's threads (sweeps, fits), whose
+/// steps run on threads where Python's signal handlers cannot run; it costs a thread start.
+fn on_own_thread<T: Send, E: Send>(
     py: Python<'_>,
     work: impl FnOnce() -> Result<T, E> + Send,
     err: impl Fn(E) -> PyErr,
@@ -1048,11 +1070,15 @@ fn ac_sweep<'py>(
     let threads = threads_of(threads)?;
     let setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     let amplitudes = amplitudes_or_scene(&setup.scene, amplitudes_v)?;
-    let rows = interruptible(py, || {
-        on_threads(threads, || {
-            analysis::ac_sweep(&setup.model, &setup.programme, &setup.opts, &amplitudes)
-        })
-    })?;
+    let rows = on_own_thread(
+        py,
+        || {
+            on_threads(threads, || {
+                analysis::ac_sweep(&setup.model, &setup.programme, &setup.opts, &amplitudes)
+            })
+        },
+        to_py_err,
+    )?;
     rows.into_iter()
         .map(|c| {
             let rec = CycleRecord::unchecked(&setup.scene.name, &setup.programme, c, &setup.opts);
@@ -1111,17 +1137,21 @@ fn ac_sweep_refined<'py>(
         agreeing_runs,
         ..Refinement::new(units::mw(power_tol_mw))
     };
-    let rows = interruptible(py, || {
-        on_threads(threads, || {
-            analysis::ac_sweep_refined(
-                &setup.model,
-                &setup.programme,
-                &setup.opts,
-                &amplitudes,
-                &refine,
-            )
-        })
-    })?;
+    let rows = on_own_thread(
+        py,
+        || {
+            on_threads(threads, || {
+                analysis::ac_sweep_refined(
+                    &setup.model,
+                    &setup.programme,
+                    &setup.opts,
+                    &amplitudes,
+                    &refine,
+                )
+            })
+        },
+        to_py_err,
+    )?;
     rows.into_iter()
         .map(|r| {
             let rec = CycleRecord::refined(&setup.scene.name, &setup.programme, r);
@@ -1740,7 +1770,7 @@ fn fit<'py>(
         return Err(invalid("free", "give at least one parameter to fit"));
     }
     let scene_in = scene.get();
-    let result = interruptible_with(
+    let result = on_own_thread(
         py,
         || -> Result<_, FitError> {
             let sets = data

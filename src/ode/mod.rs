@@ -45,7 +45,7 @@ mod stepper;
 mod system;
 mod tsit5;
 
-pub use cancel::Cancel;
+pub use cancel::{Cancel, CANCEL_CHECK_INTERVAL};
 pub use dense::{DenseOutput, StepPolynomial};
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
