@@ -36,14 +36,26 @@ fn static_reports_the_library_values() {
         &StaticOptions::new(scene.detector.contact_threshold_n),
     )
     .unwrap();
-    assert_eq!(v["touchdown_power"].as_f64().unwrap(), h.touchdown.power);
-    assert_eq!(v["takeoff_power"].as_f64().unwrap(), h.takeoff.power);
-    assert_eq!(v["hysteresis"].as_f64().unwrap(), h.hysteresis);
-    let vpi = v["pull_in_voltage"].as_f64().unwrap();
+    // the library's result, serialized: every key with its unit
+    assert_eq!(
+        v["touchdown"]["power_w"].as_f64().unwrap(),
+        h.touchdown.power
+    );
+    assert_eq!(
+        v["touchdown"]["at"]["d_m"].as_f64().unwrap(),
+        h.touchdown.at.d
+    );
+    assert_eq!(v["takeoff"]["power_w"].as_f64().unwrap(), h.takeoff.power);
+    assert_eq!(v["hysteresis_w"].as_f64().unwrap(), h.hysteresis);
+    assert_eq!(v["scene"].as_str(), Some(scene.name.as_str()));
+    assert_eq!(v["status"].as_str(), Some("converged"));
+    let vpi = v["pull_in"]["voltage_v"].as_f64().unwrap();
     assert!((2.0..10.0).contains(&vpi));
     let folds = v["folds"].as_array().unwrap();
     assert_eq!(folds.len(), 2);
-    assert!(folds.iter().all(|f| f["power"].is_f64() && f["d"].is_f64()));
+    assert!(folds
+        .iter()
+        .all(|f| f["power_w"].is_f64() && f["d_m"].is_f64()));
 }
 
 #[test]
@@ -68,16 +80,26 @@ fn cycle_and_sweep_report_every_key_and_the_csv() {
         csv.to_str().unwrap(),
     ]);
     for key in [
-        "touchdown_power",
-        "takeoff_power",
-        "hysteresis",
-        "mean_temperature_rise",
-        "steps",
+        "scene",
+        "programme",
+        "v_ac_v",
+        "touchdown",
+        "takeoff",
+        "hysteresis_w",
+        "mean_temperature_rise_k",
+        "duration_s",
+        "stats",
         "wall_seconds",
+        "total_stats",
+        "status",
     ] {
         assert!(v.get(key).is_some(), "missing {key}");
     }
-    let h = v["hysteresis"].as_f64().unwrap();
+    assert_eq!(v["programme"].as_str(), Some("fixed"));
+    assert_eq!(v["v_ac_v"].as_f64(), Some(0.6));
+    let h = v["hysteresis_w"].as_f64().unwrap();
+    let (td, to) = (&v["touchdown"]["power_w"], &v["takeoff"]["power_w"]);
+    assert_eq!(h, td.as_f64().unwrap() - to.as_f64().unwrap());
     assert!(h > 0.0 && h < 6e-3, "hysteresis {h}");
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(text.starts_with("t_s,power_w,d_m,"));
@@ -86,17 +108,19 @@ fn cycle_and_sweep_report_every_key_and_the_csv() {
     let rows = json(&["sweep", "--paper", "--v-ac", "0,0.6", "--triggered"]);
     let rows = rows.as_array().unwrap();
     assert_eq!(rows.len(), 2);
-    assert_eq!(rows[0]["v_ac"].as_f64(), Some(0.0));
-    assert_eq!(rows[1]["v_ac"].as_f64(), Some(0.6));
-    assert!(rows[0]["hysteresis"].as_f64().unwrap() > rows[1]["hysteresis"].as_f64().unwrap());
+    assert_eq!(rows[0]["v_ac_v"].as_f64(), Some(0.0));
+    assert_eq!(rows[1]["v_ac_v"].as_f64(), Some(0.6));
+    assert_eq!(rows[1]["programme"].as_str(), Some("triggered"));
+    let h = |r: &serde_json::Value| r["hysteresis_w"].as_f64().unwrap();
+    assert!(h(&rows[0]) > h(&rows[1]));
 
     // Refined by default: the 0.7 V amplitude needs a tighter tolerance than the scene's to
     // settle; the status says whether both the powers and the mean temperature did.
     let rows = json(&["sweep", "--paper", "--v-ac", "0,0.7", "--refine-mw", "0.06"]);
     let rows = rows.as_array().unwrap();
     for r in rows {
-        let change = r["power_change"].as_f64().unwrap();
-        let dt = r["temperature_change"].as_f64().unwrap();
+        let change = r["power_change_w"].as_f64().unwrap();
+        let dt = r["temperature_change_k"].as_f64().unwrap();
         let converged = change <= 6e-5 && dt <= 0.05;
         let status = if converged {
             "converged"
@@ -129,23 +153,29 @@ fn calibrate_finds_the_static_touchdown_within_one_step() {
         "--margin-mw",
         "10",
     ]);
-    let td = v["touchdown_power"].as_f64().unwrap();
+    let td = v["touchdown_power_w"].as_f64().unwrap();
     // The staircase fires at the first level at or above the static touchdown (the mean-force
     // detector with the scene's threshold is the static model's criterion).
     assert!(
         td >= stat.touchdown.power - 1e-12 && td <= stat.touchdown.power + 0.5e-3,
         "{v}"
     );
-    let set = v["set_power"].as_f64().unwrap();
+    let set = v["set_power_w"].as_f64().unwrap();
     assert!((set - (td - 10e-3)).abs() < 1e-12, "{v}");
-    let to = v["takeoff_power"].as_f64().unwrap();
+    let to = v["takeoff_power_w"].as_f64().unwrap();
     assert!((to - stat.takeoff.power).abs() <= 0.5e-3 + 1e-12, "{v}");
-    let clearance = v["clearance"].as_f64().unwrap();
+    let clearance = v["clearance_m"].as_f64().unwrap();
     assert!(
         clearance > 0.0 && clearance < scene.nominal_clearance_m,
         "{v}"
     );
-    assert_eq!(v["detector"].as_str(), Some("mean contact force"));
+    assert_eq!(v["detector"].as_str(), Some("mean"));
+    assert_eq!(v["detector_name"].as_str(), Some("mean contact force"));
+    assert_eq!(v["status"].as_str(), Some("complete"));
+    assert_eq!(
+        v["levels"].as_u64(),
+        Some(v["steps"].as_array().unwrap().len() as u64)
+    );
 }
 
 #[test]

@@ -155,39 +155,42 @@ fn check_scene(args: &[&str], scene: &Scene) {
                 .as_f64()
                 .unwrap_or_else(|| panic!("key {k} in {row}"))
         };
-        assert_eq!(get("d"), d);
+        assert_eq!(get("d_m"), d);
         let r = reference(scene, d);
         let name = &scene.name;
         assert!(
-            close(get("intermolecular"), r.intermolecular),
+            close(get("intermolecular_n"), r.intermolecular),
             "{name} d={d}: LJ {} vs {}",
-            get("intermolecular"),
+            get("intermolecular_n"),
             r.intermolecular
         );
         assert!(
-            close(get("electrostatic_per_volt2"), r.electrostatic_per_volt2),
+            close(
+                get("electrostatic_per_volt2_n_per_v2"),
+                r.electrostatic_per_volt2
+            ),
             "{name} d={d}: G_e"
         );
         assert!(
-            close(get("contact"), r.contact),
+            close(get("contact_n"), r.contact),
             "{name} d={d}: contact {} vs {}",
-            get("contact"),
+            get("contact_n"),
             r.contact
         );
         assert!(
-            close(get("real_contact_area"), r.area),
+            close(get("real_contact_area_m2"), r.area),
             "{name} d={d}: area"
         );
         let fe = v * r.electrostatic_per_volt2;
         if v > 0.0 {
-            assert!(close(get("electrostatic"), fe), "{name} d={d}: F_e");
+            assert!(close(get("electrostatic_n"), fe), "{name} d={d}: F_e");
         } else {
-            assert_eq!(get("electrostatic"), 0.0);
+            assert_eq!(get("electrostatic_n"), 0.0);
         }
         let total = r.intermolecular + r.contact + fe;
         let scale = r.intermolecular.abs() + r.contact.abs() + fe.abs();
         assert!(
-            (get("total") - total).abs() <= 1e-6 * scale,
+            (get("total_n") - total).abs() <= 1e-6 * scale,
             "{name} d={d}: total"
         );
     }

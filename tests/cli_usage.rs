@@ -218,7 +218,7 @@ fn a_negative_hysteresis_is_flagged_and_warned_about() {
     let out = hdi(&["sweep", "--paper", "--triggered", "--v-ac", "0.9"]);
     let rows = stdout_json(&out);
     let r = &rows[0];
-    let h = r["hysteresis"].as_f64().unwrap();
+    let h = r["hysteresis_w"].as_f64().unwrap();
     assert!(h < 0.0, "{r}");
     let flags: Vec<&str> = r["flags"]
         .as_array()
@@ -240,8 +240,8 @@ fn every_cycle_prints_its_convergence_status() {
     let r = stdout_json(&hdi(&["cycle", "--paper", "--v-ac", "0.7"]));
     let status = r["status"].as_str().unwrap();
     assert!(matches!(status, "converged" | "not_converged"), "{r}");
-    let converged = r["power_change"].as_f64().unwrap() <= 1e-5
-        && r["temperature_change"].as_f64().unwrap() <= 0.05;
+    let converged = r["power_change_w"].as_f64().unwrap() <= 1e-5
+        && r["temperature_change_k"].as_f64().unwrap() <= 0.05;
     assert_eq!(status == "converged", converged, "{r}");
     // --agree 3: one agreeing pair more, so at least one run more
     let strict = stdout_json(&hdi(&["cycle", "--paper", "--v-ac", "0.7", "--agree", "3"]));
@@ -252,7 +252,7 @@ fn every_cycle_prints_its_convergence_status() {
     let unchecked = stdout_json(&hdi(&["cycle", "--paper", "--v-ac", "0.7", "--no-refine"]));
     assert_eq!(unchecked["status"].as_str(), Some("unchecked"));
     assert_eq!(unchecked["runs"].as_u64(), Some(1));
-    assert!(unchecked["power_change"].is_null());
+    assert!(unchecked["power_change_w"].is_null());
     // with the scene's tolerance alone the 0.7 V cycle is off by more than 0.1 mW; refined it
     // agrees with a run at a thousandfold tighter tolerance
     let tight = stdout_json(&hdi(&[
@@ -264,7 +264,7 @@ fn every_cycle_prints_its_convergence_status() {
         "1e-9",
         "--no-refine",
     ]));
-    let h = |v: &Value| v["hysteresis"].as_f64().unwrap();
+    let h = |v: &Value| v["hysteresis_w"].as_f64().unwrap();
     assert!(
         (h(&unchecked) - h(&tight)).abs() > 1e-4,
         "{unchecked} {tight}"
@@ -296,6 +296,6 @@ fn gaps_outside_the_table_are_flagged_by_name() {
         .collect();
     assert_eq!(inside, vec![false, true, true]);
     for r in rows.as_array().unwrap() {
-        assert!(r["contact"].as_f64().unwrap() >= 0.0, "{r}");
+        assert!(r["contact_n"].as_f64().unwrap() >= 0.0, "{r}");
     }
 }

@@ -56,19 +56,19 @@ def fig3d(model, scene, out):
         rows = hdi.ac_sweep_refined(model, tol_mw, amplitudes, triggered=triggered)
         good, unsettled, missing = [], [], []
         for r in rows:
-            h = r.cycle.hysteresis_mw
-            print(f"  {label:20s} {r.cycle.v_ac_v:5.2f} {h if h is not None else float('nan'):9.4f}"
+            h = r.hysteresis_mw
+            print(f"  {label:20s} {r.v_ac_v:5.2f} {h if h is not None else float('nan'):9.4f}"
                   f" {r.rtol:7.0e} {r.converged}")
             if h is None or h < 0:
-                missing.append(r.cycle.v_ac_v)
+                missing.append(r.v_ac_v)
             elif r.converged:
-                good.append((r.cycle.v_ac_v, h))
+                good.append((r.v_ac_v, h))
             else:
-                unsettled.append((r.cycle.v_ac_v, h))
+                unsettled.append((r.v_ac_v, h))
         # the line breaks (NaN) where an amplitude has no settled, valid value
         settled = dict(good)
-        ax.plot([r.cycle.v_ac_v for r in rows],
-                [settled.get(r.cycle.v_ac_v, np.nan) for r in rows], "o-", color=colour,
+        ax.plot([r.v_ac_v for r in rows],
+                [settled.get(r.v_ac_v, np.nan) for r in rows], "o-", color=colour,
                 label=label)
         if unsettled:
             ax.plot(*zip(*unsettled), "o", mfc="none", color=colour,

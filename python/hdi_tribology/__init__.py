@@ -2,8 +2,10 @@
 
 Python bindings of the Rust crate ``hdi-tribology``: the same code, the same numbers. Inputs
 are in engineering units where their name says so (``power_mw``, ``gaps_nm``, ``v_ac`` in V);
-results carry their unit in their name (``power_w``, ``d_m``, ``total_n``), with
-engineering-unit properties beside them (``power_mw``, ``d_nm``).
+results carry their SI unit in their name (``power_w``, ``d_m``, ``total_n``), with the same
+value in mW, nm or µN beside them (``power_mw``, ``d_nm``, ``total_un``). Each result is the
+crate's one representation of it, the JSON the ``hdi`` program prints: ``to_dict()`` gives it
+back, results compare by value and pickle.
 
 >>> import hdi_tribology as hdi
 >>> model = hdi.Model(hdi.Scene.paper())
@@ -13,21 +15,10 @@ True
 """
 
 from ._core import (
-    Calibration,
-    Cycle,
-    Detection,
-    Drive,
-    Equilibrium,
     LinearResponse,
-    Mode,
     Model,
-    PullIn,
-    RefinedCycle,
     SENSOR_COLUMNS,
     Scene,
-    Sensors,
-    StaticHysteresis,
-    Transition,
     __version__,
     ac_sweep,
     ac_sweep_refined,
@@ -43,6 +34,19 @@ from ._core import (
     simulate_cycle,
     simulated_dither,
     static_hysteresis,
+)
+from ._drive import Drive
+from ._results import (
+    Calibration,
+    Cycle,
+    Detection,
+    Equilibrium,
+    Mode,
+    PullIn,
+    Result,
+    Sensors,
+    StaticHysteresis,
+    Transition,
 )
 from ._errors import (
     AnalysisError,
@@ -71,7 +75,7 @@ __all__ = [
     "Model",
     "NoConvergenceError",
     "PullIn",
-    "RefinedCycle",
+    "Result",
     "SENSOR_COLUMNS",
     "Scene",
     "SceneError",

@@ -2,14 +2,25 @@
 ``_k`` (SI) and ``_nm``, ``_mw``, ``_un`` (engineering units); voltages in V."""
 
 import os
-from typing import Any, Dict, List, Mapping, Optional, Sequence, TypedDict, Union
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
 
+from ._results import (
+    Calibration,
+    Cycle,
+    Equilibrium,
+    Mode,
+    PullIn,
+    Sensors,
+    StaticHysteresis,
+)
+
 __version__: str
 
 F64Array = npt.NDArray[np.float64]
+ArrayLike = npt.ArrayLike
 Target = Union["Model", "Scene"]
 
 class Scene:
@@ -50,6 +61,13 @@ class Scene:
         InvalidInputError the scene is unchanged."""
     def with_values(self, values: Mapping[str, Any]) -> Scene:
         """A validated copy with the fields (dotted paths, SI or engineering units) replaced."""
+    def keys(self) -> List[str]:
+        """Every field's dotted SI path (``"surface.height_sigma_m"``), in the file's order."""
+    def __contains__(self, path: str) -> bool:
+        """Whether ``path`` names a field (SI or engineering unit)."""
+    def __iter__(self) -> Iterator[str]:
+        """The fields' dotted SI paths, as ``keys()``."""
+    def __len__(self) -> int: ...
     def __eq__(self, other: object) -> bool: ...
 
 class Model:
@@ -73,148 +91,6 @@ class Model:
     @property
     def dofs(self) -> int:
         """Degrees of freedom of the structure: the length of ``Equilibrium.q``, ``Mode.shape``."""
-
-class Equilibrium:
-    """A static equilibrium of the slider."""
-
-    d_m: float
-    """Bulge gap (m)."""
-    y_m: float
-    """Head displacement away from the disk (m)."""
-    protrusion_m: float
-    """Thermal protrusion (m)."""
-    power_w: float
-    """Heater power (W)."""
-    stiffness_n_per_m: float
-    """Total stiffness (N/m)."""
-    interface_force_n: float
-    """Interface force (N), positive away from the disk."""
-    contact_force_n: float
-    """Contact force (N)."""
-    stable: bool
-    """Whether the equilibrium is stable."""
-    q: List[float]
-    """Every coordinate of the structure, one per degree of freedom (m; rad for a pitch):
-    ``[y]`` rigid, ``[y, z]`` bulge (body heave, bulge), ``[y, θ]`` pitch."""
-    @property
-    def d_nm(self) -> float:
-        """Bulge gap (nm)."""
-    @property
-    def power_mw(self) -> float:
-        """Heater power (mW)."""
-
-class Transition:
-    """A touchdown or take-off on the static equilibria."""
-
-    power_w: float
-    """Heater power (W)."""
-    cause: str
-    """``"fold"`` (the branch ends) or ``"threshold"`` (contact force crosses the detector's)."""
-    at: Equilibrium
-    """The equilibrium where it happens."""
-    @property
-    def power_mw(self) -> float:
-        """Heater power (mW)."""
-
-class StaticHysteresis:
-    """Static touchdown, take-off and their difference."""
-
-    touchdown: Transition
-    takeoff: Transition
-    hysteresis_w: float
-    """Touchdown minus take-off power (W)."""
-    @property
-    def hysteresis_mw(self) -> float:
-        """Touchdown minus take-off power (mW)."""
-
-class PullIn:
-    """The pull-in voltage."""
-
-    voltage_v: float
-    """|V − φ| at pull-in (V)."""
-    d_m: float
-    """Bulge gap where the head jumps in (m)."""
-    cause: str
-    """``"fold"`` or ``"threshold"``."""
-
-class Detection:
-    """A touchdown or take-off detected in a cycle."""
-
-    time_s: float
-    """Time of detection (s)."""
-    power_w: float
-    """Programme heater power then (W)."""
-    @property
-    def power_mw(self) -> float:
-        """Programme heater power then (mW)."""
-
-class Cycle:
-    """One touchdown/take-off cycle (without its time series)."""
-
-    v_ac_v: float
-    """AC amplitude (V)."""
-    touchdown: Optional[Detection]
-    """Touchdown, None if not detected."""
-    takeoff: Optional[Detection]
-    """Take-off, None if not detected."""
-    hysteresis_w: Optional[float]
-    """Touchdown minus take-off power (W); None unless both were detected."""
-    mean_temperature_rise_k: float
-    """Mean flash temperature rise in contact (K)."""
-    duration_s: float
-    """Simulated time (s)."""
-    steps: int
-    """Accepted solver steps."""
-    rejected_steps: int
-    """Rejected solver steps."""
-    wall_seconds: float
-    """Wall time of the simulation inside Rust (s)."""
-    flags: List[str]
-    """What is wrong with the cycle, empty when nothing is: ``no_touchdown``, ``no_takeoff``,
-    ``negative_hysteresis`` (a detection artefact, not a hysteresis)."""
-    @property
-    def hysteresis_mw(self) -> Optional[float]:
-        """Touchdown minus take-off power (mW); None unless both were detected."""
-
-class RefinedCycle:
-    """A cycle rerun at tighter tolerances until its powers settle. Check ``converged``."""
-
-    cycle: Cycle
-    """The last, most accurate run."""
-    rtol: float
-    """Its relative tolerance."""
-    atol_m: float
-    """Its absolute tolerance on the displacement (m)."""
-    power_change_w: float
-    """Largest change of touchdown or take-off power from the run before (W); inf when a
-    detection came or went between the two."""
-    temperature_change_k: float
-    """Change of the mean temperature rise from the run before (K)."""
-    converged: bool
-    """Whether both changes are within the tolerances asked for."""
-    status: str
-    """``"converged"`` or ``"not_converged"``."""
-    flags: List[str]
-    """The cycle's flags, and ``not_converged``."""
-    runs: int
-    """Cycles run."""
-    steps: int
-    """Accepted steps over all runs."""
-    wall_seconds: float
-    """Wall time over all runs (s)."""
-
-class Mode:
-    """One mode of the linearised slider."""
-
-    eigenvalue: complex
-    """Eigenvalue λ (1/s)."""
-    frequency_hz: float
-    """|Im λ| / 2π (Hz)."""
-    damping_ratio: float
-    """−Re λ / |λ|."""
-    shape: List[float]
-    """Displacement part of the eigenvector over the structure's coordinates (as
-    ``Equilibrium.q``), largest entry 1 and real there; all zero for a mode of the lags alone."""
 
 class LinearResponse:
     """The linearised slider about its flying equilibrium."""
@@ -252,98 +128,12 @@ class LinearResponse:
         """Predicted dither amplitude at 2f (nm)."""
     def transfer(self, omega_rad_s: F64Array) -> npt.NDArray[np.complex128]:
         """H(iω) (m/N), displacement per interface force, at each ω (rad/s)."""
-
-class Calibration:
-    """A touchdown calibration as drive firmware does it."""
-
-    detector: str
-    touchdown_power_w: float
-    """First heater level where contact was seen (W)."""
-    takeoff_power_w: Optional[float]
-    """First level on the way down without contact (W), None if not searched or not found."""
-    set_power_w: float
-    """Operating power: touchdown minus the margin (W)."""
-    clearance_m: float
-    """Static flying clearance at the set power, DC voltage only (m)."""
-    contrast: float
-    """Detector level at touchdown over the level before."""
-    levels: int
-    """Heater levels run."""
-    simulated_time_s: float
-    """Simulated time (s)."""
-    @property
-    def hysteresis_w(self) -> Optional[float]:
-        """Touchdown minus take-off level (W)."""
-    @property
-    def clearance_nm(self) -> float:
-        """Clearance at the set power (nm)."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The response as plain values: equilibrium, modes, stable, gain_at_2f_m_per_n,
+        force_at_2f_n, dither_amplitude_m."""
 
 SENSOR_COLUMNS: List[str]
 """The columns of a sensor stream (``replay``, ``hdi drive``), units in their names."""
-
-class Sensors:
-    """One controller period's sensors and the true values behind them (the columns of
-    ``hdi drive``, in the units their names carry)."""
-
-    time_s: float
-    """Time at the end of the period (s)."""
-    heater_mw: float
-    """Heater power held over the period (mW)."""
-    contact_resistance_ohm: float
-    """Embedded contact sensor's resistance (Ω)."""
-    acoustic_v: float
-    """Acoustic-emission RMS (V)."""
-    readback_fundamental_v: float
-    """Read-back amplitude, fundamental (V)."""
-    readback_third_v: float
-    """Read-back amplitude, third harmonic (V)."""
-    hr_clearance_change_nm: float
-    """Harmonic-ratio clearance change since the drive's first period (nm)."""
-    true_gap_nm: float
-    """True bulge gap at the end of the period (nm)."""
-    true_contact_force_un: float
-    """True contact force, mean over the period (µN)."""
-    true_sensor_temperature_k: float
-    """True contact-sensor temperature (K above its reference)."""
-    true_disk_height_nm: float
-    """Disk surface height under the head (nm)."""
-    true_ambient_k: float
-    """Ambient temperature change since the start (K)."""
-    true_protrusion_nm: float
-    """True protrusion at the end of the period (nm)."""
-    true_friction_power_mw: float
-    """True frictional power over the period (mW)."""
-
-class Drive:
-    """A simulated drive for firmware prototyping: the scene's slider over a disk with run-out
-    and waviness (or a flat one), with a heater, a head–disk voltage and the sensors firmware
-    reads, stepped at the controller's rate. Starts at rest in the flying equilibrium at
-    ``initial_power_mw``. The same seed gives the same stream, bit for bit. A ``Drive``
-    belongs to the thread that made it. ``atol_pm`` (default 0.01) and ``atol_flight_pm``
-    (default ``atol_pm``, at least ``atol_pm``) are the integration's displacement tolerances
-    near contact and in flight (pm; equal for one tolerance throughout)."""
-
-    def __init__(self, scene: Union[Scene, Model], *, seed: int = 1, radius_mm: float = 25.0,
-                 flat_disk: bool = False, initial_power_mw: float = 60.0,
-                 atol_pm: Optional[float] = None,
-                 atol_flight_pm: Optional[float] = None) -> None: ...
-    def step(self, heater_mw: float, *, dc_v: float = 0.0, ac_v: float = 0.0,
-             ac_khz: float = 0.0, dt_us: float = 50.0) -> Sensors:
-        """Holds the heater at ``heater_mw`` (mW) and the voltage at ``dc_v`` (V) plus an AC
-        dither of ``ac_v`` (V) at ``ac_khz`` (kHz) for one period of ``dt_us`` (µs); returns
-        the sensors at its end."""
-    @property
-    def time_s(self) -> float:
-        """Simulated time so far (s)."""
-    @property
-    def term_states(self) -> List[float]:
-        """The states of the model's terms with memory at the drive's time."""
-    @property
-    def stats(self) -> Dict[str, int]:
-        """Integrator work so far: accepted, rejected, rhs_evals, jac_evals, lu_decomps."""
-    @property
-    def seed(self) -> int:
-        """Seed of the disk's random waviness and of the sensor noise."""
 
 def replay(scene: Union[Scene, Model], time_s: Sequence[float], heater_mw: Sequence[float],
            voltage_dc_v: Sequence[float], voltage_ac_v: Optional[Sequence[float]] = None,
@@ -367,9 +157,10 @@ class Forces(TypedDict):
     total_n: F64Array
     in_table_range: npt.NDArray[np.bool_]
 
-def forces(target: Target, gaps_nm: F64Array, protrusion_nm: float = 0.0) -> Forces:
-    """Every interface force at bulge gaps ``gaps_nm`` (nm; pad gaps ``gaps_nm +
-    protrusion_nm``) at the scene's DC voltage: float64 arrays shaped as ``gaps_nm``, in N
+def forces(target: Target, gaps_nm: ArrayLike, protrusion_nm: float = 0.0) -> Forces:
+    """Every interface force at bulge gaps ``gaps_nm`` (nm, any array_like of any shape; pad
+    gaps ``gaps_nm + protrusion_nm``) at the scene's DC voltage: float64 arrays shaped as
+    ``gaps_nm``, in N
     (positive away from the disk), N/V² and m², and ``in_table_range`` (False where a gap lies
     outside the scene's force tables: computed by direct quadrature there)."""
 
@@ -385,9 +176,9 @@ def clearance_change(target: Target, dc_voltages_v: Sequence[float], contact_thr
     (W), ``clearance_change_m`` (m)."""
 
 def s_curve(target: Target) -> Dict[str, Any]:
-    """Static equilibria along the gap: arrays ``d_m``, ``power_w``, ``y_m``,
-    ``stiffness_n_per_m``, ``contact_force_n``, ``stable`` (bool), and ``folds``, a list of
-    ``{"power_w", "d_m", "jump_in"}``."""
+    """Static equilibria along the gap: arrays ``d_m``, ``y_m``, ``protrusion_m``, ``power_w``,
+    ``stiffness_n_per_m``, ``interface_force_n``, ``contact_force_n``, ``stable`` (bool),
+    ``volt2_v2``, and ``folds``, a list of ``{"power_w", "d_m", "jump_in"}``."""
 
 def simulate_cycle(
     target: Target,
@@ -401,11 +192,12 @@ def simulate_cycle(
 ) -> Dict[str, Any]:
     """One touchdown/take-off cycle at AC amplitude ``v_ac`` (V; default the scene's), under
     the scene's programme (or the touchdown-triggered protocol). ``rtol`` scales the absolute
-    tolerance with it unless ``atol_nm`` (nm) is given, as ``hdi cycle`` does. Returns ``cycle`` (Cycle),
+    tolerance with it unless ``atol_nm`` (nm) is given, as ``hdi cycle`` does. Returns ``cycle``
+    (Cycle, as ``hdi cycle --no-refine`` prints it),
     ``touchdown``/``takeoff`` (Detection or None) and, with ``series``, float64 arrays per
     accepted step: ``t_s``, ``power_w``, ``d_m``, ``air_bearing_n``, ``intermolecular_n``,
     ``electrostatic_n``, ``contact_n``, ``total_n``, ``temperature_rise_k``, ``indicator_n``
-    (NaN until the detector window has filled)."""
+    (NaN until the detector window has filled), and ``term_states`` with terms of memory."""
 
 def ac_sweep(
     target: Target,
@@ -418,7 +210,8 @@ def ac_sweep(
     threads: Optional[int] = None,
 ) -> List[Cycle]:
     """One cycle per AC amplitude (V; default the scene's sweep list), on ``threads`` rayon
-    threads (default all cores), GIL released; in the order of the amplitudes."""
+    threads (default all cores), GIL released, each run once (status ``"unchecked"``); in the
+    order of the amplitudes. Ctrl-C stops it."""
 
 def ac_sweep_refined(
     target: Target,
@@ -433,11 +226,11 @@ def ac_sweep_refined(
     rtol: Optional[float] = None,
     atol_nm: Optional[float] = None,
     threads: Optional[int] = None,
-) -> List[RefinedCycle]:
+) -> List[Cycle]:
     """``ac_sweep`` with the tolerances tightened tenfold per run (at most ``max_runs``) until
     touchdown and take-off move by at most ``power_tol_mw`` (mW) and the mean temperature rise
     by at most ``temperature_tol_k`` (K) over ``agreeing_runs`` successive runs (3 also catches
-    a take-off a whole period of V² off in two successive runs alike)."""
+    a take-off a whole period of V² off in two successive runs alike). Check ``status``."""
 
 def linear_response(target: Target, power_mw: float) -> LinearResponse:
     """The linearised slider about its flying equilibrium at ``power_mw`` (mW): modes,

@@ -1,18 +1,23 @@
 //! Python bindings of `hdi-tribology`: a thin layer over the crate's public API.
 //!
 //! Every function here converts its arguments, calls one function of the crate with the GIL
-//! released, and converts the result. Nothing of the physics or the analyses lives here. Inputs
-//! are in engineering units where the name says so (`_mw`, `_nm`, `_v`); results carry their
-//! SI unit in their name (`power_w`, `d_m`) and engineering-unit properties beside them.
+//! released, and converts the result. Nothing of the physics or the analyses lives here, and no
+//! result is mirrored: each comes back as the crate serializes it (`analysis::record`, the JSON
+//! of the `hdi` program), wrapped in a read-only object of `hdi_tribology._results`. Inputs are
+//! in engineering units where the name says so (`_mw`, `_nm`, `_v`).
+//!
+//! Long calls run on a thread of their own while the calling thread checks for signals: Ctrl-C
+//! cancels the work ([`Cancel`]) and raises `KeyboardInterrupt` as soon as it has stopped.
 
 // A Python function's keyword arguments are its options: many arguments are the API here.
 #![allow(clippy::too_many_arguments)]
 
-use std::sync::Arc;
+use std::sync::{Arc, RwLock};
+use std::time::Duration;
 
-use hdi_tribology::analysis::sweep::{self, Flag};
+use hdi_tribology::analysis::record::{CalibrationRecord, CycleRecord, StaticRecord};
 use hdi_tribology::analysis::{
-    self, CycleOptions, CycleResult, HeaterProgramme, Refinement, ScanGrid, StaticOptions,
+    self, CycleOptions, HeaterProgramme, Refinement, ScanGrid, StaticOptions,
 };
 use hdi_tribology::calibration::{
     self, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
@@ -25,12 +30,15 @@ use hdi_tribology::drive::{
 use hdi_tribology::fit::{DataSet, FitError, FitOptions, FreeParameter};
 use hdi_tribology::force::{Gaps, RelaxingState};
 use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::ode::Cancel;
 use hdi_tribology::scene::{FieldPath, PathError};
 use hdi_tribology::units;
-use numpy::{PyArray1, PyReadonlyArray1};
-use pyo3::exceptions::{PyKeyError, PyTypeError};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use serde::Serialize;
+use serde_json::Value;
 
 type Scn = hdi_tribology::scene::Scene;
 
@@ -109,31 +117,178 @@ fn json_module(py: Python<'_>) -> PyResult<Bound<'_, PyModule>> {
     py.import("json")
 }
 
+fn json_to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
+    json_module(py)?.call_method1("loads", (v.to_string(),))
+}
+
+/// The crate's serde form of `x`: the one representation of a result.
+fn to_value(x: &impl Serialize) -> PyResult<Value> {
+    serde_json::to_value(x).map_err(|e| invalid("result", format!("cannot convert it: {e}")))
+}
+
+/// The object of class `class` of `hdi_tribology._results` holding `v`.
+fn record<'py>(py: Python<'py>, class: &str, v: &Value) -> PyResult<Bound<'py, PyAny>> {
+    let data = json_to_py(py, v)?;
+    py.import("hdi_tribology._results")?
+        .getattr(class)?
+        .call1((data,))
+}
+
+/// An equilibrium's serde form with what it cannot know itself: its coordinates `q`, one per
+/// degree of freedom of the structure, and whether it is `stable`.
+fn equilibrium_value(e: &analysis::Equilibrium, dofs: usize) -> PyResult<Value> {
+    let mut v = to_value(e)?;
+    if let Value::Object(m) = &mut v {
+        m.insert("stable".into(), Value::Bool(e.is_stable()));
+        m.insert(
+            "q".into(),
+            to_value(&e.q.iter().take(dofs).collect::<Vec<_>>())?,
+        );
+    }
+    Ok(v)
+}
+
+/// Runs `work` without the GIL on this thread, watching a [`Cancel`] flag whose check runs
+/// Python's signal handlers (from the integration's steps, at most every 50 ms): on Ctrl-C (or
+/// any handler that raises) the work stops at its next step and the handler's exception
+/// (`KeyboardInterrupt`) is raised here. For work that runs on rayon's threads, see
+/// [`on_own_thread`].
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> hdi_tribology::Result<T> + Send,
+) -> PyResult<T> {
+    let caught: Arc<std::sync::Mutex<Option<PyErr>>> = Arc::default();
+    let slot = caught.clone();
+    let cancel = Cancel::with_check(move || {
+        Python::attach(|py| match py.check_signals() {
+            Ok(()) => false,
+            Err(e) => {
+                if let Ok(mut s) = slot.lock() {
+                    *s = Some(e);
+                }
+                true
+            }
+        })
+    });
+    let out = py.detach(|| cancel.watch(work));
+    if let Some(e) = caught.lock().ok().and_then(|mut s| s.take()) {
+        return Err(e);
+    }
+    out.map_err(to_py_err)
+}
+
+/// Runs `work` without the GIL on a thread of its own, watching a [`Cancel`] flag, while this
+/// thread checks for signals every 50 ms: on Ctrl-C (or any signal handler that raises) the
+/// flag is raised, the work stops at its next integration step, and the handler's exception
+/// (`KeyboardInterrupt`) is raised here. For work on rayon's threads (sweeps, fits), whose
+/// steps run on threads where Python's signal handlers cannot run; it costs a thread start.
+fn on_own_thread<T: Send, E: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T, E> + Send,
+    err: impl Fn(E) -> PyErr,
+) -> PyResult<T> {
+    let cancel = Cancel::new();
+    let (tx, rx) = std::sync::mpsc::channel();
+    // (a lock only to share the receiver with the detached waits; one thread uses it)
+    let rx = std::sync::Mutex::new(rx);
+    std::thread::scope(|s| {
+        let worker = {
+            let cancel = cancel.clone();
+            s.spawn(move || {
+                let out = cancel.watch(work);
+                let _ = tx.send(());
+                out
+            })
+        };
+        loop {
+            let timed_out = py.detach(|| match rx.lock() {
+                Ok(rx) => matches!(
+                    rx.recv_timeout(Duration::from_millis(50)),
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout)
+                ),
+                Err(_) => false,
+            });
+            if !timed_out {
+                break;
+            }
+            if let Err(signal) = py.check_signals() {
+                cancel.cancel();
+                let _ = py.detach(|| worker.join());
+                return Err(signal);
+            }
+        }
+        match py.detach(|| worker.join()) {
+            Ok(out) => out.map_err(err),
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
+    })
+}
+
+/// A count given as a Python int: an `InvalidInputError` naming `name` when it is below `min`
+/// or too large.
+fn count(name: &str, v: i128, min: i128) -> PyResult<usize> {
+    if v < min {
+        return Err(invalid(name, format!("must be at least {min}, got {v}")));
+    }
+    usize::try_from(v).map_err(|_| invalid(name, format!("is too large: {v}")))
+}
+
+/// A seed given as a Python int: 0 to 2⁶⁴ − 1.
+fn seed_of(name: &str, v: i128) -> PyResult<u64> {
+    u64::try_from(v).map_err(|_| invalid(name, format!("must lie in [0, 2^64 - 1], got {v}")))
+}
+
+/// A finite number ≥ 0 in the unit `unit`, named `name`.
+fn non_negative(name: &str, v: f64, unit: &str) -> PyResult<f64> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(
+            name,
+            format!("must be finite and ≥ 0 {unit}, got {v} {unit}"),
+        ))
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Scene
 
 /// A whole head–disk interface, validated (see `docs/scene_format.md`).
 ///
 /// Fields are SI with the unit in their name; `scene["surface.height_sigma_nm"]` reads (and
-/// assignment writes) any dimensional field in an engineering unit instead.
-#[pyclass(module = "hdi_tribology", name = "Scene", eq)]
-#[derive(Clone, PartialEq)]
+/// assignment writes) any dimensional field in an engineering unit instead. `keys()`, `in` and
+/// iteration list the fields by their dotted SI paths. A scene may be shared between threads:
+/// each assignment replaces it whole, under a lock.
+#[pyclass(module = "hdi_tribology", name = "Scene", frozen)]
 struct Scene {
-    inner: Scn,
+    inner: RwLock<Scn>,
 }
 
-fn scene_to_dict<'py>(py: Python<'py>, s: &Scn) -> PyResult<Bound<'py, PyAny>> {
-    let text = s.to_json_string().py()?;
-    json_module(py)?.call_method1("loads", (text,))
+impl Scene {
+    fn of(inner: Scn) -> Self {
+        Scene {
+            inner: RwLock::new(inner),
+        }
+    }
+
+    /// A copy of the scene as it is now.
+    fn get(&self) -> Scn {
+        match self.inner.read() {
+            Ok(s) => s.clone(),
+            Err(poisoned) => poisoned.into_inner().clone(),
+        }
+    }
 }
 
 fn scene_from_dict(py: Python<'_>, d: &Bound<'_, PyAny>) -> PyResult<Scn> {
-    let text: String = json_module(py)?.call_method1("dumps", (d,))?.extract()?;
+    let text: String = json_module(py)?
+        .call_method1("dumps", (plain(py, d)?,))?
+        .extract()?;
     py.detach(|| Scn::from_json_str(&text)).py()
 }
 
 /// The scene's serde form (SI), which the library's field paths resolve against.
-fn scene_value(s: &Scn) -> PyResult<serde_json::Value> {
+fn scene_value(s: &Scn) -> PyResult<Value> {
     serde_json::to_value(s).map_err(|e| invalid("scene", e.to_string()))
 }
 
@@ -149,13 +304,37 @@ fn path_err(e: PathError) -> PyErr {
     }
 }
 
-fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
-    json_module(py)?.call_method1("loads", (v.to_string(),))
+/// `v` with numpy scalars and arrays (anywhere inside lists and dicts) as plain Python values.
+fn plain<'py>(py: Python<'py>, v: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let np = py.import("numpy")?;
+    let generic = np.getattr("generic")?;
+    let ndarray = np.getattr("ndarray")?;
+    if v.is_instance(&generic)? || v.is_instance(&ndarray)? {
+        return v.call_method0("tolist");
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        let out = PyDict::new(py);
+        for (k, x) in d.iter() {
+            out.set_item(k, plain(py, &x)?)?;
+        }
+        return Ok(out.into_any());
+    }
+    if let Ok(l) = v.cast::<PyList>() {
+        let out = PyList::empty(py);
+        for x in l.iter() {
+            out.append(plain(py, &x)?)?;
+        }
+        return Ok(out.into_any());
+    }
+    Ok(v.clone())
 }
 
 /// A Python value for the field `path`, as the scene's serde form holds values.
-fn py_to_json(py: Python<'_>, path: &str, v: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
-    let text: String = json_module(py)?.call_method1("dumps", (v,))?.extract()?;
+fn py_to_json(py: Python<'_>, path: &str, v: &Bound<'_, PyAny>) -> PyResult<Value> {
+    let text: String = json_module(py)?
+        .call_method1("dumps", (plain(py, v)?,))
+        .map_err(|e| invalid(path, format!("not a value a scene can hold: {e}")))?
+        .extract()?;
     serde_json::from_str(&text).map_err(|e| {
         invalid(
             path,
@@ -164,114 +343,183 @@ fn py_to_json(py: Python<'_>, path: &str, v: &Bound<'_, PyAny>) -> PyResult<serd
     })
 }
 
+/// The dotted paths of every leaf of `v` (a number, string, list or null), below `prefix`.
+fn leaf_paths(v: &Value, prefix: &str, out: &mut Vec<String>) {
+    match v {
+        Value::Object(m) => {
+            for (k, x) in m {
+                let p = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                leaf_paths(x, &p, out);
+            }
+        }
+        _ => out.push(prefix.to_string()),
+    }
+}
+
+/// `scene` with the fields `values` (dotted paths as given, values already converted) set,
+/// validated. A name the scene has no field of is a `KeyError`, as reading it is: one that
+/// neither reads before nor after (an optional section, absent before, reads after).
+fn with_fields(scene: &Scn, values: &[(String, Value)]) -> PyResult<Scn> {
+    let mut root = scene_value(scene)?;
+    let mut absent = Vec::new();
+    for (path, value) in values {
+        let field = FieldPath::at(&root, path).map_err(path_err)?;
+        if let Err(e) = field.read(&root) {
+            absent.push((path, e));
+        }
+        field.write(&mut root, value.clone());
+    }
+    let updated = Scn::from_json_str(&root.to_string());
+    let unknown = |path: &str, e: PathError| {
+        PyKeyError::new_err(format!("`{path}` is not a field of the scene ({e})"))
+    };
+    match updated {
+        Err(hdi_tribology::Error::Scene { .. }) if !absent.is_empty() => {
+            let (path, e) = absent.swap_remove(0);
+            Err(unknown(path, e))
+        }
+        Err(e) => Err(to_py_err(e)),
+        Ok(new) => {
+            let after = scene_value(&new)?;
+            for (path, e) in absent {
+                let reads = FieldPath::at(&after, path).and_then(|f| f.read(&after));
+                if reads.is_err() {
+                    return Err(unknown(path, e));
+                }
+            }
+            Ok(new)
+        }
+    }
+}
+
 #[pymethods]
 impl Scene {
     /// The built-in scene of the letter (SI units inside).
     #[staticmethod]
     fn paper() -> Self {
-        Scene {
-            inner: Scn::paper(),
-        }
+        Scene::of(Scn::paper())
     }
 
     /// Reads a `.toml` or `.json` scene file and validates it.
     #[staticmethod]
     fn from_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Self> {
-        let inner = py.detach(|| Scn::from_path(&path)).py()?;
-        Ok(Scene { inner })
+        Ok(Scene::of(py.detach(|| Scn::from_path(&path)).py()?))
     }
 
     /// Parses a TOML scene and validates it.
     #[staticmethod]
     fn from_toml(text: &str) -> PyResult<Self> {
-        Ok(Scene {
-            inner: Scn::from_toml_str(text).py()?,
-        })
+        Ok(Scene::of(Scn::from_toml_str(text).py()?))
     }
 
     /// Parses a JSON scene and validates it.
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
-        Ok(Scene {
-            inner: Scn::from_json_str(text).py()?,
-        })
+        Ok(Scene::of(Scn::from_json_str(text).py()?))
     }
 
     /// A scene from a dict shaped as the JSON file (fields may use engineering units).
     #[staticmethod]
     fn from_dict(py: Python<'_>, d: &Bound<'_, PyAny>) -> PyResult<Self> {
-        Ok(Scene {
-            inner: scene_from_dict(py, d)?,
-        })
+        Ok(Scene::of(scene_from_dict(py, d)?))
     }
 
     /// The scene as a dict of plain Python values, SI units.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        scene_to_dict(py, &self.inner)
+        json_to_py(py, &scene_value(&self.get())?)
     }
 
     /// The scene as TOML text.
     fn to_toml(&self) -> PyResult<String> {
-        self.inner.to_toml_string().py()
+        self.get().to_toml_string().py()
     }
 
     /// The scene as JSON text.
     fn to_json(&self) -> PyResult<String> {
-        self.inner.to_json_string().py()
+        self.get().to_json_string().py()
     }
 
     /// The scene's name.
     #[getter]
     fn name(&self) -> String {
-        self.inner.name.clone()
+        self.get().name
     }
 
     /// A field by its dotted path, in SI (`"surface.height_sigma_m"`) or in an engineering unit
     /// (`"surface.height_sigma_nm"`).
     fn __getitem__<'py>(&self, py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyAny>> {
-        let root = scene_value(&self.inner)?;
+        let root = scene_value(&self.get())?;
         let v = FieldPath::at(&root, path)
             .and_then(|f| f.read(&root))
             .map_err(path_err)?;
         json_to_py(py, &v)
     }
 
-    /// Sets a field by its dotted path (SI or engineering unit); the scene is validated again and
-    /// left unchanged when the new value is refused.
-    fn __setitem__(
-        &mut self,
-        py: Python<'_>,
-        path: &str,
-        value: &Bound<'_, PyAny>,
-    ) -> PyResult<()> {
-        let updated = PyDict::new(py);
-        updated.set_item(path, value)?;
-        *self = self.with_values(py, &updated)?;
+    /// Sets a field by its dotted path (SI or engineering unit; numpy scalars and arrays
+    /// taken); the scene is validated again and left unchanged when the new value is refused. A
+    /// name the scene has no field of is a `KeyError`.
+    fn __setitem__(&self, py: Python<'_>, path: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let value = py_to_json(py, path, value)?;
+        let mut guard = self
+            .inner
+            .write()
+            .map_err(|_| PyRuntimeError::new_err("the scene was poisoned by a panic"))?;
+        let updated = with_fields(&guard, &[(path.to_string(), value)])?;
+        *guard = updated;
         Ok(())
     }
 
     /// A copy with the given fields (dotted paths, SI or engineering units) replaced, validated.
     fn with_values(&self, py: Python<'_>, values: &Bound<'_, PyDict>) -> PyResult<Self> {
-        let mut root = scene_value(&self.inner)?;
+        let mut given = Vec::new();
         for (k, v) in values.iter() {
             let path: String = k.extract()?;
             let value = py_to_json(py, &path, &v)?;
-            FieldPath::at(&root, &path)
-                .map_err(path_err)?
-                .write(&mut root, value);
+            given.push((path, value));
         }
-        let text = root.to_string();
-        Ok(Scene {
-            inner: py.detach(|| Scn::from_json_str(&text)).py()?,
-        })
+        let scene = self.get();
+        Ok(Scene::of(py.detach(|| with_fields(&scene, &given))?))
+    }
+
+    /// Every field's dotted path, SI (`"surface.height_sigma_m"`), in the order of the file.
+    fn keys(&self) -> PyResult<Vec<String>> {
+        let mut out = Vec::new();
+        leaf_paths(&scene_value(&self.get())?, "", &mut out);
+        Ok(out)
+    }
+
+    /// Whether `path` names a field (SI or engineering unit).
+    fn __contains__(&self, path: &str) -> PyResult<bool> {
+        let root = scene_value(&self.get())?;
+        Ok(FieldPath::at(&root, path)
+            .and_then(|f| f.read(&root))
+            .is_ok())
+    }
+
+    fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        PyList::new(py, self.keys()?)?.call_method0("__iter__")
+    }
+
+    fn __len__(&self) -> PyResult<usize> {
+        Ok(self.keys()?.len())
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<Scene>()
+            .is_ok_and(|o| self.get() == o.get().get())
     }
 
     fn __repr__(&self) -> String {
-        format!("Scene(name={:?})", self.inner.name)
+        format!("Scene(name={:?})", self.get().name)
     }
 
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
-        let text = slf.borrow().inner.to_json_string().py()?;
+        let text = slf.get().get().to_json_string().py()?;
         Ok((slf.get_type().getattr("from_json")?, (text,)))
     }
 }
@@ -287,17 +535,23 @@ struct Model {
     model: Arc<SliderModel>,
 }
 
-#[pymethods]
 impl Model {
-    #[new]
-    fn new(py: Python<'_>, scene: &Scene) -> PyResult<Self> {
-        let scene = Arc::new(scene.inner.clone());
+    fn build(py: Python<'_>, scene: Scn) -> PyResult<Self> {
+        let scene = Arc::new(scene);
         let s = scene.clone();
-        let model = py.detach(move || SliderModel::from_scene(&s)).py()?;
+        let model = interruptible(py, move || SliderModel::from_scene(&s))?;
         Ok(Model {
             scene,
             model: Arc::new(model),
         })
+    }
+}
+
+#[pymethods]
+impl Model {
+    #[new]
+    fn new(py: Python<'_>, scene: &Scene) -> PyResult<Self> {
+        Model::build(py, scene.get())
     }
 
     /// The structure's preset, as the scene file names it: `"rigid"`, `"bulge"`, `"pitch"` or
@@ -350,9 +604,7 @@ impl Model {
     /// The scene the model was built from (a copy).
     #[getter]
     fn scene(&self) -> Scene {
-        Scene {
-            inner: (*self.scene).clone(),
-        }
+        Scene::of((*self.scene).clone())
     }
 
     fn __repr__(&self) -> String {
@@ -371,11 +623,11 @@ fn model_of(py: Python<'_>, target: &Bound<'_, PyAny>) -> PyResult<(Arc<Scn>, Ar
         return Ok((m.scene.clone(), m.model.clone()));
     }
     if let Ok(s) = target.cast::<Scene>() {
-        let m = Model::new(py, &s.borrow())?;
+        let m = Model::build(py, s.get().get())?;
         return Ok((m.scene, m.model));
     }
-    Err(pyo3::exceptions::PyTypeError::new_err(
-        "expected a hdi_tribology.Model or hdi_tribology.Scene",
+    Err(PyTypeError::new_err(
+        "target: expected a hdi_tribology.Model or hdi_tribology.Scene",
     ))
 }
 
@@ -386,44 +638,78 @@ fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
     PyArray1::from_vec(py, v).into_any()
 }
 
-/// Every interface force at bulge gaps `gaps_nm` (nm), pad gaps `gaps_nm + protrusion_nm`, at
-/// the scene's DC voltage. Returns a dict of float64 arrays shaped as `gaps_nm`: `d_m` (m),
+/// How one column of `forces` is read from a breakdown.
+type ForceColumn = fn(&hdi_tribology::force::Breakdown) -> f64;
+
+/// The columns of `forces`, named as `hdi forces` names its keys (`force::Breakdown`'s serde
+/// form), and how each is read from a breakdown.
+const FORCE_COLUMNS: [(&str, ForceColumn); 7] = [
+    ("intermolecular_n", |b| b.intermolecular),
+    ("contact_n", |b| b.contact),
+    ("electrostatic_per_volt2_n_per_v2", |b| {
+        b.electrostatic_per_volt2
+    }),
+    ("electrostatic_n", |b| b.electrostatic),
+    ("other_n", |b| b.other),
+    ("real_contact_area_m2", |b| b.real_contact_area),
+    ("total_n", |b| b.total),
+];
+
+/// Gaps per chunk of `forces`: between chunks the call checks for Ctrl-C.
+const FORCE_CHUNK: usize = 4096;
+
+/// Every interface force at bulge gaps `gaps_nm` (nm; any array_like: a scalar, a list, an int
+/// or float32 array, of any shape), pad gaps `gaps_nm + protrusion_nm`, at the scene's DC
+/// voltage. Returns a dict of float64 arrays shaped as `gaps_nm`: `d_m` (m),
 /// `intermolecular_n`, `contact_n`, `electrostatic_n`, `other_n`, `total_n` (N, positive away
-/// from the disk), `electrostatic_per_volt2_n_per_v2` (N/V²), `real_contact_area_m2` (m²).
+/// from the disk), `electrostatic_per_volt2_n_per_v2` (N/V²), `real_contact_area_m2` (m²), and
+/// the bool array `in_table_range`. Ctrl-C stops it within one chunk of gaps.
 #[pyfunction]
 #[pyo3(signature = (target, gaps_nm, protrusion_nm = 0.0))]
 fn forces<'py>(
     py: Python<'py>,
     target: &Bound<'py, PyAny>,
-    gaps_nm: PyReadonlyArray1<'py, f64>,
+    gaps_nm: &Bound<'py, PyAny>,
     protrusion_nm: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let gaps: Vec<f64> = gaps_nm.as_array().iter().map(|&g| units::nm(g)).collect();
-    for (i, &g) in gaps.iter().enumerate() {
-        if !g.is_finite() {
-            return Err(invalid(
-                &format!("gaps_nm[{i}]"),
-                format!("must be finite, got {g:?}"),
-            ));
-        }
+    let np = py.import("numpy")?;
+    let given = np
+        .call_method1("asarray", (gaps_nm, "float64"))
+        .map_err(|e| invalid("gaps_nm", format!("not an array of numbers: {e}")))?;
+    let given = given
+        .cast_into::<PyArrayDyn<f64>>()
+        .map_err(|_| invalid("gaps_nm", "not an array of numbers"))?;
+    let shape: Vec<usize> = given.shape().to_vec();
+    let flat: Vec<f64> = given.readonly().as_array().iter().copied().collect();
+    if let Some(i) = flat.iter().position(|g| !g.is_finite()) {
+        let index: Vec<usize> = np
+            .call_method1("unravel_index", (i, shape.clone()))?
+            .extract()?;
+        let at = index
+            .iter()
+            .map(|k| k.to_string())
+            .collect::<Vec<_>>()
+            .join(", ");
+        return Err(invalid(
+            &format!("gaps_nm[{at}]"),
+            format!("must be finite, got {} nm", flat[i]),
+        ));
     }
     if !protrusion_nm.is_finite() {
         return Err(invalid(
             "protrusion_nm",
-            format!("must be finite, got {protrusion_nm:?}"),
+            format!("must be finite, got {protrusion_nm:?} nm"),
         ));
     }
+    let gaps: Vec<f64> = flat.iter().map(|&g| units::nm(g)).collect();
     let protrusion = units::nm(protrusion_nm);
     let (scene, model) = model_of(py, target)?;
     let (lo, hi) = model.forces().table_range();
-    let in_range: Vec<bool> = gaps
-        .iter()
-        .map(|&d| (lo..=hi).contains(&d) && (lo..=hi).contains(&(d + protrusion)))
-        .collect();
-    let rows = py.detach(|| {
-        let volt2 = scene.dc_volt2();
-        gaps.iter()
-            .map(|&d| {
+    let volt2 = scene.dc_volt2();
+    let mut rows = Vec::with_capacity(gaps.len());
+    for chunk in gaps.chunks(FORCE_CHUNK) {
+        let part = py.detach(|| {
+            let one = |&d: &f64| {
                 model.breakdown(
                     Gaps {
                         bulge: d,
@@ -431,177 +717,39 @@ fn forces<'py>(
                     },
                     volt2,
                 )
-            })
-            .collect::<Vec<_>>()
-    });
+            };
+            use rayon::prelude::*;
+            chunk.par_iter().map(one).collect::<Vec<_>>()
+        });
+        rows.extend(part);
+        py.check_signals()?;
+    }
+    let in_range: Vec<bool> = gaps
+        .iter()
+        .map(|&d| (lo..=hi).contains(&d) && (lo..=hi).contains(&(d + protrusion)))
+        .collect();
+    let shaped = |a: Bound<'py, PyAny>| a.call_method1("reshape", (shape.clone(),));
     let out = PyDict::new(py);
-    let col = |f: fn(&hdi_tribology::force::Breakdown) -> f64| rows.iter().map(f).collect();
-    out.set_item("d_m", array(py, gaps))?;
-    out.set_item("intermolecular_n", array(py, col(|b| b.intermolecular)))?;
-    out.set_item("contact_n", array(py, col(|b| b.contact)))?;
+    out.set_item("d_m", shaped(array(py, gaps))?)?;
+    for (name, get) in FORCE_COLUMNS {
+        out.set_item(name, shaped(array(py, rows.iter().map(get).collect()))?)?;
+    }
     out.set_item(
-        "electrostatic_per_volt2_n_per_v2",
-        array(py, col(|b| b.electrostatic_per_volt2)),
+        "in_table_range",
+        shaped(PyArray1::from_vec(py, in_range).into_any())?,
     )?;
-    out.set_item("electrostatic_n", array(py, col(|b| b.electrostatic)))?;
-    out.set_item("other_n", array(py, col(|b| b.other)))?;
-    out.set_item(
-        "real_contact_area_m2",
-        array(py, col(|b| b.real_contact_area)),
-    )?;
-    out.set_item("total_n", array(py, col(|b| b.total)))?;
-    out.set_item("in_table_range", PyArray1::from_vec(py, in_range))?;
     Ok(out)
 }
 
 // ---------------------------------------------------------------------------------------------
 // Static analyses
 
-/// A static equilibrium of the slider.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-#[derive(Clone)]
-struct Equilibrium {
-    /// Bulge gap (m).
-    d_m: f64,
-    /// Head displacement away from the disk (m).
-    y_m: f64,
-    /// Thermal protrusion (m).
-    protrusion_m: f64,
-    /// Heater power (W).
-    power_w: f64,
-    /// Total stiffness (N/m).
-    stiffness_n_per_m: f64,
-    /// Interface force (N).
-    interface_force_n: f64,
-    /// Contact force (N).
-    contact_force_n: f64,
-    /// Whether the equilibrium is stable.
-    stable: bool,
-    /// Every coordinate of the structure (m for displacements, rad for the pitch; one per degree
-    /// of freedom: `[y]` for the rigid slider, `[y, z]` for `bulge`, `[y, θ]` for `pitch`).
-    q: Vec<f64>,
-}
-
-impl Equilibrium {
-    /// The equilibrium `e` of a structure of `dofs` coordinates.
-    fn of(e: &analysis::Equilibrium, dofs: usize) -> Self {
-        Equilibrium {
-            q: e.q.iter().take(dofs).copied().collect(),
-            d_m: e.d,
-            y_m: e.y,
-            protrusion_m: e.protrusion,
-            power_w: e.power,
-            stiffness_n_per_m: e.stiffness,
-            interface_force_n: e.interface_force,
-            contact_force_n: e.contact_force,
-            stable: e.is_stable(),
-        }
-    }
-}
-
-#[pymethods]
-impl Equilibrium {
-    /// Bulge gap (nm).
-    #[getter]
-    fn d_nm(&self) -> f64 {
-        units::to_nm(self.d_m)
-    }
-    /// Heater power (mW).
-    #[getter]
-    fn power_mw(&self) -> f64 {
-        units::to_mw(self.power_w)
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "Equilibrium(d_nm={:.4}, power_mw={:.4}, stiffness_n_per_m={:.4e}, stable={})",
-            self.d_nm(),
-            self.power_mw(),
-            self.stiffness_n_per_m,
-            if self.stable { "True" } else { "False" }
-        )
-    }
-}
-
-/// A touchdown or take-off on the static equilibria.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-#[derive(Clone)]
-struct Transition {
-    /// Heater power (W).
-    power_w: f64,
-    /// `"fold"` (the branch ends) or `"threshold"` (the contact force crosses the detector's).
-    cause: String,
-    /// The equilibrium where it happens.
-    at: Equilibrium,
-}
-
-fn cause_name(c: analysis::Cause) -> String {
-    match c {
-        analysis::Cause::Fold => "fold".into(),
-        analysis::Cause::Threshold => "threshold".into(),
-    }
-}
-
-impl Transition {
-    fn of(t: &analysis::Transition, dofs: usize) -> Self {
-        Transition {
-            power_w: t.power,
-            cause: cause_name(t.cause),
-            at: Equilibrium::of(&t.at, dofs),
-        }
-    }
-}
-
-#[pymethods]
-impl Transition {
-    /// Heater power (mW).
-    #[getter]
-    fn power_mw(&self) -> f64 {
-        units::to_mw(self.power_w)
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "Transition(power_mw={:.4}, cause={:?}, d_nm={:.4})",
-            self.power_mw(),
-            self.cause,
-            self.at.d_nm()
-        )
-    }
-}
-
-/// Static touchdown, take-off and their hysteresis.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-struct StaticHysteresis {
-    /// Touchdown.
-    touchdown: Transition,
-    /// Take-off.
-    takeoff: Transition,
-    /// Touchdown minus take-off power (W).
-    hysteresis_w: f64,
-}
-
-#[pymethods]
-impl StaticHysteresis {
-    /// Touchdown minus take-off power (mW).
-    #[getter]
-    fn hysteresis_mw(&self) -> f64 {
-        units::to_mw(self.hysteresis_w)
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "StaticHysteresis(touchdown_mw={:.4}, takeoff_mw={:.4}, hysteresis_mw={:.4})",
-            self.touchdown.power_mw(),
-            self.takeoff.power_mw(),
-            self.hysteresis_mw()
-        )
-    }
-}
-
 fn static_options(scene: &Scn, threshold_un: Option<f64>) -> PyResult<StaticOptions> {
     let threshold = match threshold_un {
         Some(t) if !(t.is_finite() && t > 0.0) => {
             return Err(invalid(
                 "contact_threshold_un",
-                format!("must be finite and > 0 µN, got {t:?}"),
+                format!("must be finite and > 0 µN, got {t:?} µN"),
             ))
         }
         Some(t) => t * 1e-6,
@@ -610,74 +758,82 @@ fn static_options(scene: &Scn, threshold_un: Option<f64>) -> PyResult<StaticOpti
     Ok(StaticOptions::new(threshold))
 }
 
+/// Replaces the `at` equilibrium of the transition at `key` of `v` by its full form.
+fn with_equilibrium(
+    v: &mut Value,
+    key: &str,
+    e: &analysis::Equilibrium,
+    dofs: usize,
+) -> PyResult<()> {
+    if let Some(t) = v.get_mut(key) {
+        t["at"] = equilibrium_value(e, dofs)?;
+    }
+    Ok(())
+}
+
 /// Static touchdown and take-off powers at the scene's DC voltage, with the contact threshold
-/// of the scene's detector (or `contact_threshold_un`, µN).
+/// of the scene's detector (or `contact_threshold_un`, µN): a `StaticHysteresis`, as `hdi
+/// static` prints it.
 #[pyfunction]
 #[pyo3(signature = (target, contact_threshold_un = None))]
-fn static_hysteresis(
-    py: Python<'_>,
-    target: &Bound<'_, PyAny>,
+fn static_hysteresis<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
     contact_threshold_un: Option<f64>,
-) -> PyResult<StaticHysteresis> {
+) -> PyResult<Bound<'py, PyAny>> {
     let (scene, model) = model_of(py, target)?;
     let opts = static_options(&scene, contact_threshold_un)?;
-    let h = py
-        .detach(|| analysis::static_hysteresis(&model, &opts))
-        .py()?;
+    let h = interruptible(py, || analysis::static_hysteresis(&model, &opts))?;
     let dofs = model.structure().dofs();
-    Ok(StaticHysteresis {
-        touchdown: Transition::of(&h.touchdown, dofs),
-        takeoff: Transition::of(&h.takeoff, dofs),
-        hysteresis_w: h.hysteresis,
-    })
+    let mut v = to_value(&StaticRecord::new(&scene.name, h))?;
+    with_equilibrium(&mut v, "touchdown", &h.touchdown.at, dofs)?;
+    with_equilibrium(&mut v, "takeoff", &h.takeoff.at, dofs)?;
+    record(py, "StaticHysteresis", &v)
 }
 
-/// The pull-in voltage.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-struct PullIn {
-    /// Pull-in voltage |V − φ| (V).
-    voltage_v: f64,
-    /// Bulge gap where the head jumps in (m).
-    d_m: f64,
-    /// `"fold"` or `"threshold"`.
-    cause: String,
-}
-
-#[pymethods]
-impl PullIn {
-    fn __repr__(&self) -> String {
-        format!(
-            "PullIn(voltage_v={:.4}, d_nm={:.4}, cause={:?})",
-            self.voltage_v,
-            units::to_nm(self.d_m),
-            self.cause
-        )
-    }
-}
-
-/// The voltage that pulls the head into contact at heater power `power_mw` (mW).
+/// The voltage that pulls the head into contact at heater power `power_mw` (mW): a `PullIn`.
 #[pyfunction]
 #[pyo3(signature = (target, power_mw = 0.0, contact_threshold_un = None))]
-fn pull_in_voltage(
-    py: Python<'_>,
-    target: &Bound<'_, PyAny>,
+fn pull_in_voltage<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
     power_mw: f64,
     contact_threshold_un: Option<f64>,
-) -> PyResult<PullIn> {
+) -> PyResult<Bound<'py, PyAny>> {
+    let power = units::mw(non_negative("power_mw", power_mw, "mW")?);
     let (scene, model) = model_of(py, target)?;
     let opts = static_options(&scene, contact_threshold_un)?;
-    let p = py
-        .detach(|| analysis::pull_in_voltage(&model, units::mw(power_mw), &opts))
-        .py()?;
-    Ok(PullIn {
-        voltage_v: p.voltage,
-        d_m: p.d,
-        cause: cause_name(p.cause),
-    })
+    let p = interruptible(py, || analysis::pull_in_voltage(&model, power, &opts))?;
+    record(py, "PullIn", &to_value(&p)?)
 }
 
-/// Clearance change with DC voltage (the letter's Fig. 2b). Returns a dict of float64 arrays:
-/// `dc_voltage_v` (V), `touchdown_power_w` (W), `clearance_change_m` (m).
+/// Columns of the serde forms of `rows`: one float64 array per numeric key, a bool array per
+/// boolean key (the keys of the JSON of one row).
+fn columns<'py>(py: Python<'py>, rows: &[Value], out: &Bound<'py, PyDict>) -> PyResult<()> {
+    let Some(Value::Object(first)) = rows.first() else {
+        return Ok(());
+    };
+    for key in first.keys() {
+        if first[key].is_boolean() {
+            let col: Vec<bool> = rows
+                .iter()
+                .map(|r| r[key].as_bool().unwrap_or(false))
+                .collect();
+            out.set_item(key, PyArray1::from_vec(py, col))?;
+        } else if first[key].is_number() || first[key].is_null() {
+            let col: Vec<f64> = rows
+                .iter()
+                .map(|r| r[key].as_f64().unwrap_or(f64::NAN))
+                .collect();
+            out.set_item(key, array(py, col))?;
+        }
+    }
+    Ok(())
+}
+
+/// Clearance change with DC voltage (the letter's Fig. 2b). Returns a dict of float64 arrays,
+/// the keys of `ClearanceChange`'s serde form: `dc_voltage_v` (V), `touchdown_power_w` (W),
+/// `clearance_change_m` (m).
 #[pyfunction]
 #[pyo3(signature = (target, dc_voltages_v, contact_threshold_un = None))]
 fn clearance_change<'py>(
@@ -686,180 +842,53 @@ fn clearance_change<'py>(
     dc_voltages_v: Vec<f64>,
     contact_threshold_un: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    for (i, v) in dc_voltages_v.iter().enumerate() {
+        if !v.is_finite() {
+            return Err(invalid(
+                &format!("dc_voltages_v[{i}]"),
+                format!("must be finite, got {v} V"),
+            ));
+        }
+    }
     let (scene, model) = model_of(py, target)?;
     let opts = static_options(&scene, contact_threshold_un)?;
-    let rows = py
-        .detach(|| analysis::clearance_change(&model, &dc_voltages_v, &opts))
-        .py()?;
+    let rows = interruptible(py, || {
+        analysis::clearance_change(&model, &dc_voltages_v, &opts)
+    })?;
+    let values = rows.iter().map(to_value).collect::<PyResult<Vec<_>>>()?;
     let out = PyDict::new(py);
-    out.set_item(
-        "dc_voltage_v",
-        array(py, rows.iter().map(|r| r.dc_voltage).collect()),
-    )?;
-    out.set_item(
-        "touchdown_power_w",
-        array(py, rows.iter().map(|r| r.touchdown_power).collect()),
-    )?;
-    out.set_item(
-        "clearance_change_m",
-        array(py, rows.iter().map(|r| r.clearance_change).collect()),
-    )?;
+    columns(py, &values, &out)?;
+    if rows.is_empty() {
+        for k in ["dc_voltage_v", "touchdown_power_w", "clearance_change_m"] {
+            out.set_item(k, array(py, Vec::new()))?;
+        }
+    }
     Ok(out)
 }
 
 /// The S-curve of static equilibria along the bulge gap, at the scene's DC voltage. Returns a
-/// dict: float64 arrays `d_m`, `power_w`, `y_m`, `stiffness_n_per_m`, `contact_force_n`, a
-/// bool array `stable`, and `folds`, a list of dicts `{power_w, d_m, jump_in}`.
+/// dict: float64 arrays `d_m`, `power_w`, `y_m`, `protrusion_m`, `stiffness_n_per_m`,
+/// `interface_force_n`, `contact_force_n`, a bool array `stable`, `volt2_v2`, and `folds`, a
+/// list of dicts `{power_w, d_m, jump_in}`.
 #[pyfunction]
 fn s_curve<'py>(py: Python<'py>, target: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
     let (_, model) = model_of(py, target)?;
-    let c = py
-        .detach(|| analysis::s_curve(&model, None, &ScanGrid::default()))
-        .py()?;
+    let c = interruptible(py, || analysis::s_curve(&model, None, &ScanGrid::default()))?;
+    let dofs = model.structure().dofs();
+    let points = c
+        .points
+        .iter()
+        .map(|e| equilibrium_value(e, dofs))
+        .collect::<PyResult<Vec<_>>>()?;
     let out = PyDict::new(py);
-    let col = |f: fn(&analysis::Equilibrium) -> f64| c.points.iter().map(f).collect();
-    out.set_item("d_m", array(py, col(|e| e.d)))?;
-    out.set_item("power_w", array(py, col(|e| e.power)))?;
-    out.set_item("y_m", array(py, col(|e| e.y)))?;
-    out.set_item("stiffness_n_per_m", array(py, col(|e| e.stiffness)))?;
-    out.set_item("contact_force_n", array(py, col(|e| e.contact_force)))?;
-    let stable: Vec<bool> = c.points.iter().map(|e| e.is_stable()).collect();
-    out.set_item("stable", PyArray1::from_vec(py, stable))?;
-    let folds = PyList::empty(py);
-    for f in &c.folds {
-        let d = PyDict::new(py);
-        d.set_item("power_w", f.power)?;
-        d.set_item("d_m", f.d)?;
-        d.set_item("jump_in", f.jump_in)?;
-        folds.append(d)?;
-    }
-    out.set_item("folds", folds)?;
+    columns(py, &points, &out)?;
+    out.set_item("volt2_v2", c.volt2)?;
+    out.set_item("folds", json_to_py(py, &to_value(&c.folds)?)?)?;
     Ok(out)
 }
 
 // ---------------------------------------------------------------------------------------------
 // Cycles and sweeps
-
-/// A detected touchdown or take-off in a cycle.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-#[derive(Clone)]
-struct Detection {
-    /// Time of detection (s).
-    time_s: f64,
-    /// Programme heater power then (W).
-    power_w: f64,
-}
-
-#[pymethods]
-impl Detection {
-    /// Programme heater power then (mW).
-    #[getter]
-    fn power_mw(&self) -> f64 {
-        units::to_mw(self.power_w)
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "Detection(time_s={:.6e}, power_mw={:.4})",
-            self.time_s,
-            self.power_mw()
-        )
-    }
-}
-
-fn detection(d: Option<analysis::cycle::Detection>) -> Option<Detection> {
-    d.map(|d| Detection {
-        time_s: d.time,
-        power_w: d.power,
-    })
-}
-
-/// One touchdown/take-off cycle, without its time series.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-#[derive(Clone)]
-struct Cycle {
-    /// AC amplitude (V).
-    v_ac_v: f64,
-    /// Touchdown, `None` if none was detected.
-    touchdown: Option<Detection>,
-    /// Take-off, `None` if none was detected.
-    takeoff: Option<Detection>,
-    /// Touchdown minus take-off power (W), `None` unless both were detected.
-    hysteresis_w: Option<f64>,
-    /// Mean flash temperature rise while in contact (K).
-    mean_temperature_rise_k: f64,
-    /// Simulated time (s).
-    duration_s: f64,
-    /// Accepted solver steps.
-    steps: usize,
-    /// Rejected solver steps.
-    rejected_steps: usize,
-    /// Wall time of the simulation in Rust (s).
-    wall_seconds: f64,
-    /// What is wrong with the cycle, empty when nothing is: `no_touchdown`, `no_takeoff`,
-    /// `negative_hysteresis` (a detection artefact, not a hysteresis).
-    flags: Vec<String>,
-}
-
-impl From<&CycleResult> for Cycle {
-    fn from(r: &CycleResult) -> Self {
-        Cycle {
-            v_ac_v: r.v_ac,
-            touchdown: detection(r.touchdown),
-            takeoff: detection(r.takeoff),
-            hysteresis_w: r.hysteresis,
-            mean_temperature_rise_k: r.mean_temperature_rise,
-            duration_s: r.duration,
-            steps: r.stats.accepted,
-            rejected_steps: r.stats.rejected,
-            wall_seconds: r.wall_seconds,
-            flags: flag_names(&sweep::flags(r)),
-        }
-    }
-}
-
-/// The crate's flags by their snake_case names (`no_touchdown`, `negative_hysteresis`, …), as
-/// the `hdi` program prints them.
-fn flag_names(flags: &[Flag]) -> Vec<String> {
-    flags
-        .iter()
-        .map(|f| match serde_json::to_value(f) {
-            Ok(serde_json::Value::String(s)) => s,
-            _ => f.to_string(),
-        })
-        .collect()
-}
-
-fn fmt_flags(flags: &[String]) -> String {
-    if flags.is_empty() {
-        String::new()
-    } else {
-        format!(", flags={flags:?}")
-    }
-}
-
-fn fmt_opt_mw(x: Option<f64>) -> String {
-    x.map_or("None".into(), |p| format!("{:.4}", units::to_mw(p)))
-}
-
-#[pymethods]
-impl Cycle {
-    /// Touchdown minus take-off power (mW), `None` unless both were detected.
-    #[getter]
-    fn hysteresis_mw(&self) -> Option<f64> {
-        self.hysteresis_w.map(units::to_mw)
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "Cycle(v_ac_v={}, touchdown_mw={}, takeoff_mw={}, hysteresis_mw={}, steps={}{})",
-            self.v_ac_v,
-            fmt_opt_mw(self.touchdown.as_ref().map(|d| d.power_w)),
-            fmt_opt_mw(self.takeoff.as_ref().map(|d| d.power_w)),
-            fmt_opt_mw(self.hysteresis_w),
-            self.steps,
-            fmt_flags(&self.flags)
-        )
-    }
-}
 
 /// How a cycle is run: programme, options and the AC amplitude override.
 struct CycleSetup {
@@ -877,6 +906,19 @@ fn cycle_setup(
     rtol: Option<f64>,
     atol_nm: Option<f64>,
 ) -> PyResult<CycleSetup> {
+    if let Some(r) = rtol {
+        if !(r.is_finite() && r > 0.0 && r < 1.0) {
+            return Err(invalid("rtol", format!("must lie in (0, 1), got {r}")));
+        }
+    }
+    if let Some(a) = atol_nm {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(invalid(
+                "atol_nm",
+                format!("must be finite and > 0 nm, got {a} nm"),
+            ));
+        }
+    }
     let (scene, model) = model_of(py, target)?;
     let mut opts = CycleOptions::from_scene(&scene).py()?;
     if let Some(m) = method {
@@ -905,14 +947,27 @@ fn cycle_setup(
     })
 }
 
+/// The model at AC amplitude `v_ac` (V), or `None` for the model itself.
+fn at_amplitude(model: &SliderModel, v_ac: Option<f64>) -> PyResult<Option<SliderModel>> {
+    match v_ac {
+        None => Ok(None),
+        Some(a) => Ok(Some(model.with_voltage(Voltage {
+            ac_amplitude: non_negative("v_ac", a, "V")?,
+            ..model.voltage()
+        }))),
+    }
+}
+
 /// One touchdown/take-off cycle under the scene's heater programme (or the touchdown-triggered
-/// protocol), at AC amplitude `v_ac` (V; default: the scene's).
+/// protocol), at AC amplitude `v_ac` (V; default: the scene's), run once at the tolerances given.
 ///
-/// Returns a dict: the summary `cycle` (a `Cycle`), `touchdown` and `takeoff` (`Detection` or
-/// `None`), and with `series=True` float64 arrays, one value per accepted step: `t_s` (s),
-/// `power_w` (W), `d_m` (m), `air_bearing_n`, `intermolecular_n`, `electrostatic_n`,
-/// `contact_n`, `total_n` (N), `temperature_rise_k` (K), `indicator_n` (N, NaN before the
-/// detector window has filled).
+/// Returns a dict: the summary `cycle` (a `Cycle`, as `hdi cycle --no-refine` prints it),
+/// `touchdown` and `takeoff` (`Detection` or `None`), and with `series=True` float64 arrays, one
+/// value per accepted step, the columns of the CSV of `hdi cycle --csv`: `t_s` (s), `power_w`
+/// (W), `d_m` (m), `air_bearing_n`, `intermolecular_n`, `electrostatic_n`, `contact_n`,
+/// `total_n` (N), `temperature_rise_k` (K), `indicator_n` (N, NaN before the detector window
+/// has filled: an empty field in the CSV), and `term_states` when the model has terms with
+/// memory.
 #[pyfunction]
 #[pyo3(signature = (target, v_ac = None, *, triggered = false, method = None, rtol = None, atol_nm = None, series = true))]
 fn simulate_cycle<'py>(
@@ -927,24 +982,19 @@ fn simulate_cycle<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     setup.opts.keep_series = series;
-    let r = py
-        .detach(|| match v_ac {
-            Some(a) => {
-                let m = setup.model.with_voltage(Voltage {
-                    ac_amplitude: a,
-                    ..setup.model.voltage()
-                });
-                analysis::simulate_cycle(&m, &setup.programme, &setup.opts)
-            }
-            None => analysis::simulate_cycle(&setup.model, &setup.programme, &setup.opts),
-        })
-        .py()?;
+    let changed = at_amplitude(&setup.model, v_ac)?;
+    let m: &SliderModel = changed.as_ref().unwrap_or(&setup.model);
+    let mut r = interruptible(py, || {
+        analysis::simulate_cycle(m, &setup.programme, &setup.opts)
+    })?;
+    let s = r.series.take();
+    let rec = CycleRecord::unchecked(&setup.scene.name, &setup.programme, r, &setup.opts);
+    let cycle = record(py, "Cycle", &to_value(&rec)?)?;
     let out = PyDict::new(py);
-    let summary = Cycle::from(&r);
-    out.set_item("touchdown", summary.touchdown.clone())?;
-    out.set_item("takeoff", summary.takeoff.clone())?;
-    out.set_item("cycle", summary)?;
-    if let Some(s) = r.series {
+    out.set_item("touchdown", cycle.getattr("touchdown")?)?;
+    out.set_item("takeoff", cycle.getattr("takeoff")?)?;
+    out.set_item("cycle", cycle)?;
+    if let Some(s) = s {
         out.set_item("t_s", array(py, s.t))?;
         out.set_item("power_w", array(py, s.power))?;
         out.set_item("d_m", array(py, s.d))?;
@@ -963,23 +1013,26 @@ fn simulate_cycle<'py>(
     Ok(out)
 }
 
-/// Runs `work` on a rayon pool of `threads` threads (the global pool when `None`).
+/// Runs `work` on a rayon pool of `threads` threads (the global pool when `None`), watching
+/// the caller's cancellation flag there.
 fn on_threads<T: Send>(
     threads: Option<usize>,
     work: impl FnOnce() -> hdi_tribology::Result<T> + Send,
-) -> PyResult<T> {
+) -> hdi_tribology::Result<T> {
     match threads {
-        None => work().py(),
-        Some(0) => Err(invalid("threads", "must be at least 1, got 0")),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| invalid("threads", e.to_string()))?
-            .install(work)
-            .py(),
+        None => work(),
+        Some(n) => {
+            let cancel = Cancel::current();
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| hdi_tribology::Error::invalid("threads", e.to_string()))?
+                .install(|| Cancel::carry(&cancel, work))
+        }
     }
 }
 
+/// The amplitudes asked for (the scene's sweep list when `None`), each finite and ≥ 0 V.
 fn amplitudes_or_scene(scene: &Scn, amplitudes_v: Option<Vec<f64>>) -> PyResult<Vec<f64>> {
     let a = amplitudes_v.unwrap_or_else(|| scene.sweep.ac_amplitudes_v.clone());
     if a.is_empty() {
@@ -988,98 +1041,94 @@ fn amplitudes_or_scene(scene: &Scn, amplitudes_v: Option<Vec<f64>>) -> PyResult<
             "no amplitudes: give a list or a [sweep] list in the scene",
         ));
     }
+    for (i, &v) in a.iter().enumerate() {
+        non_negative(&format!("amplitudes_v[{i}]"), v, "V")?;
+    }
     Ok(a)
 }
 
+fn threads_of(threads: Option<i128>) -> PyResult<Option<usize>> {
+    threads.map(|t| count("threads", t, 1)).transpose()
+}
+
 /// One cycle per AC amplitude (V; default: the scene's sweep list), in parallel on rayon
-/// (`threads` threads, default all cores) with the GIL released. Returns a list of `Cycle`, in
-/// the order of the amplitudes; results do not depend on the thread count.
+/// (`threads` threads, default all cores) with the GIL released, each run once: a list of
+/// `Cycle` (status `"unchecked"`), in the order of the amplitudes, as `hdi sweep --no-refine`
+/// prints them; results do not depend on the thread count.
 #[pyfunction]
 #[pyo3(signature = (target, amplitudes_v = None, *, triggered = false, method = None, rtol = None, atol_nm = None, threads = None))]
-fn ac_sweep(
-    py: Python<'_>,
-    target: &Bound<'_, PyAny>,
+fn ac_sweep<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
     amplitudes_v: Option<Vec<f64>>,
     triggered: bool,
     method: Option<&str>,
     rtol: Option<f64>,
     atol_nm: Option<f64>,
-    threads: Option<usize>,
-) -> PyResult<Vec<Cycle>> {
+    threads: Option<i128>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let threads = threads_of(threads)?;
     let setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     let amplitudes = amplitudes_or_scene(&setup.scene, amplitudes_v)?;
-    let rows = py.detach(|| {
-        on_threads(threads, || {
-            analysis::ac_sweep(&setup.model, &setup.programme, &setup.opts, &amplitudes)
+    let rows = on_own_thread(
+        py,
+        || {
+            on_threads(threads, || {
+                analysis::ac_sweep(&setup.model, &setup.programme, &setup.opts, &amplitudes)
+            })
+        },
+        to_py_err,
+    )?;
+    rows.into_iter()
+        .map(|c| {
+            let rec = CycleRecord::unchecked(&setup.scene.name, &setup.programme, c, &setup.opts);
+            record(py, "Cycle", &to_value(&rec)?)
         })
-    })?;
-    Ok(rows.iter().map(Cycle::from).collect())
-}
-
-/// A cycle run at tighter and tighter tolerances until its powers settle.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-struct RefinedCycle {
-    /// The last (most accurate) cycle.
-    cycle: Cycle,
-    /// Its relative tolerance.
-    rtol: f64,
-    /// Its absolute tolerance on the displacement (m).
-    atol_m: f64,
-    /// Largest change of touchdown or take-off power from the run before (W); infinite when a
-    /// detection came or went between the two.
-    power_change_w: f64,
-    /// Change of the mean temperature rise from the run before (K).
-    temperature_change_k: f64,
-    /// Whether both changes are within the tolerances asked for.
-    converged: bool,
-    /// `"converged"` or `"not_converged"`.
-    status: String,
-    /// The cycle's flags, and `not_converged`.
-    flags: Vec<String>,
-    /// Cycles run.
-    runs: usize,
-    /// Accepted steps over all runs.
-    steps: usize,
-    /// Wall time over all runs (s).
-    wall_seconds: f64,
-}
-
-#[pymethods]
-impl RefinedCycle {
-    fn __repr__(&self) -> String {
-        format!(
-            "RefinedCycle(v_ac_v={}, hysteresis_mw={}, rtol={:e}, power_change_mw={:.3e}, status={:?}, runs={}{})",
-            self.cycle.v_ac_v,
-            fmt_opt_mw(self.cycle.hysteresis_w),
-            self.rtol,
-            units::to_mw(self.power_change_w),
-            self.status,
-            self.runs,
-            fmt_flags(&self.flags)
-        )
-    }
+        .collect()
 }
 
 /// `ac_sweep` with the tolerances refined per amplitude (tenfold tighter per run, at most
 /// `max_runs` runs) until touchdown and take-off move by at most `power_tol_mw` (mW) and the
 /// mean temperature rise by at most `temperature_tol_k` (K) over `agreeing_runs` successive runs.
-/// Returns a list of `RefinedCycle`; check `converged` (or `flags`) before trusting a row.
+/// Returns a list of `Cycle`, as `hdi sweep` prints them; check `status` (and `flags`) before
+/// trusting a row.
 #[pyfunction]
 #[pyo3(signature = (target, power_tol_mw, amplitudes_v = None, *, temperature_tol_k = 0.05, max_runs = 4, agreeing_runs = 2, triggered = false, method = None, rtol = None, atol_nm = None, threads = None))]
-fn ac_sweep_refined(
-    py: Python<'_>,
-    target: &Bound<'_, PyAny>,
+fn ac_sweep_refined<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
     power_tol_mw: f64,
     amplitudes_v: Option<Vec<f64>>,
     temperature_tol_k: f64,
-    max_runs: usize,
-    agreeing_runs: usize,
+    max_runs: i128,
+    agreeing_runs: i128,
     triggered: bool,
     method: Option<&str>,
     rtol: Option<f64>,
     atol_nm: Option<f64>,
-    threads: Option<usize>,
-) -> PyResult<Vec<RefinedCycle>> {
+    threads: Option<i128>,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let threads = threads_of(threads)?;
+    if !(power_tol_mw.is_finite() && power_tol_mw > 0.0) {
+        return Err(invalid(
+            "power_tol_mw",
+            format!("must be finite and > 0 mW, got {power_tol_mw} mW"),
+        ));
+    }
+    if !(temperature_tol_k.is_finite() && temperature_tol_k > 0.0) {
+        return Err(invalid(
+            "temperature_tol_k",
+            format!("must be finite and > 0 K, got {temperature_tol_k} K"),
+        ));
+    }
+    let max_runs = count("max_runs", max_runs, 2)?;
+    let agreeing_runs = count("agreeing_runs", agreeing_runs, 2)?;
+    if agreeing_runs > max_runs {
+        return Err(invalid(
+            "agreeing_runs",
+            format!("must be at most max_runs ({max_runs}), got {agreeing_runs}"),
+        ));
+    }
     let setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     let amplitudes = amplitudes_or_scene(&setup.scene, amplitudes_v)?;
     let refine = Refinement {
@@ -1088,68 +1137,37 @@ fn ac_sweep_refined(
         agreeing_runs,
         ..Refinement::new(units::mw(power_tol_mw))
     };
-    let rows = py.detach(|| {
-        on_threads(threads, || {
-            analysis::ac_sweep_refined(
-                &setup.model,
-                &setup.programme,
-                &setup.opts,
-                &amplitudes,
-                &refine,
-            )
+    let rows = on_own_thread(
+        py,
+        || {
+            on_threads(threads, || {
+                analysis::ac_sweep_refined(
+                    &setup.model,
+                    &setup.programme,
+                    &setup.opts,
+                    &amplitudes,
+                    &refine,
+                )
+            })
+        },
+        to_py_err,
+    )?;
+    rows.into_iter()
+        .map(|r| {
+            let rec = CycleRecord::refined(&setup.scene.name, &setup.programme, r);
+            record(py, "Cycle", &to_value(&rec)?)
         })
-    })?;
-    Ok(rows
-        .iter()
-        .map(|r| RefinedCycle {
-            cycle: Cycle::from(&r.cycle),
-            rtol: r.rtol,
-            atol_m: r.atol,
-            power_change_w: r.change,
-            temperature_change_k: r.temperature_change,
-            converged: r.converged,
-            status: if r.converged {
-                "converged"
-            } else {
-                "not_converged"
-            }
-            .into(),
-            flags: flag_names(&r.flags()),
-            runs: r.runs,
-            steps: r.stats.accepted,
-            wall_seconds: r.wall_seconds,
-        })
-        .collect())
+        .collect()
 }
 
 // ---------------------------------------------------------------------------------------------
 // Linear response
 
-/// One mode of the linearised slider.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-#[derive(Clone)]
-struct Mode {
-    /// Eigenvalue λ (1/s), complex.
-    eigenvalue: numpy::Complex64,
-    /// `|Im λ| / 2π` (Hz).
-    frequency_hz: f64,
-    /// Damping ratio `−Re λ / |λ|`.
-    damping_ratio: f64,
-    /// Mode shape over the structure's coordinates (one per degree of freedom, as
-    /// `Equilibrium.q`): the eigenvector's displacement part scaled so that its largest entry is
-    /// 1 and rotated to be real there. All zero for a mode of the lags alone (thermal or
-    /// interface lag), which moves no coordinate.
-    shape: Vec<f64>,
-}
-
-#[pymethods]
-impl Mode {
-    fn __repr__(&self) -> String {
-        format!(
-            "Mode(frequency_hz={:.6e}, damping_ratio={:.4e}, shape={:?})",
-            self.frequency_hz, self.damping_ratio, self.shape
-        )
-    }
+/// A mode's serde form with its shape cut to the structure's `dofs` coordinates.
+fn mode_value(m: &analysis::Mode, dofs: usize) -> PyResult<Value> {
+    let mut v = to_value(m)?;
+    v["shape"] = to_value(&m.shape.iter().take(dofs).collect::<Vec<_>>())?;
+    Ok(v)
 }
 
 /// The linear response about the flying equilibrium at one heater power.
@@ -1163,23 +1181,22 @@ struct LinearResponse {
 impl LinearResponse {
     /// The equilibrium (under the mean V²).
     #[getter]
-    fn equilibrium(&self) -> Equilibrium {
-        Equilibrium::of(&self.inner.equilibrium, self.dofs)
+    fn equilibrium<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        record(
+            py,
+            "Equilibrium",
+            &equilibrium_value(&self.inner.equilibrium, self.dofs)?,
+        )
     }
     /// Every mode (`Mode`: eigenvalue, frequency, damping ratio, shape), by ascending
     /// frequency: one pair of complex eigenvalues per vibrating degree of freedom, plus real ones
     /// for overdamped motions and lags.
     #[getter]
-    fn modes(&self) -> Vec<Mode> {
+    fn modes<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
         self.inner
             .modes
             .iter()
-            .map(|m| Mode {
-                eigenvalue: numpy::Complex64::new(m.re, m.im),
-                frequency_hz: m.frequency,
-                damping_ratio: m.damping_ratio,
-                shape: m.shape.iter().take(self.dofs).copied().collect(),
-            })
+            .map(|m| record(py, "Mode", &mode_value(m, self.dofs)?))
             .collect()
     }
     /// Eigenvalues as complex numbers (1/s).
@@ -1236,13 +1253,28 @@ impl LinearResponse {
         let h: Vec<_> = py.detach(|| w.iter().map(|&w| self.inner.transfer(w)).collect());
         PyArray1::from_vec(py, h)
     }
+    /// The response as plain Python values (`hdi_tribology.analysis.LinearResponse`'s serde
+    /// form: the equilibrium, the modes, `stable`, `gain_at_2f_m_per_n`, `force_at_2f_n`,
+    /// `dither_amplitude_m`).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let mut v = to_value(&self.inner)?;
+        v["equilibrium"] = equilibrium_value(&self.inner.equilibrium, self.dofs)?;
+        v["modes"] = Value::Array(
+            self.inner
+                .modes
+                .iter()
+                .map(|m| mode_value(m, self.dofs))
+                .collect::<PyResult<_>>()?,
+        );
+        json_to_py(py, &v)
+    }
     fn __repr__(&self) -> String {
         format!(
-            "LinearResponse(power_mw={:.4}, d_nm={:.4}, stable={}, dither_amplitude_nm={:.4e})",
-            units::to_mw(self.inner.equilibrium.power),
-            units::to_nm(self.inner.equilibrium.d),
+            "LinearResponse(power_w={}, d_m={}, stable={}, dither_amplitude_m={})",
+            self.inner.equilibrium.power,
+            self.inner.equilibrium.d,
             if self.inner.stable { "True" } else { "False" },
-            self.dither_amplitude_nm()
+            self.inner.dither_amplitude
         )
     }
 }
@@ -1254,26 +1286,13 @@ fn linear_response(
     target: &Bound<'_, PyAny>,
     power_mw: f64,
 ) -> PyResult<LinearResponse> {
+    let power = units::mw(non_negative("power_mw", power_mw, "mW")?);
     let (_, model) = model_of(py, target)?;
-    let inner = py
-        .detach(|| analysis::linear_response(&model, units::mw(power_mw)))
-        .py()?;
+    let inner = interruptible(py, || analysis::linear_response(&model, power))?;
     Ok(LinearResponse {
         inner,
         dofs: model.structure().dofs(),
     })
-}
-
-/// The model at AC amplitude `v_ac` (V), or the model itself when `None`.
-fn at_amplitude(model: &SliderModel, v_ac: Option<f64>) -> PyResult<Option<SliderModel>> {
-    match v_ac {
-        None => Ok(None),
-        Some(a) if !a.is_finite() => Err(invalid("v_ac", format!("must be finite, got {a:?} V"))),
-        Some(a) => Ok(Some(model.with_voltage(Voltage {
-            ac_amplitude: a,
-            ..model.voltage()
-        }))),
-    }
 }
 
 /// The stable flying equilibrium at heater power `power_mw` (mW), reached scanning down from the
@@ -1283,26 +1302,24 @@ fn at_amplitude(model: &SliderModel, v_ac: Option<f64>) -> PyResult<Option<Slide
 /// the head is then in contact.
 #[pyfunction]
 #[pyo3(signature = (target, power_mw, *, v_ac = None))]
-fn flying_equilibrium(
-    py: Python<'_>,
-    target: &Bound<'_, PyAny>,
+fn flying_equilibrium<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
     power_mw: f64,
     v_ac: Option<f64>,
-) -> PyResult<Equilibrium> {
+) -> PyResult<Bound<'py, PyAny>> {
+    let power = units::mw(non_negative("power_mw", power_mw, "mW")?);
     let (_, model) = model_of(py, target)?;
     let changed = at_amplitude(&model, v_ac)?;
     let m: &SliderModel = changed.as_ref().unwrap_or(&model);
-    let e = py
-        .detach(|| {
-            analysis::flying_equilibrium(
-                m,
-                units::mw(power_mw),
-                m.voltage().mean_squared(),
-                &ScanGrid::default(),
-            )
-        })
-        .py()?;
-    Ok(Equilibrium::of(&e, model.structure().dofs()))
+    let e = interruptible(py, || {
+        analysis::flying_equilibrium(m, power, m.voltage().mean_squared(), &ScanGrid::default())
+    })?;
+    record(
+        py,
+        "Equilibrium",
+        &equilibrium_value(&e, model.structure().dofs())?,
+    )
 }
 
 /// The dither of the bulge at twice the AC frequency from a simulation at constant heater power
@@ -1317,79 +1334,37 @@ fn simulated_dither(
     target: &Bound<'_, PyAny>,
     power_mw: f64,
     v_ac: Option<f64>,
-    settle: usize,
-    periods: usize,
+    settle: i128,
+    periods: i128,
     method: Option<&str>,
     rtol: Option<f64>,
     atol_nm: Option<f64>,
 ) -> PyResult<f64> {
+    let power = units::mw(non_negative("power_mw", power_mw, "mW")?);
+    let settle = count("settle", settle, 0)?;
+    let periods = count("periods", periods, 1)?;
     let setup = cycle_setup(py, target, false, method, rtol, atol_nm)?;
     let changed = at_amplitude(&setup.model, v_ac)?;
     let m: &SliderModel = changed.as_ref().unwrap_or(&setup.model);
-    py.detach(|| {
-        analysis::response::simulated_dither(m, units::mw(power_mw), &setup.opts, settle, periods)
+    interruptible(py, || {
+        analysis::response::simulated_dither(m, power, &setup.opts, settle, periods)
     })
-    .py()
 }
 
 // ---------------------------------------------------------------------------------------------
 // Calibration
 
-/// The outcome of a touchdown calibration as drive firmware does it.
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-struct Calibration {
-    /// Detector used.
-    detector: String,
-    /// First heater level where contact was seen (W).
-    touchdown_power_w: f64,
-    /// First level on the way down without contact (W), `None` if not searched or not found.
-    takeoff_power_w: Option<f64>,
-    /// Operating power: touchdown power minus the margin (W).
-    set_power_w: f64,
-    /// Static flying clearance at the set power, DC voltage only (m).
-    clearance_m: f64,
-    /// Detector level at touchdown over the level before.
-    contrast: f64,
-    /// Heater levels run.
-    levels: usize,
-    /// Simulated time (s).
-    simulated_time_s: f64,
-}
-
-#[pymethods]
-impl Calibration {
-    /// Touchdown minus take-off level (W), `None` without a take-off.
-    #[getter]
-    fn hysteresis_w(&self) -> Option<f64> {
-        self.takeoff_power_w.map(|t| self.touchdown_power_w - t)
-    }
-    /// Static flying clearance at the set power (nm).
-    #[getter]
-    fn clearance_nm(&self) -> f64 {
-        units::to_nm(self.clearance_m)
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "Calibration(detector={:?}, touchdown_mw={:.4}, takeoff_mw={}, set_power_mw={:.4}, clearance_nm={:.4})",
-            self.detector,
-            units::to_mw(self.touchdown_power_w),
-            fmt_opt_mw(self.takeoff_power_w),
-            units::to_mw(self.set_power_w),
-            self.clearance_nm()
-        )
-    }
-}
-
 /// Touchdown calibration: heater steps of `step_mw` from `start_mw` (default: the power whose
 /// protrusion leaves 5 nm of the nominal clearance) up to `max_mw` (default `start_mw + 60`)
 /// until the detector fires, then down to take-off; the heater is set `margin_mw` below
 /// touchdown. Detectors: `"mean"` (the scene's), `"ae"` (acoustic-emission proxy),
-/// `"vibration"`. `dither_v` adds an AC dither (V) while calibrating.
+/// `"vibration"`. `dither_v` adds an AC dither (V) while calibrating. Returns a `Calibration`,
+/// as `hdi calibrate` prints it.
 #[pyfunction]
 #[pyo3(signature = (target, *, detector = "mean", start_mw = None, step_mw = 0.5, max_mw = None, margin_mw = 15.0, dither_v = None, find_takeoff = true))]
-fn calibrate(
-    py: Python<'_>,
-    target: &Bound<'_, PyAny>,
+fn calibrate<'py>(
+    py: Python<'py>,
+    target: &Bound<'py, PyAny>,
     detector: &str,
     start_mw: Option<f64>,
     step_mw: f64,
@@ -1397,7 +1372,20 @@ fn calibrate(
     margin_mw: f64,
     dither_v: Option<f64>,
     find_takeoff: bool,
-) -> PyResult<Calibration> {
+) -> PyResult<Bound<'py, PyAny>> {
+    if let Some(s) = start_mw {
+        non_negative("start_mw", s, "mW")?;
+    }
+    if let Some(m) = max_mw {
+        non_negative("max_mw", m, "mW")?;
+    }
+    if !(step_mw.is_finite() && step_mw > 0.0) {
+        return Err(invalid(
+            "step_mw",
+            format!("must be finite and > 0 mW, got {step_mw} mW"),
+        ));
+    }
+    non_negative("margin_mw", margin_mw, "mW")?;
     let (scene, model) = model_of(py, target)?;
     let start_mw = start_mw.unwrap_or_else(|| {
         1e3 * ((scene.nominal_clearance_m - 5e-9) / scene.heater.efficiency_m_per_w).max(0.0)
@@ -1405,12 +1393,12 @@ fn calibrate(
     let max_mw = max_mw.unwrap_or(start_mw + 60.0);
     let mut opts = CalibrationOptions::from_mw(start_mw, step_mw, max_mw, margin_mw);
     opts.find_takeoff = find_takeoff;
-    let dithered = dither_v.map(|v| {
-        model.with_voltage(Voltage {
-            ac_amplitude: v,
-            ..model.voltage()
-        })
-    });
+    let dithered = at_amplitude(&model, dither_v).map_err(|_| {
+        invalid(
+            "dither_v",
+            format!("must be finite and ≥ 0 V, got {dither_v:?} V"),
+        )
+    })?;
     let model: &SliderModel = dithered.as_ref().unwrap_or(&model);
     let (th, window) = (scene.detector.contact_threshold_n, scene.detector.window_s);
     let mut det: Box<dyn TouchdownDetector + Send> = match detector {
@@ -1426,19 +1414,16 @@ fn calibrate(
             ))
         }
     };
-    let c = py
-        .detach(|| calibration::calibrate(model, det.as_mut(), &opts))
-        .py()?;
-    Ok(Calibration {
-        detector: c.detector.clone(),
-        touchdown_power_w: c.touchdown_power,
-        takeoff_power_w: c.takeoff_power,
-        set_power_w: c.set_power,
-        clearance_m: c.clearance,
-        contrast: c.contrast,
-        levels: c.steps.len(),
-        simulated_time_s: c.simulated_time,
-    })
+    let clock = std::time::Instant::now();
+    let c = interruptible(py, || calibration::calibrate(model, det.as_mut(), &opts))?;
+    let rec = CalibrationRecord::new(
+        &scene.name,
+        detector,
+        c,
+        find_takeoff,
+        clock.elapsed().as_secs_f64(),
+    );
+    record(py, "Calibration", &to_value(&rec)?)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1455,18 +1440,16 @@ fn plant_of(
     initial_power_mw: f64,
     atol_pm: [Option<f64>; 2],
 ) -> PyResult<Plant> {
-    if !(radius_mm.is_finite() && radius_mm > 0.0) {
+    if !(radius_mm.is_finite() && radius_mm > 0.0 && radius_mm <= MAX_RADIUS_MM) {
         return Err(invalid(
             "radius_mm",
-            format!("must be a positive number of mm, got {radius_mm}"),
+            format!(
+                "must be a radius on a disk, in (0, {MAX_RADIUS_MM}] mm (a 3.5-inch disk ends \
+                 at 47.5 mm), got {radius_mm} mm"
+            ),
         ));
     }
-    if !(initial_power_mw.is_finite() && initial_power_mw >= 0.0) {
-        return Err(invalid(
-            "initial_power_mw",
-            format!("must be ≥ 0 mW, got {initial_power_mw} mW"),
-        ));
-    }
+    non_negative("initial_power_mw", initial_power_mw, "mW")?;
     let opts = DriveOptions {
         initial_power: units::mw(initial_power_mw),
         disk: if flat_disk {
@@ -1481,104 +1464,27 @@ fn plant_of(
     // A `Model` drives as it is (its terms with memory included), a `Scene` at its own zone.
     if let Ok(m) = scene.cast::<Model>() {
         let model = m.get().model.clone();
-        return py
-            .detach(|| Plant::from_model(&model, radius_mm * 1e-3, seed, opts))
-            .py();
+        return interruptible(py, || {
+            Plant::from_model(&model, radius_mm * 1e-3, seed, opts)
+        });
     }
-    let scene = scene.cast::<Scene>().map_err(|_| {
-        pyo3::exceptions::PyTypeError::new_err("scene: expected a Scene or a Model")
-    })?;
-    let scene = &scene.borrow().inner;
-    py.detach(|| Plant::new(scene, &scene_zone(scene, radius_mm * 1e-3)?, seed, opts))
-        .py()
+    let scene = scene
+        .cast::<Scene>()
+        .map_err(|_| PyTypeError::new_err("scene: expected a Scene or a Model"))?
+        .get()
+        .get();
+    interruptible(py, || {
+        Plant::new(&scene, &scene_zone(&scene, radius_mm * 1e-3)?, seed, opts)
+    })
 }
 
-/// One controller period's sensors, as the firmware reads them, and the true values behind
-/// them, in the units their names carry (the columns of `hdi drive`, `docs/clearance.md`).
-#[pyclass(module = "hdi_tribology", frozen, get_all)]
-struct Sensors {
-    /// Time at the end of the period (s).
-    time_s: f64,
-    /// Heater power held over the period (mW).
-    heater_mw: f64,
-    /// Embedded contact sensor's resistance (Ω).
-    contact_resistance_ohm: f64,
-    /// Acoustic-emission RMS (V).
-    acoustic_v: f64,
-    /// Read-back amplitude, fundamental (V).
-    readback_fundamental_v: f64,
-    /// Read-back amplitude, third harmonic (V).
-    readback_third_v: f64,
-    /// Harmonic-ratio clearance change since the drive's first period (nm; Wallace).
-    hr_clearance_change_nm: f64,
-    /// True bulge gap at the end of the period (nm).
-    true_gap_nm: f64,
-    /// True contact force, mean over the period (µN).
-    true_contact_force_un: f64,
-    /// True contact-sensor temperature (K above its reference).
-    true_sensor_temperature_k: f64,
-    /// Disk surface height under the head (nm).
-    true_disk_height_nm: f64,
-    /// Ambient temperature change since the start (K).
-    true_ambient_k: f64,
-    /// True protrusion at the end of the period (nm).
-    true_protrusion_nm: f64,
-    /// True frictional power over the period (mW).
-    true_friction_power_mw: f64,
-}
+/// The largest zone radius a `Drive` takes (mm).
+const MAX_RADIUS_MM: f64 = 100.0;
 
-impl Sensors {
-    /// From one row of `replay_each` (the columns of `SENSOR_COLUMNS`, in order) and the
-    /// true values the row leaves out.
-    fn of(row: &[f64; 12], truth: &hdi_tribology::drive::Truth) -> Self {
-        Sensors {
-            time_s: row[0],
-            heater_mw: row[1],
-            contact_resistance_ohm: row[2],
-            acoustic_v: row[3],
-            readback_fundamental_v: row[4],
-            readback_third_v: row[5],
-            hr_clearance_change_nm: row[6],
-            true_gap_nm: row[7],
-            true_contact_force_un: row[8],
-            true_sensor_temperature_k: row[9],
-            true_disk_height_nm: row[10],
-            true_ambient_k: row[11],
-            true_protrusion_nm: units::to_nm(truth.protrusion),
-            true_friction_power_mw: units::to_mw(truth.friction_power),
-        }
-    }
-}
-
-#[pymethods]
-impl Sensors {
-    fn __repr__(&self) -> String {
-        format!(
-            "Sensors(time_s={:.6e}, heater_mw={:.4}, contact_resistance_ohm={:.6}, acoustic_v={:.4e}, \
-             hr_clearance_change_nm={:.4}, true_gap_nm={:.4}, true_contact_force_un={:.4})",
-            self.time_s,
-            self.heater_mw,
-            self.contact_resistance_ohm,
-            self.acoustic_v,
-            self.hr_clearance_change_nm,
-            self.true_gap_nm,
-            self.true_contact_force_un
-        )
-    }
-}
-
-/// A simulated drive for firmware prototyping: the scene's slider flying over a disk with
-/// run-out and waviness (or a flat one), with a heater, a head–disk voltage and the sensors
-/// firmware reads, stepped at the controller's rate (`docs/clearance.md`).
-///
-/// `Drive(scene, *, seed=1, radius_mm=25, flat_disk=False, initial_power_mw=60, atol_pm=None,
-/// atol_flight_pm=None)` starts at rest in the flying equilibrium at `initial_power_mw`.
-/// `atol_pm` (default 0.01) and `atol_flight_pm` (default `atol_pm`, at least `atol_pm`) are
-/// the integration's displacement tolerances near contact and in flight (pm; equal for one
-/// tolerance throughout; `docs/clearance.md`, "Accuracy"). The same seed gives the same disk and the
-/// same sensor noise, bit for bit; stepping it with the commands of a command file gives the
-/// rows `replay` (and `hdi drive`) gives. A `Drive` belongs to the thread that made it.
-#[pyclass(module = "hdi_tribology", name = "Drive", unsendable)]
+/// A simulated drive for firmware prototyping (the native half of `hdi_tribology.Drive`, which
+/// checks that it is used from the thread that made it: the integrator's event closures are not
+/// `Send`). See `hdi_tribology.Drive`.
+#[pyclass(module = "hdi_tribology._core", name = "Drive", unsendable)]
 struct PyDrive {
     inner: Drive,
     wavelength: f64,
@@ -1593,13 +1499,14 @@ impl PyDrive {
     fn new(
         py: Python<'_>,
         scene: &Bound<'_, PyAny>,
-        seed: u64,
+        seed: i128,
         radius_mm: f64,
         flat_disk: bool,
         initial_power_mw: f64,
         atol_pm: Option<f64>,
         atol_flight_pm: Option<f64>,
     ) -> PyResult<Self> {
+        let seed = seed_of("seed", seed)?;
         let tol = [atol_pm, atol_flight_pm];
         let plant = plant_of(py, scene, seed, radius_mm, flat_disk, initial_power_mw, tol)?;
         let wavelength = plant.sensor_spec().readback.wavelength;
@@ -1612,16 +1519,17 @@ impl PyDrive {
 
     /// Holds the heater at `heater_mw` (mW) and the voltage at `dc_v` (V) plus an AC dither of
     /// amplitude `ac_v` (V) at `ac_khz` (kHz) for one controller period of `dt_us` (µs), and
-    /// returns the `Sensors` at its end.
+    /// returns the `Sensors` at its end: the columns of `SENSOR_COLUMNS`, as `replay` gives them.
     #[pyo3(signature = (heater_mw, *, dc_v = 0.0, ac_v = 0.0, ac_khz = 0.0, dt_us = 50.0))]
-    fn step(
+    fn step<'py>(
         &mut self,
+        py: Python<'py>,
         heater_mw: f64,
         dc_v: f64,
         ac_v: f64,
         ac_khz: f64,
         dt_us: f64,
-    ) -> PyResult<Sensors> {
+    ) -> PyResult<Bound<'py, PyAny>> {
         let row = CommandRow {
             time_s: 0.0,
             heater_mw,
@@ -1659,7 +1567,14 @@ impl PyDrive {
         let lr = s.readback.log_ratio();
         let lr0 = *self.reference.get_or_insert(lr);
         let row = sensor_row(&s, lr0, self.wavelength);
-        Ok(Sensors::of(&row, &s.truth))
+        let v = Value::Object(
+            SENSOR_COLUMNS
+                .iter()
+                .zip(row)
+                .map(|(k, x)| Ok(((*k).to_string(), to_value(&x)?)))
+                .collect::<PyResult<_>>()?,
+        );
+        record(py, "Sensors", &v)
     }
 
     /// Simulated time so far (s).
@@ -1675,18 +1590,11 @@ impl PyDrive {
         self.inner.term_states().to_vec()
     }
 
-    /// The integrator's work so far: a dict of `accepted`, `rejected`, `rhs_evals`,
-    /// `jac_evals` and `lu_decomps`.
+    /// The integrator's work so far, as the crate serializes it: a dict of `accepted`,
+    /// `rejected`, `rhs_evals`, `jac_evals`, `lu_decomps`, … .
     #[getter]
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let st = self.inner.stats();
-        let d = PyDict::new(py);
-        d.set_item("accepted", st.accepted)?;
-        d.set_item("rejected", st.rejected)?;
-        d.set_item("rhs_evals", st.rhs_evals)?;
-        d.set_item("jac_evals", st.jac_evals)?;
-        d.set_item("lu_decomps", st.lu_decomps)?;
-        Ok(d)
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &to_value(&self.inner.stats())?)
     }
 
     /// The seed of the disk's random waviness and of the sensor noise.
@@ -1695,14 +1603,11 @@ impl PyDrive {
         self.inner.plant().seed()
     }
 
-    fn __repr__(&self) -> String {
-        format!(
-            "Drive(scene={:?}, seed={}, radius_mm={}, time_s={:.6e})",
-            self.inner.plant().zone().name,
-            self.inner.plant().seed(),
-            self.inner.plant().zone().radius * 1e3,
-            self.inner.time()
-        )
+    /// The zone's scene name and radius (mm).
+    #[getter]
+    fn zone(&self) -> (String, f64) {
+        let z = self.inner.plant().zone();
+        (z.name.clone(), z.radius * 1e3)
     }
 }
 
@@ -1710,7 +1615,8 @@ impl PyDrive {
 /// the sensor columns as float64 arrays (the CSV's columns, `SENSOR_COLUMNS`; units in their
 /// names), bit for bit the CLI's. Each command holds from its `time_s` until the next; the last
 /// time ends the run. `voltage_ac_v` and `ac_frequency_khz` default to zeros; `atol_pm` and
-/// `atol_flight_pm` are the tolerances of `Drive`. The GIL is released while the drive runs.
+/// `atol_flight_pm` are the tolerances of `Drive`. The GIL is released while the drive runs,
+/// and Ctrl-C stops it.
 #[pyfunction]
 #[pyo3(signature = (scene, time_s, heater_mw, voltage_dc_v, voltage_ac_v = None, ac_frequency_khz = None, *, rate_khz = 20.0, seed = 1, radius_mm = 25.0, flat_disk = false, atol_pm = None, atol_flight_pm = None))]
 fn replay<'py>(
@@ -1722,12 +1628,13 @@ fn replay<'py>(
     voltage_ac_v: Option<Vec<f64>>,
     ac_frequency_khz: Option<Vec<f64>>,
     rate_khz: f64,
-    seed: u64,
+    seed: i128,
     radius_mm: f64,
     flat_disk: bool,
     atol_pm: Option<f64>,
     atol_flight_pm: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let seed = seed_of("seed", seed)?;
     let n = time_s.len();
     let ac = voltage_ac_v.unwrap_or_else(|| vec![0.0; n]);
     let f = ac_frequency_khz.unwrap_or_else(|| vec![0.0; n]);
@@ -1770,18 +1677,16 @@ fn replay<'py>(
         [atol_pm, atol_flight_pm],
     )?;
     let dt = 1e-3 / rate_khz;
-    let columns = py
-        .detach(|| {
-            let mut cols: Vec<Vec<f64>> = vec![Vec::new(); SENSOR_COLUMNS.len()];
-            replay_each(&plant, &rows, dt, |row| {
-                for (c, v) in cols.iter_mut().zip(row) {
-                    c.push(*v);
-                }
-                Ok(())
-            })?;
-            Ok::<_, hdi_tribology::Error>(cols)
-        })
-        .py()?;
+    let columns = interruptible(py, || {
+        let mut cols: Vec<Vec<f64>> = vec![Vec::new(); SENSOR_COLUMNS.len()];
+        replay_each(&plant, &rows, dt, |row| {
+            for (c, v) in cols.iter_mut().zip(row) {
+                c.push(*v);
+            }
+            Ok(())
+        })?;
+        Ok(cols)
+    })?;
     let out = PyDict::new(py);
     for (name, col) in SENSOR_COLUMNS.iter().zip(columns) {
         out.set_item(name, array(py, col))?;
@@ -1836,10 +1741,11 @@ fn fit_error(e: FitError) -> PyErr {
 /// see `docs/fit.md`). Each parameter is named as a scene file names it, in that name's unit,
 /// with optional bounds: `"height_sigma_nm"`, `"efficiency_nm_per_mw=0.05:0.2"`.
 ///
-/// Returns a dict: `scene` (the fitted `Scene`), `parameters` (list of dicts: name, value,
-/// unit, standard_error, …), `correlation`, `residuals`, `identifiability`, `points`, `chi2`,
-/// `residual_scale`, `converged`, `termination`, `evaluations`, `starts`, `integration`,
-/// `trusted` and `warnings`, as `hdi fit` prints them. Check `trusted` and `warnings`.
+/// Returns a dict: the JSON `hdi fit` prints, with `scene` the fitted `Scene`: `parameters`
+/// (list of dicts: name, value, unit, standard_error, …), `correlation`, `residuals`,
+/// `identifiability`, `points`, `chi2`, `residual_scale`, `converged`, `termination`,
+/// `evaluations`, `starts`, `integration`, `trusted` and `warnings`. Check `trusted` and
+/// `warnings`. Ctrl-C stops it.
 #[pyfunction]
 #[pyo3(signature = (scene, data, free, *, starts = 1, seed = 1, max_evaluations = 400))]
 fn fit<'py>(
@@ -1847,39 +1753,48 @@ fn fit<'py>(
     scene: &Scene,
     data: Vec<std::path::PathBuf>,
     free: Vec<String>,
-    starts: usize,
-    seed: u64,
-    max_evaluations: usize,
+    starts: i128,
+    seed: i128,
+    max_evaluations: i128,
 ) -> PyResult<Bound<'py, PyAny>> {
     let options = FitOptions {
-        starts,
-        seed,
-        max_evaluations,
+        starts: count("starts", starts, 1)?,
+        seed: seed_of("seed", seed)?,
+        max_evaluations: count("max_evaluations", max_evaluations, 1)?,
         ..FitOptions::default()
     };
-    let scene_in = scene.inner.clone();
-    let result = py
-        .detach(|| -> Result<_, FitError> {
+    if data.is_empty() {
+        return Err(invalid("data", "give at least one data file"));
+    }
+    if free.is_empty() {
+        return Err(invalid("free", "give at least one parameter to fit"));
+    }
+    let scene_in = scene.get();
+    let result = on_own_thread(
+        py,
+        || -> Result<_, FitError> {
             let sets = data
                 .iter()
                 .map(DataSet::from_path)
                 .collect::<Result<Vec<_>, _>>()?;
             let free = free
                 .iter()
-                .map(|f| f.parse::<FreeParameter>())
+                .enumerate()
+                .map(|(i, f)| {
+                    f.parse::<FreeParameter>().map_err(|e| match e {
+                        hdi_tribology::Error::InvalidInput { reason, .. } => {
+                            hdi_tribology::Error::invalid(format!("free[{i}]"), reason)
+                        }
+                        other => other,
+                    })
+                })
                 .collect::<Result<Vec<_>, _>>()?;
             hdi_tribology::fit::fit(&scene_in, &sets, &free, &options)
-        })
-        .map_err(fit_error)?;
-    let text = serde_json::to_string(&result)
-        .map_err(|e| invalid("fit", format!("cannot convert the result: {e}")))?;
-    let out = json_module(py)?.call_method1("loads", (text,))?;
-    out.set_item(
-        "scene",
-        Scene {
-            inner: result.scene,
         },
+        fit_error,
     )?;
+    let out = json_to_py(py, &to_value(&result)?)?;
+    out.set_item("scene", Scene::of(result.scene))?;
     Ok(out)
 }
 
@@ -1888,19 +1803,11 @@ fn fit<'py>(
 /// The native core of the `hdi_tribology` Python package.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // numpy's C API is fetched now, not inside a later call that a pending Ctrl-C could break.
+    let _ = PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add_class::<Scene>()?;
     m.add_class::<Model>()?;
-    m.add_class::<Equilibrium>()?;
-    m.add_class::<Transition>()?;
-    m.add_class::<StaticHysteresis>()?;
-    m.add_class::<PullIn>()?;
-    m.add_class::<Detection>()?;
-    m.add_class::<Cycle>()?;
-    m.add_class::<RefinedCycle>()?;
-    m.add_class::<Mode>()?;
     m.add_class::<LinearResponse>()?;
-    m.add_class::<Calibration>()?;
-    m.add_class::<Sensors>()?;
     m.add_class::<PyDrive>()?;
     m.add_function(wrap_pyfunction!(forces, m)?)?;
     m.add_function(wrap_pyfunction!(static_hysteresis, m)?)?;

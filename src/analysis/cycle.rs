@@ -48,6 +48,22 @@ pub enum HeaterProgramme {
     },
 }
 
+impl HeaterProgramme {
+    /// `"fixed"` or `"triggered"`, as results record the programme.
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::HeaterProgramme;
+    /// let p = HeaterProgramme::Triggered { start_power: 0.0, ramp_rate: 1.0, overshoot: 0.0 };
+    /// assert_eq!(p.name(), "triggered");
+    /// ```
+    pub fn name(&self) -> &'static str {
+        match self {
+            HeaterProgramme::Fixed(_) => "fixed",
+            HeaterProgramme::Triggered { .. } => "triggered",
+        }
+    }
+}
+
 /// The contact detector standing in for the acoustic-emission sensor.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Detector {
@@ -164,8 +180,10 @@ impl CycleOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Detection {
     /// Time (s).
+    #[serde(rename = "time_s")]
     pub time: f64,
     /// Programme power at that time (W).
+    #[serde(rename = "power_w")]
     pub power: f64,
 }
 
@@ -254,16 +272,20 @@ impl TimeSeries {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CycleResult {
     /// AC amplitude of the cycle (V).
+    #[serde(rename = "v_ac_v")]
     pub v_ac: f64,
     /// Touchdown, if detected.
     pub touchdown: Option<Detection>,
     /// Take-off, if detected.
     pub takeoff: Option<Detection>,
     /// `P(t_TD) − P(t_TO)` (W), when both were detected.
+    #[serde(rename = "hysteresis_w")]
     pub hysteresis: Option<f64>,
     /// Time mean of the flash temperature over the whole programme (K).
+    #[serde(rename = "mean_temperature_rise_k")]
     pub mean_temperature_rise: f64,
     /// Length of the programme (s).
+    #[serde(rename = "duration_s")]
     pub duration: f64,
     /// The programme actually run (for the triggered protocol: as fixed by the detection).
     #[serde(skip)]
@@ -272,7 +294,8 @@ pub struct CycleResult {
     pub stats: Stats,
     /// Wall-clock time of the simulation (s).
     pub wall_seconds: f64,
-    /// Time series, when asked for.
+    /// Time series, when asked for (not serialized: it is the CSV's, [`TimeSeries::write_csv`]).
+    #[serde(skip)]
     pub series: Option<TimeSeries>,
 }
 

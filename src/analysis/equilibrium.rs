@@ -18,20 +18,29 @@ use serde::Serialize;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Equilibrium {
     /// Bulge gap `d` (m).
+    #[serde(rename = "d_m")]
     pub d: f64,
     /// Air-bearing displacement `y` of the slider body (m): `q₀`.
+    #[serde(rename = "y_m")]
     pub y: f64,
-    /// All coordinates `q` of the structure (m, rad).
+    /// All coordinates `q` of the structure (m, rad); not serialized (its length is the
+    /// structure's, which the equilibrium does not know).
+    #[serde(skip)]
     pub q: Dofs,
     /// Protrusion `δ` (m).
+    #[serde(rename = "protrusion_m")]
     pub protrusion: f64,
     /// Heater power `P = δ/η` (W).
+    #[serde(rename = "power_w")]
     pub power: f64,
     /// Total stiffness `k_ab − ∂F_if/∂y` (N/m); positive is stable.
+    #[serde(rename = "stiffness_n_per_m")]
     pub stiffness: f64,
     /// Interface force (N).
+    #[serde(rename = "interface_force_n")]
     pub interface_force: f64,
     /// Contact force (N).
+    #[serde(rename = "contact_force_n")]
     pub contact_force: f64,
 }
 
@@ -55,8 +64,10 @@ impl Equilibrium {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Fold {
     /// Heater power at the fold (W).
+    #[serde(rename = "power_w")]
     pub power: f64,
     /// Bulge gap at the fold (m).
+    #[serde(rename = "d_m")]
     pub d: f64,
     /// `true` where the power has a local maximum along decreasing `d` (the flying branch ends
     /// and the head jumps into contact); `false` at a local minimum (the contact branch ends).
@@ -374,6 +385,7 @@ fn fold_tolerance(a: f64, b: f64, h0: f64) -> f64 {
 #[derive(Clone, Debug, Serialize)]
 pub struct SCurve {
     /// `V²` the curve was computed at (V²).
+    #[serde(rename = "volt2_v2")]
     pub volt2: f64,
     /// Equilibria ordered by decreasing gap (increasing power on stable flying parts).
     pub points: Vec<Equilibrium>,

@@ -8,6 +8,7 @@ pub mod cycle;
 pub mod equilibrium;
 pub mod protocol;
 pub mod pull_in;
+pub mod record;
 pub mod response;
 pub mod roots;
 pub mod sensitivity;

@@ -18,8 +18,10 @@ use serde::Serialize;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PullIn {
     /// `|V_dc − φ|` at pull-in (V).
+    #[serde(rename = "voltage_v")]
     pub voltage: f64,
     /// Bulge gap just before the jump (m).
+    #[serde(rename = "d_m")]
     pub d: f64,
     /// Fold of the flying branch or contact threshold.
     pub cause: Cause,
@@ -159,10 +161,13 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ClearanceChange {
     /// DC voltage `V_dc` (V).
+    #[serde(rename = "dc_voltage_v")]
     pub dc_voltage: f64,
     /// Touchdown power at that voltage (W).
+    #[serde(rename = "touchdown_power_w")]
     pub touchdown_power: f64,
     /// `ΔFH = η (P_TD(V_dc) − P_TD(φ))` (m); negative is a loss of clearance.
+    #[serde(rename = "clearance_change_m")]
     pub clearance_change: f64,
 }
 

@@ -21,10 +21,13 @@ use std::f64::consts::PI;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Mode {
     /// Eigenvalue real part (1/s).
+    #[serde(rename = "re_per_s")]
     pub re: f64,
     /// Eigenvalue imaginary part (1/s).
+    #[serde(rename = "im_per_s")]
     pub im: f64,
     /// `|Im λ| / 2π` (Hz).
+    #[serde(rename = "frequency_hz")]
     pub frequency: f64,
     /// Damping ratio `−Re λ / |λ|`.
     pub damping_ratio: f64,
@@ -44,10 +47,13 @@ pub struct LinearResponse {
     /// Whether every eigenvalue has a negative real part.
     pub stable: bool,
     /// `|H(i·2π·2f)|` (m/N).
+    #[serde(rename = "gain_at_2f_m_per_n")]
     pub gain_at_2f: f64,
     /// Amplitude of the force at `2f`: `|G_e| V_ac²/2` (N).
+    #[serde(rename = "force_at_2f_n")]
     pub force_at_2f: f64,
     /// Predicted dither amplitude of the bulge at `2f` (m).
+    #[serde(rename = "dither_amplitude_m")]
     pub dither_amplitude: f64,
     #[serde(skip)]
     a: DMatrix<f64>,

@@ -64,7 +64,12 @@ fn per_amplitude<T: Send>(
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
-        amplitudes.par_iter().map(one).collect()
+        // The workers watch the caller's cancellation flag.
+        let cancel = crate::ode::Cancel::current();
+        amplitudes
+            .par_iter()
+            .map(|a| crate::ode::Cancel::carry(&cancel, || one(a)))
+            .collect()
     }
     #[cfg(not(feature = "parallel"))]
     {
@@ -155,11 +160,14 @@ pub struct RefinedCycle {
     /// The relative tolerance of that cycle.
     pub rtol: f64,
     /// The absolute displacement tolerance of that cycle (m), tightened with `rtol`.
+    #[serde(rename = "atol_m")]
     pub atol: f64,
     /// Largest change of the touchdown and take-off powers between the last two runs (W); ∞
     /// when one of them was detected in one run and not in the other.
+    #[serde(rename = "power_change_w")]
     pub change: f64,
     /// Change of the mean flash-temperature rise between the last two runs (K).
+    #[serde(rename = "temperature_change_k")]
     pub temperature_change: f64,
     /// Whether `change ≤ power_tol` and `temperature_change ≤ temperature_tol` held for each of
     /// the last `agreeing_runs − 1` tightenings.
@@ -274,6 +282,10 @@ pub enum Flag {
     /// The refined tolerances did not bring the powers and the mean temperature within their
     /// tolerances.
     NotConverged,
+    /// A calibration's take-off heard by a high-pass detector without a dither: the detector
+    /// hears only changes, so it stops firing at the first step down, which is then no take-off
+    /// (docs/clearance.md).
+    TakeoffWithoutDither,
 }
 
 impl std::fmt::Display for Flag {
@@ -283,6 +295,7 @@ impl std::fmt::Display for Flag {
             Flag::NoTakeoff => "no take-off detected",
             Flag::NegativeHysteresis => "negative hysteresis",
             Flag::NotConverged => "not converged",
+            Flag::TakeoffWithoutDither => "take-off heard without a dither",
         })
     }
 }

@@ -25,6 +25,7 @@ pub enum Cause {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Transition {
     /// Heater power (W).
+    #[serde(rename = "power_w")]
     pub power: f64,
     /// The equilibrium where it happens.
     pub at: Equilibrium,
@@ -89,6 +90,7 @@ pub struct StaticHysteresis {
     /// Take-off.
     pub takeoff: Transition,
     /// `P_TD − P_TO` (W).
+    #[serde(rename = "hysteresis_w")]
     pub hysteresis: f64,
 }
 

@@ -176,12 +176,14 @@ impl CalibrationOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct StepRecord {
     /// Heater level (W).
+    #[serde(rename = "power_w")]
     pub power: f64,
     /// `true` on the way down (take-off search).
     pub descending: bool,
     /// Largest detector level in the measurement window.
     pub peak_level: f64,
     /// Smallest bulge gap over the whole level (m).
+    #[serde(rename = "min_gap_m")]
     pub min_gap: f64,
     /// Whether the detector saw contact in the measurement window.
     pub contact: bool,
@@ -190,17 +192,22 @@ pub struct StepRecord {
 /// The outcome of one calibration.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Calibration {
-    /// Name of the detector used.
+    /// Name of the detector used (its own description).
+    #[serde(rename = "detector_name")]
     pub detector: String,
     /// First heater level where contact was seen (W).
+    #[serde(rename = "touchdown_power_w")]
     pub touchdown_power: f64,
     /// On the way down, the first level where contact was no longer seen (W); `None` when the
     /// search was off or contact persisted down to the start power.
+    #[serde(rename = "takeoff_power_w")]
     pub takeoff_power: Option<f64>,
     /// Operating power `touchdown_power − margin` (W).
+    #[serde(rename = "set_power_w")]
     pub set_power: f64,
     /// Clearance at the operating power: the bulge gap of the static flying equilibrium at
     /// `set_power` with the DC voltage only (the dither is off in operation) (m).
+    #[serde(rename = "clearance_m")]
     pub clearance: f64,
     /// Peak detector level at touchdown over that at the level before (∞ if that was 0): how
     /// sharply the detector separates contact from flying.
@@ -208,6 +215,7 @@ pub struct Calibration {
     /// Every level, in the order run.
     pub steps: Vec<StepRecord>,
     /// Simulated time (s).
+    #[serde(rename = "simulated_time_s")]
     pub simulated_time: f64,
     /// Solver work, summed over the levels.
     pub stats: Stats,

@@ -313,6 +313,7 @@ pub struct ReplaySummary {
     /// Periods run.
     pub periods: usize,
     /// Drive time simulated (s).
+    #[serde(rename = "simulated_time_s")]
     pub simulated_time: f64,
 }
 

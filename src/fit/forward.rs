@@ -288,7 +288,11 @@ impl<'a> Evaluator<'a> {
         #[cfg(feature = "parallel")]
         {
             use rayon::prelude::*;
-            (0..n).into_par_iter().map(column).collect()
+            let cancel = crate::ode::Cancel::current();
+            (0..n)
+                .into_par_iter()
+                .map(|i| crate::ode::Cancel::carry(&cancel, || column(i)))
+                .collect()
         }
         #[cfg(not(feature = "parallel"))]
         {

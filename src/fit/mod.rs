@@ -21,14 +21,12 @@
 //! # Ok::<(), hdi_tribology::fit::FitError>(())
 //! ```
 
-mod cli;
 mod data;
 mod forward;
 pub mod goodness;
 mod params;
 mod solve;
 
-pub use cli::{run_cli, write_plots, CliArgs};
 pub use data::{CurveKind, DataError, DataSet, Observed, Quantity, Unit};
 pub use params::FreeParameter;
 pub use solve::{

@@ -501,7 +501,11 @@ fn jacobian_columns(
             #[cfg(feature = "parallel")]
             {
                 use rayon::prelude::*;
-                which.par_iter().map(|&j| f(j)).collect()
+                let cancel = crate::ode::Cancel::current();
+                which
+                    .par_iter()
+                    .map(|&j| crate::ode::Cancel::carry(&cancel, || f(j)))
+                    .collect()
             }
             #[cfg(not(feature = "parallel"))]
             {
@@ -847,6 +851,27 @@ struct Optimum<'h> {
 /// the start is one the data do not touch; it is held at its start.
 const UNTOUCHED_COLUMN: f64 = 1e-12;
 
+/// Why the optimiser stopped, in words (the JSON's `termination`).
+fn termination_text(t: &levenberg_marquardt::TerminationReason) -> String {
+    use levenberg_marquardt::TerminationReason as T;
+    match t {
+        T::Converged { ftol, xtol } => match (ftol, xtol) {
+            (true, true) => "converged: cost and parameters settled".into(),
+            (true, false) => "converged: cost settled".into(),
+            _ => "converged: parameters settled".into(),
+        },
+        T::ResidualsZero => "converged: residuals zero".into(),
+        T::Orthogonal => "converged: gradient zero (residuals orthogonal to the Jacobian)".into(),
+        T::LostPatience => "stopped: the evaluation budget was used up".into(),
+        T::NoImprovementPossible(what) => format!("stopped: no improvement possible ({what})"),
+        T::User(what) => format!("stopped: the model failed ({what})"),
+        T::Numerical(what) => format!("stopped: a non-finite number ({what})"),
+        T::NoParameters => "stopped: no parameters".into(),
+        T::NoResiduals => "stopped: no residuals".into(),
+        T::WrongDimensions(what) => format!("stopped: wrong dimensions ({what})"),
+    }
+}
+
 /// One start of the optimiser: its outcome, and (cost, end, converged, termination) when the
 /// start could be evaluated.
 #[allow(clippy::type_complexity)]
@@ -892,7 +917,7 @@ fn run_start(
     let cost = solved
         .residuals_at(&u)
         .map_or(f64::INFINITY, |r| r.iter().map(|v| v * v).sum());
-    let mut termination = format!("{:?}", report.termination);
+    let mut termination = termination_text(&report.termination);
     if let Some(e) = solved.error.borrow().as_ref() {
         termination.push_str(&format!(" (last model error: {e})"));
     }

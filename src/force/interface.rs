@@ -78,18 +78,25 @@ pub(crate) fn by_coupling(static_part: f64, per_volt2: f64, volt2: f64) -> f64 {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Breakdown {
     /// Intermolecular force, N.
+    #[serde(rename = "intermolecular_n")]
     pub intermolecular: f64,
     /// Asperity contact force, N.
+    #[serde(rename = "contact_n")]
     pub contact: f64,
     /// Electrostatic force per V², N/V².
+    #[serde(rename = "electrostatic_per_volt2_n_per_v2")]
     pub electrostatic_per_volt2: f64,
     /// Electrostatic force at the given V², N.
+    #[serde(rename = "electrostatic_n")]
     pub electrostatic: f64,
     /// Terms of kind [`TermKind::Other`], N.
+    #[serde(rename = "other_n")]
     pub other: f64,
     /// Real contact area, m².
+    #[serde(rename = "real_contact_area_m2")]
     pub real_contact_area: f64,
     /// Sum of the forces, N.
+    #[serde(rename = "total_n")]
     pub total: f64,
 }
 

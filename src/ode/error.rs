@@ -76,6 +76,12 @@ pub enum OdeError {
         /// `atol / rtol` of that component.
         significant: f64,
     },
+    /// The integration was cancelled from outside ([`Cancel`](super::Cancel)).
+    #[error("cancelled at t = {t}")]
+    Cancelled {
+        /// Time reached.
+        t: f64,
+    },
     /// The iteration matrix of a stiff method stayed singular as the step shrank.
     #[error("singular iteration matrix at t = {t} (h = {h:e})")]
     SingularMatrix {

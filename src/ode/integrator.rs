@@ -874,6 +874,9 @@ where
         let mut h = self.h;
         loop {
             let attempts = self.ctx.stats.accepted + self.ctx.stats.rejected;
+            if super::Cancel::requested() {
+                return Err(OdeError::Cancelled { t });
+            }
             if attempts >= self.max_steps {
                 return Err(OdeError::TooManySteps {
                     t,

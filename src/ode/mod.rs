@@ -27,6 +27,7 @@
 //! # Ok::<(), hdi_tribology::ode::OdeError>(())
 //! ```
 
+mod cancel;
 mod dense;
 mod dop853;
 mod driver;
@@ -44,6 +45,7 @@ mod stepper;
 mod system;
 mod tsit5;
 
+pub use cancel::{Cancel, CANCEL_CHECK_INTERVAL};
 pub use dense::{DenseOutput, StepPolynomial};
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};

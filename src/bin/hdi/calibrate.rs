@@ -1,23 +1,25 @@
 //! `hdi calibrate`: touchdown calibration as drive firmware does it.
 
+use hdi_tribology::analysis::record::CalibrationRecord;
+use hdi_tribology::analysis::sweep::Flag;
 use hdi_tribology::calibration::{
     calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
     VibrationRms, MAX_LEVELS,
 };
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::units::fmt_short;
-use serde::Serialize;
 
 use crate::common::{self, non_negative, positive, volts, CliError, SceneArgs};
 
 /// Heater steps of --step-mw from --start-mw up to --max-mw until the detector fires, then back
-/// down to take-off; the heater is then set --margin-mw below touchdown. JSON: detector,
-/// touchdown_power, takeoff_power, hysteresis, set_power (W), clearance (m, static model at the
-/// set power without dither), contrast (detector level at touchdown over the level before),
-/// levels, simulated_time, wall_seconds (s), and flags: no_takeoff; takeoff_without_dither when
-/// a high-pass detector (ae, vibration) ran without a dither, whose take-off is then only the
-/// first step down (docs/clearance.md). A detector that fires at the start power already is an
-/// error: there is no touchdown to find.
+/// down to take-off; the heater is then set --margin-mw below touchdown. JSON, each key with its
+/// unit: scene, detector (as given), detector_name, touchdown_power_w, takeoff_power_w,
+/// hysteresis_w, set_power_w, clearance_m (static model at the set power without dither),
+/// contrast (detector level at touchdown over the level before), steps (every level), levels,
+/// simulated_time_s, stats, wall_seconds, status (complete or incomplete) and flags:
+/// no_takeoff; takeoff_without_dither when a high-pass detector (ae, vibration) ran without a
+/// dither, whose take-off is then only the first step down (docs/clearance.md). A detector that
+/// fires at the start power already is an error: there is no touchdown to find.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -68,21 +70,6 @@ impl DetectorKind {
             DetectorKind::Vibration => "vibration",
         }
     }
-}
-
-#[derive(Serialize)]
-struct Report {
-    detector: String,
-    touchdown_power: f64,
-    takeoff_power: Option<f64>,
-    hysteresis: Option<f64>,
-    set_power: f64,
-    clearance: f64,
-    contrast: f64,
-    levels: usize,
-    simulated_time: f64,
-    wall_seconds: f64,
-    flags: Vec<&'static str>,
 }
 
 pub fn run(a: Args) -> Result<(), CliError> {
@@ -150,9 +137,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
         })
     })?;
     drop(progress);
-    let mut flags = Vec::new();
-    if c.takeoff_power.is_some() && detector.high_pass() && model.voltage().ac_amplitude == 0.0 {
-        flags.push("takeoff_without_dither");
+    let without_dither =
+        c.takeoff_power.is_some() && detector.high_pass() && model.voltage().ac_amplitude == 0.0;
+    if without_dither {
         common::warn(&format!(
             "the take-off {} is not a take-off: the {} detector hears only changes, and without \
              a dither it hears nothing in steady contact, so it stops firing at the first step \
@@ -161,23 +148,20 @@ pub fn run(a: Args) -> Result<(), CliError> {
             a.detector.name(),
         ));
     }
-    if opts.find_takeoff && c.takeoff_power.is_none() {
-        flags.push("no_takeoff");
+    let mut record = CalibrationRecord::new(
+        &scene.name,
+        a.detector.name(),
+        c,
+        opts.find_takeoff,
+        clock.elapsed().as_secs_f64(),
+    );
+    if without_dither {
+        record = record.flagged(Flag::TakeoffWithoutDither);
+    }
+    if opts.find_takeoff && record.calibration.takeoff_power.is_none() {
         common::warn(&format!(
             "no take-off found down to {start_shown}: no hysteresis"
         ));
     }
-    common::print_json(&Report {
-        hysteresis: c.hysteresis(),
-        detector: c.detector,
-        touchdown_power: c.touchdown_power,
-        takeoff_power: c.takeoff_power,
-        set_power: c.set_power,
-        clearance: c.clearance,
-        contrast: c.contrast,
-        levels: c.steps.len(),
-        simulated_time: c.simulated_time,
-        wall_seconds: clock.elapsed().as_secs_f64(),
-        flags,
-    })
+    common::print_json(&record)
 }

@@ -2,22 +2,22 @@
 
 use std::path::PathBuf;
 
-use hdi_tribology::analysis::sweep::{flags, Flag};
+use crate::common::{self, positive, rtol, volts, CliError, Output, SceneArgs};
+use hdi_tribology::analysis::record::CycleRecord;
+use hdi_tribology::analysis::sweep::Flag;
 use hdi_tribology::analysis::{
-    ac_sweep, ac_sweep_refined, CycleOptions, CycleResult, HeaterProgramme, RefinedCycle,
-    Refinement,
+    ac_sweep, ac_sweep_refined, CycleOptions, HeaterProgramme, Refinement, TimeSeries,
 };
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::units::{fmt_short, mw as from_mw, nm as from_nm};
-use serde::Serialize;
-
-use crate::common::{self, positive, rtol, volts, CliError, Output, SceneArgs};
 
 /// One touchdown/take-off cycle under the scene's fixed heater programme (or the
-/// touchdown-triggered protocol), JSON: v_ac (V), touchdown_power, takeoff_power, hysteresis
-/// (W), mean_temperature_rise (K), steps, wall_seconds, rtol, atol_m, runs, power_change (W),
-/// temperature_change (K), status and flags.
+/// touchdown-triggered protocol), JSON, each key with its unit: scene, programme (fixed or
+/// triggered), v_ac_v, touchdown and takeoff ({time_s, power_w} or null), hysteresis_w,
+/// mean_temperature_rise_k, duration_s, stats and wall_seconds (of the run kept), rtol, atol_m,
+/// runs, power_change_w, temperature_change_k, total_stats, total_wall_seconds (over every run),
+/// status and flags (docs/python.md, "Results").
 ///
 /// By default the solver tolerances are tightened tenfold per run until touchdown and take-off
 /// move by at most --refine-mw and the mean temperature rise by at most --refine-k; status is then
@@ -108,18 +108,23 @@ impl CycleArgs {
         Ok((model, programme, opts))
     }
 
-    /// One report per amplitude, refined unless --no-refine; flags are warned about on stderr.
+    /// One record per amplitude, refined unless --no-refine; flags are warned about on stderr.
     pub fn run(
         &self,
+        scene: &Scene,
         model: &SliderModel,
         programme: &HeaterProgramme,
         opts: &CycleOptions,
         amplitudes: &[f64],
-    ) -> Result<Vec<(Report, CycleResult)>, CliError> {
-        let rows: Vec<(Report, CycleResult)> = if self.no_refine {
+    ) -> Result<Vec<(CycleRecord, Option<TimeSeries>)>, CliError> {
+        let name = scene.name.as_str();
+        let rows: Vec<(CycleRecord, Option<TimeSeries>)> = if self.no_refine {
             ac_sweep(model, programme, opts, amplitudes)?
                 .into_iter()
-                .map(|c| (Report::unchecked(&c, opts), c))
+                .map(|mut c| {
+                    let series = c.series.take();
+                    (CycleRecord::unchecked(name, programme, c, opts), series)
+                })
                 .collect()
         } else {
             if self.agree > self.max_runs {
@@ -152,107 +157,43 @@ impl CycleArgs {
             }
             ac_sweep_refined(model, programme, opts, amplitudes, &refine)?
                 .into_iter()
-                .map(|r| (Report::refined(&r), r.cycle))
+                .map(|mut r| {
+                    let series = r.cycle.series.take();
+                    (CycleRecord::refined(name, programme, r), series)
+                })
                 .collect()
         };
         for (r, _) in &rows {
-            r.warn();
+            warn(r);
         }
         Ok(rows)
     }
 }
 
-/// One cycle as printed.
-#[derive(Serialize)]
-pub struct Report {
-    v_ac: f64,
-    touchdown_power: Option<f64>,
-    takeoff_power: Option<f64>,
-    hysteresis: Option<f64>,
-    mean_temperature_rise: f64,
-    steps: usize,
-    wall_seconds: f64,
-    rtol: f64,
-    atol_m: f64,
-    runs: usize,
-    power_change: Option<f64>,
-    temperature_change: Option<f64>,
-    status: &'static str,
-    flags: Vec<Flag>,
-}
-
-impl Report {
-    fn base(c: &CycleResult) -> Report {
-        Report {
-            v_ac: c.v_ac,
-            touchdown_power: c.touchdown.map(|d| d.power),
-            takeoff_power: c.takeoff.map(|d| d.power),
-            hysteresis: c.hysteresis,
-            mean_temperature_rise: c.mean_temperature_rise,
-            steps: c.stats.accepted,
-            wall_seconds: c.wall_seconds,
-            rtol: 0.0,
-            atol_m: 0.0,
-            runs: 1,
-            power_change: None,
-            temperature_change: None,
-            status: "unchecked",
-            flags: flags(c),
-        }
-    }
-
-    fn unchecked(c: &CycleResult, opts: &CycleOptions) -> Report {
-        Report {
-            rtol: opts.solver.rtol,
-            atol_m: opts.solver.atol_displacement,
-            ..Report::base(c)
-        }
-    }
-
-    fn refined(r: &RefinedCycle) -> Report {
-        Report {
-            steps: r.stats.accepted,
-            wall_seconds: r.wall_seconds,
-            rtol: r.rtol,
-            atol_m: r.atol,
-            runs: r.runs,
-            // ∞ (a detection that comes and goes) is printed as null
-            power_change: Some(r.change).filter(|x| x.is_finite()),
-            temperature_change: Some(r.temperature_change),
-            status: if r.converged {
-                "converged"
-            } else {
-                "not_converged"
-            },
-            flags: r.flags(),
-            ..Report::base(&r.cycle)
-        }
-    }
-
-    /// One line on stderr per flag.
-    fn warn(&self) {
-        let at = format!("--v-ac {}", fmt_short(self.v_ac));
-        for f in &self.flags {
-            let detail = match f {
-                Flag::NegativeHysteresis => format!(
-                    ": take-off {} lies above touchdown {} (hysteresis {}), a detection artefact, \
-                     not a hysteresis",
-                    common::mw(self.takeoff_power.unwrap_or(f64::NAN)),
-                    common::mw(self.touchdown_power.unwrap_or(f64::NAN)),
-                    common::mw(self.hysteresis.unwrap_or(f64::NAN)),
-                ),
-                Flag::NotConverged => format!(
-                    " after {} runs down to rtol {}: touchdown/take-off still moved by {}, \
-                     mean temperature rise by {} K",
-                    self.runs,
-                    fmt_short(self.rtol),
-                    self.power_change.map_or("a detection".into(), common::mw),
-                    fmt_short(self.temperature_change.unwrap_or(f64::NAN)),
-                ),
-                Flag::NoTouchdown | Flag::NoTakeoff => String::new(),
-            };
-            common::warn(&format!("{at}: {f}{detail}"));
-        }
+/// One line on stderr per flag of `r`.
+fn warn(r: &CycleRecord) {
+    let c = &r.cycle;
+    let at = format!("--v-ac {}", fmt_short(c.v_ac));
+    for f in &r.flags {
+        let detail = match f {
+            Flag::NegativeHysteresis => format!(
+                ": take-off {} lies above touchdown {} (hysteresis {}), a detection artefact, \
+                 not a hysteresis",
+                common::mw(c.takeoff.map_or(f64::NAN, |d| d.power)),
+                common::mw(c.touchdown.map_or(f64::NAN, |d| d.power)),
+                common::mw(c.hysteresis.unwrap_or(f64::NAN)),
+            ),
+            Flag::NotConverged => format!(
+                " after {} runs down to rtol {}: touchdown/take-off still moved by {}, \
+                 mean temperature rise by {} K",
+                r.runs,
+                fmt_short(r.rtol),
+                r.power_change_w.map_or("a detection".into(), common::mw),
+                fmt_short(r.temperature_change_k.unwrap_or(f64::NAN)),
+            ),
+            Flag::NoTouchdown | Flag::NoTakeoff | Flag::TakeoffWithoutDither => String::new(),
+        };
+        common::warn(&format!("{at}: {f}{detail}"));
     }
 }
 
@@ -268,14 +209,14 @@ pub fn run(a: Args) -> Result<(), CliError> {
     opts.keep_series = out.is_some();
     let v_ac = a.v_ac.unwrap_or(model.voltage().ac_amplitude);
     let progress = common::Progress::spinner("cycle: refining until converged");
-    let (report, cycle) = a
+    let (record, series) = a
         .cycle
-        .run(&model, &programme, &opts, &[v_ac])?
+        .run(&scene, &model, &programme, &opts, &[v_ac])?
         .pop()
         .ok_or_else(|| CliError::Failed("the cycle gave no result".into()))?;
     drop(progress);
-    if let (Some(out), Some(series)) = (out, cycle.series) {
+    if let (Some(out), Some(series)) = (out, series) {
         out.write_via_path(|p| Ok(series.write_csv(p)?))?;
     }
-    common::print_json(&report)
+    common::print_json(&record)
 }

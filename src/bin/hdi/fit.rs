@@ -2,7 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use hdi_tribology::fit::{run_cli, CliArgs, FitError, FitOptions};
+use hdi_tribology::fit::{fit, DataSet, FitError, FitOptions, FitResult, FreeParameter};
+use hdi_tribology::Error;
 
 use crate::common::{self, CliError, Output, SceneArgs};
 
@@ -66,7 +67,7 @@ fn check_plot_dir(dir: &Path) -> Result<(), CliError> {
     }
 }
 
-/// Writes the plots `run_cli` drew in `scratch` into `dir`, each through [`Output`].
+/// Writes the plots drawn in `scratch` into `dir`, each through [`Output`].
 fn deliver_plots(scratch: &Path, dir: &Path) -> Result<(), CliError> {
     std::fs::create_dir_all(dir)
         .map_err(|e| CliError::Failed(format!("--plot {}: {e}", dir.display())))?;
@@ -89,35 +90,103 @@ pub fn run(a: Args) -> Result<(), CliError> {
         check_plot_dir(dir)?;
     }
     let scene = a.scene.load()?;
-    // The library draws into a scratch folder; the plots then go through the one writer.
-    let scratch = match a.plot {
-        Some(_) => Some(
-            tempfile::tempdir()
-                .map_err(|e| CliError::Failed(format!("--plot: no scratch folder: {e}")))?,
-        ),
-        None => None,
-    };
-    let args = CliArgs {
-        scene,
-        data: a.data,
-        free: a.free,
-        options: FitOptions {
-            starts: a.starts as usize,
-            seed: a.seed,
-            ..FitOptions::default()
-        },
-        plot: scratch.as_ref().map(|d| d.path().to_path_buf()),
+    let failed = |e: FitError| CliError::Failed(e.to_string());
+    let data = a
+        .data
+        .iter()
+        .map(DataSet::from_path)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| CliError::Failed(e.to_string()))?;
+    let free = a
+        .free
+        .iter()
+        .flat_map(|s| s.split(','))
+        .filter(|s| !s.trim().is_empty())
+        .map(str::parse)
+        .collect::<hdi_tribology::Result<Vec<FreeParameter>>>()?;
+    let options = FitOptions {
+        starts: a.starts as usize,
+        seed: a.seed,
+        ..FitOptions::default()
     };
     let progress = common::Progress::spinner("fit: least squares");
-    let json = run_cli(&args).map_err(|e: FitError| CliError::Failed(e.to_string()))?;
+    let result = fit(&scene, &data, &free, &options).map_err(failed)?;
     drop(progress);
-    if let (Some(scratch), Some(dir)) = (&scratch, &a.plot) {
+    if let Some(dir) = &a.plot {
+        // Drawn into a scratch folder; each plot then goes through the one writer.
+        let scratch = tempfile::tempdir()
+            .map_err(|e| CliError::Failed(format!("--plot: no scratch folder: {e}")))?;
+        write_plots(&result, scratch.path())?;
         deliver_plots(scratch.path(), dir)?;
     }
-    let value: serde_json::Value =
-        serde_json::from_str(&json).map_err(|e| CliError::Failed(e.to_string()))?;
-    if value["trusted"] == serde_json::Value::Bool(false) {
+    if !result.trusted {
         common::warn("the fit is not trusted; see \"warnings\" in the output");
     }
-    common::print_text(&json)
+    common::print_json(&result)
+}
+
+/// Writes, per measured column, `<file>_<column>.svg` (data and fit) and
+/// `<file>_<column>_residuals.svg` into `dir`; returns the files written.
+#[cfg(feature = "plot")]
+fn write_plots(result: &FitResult, dir: &Path) -> hdi_tribology::Result<Vec<PathBuf>> {
+    use hdi_tribology::report::{Chart, Series};
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let mut written = Vec::new();
+    for t in &result.residuals {
+        let stem = Path::new(&t.file)
+            .file_stem()
+            .map_or("data".into(), |s| s.to_string_lossy().into_owned());
+        let name = format!("{stem}_{}", t.column);
+        let pts = |f: fn(&hdi_tribology::fit::ResidualRow) -> f64| {
+            t.rows.iter().map(|r| (r.x, f(r))).collect::<Vec<_>>()
+        };
+        let mut fitted = pts(|r| r.fitted);
+        fitted.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let title = format!("{} against {}", t.column, t.x_column);
+        let path = dir.join(format!("{name}.svg"));
+        Chart {
+            title: &title,
+            x_label: &t.x_column,
+            y_label: &t.column,
+            series: vec![
+                Series::line("fitted model", fitted),
+                Series::markers("measured", pts(|r| r.measured)),
+            ],
+            ..Chart::default()
+        }
+        .to_svg(&path, 720, 440)?;
+        written.push(path);
+        let rtitle = format!("residuals (fitted − measured) of {}", t.column);
+        let path = dir.join(format!("{name}_residuals.svg"));
+        let mut zero = vec![(
+            t.rows.iter().map(|r| r.x).fold(f64::INFINITY, f64::min),
+            0.0,
+        )];
+        zero.push((
+            t.rows.iter().map(|r| r.x).fold(f64::NEG_INFINITY, f64::max),
+            0.0,
+        ));
+        Chart {
+            title: &rtitle,
+            x_label: &t.x_column,
+            y_label: &t.column,
+            series: vec![
+                Series::line("zero", zero),
+                Series::markers("residual", pts(|r| r.residual)),
+            ],
+            ..Chart::default()
+        }
+        .to_svg(&path, 720, 320)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// Without the `plot` feature there is nothing to draw with.
+#[cfg(not(feature = "plot"))]
+fn write_plots(_result: &FitResult, _dir: &Path) -> hdi_tribology::Result<Vec<PathBuf>> {
+    Err(Error::invalid("--plot", "this build has no `plot` feature"))
 }

@@ -6,10 +6,10 @@ use serde::Serialize;
 
 use crate::common::{self, list, number, CliError, List, SceneArgs};
 
-/// Interface forces at bulge gaps D, JSON, one object per gap: d (m), intermolecular, contact,
-/// electrostatic_per_volt2 (N/V²), electrostatic (at the scene's DC voltage minus the contact
-/// potential), other, real_contact_area (m²), total (N, positive = away from the disk), and
-/// in_table_range. Pad-gap terms see D + the protrusion. A gap outside the scene's force table
+/// Interface forces at bulge gaps D, JSON, one object per gap, each key with its unit: d_m,
+/// intermolecular_n, contact_n, electrostatic_per_volt2_n_per_v2, electrostatic_n (at the
+/// scene's DC voltage minus the contact potential), other_n, real_contact_area_m2, total_n
+/// (positive = away from the disk), and in_table_range. Pad-gap terms see D + the protrusion. A gap outside the scene's force table
 /// range is computed by direct quadrature, flagged, and warned about on stderr.
 #[derive(clap::Args)]
 pub struct Args {
@@ -33,7 +33,7 @@ pub struct Args {
 
 #[derive(Serialize)]
 struct Row {
-    d: f64,
+    d_m: f64,
     #[serde(flatten)]
     forces: Breakdown,
     in_table_range: bool,
@@ -82,7 +82,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             ));
         }
         rows.push(Row {
-            d,
+            d_m: d,
             forces,
             in_table_range,
         });

@@ -35,7 +35,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     ));
     let rows: Vec<_> = a
         .cycle
-        .run(&model, &programme, &opts, &amplitudes)?
+        .run(&scene, &model, &programme, &opts, &amplitudes)?
         .into_iter()
         .map(|(r, _)| r)
         .collect();
