@@ -17,6 +17,7 @@ use crate::ode::{self, Method, Stats, StepStatus};
 use crate::sim::{self, Flow, Observer, Problem, SizedRun, StepView};
 use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector};
 use serde::Serialize;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Largest length of the touchdown-triggered search, in overshoots (`overshoot / ramp_rate` of
@@ -724,8 +725,8 @@ where
     let y0: OVector<f64, D> = problem.initial_state(D::name(), &rest);
     // Stop where the lumped model ends: the pad gap h0 + y reaching zero puts the slider body
     // into the disk (no pad contact is modelled; a power-law bearing is singular there).
-    let h0 = model.nominal_clearance();
-    let guard = ode::Event::new(move |_t, s: &OVector<f64, D>| h0 + s[0])
+    let body = Arc::clone(problem.system().model_arc());
+    let guard = ode::Event::new(move |_t, s: &OVector<f64, D>| body.pad_gap(s[0], 0.0))
         .direction(ode::Direction::Falling)
         .terminal(true);
     let end = initial_programme.end_time();

@@ -466,8 +466,15 @@ impl SliderModel {
         let h0 = self.nominal_clearance + offset;
         Gaps {
             bulge: h0 + self.structure.bulge_displacement(q) - delta,
-            pad: h0 + q[0],
+            pad: self.pad_gap(q[0], offset),
         }
+    }
+
+    /// The pad gap `h0 + offset + y` (m) at body heave `y` (m): where the slider body meets
+    /// the disk when it reaches zero (the end of the lumped model).
+    #[inline]
+    pub fn pad_gap(&self, y: f64, offset: f64) -> f64 {
+        self.nominal_clearance + offset + y
     }
 
     /// The gaps when the bulge gap is held at `d` and the body heaves by `y` (m): the pad gap
@@ -476,7 +483,7 @@ impl SliderModel {
     pub fn gaps_at(&self, d: f64, y: f64) -> Gaps {
         Gaps {
             bulge: d,
-            pad: self.nominal_clearance + y,
+            pad: self.pad_gap(y, 0.0),
         }
     }
 
