@@ -296,6 +296,10 @@ impl StatefulTerm for Meniscus {
     fn tolerances(&self, displacement: f64, atol: &mut [f64]) {
         atol[0] = displacement;
     }
+    /// At rest `d* = d`, and the force sees `d` and `d*` alone.
+    fn rests_on_bulge_gap(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

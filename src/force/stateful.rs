@@ -70,6 +70,13 @@ pub trait StatefulTerm: Debug + Send + Sync {
     /// The absolute accuracy each state needs when displacements are integrated to
     /// `displacement` (m).
     fn tolerances(&self, displacement: f64, atol: &mut [f64]);
+    /// Whether the force at rest (the force at the [`StatefulTerm::equilibrium`] states) depends
+    /// on the bulge gap alone, never on the pad gap: the static balance, which holds the bulge
+    /// gap, then evaluates it once per balance instead of once per Newton step. False by
+    /// default (a term that says true and sees the pad gap would get a wrong balance).
+    fn rests_on_bulge_gap(&self) -> bool {
+        false
+    }
 }
 
 /// One first-order state that relaxes towards a target proportional to the bulge gap,
@@ -164,6 +171,10 @@ impl StatefulTerm for RelaxingState {
             .abs()
             .max(self.start.map_or(0.0, |x0| x0.abs() / 1e-9));
         atol[0] = displacement * per_m.max(f64::MIN_POSITIVE);
+    }
+    /// The equilibrium `a d` and the force `k x` see the bulge gap alone.
+    fn rests_on_bulge_gap(&self) -> bool {
+        true
     }
     fn force(&self, _g: Gaps, x: &[f64]) -> StateForce {
         let mut d_state = [0.0; MAX_TERM_STATES];

@@ -493,6 +493,12 @@ impl SliderModel {
         self.with_stateful(add_scaled(s, e, volt2), g)
     }
 
+    /// Whether every stateful term's force at rest depends on the bulge gap alone
+    /// ([`StatefulTerm::rests_on_bulge_gap`]; true when there are none).
+    fn stateful_rest_on_bulge_gap(&self) -> bool {
+        self.stateful.iter().all(|t| t.rests_on_bulge_gap())
+    }
+
     /// `f` plus the forces of the stateful terms with their states at equilibrium at `g`, and
     /// the total derivatives along the gaps (through the equilibrium's own slope,
     /// `∂x/∂d = −(∂ẋ/∂x)⁻¹ ∂ẋ/∂d`): what a static analysis sees of a term with memory. `f` as
@@ -506,6 +512,19 @@ impl SliderModel {
             term.equilibrium(g, &mut x[..k]);
             let s = term.force(g, &x[..k]);
             let p = term.rate_partials(g, &x[..k]);
+            if k == 1 {
+                // The 1 × 1 solve in closed form: the division the LU below would do, with
+                // its answer where ∂ẋ/∂x = 0 (no slope through the state).
+                let a = p.d_state[0][0];
+                let slope = |rate: [f64; MAX_TERM_STATES]| {
+                    let dx = if a == 0.0 { 0.0 } else { rate[0] / a };
+                    -(s.d_state[0] * dx)
+                };
+                f.value += s.force.value;
+                f.d_bulge += s.force.d_bulge + slope(p.d_bulge);
+                f.d_pad += s.force.d_pad + slope(p.d_pad);
+                continue;
+            }
             // ∂ẋ/∂x, padded with the identity beyond the term's states.
             let a = SMatrix::<f64, MAX_TERM_STATES, MAX_TERM_STATES>::from_fn(|r, c| {
                 if r < k && c < k {
@@ -621,8 +640,9 @@ impl SliderModel {
         let at = |q0: f64| self.gaps_at(d, q0);
         let residual = |q: &Dofs, f: &ForceEval| self.balance_residual(q, f);
         // With no pad-gap term the interface force depends on `d` alone, which is held: one
-        // evaluation serves every Newton step (the same numbers, fewer look-ups).
-        let pad_free = !self.forces.uses_pad_gap() && self.stateful.is_empty();
+        // evaluation serves every Newton step (the same numbers, fewer look-ups). Stateful
+        // terms enter at rest, which for most of them is a function of `d` alone too.
+        let pad_free = !self.forces.uses_pad_gap() && self.stateful_rest_on_bulge_gap();
         // Start from the linearised bearing.
         let f0 = self.interface_force(at(0.0), volt2);
         let j0 = st.tangent(self.bearing.stiffness(0.0), 0.0, 0.0);
@@ -894,5 +914,64 @@ fn add_scaled(a: ForceEval, b: ForceEval, scale: f64) -> ForceEval {
         value: by_coupling(a.value, b.value, scale),
         d_bulge: by_coupling(a.d_bulge, b.d_bulge, scale),
         d_pad: by_coupling(a.d_pad, b.d_pad, scale),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::force::{RatePartials, RelaxingState, StateForce};
+
+    /// A term that hides that its force at rest sees the bulge gap alone.
+    #[derive(Debug)]
+    struct Opaque(RelaxingState);
+
+    impl StatefulTerm for Opaque {
+        fn name(&self) -> &str {
+            "opaque"
+        }
+        fn states(&self) -> usize {
+            self.0.states()
+        }
+        fn equilibrium(&self, g: Gaps, x: &mut [f64]) {
+            self.0.equilibrium(g, x)
+        }
+        fn rates(&self, g: Gaps, x: &[f64], dx: &mut [f64]) {
+            self.0.rates(g, x, dx)
+        }
+        fn rate_partials(&self, g: Gaps, x: &[f64]) -> RatePartials {
+            self.0.rate_partials(g, x)
+        }
+        fn force(&self, g: Gaps, x: &[f64]) -> StateForce {
+            self.0.force(g, x)
+        }
+        fn tolerances(&self, displacement: f64, atol: &mut [f64]) {
+            self.0.tolerances(displacement, atol)
+        }
+    }
+
+    /// The balance's shortcut for terms at rest on the bulge gap alone (one force evaluation per
+    /// balance) gives the numbers of the Newton iteration that evaluates at every step.
+    #[test]
+    fn the_bulge_gap_shortcut_keeps_the_balance() {
+        let plain = SliderModel::from_scene(&Scene::paper()).unwrap();
+        // A lagged spring of −2e-3 N per nm of bulge gap at rest: strong enough to matter.
+        let term = RelaxingState::new(1e-6, 1e9, -2e-3, None).unwrap();
+        let fast = plain.with_stateful_term(term).unwrap();
+        let slow = plain.with_stateful_term(Opaque(term)).unwrap();
+        assert!(fast.stateful_rest_on_bulge_gap() && !slow.stateful_rest_on_bulge_gap());
+        for d in [0.5e-9, 1.5e-9, 4e-9, 12e-9] {
+            for exact in [false, true] {
+                let a = fast.balance(d, 0.36, exact).unwrap();
+                let b = slow.balance(d, 0.36, exact).unwrap();
+                assert_eq!(a, b, "d = {d:e} m, exact: {exact}");
+                // and the term is there: its force at rest is part of the balance's force
+                let without = plain.balance(d, 0.36, exact).unwrap().1.value;
+                assert!(
+                    (a.1.value - without - (-2e-3 * 1e9 * d)).abs()
+                        < 1e-12 * without.abs().max(1.0)
+                );
+            }
+        }
     }
 }
