@@ -13,6 +13,7 @@ True
 """
 
 from ._core import (
+    AirBearing,
     Calibration,
     Cycle,
     Detection,
@@ -31,6 +32,7 @@ from ._core import (
     __version__,
     ac_sweep,
     ac_sweep_refined,
+    bearing,
     calibrate,
     clearance_change,
     fit,
@@ -56,6 +58,7 @@ from ._errors import (
 )
 
 __all__ = [
+    "AirBearing",
     "AnalysisError",
     "Calibration",
     "Cycle",
@@ -82,6 +85,7 @@ __all__ = [
     "__version__",
     "ac_sweep",
     "ac_sweep_refined",
+    "bearing",
     "calibrate",
     "clearance_change",
     "fit",

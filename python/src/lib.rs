@@ -32,6 +32,8 @@ use pyo3::exceptions::{PyKeyError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+mod bearing;
+
 type Scn = hdi_tribology::scene::Scene;
 
 // ---------------------------------------------------------------------------------------------
@@ -1916,6 +1918,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(replay, m)?)?;
+    bearing::register(m)?;
     m.add("SENSOR_COLUMNS", SENSOR_COLUMNS.to_vec())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
