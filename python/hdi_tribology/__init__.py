@@ -15,6 +15,7 @@ True
 """
 
 from ._core import (
+    AirBearing,
     LinearResponse,
     Model,
     SENSOR_COLUMNS,
@@ -22,6 +23,7 @@ from ._core import (
     __version__,
     ac_sweep,
     ac_sweep_refined,
+    bearing,
     calibrate,
     clearance_change,
     fit,
@@ -60,6 +62,7 @@ from ._errors import (
 )
 
 __all__ = [
+    "AirBearing",
     "AnalysisError",
     "Calibration",
     "Cycle",
@@ -86,6 +89,7 @@ __all__ = [
     "__version__",
     "ac_sweep",
     "ac_sweep_refined",
+    "bearing",
     "calibrate",
     "clearance_change",
     "fit",

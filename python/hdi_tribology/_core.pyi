@@ -282,3 +282,43 @@ def fit(
     ``residual_scale``, ``converged``, ``termination``, ``evaluations``, ``starts``,
     ``integration``, ``trusted``, ``warnings``. Raises DataFileError on a bad file."""
 
+
+class AirBearing:
+    """The equilibrium of a slider on its air bearing (``bearing``). Attitude in nm and µrad;
+    ``stiffness`` and ``damping`` are 3×3 SI matrices, rows (force, pitch moment, roll moment),
+    columns (fly height, pitch, roll)."""
+    fly_height_nm: float
+    pitch_urad: float
+    roll_urad: float
+    trailing_edge_spacing_nm: float
+    bulge_spacing_nm: float
+    min_spacing_nm: float
+    load_mn: float
+    pitch_moment_un_m: float
+    roll_moment_un_m: float
+    bearing_number: float
+    stiffness: List[List[float]]
+    damping: List[List[float]]
+    imbalance: float
+    tolerance: float
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def cells(self) -> tuple[int, int]: ...
+    @property
+    def convergence(self) -> List[Dict[str, Any]]: ...
+    @property
+    def pressure_pa(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def x_um(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def y_um(self) -> npt.NDArray[np.float64]: ...
+
+def bearing(geometry: Union[str, "os.PathLike[str]"], *, cells: Optional[int] = None,
+            radius_mm: Optional[float] = None, rpm: Optional[float] = None,
+            skew_deg: Optional[float] = None, preload_mn: Optional[float] = None) -> AirBearing:
+    """The attitude of the slider of the bearing file ``geometry`` (TOML, JSON or the text
+    format) on ``cells`` control volumes a side (default the file's grid), with the disk radius,
+    speed, skew and preload in place of the file's when given: fly height, pitch and roll,
+    stiffness, damping, load, pressure and convergence. Raises InvalidInputError naming the
+    argument or the file's field, AnalysisError when the slider does not fly."""

@@ -40,6 +40,8 @@ use pyo3::types::{PyDict, PyList};
 use serde::Serialize;
 use serde_json::Value;
 
+mod bearing;
+
 type Scn = hdi_tribology::scene::Scene;
 
 // ---------------------------------------------------------------------------------------------
@@ -1823,6 +1825,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(replay, m)?)?;
+    bearing::register(m)?;
     m.add("SENSOR_COLUMNS", SENSOR_COLUMNS.to_vec())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -484,6 +484,56 @@ impl Equilibrium {
         Ok(out)
     }
 
+    /// ```
+    /// # use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec};
+    /// # let mut spec = BearingSpec::from_path(concat!(
+    /// #     env!("CARGO_MANIFEST_DIR"), "/scenes/bearing/two_rail_taper_flat.toml"))?;
+    /// # spec.grid.nx = 33;
+    /// # spec.grid.ny = 33;
+    /// # let eq = solve_attitude(&spec.build()?, &AttitudeOptions::default())?;
+    /// let curve = eq.heave_curve(&[0.0, 20e-9])?;
+    /// assert!((curve[0].1 - 49e-3).abs() < 1e-9);
+    /// assert_eq!(curve[0].2, -eq.stiffness()[0][0]);
+    /// assert!(curve[1].1 < curve[0].1 && curve[1].2 < 0.0);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
+    /// The bearing's force along a heave: for each of `offsets` (m, added to the fly height
+    /// with pitch and roll held), `(offset, force (N), ∂force/∂fly height (N/m))`, the
+    /// derivative from the pressure's sensitivity (one linear solve), not from differences. At
+    /// offset 0 it is the equilibrium's own: the preload balanced and `−K[0][0]`.
+    pub fn heave_curve(&self, offsets: &[f64]) -> Result<Vec<(f64, f64, f64)>> {
+        let r = &self.reynolds;
+        let mut out = Vec::with_capacity(offsets.len());
+        for &d in offsets {
+            if d == 0.0 {
+                out.push((0.0, self.loads[0], self.load_jacobian[0][0]));
+                continue;
+            }
+            let mut att = self.attitude;
+            att.fly_height += d;
+            if r.min_spacing(&att) < SPACING_FLOOR {
+                return Err(Error::invalid(
+                    "heave offset",
+                    format!(
+                        "{:.3} nm brings the slider below the {:.1} nm the bearing solve reaches",
+                        d * 1e9,
+                        SPACING_FLOOR * 1e9
+                    ),
+                ));
+            }
+            let mut p = self.pressure.clone();
+            for (pc, dc) in p.iter_mut().zip(&self.dps[0]) {
+                *pc = (*pc + dc * d).max(0.5 * *pc);
+            }
+            let h = r.spacing(&att);
+            let (_, f) = r.solve_spacing(&h, &mut p)?;
+            let (k, _, _) = r.sensitivities(&p, &h, &f, FINAL_SENSITIVITY_RTOL)?;
+            out.push((d, r.loads(&p)[0], k[0][0]));
+        }
+        Ok(out)
+    }
+
     /// The bearing number at the reference spacing (10 nm).
     pub fn bearing_number(&self) -> f64 {
         self.reynolds.bearing_number()

@@ -217,6 +217,23 @@ fn face(
     (j, jl, jr)
 }
 
+/// The direction a face is normal to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Axis {
+    X,
+    Y,
+}
+
+/// The flux through one face ([`Reynolds::face_flux`]): the cells below and above it (none on
+/// the slider's edge), the flux from below to above, and its derivatives in the two pressures.
+struct FaceFlux {
+    low: Option<usize>,
+    high: Option<usize>,
+    flux: f64,
+    d_low: f64,
+    d_high: f64,
+}
+
 impl Reynolds {
     /// The equation of `bearing` on the grid of `nx × ny` control volumes at the bearing's
     /// refinement.
@@ -340,106 +357,89 @@ impl Reynolds {
         if let Some(a) = jac.as_deref_mut() {
             a.clear();
         }
-        let [lx, ly] = self.lambda;
-        // Faces normal to x.
-        for j in 0..ny {
-            let area = self.dy[j];
-            for i in 0..=nx {
-                let (cl, cr) = ((j * nx + i).wrapping_sub(1), j * nx + i);
-                let left = i > 0;
-                let right = i < nx;
-                let (pl, gl, dgl, al) = if left {
-                    (p[cl], g[cl], dg[cl], 0.5 * self.dx[i - 1])
-                } else {
-                    (1.0, 1.0, 0.0, 0.0)
-                };
-                let (pr, gr, dgr, ar) = if right {
-                    (p[cr], g[cr], dg[cr], 0.5 * self.dx[i])
-                } else {
-                    (1.0, 1.0, 0.0, 0.0)
-                };
-                let hf = self.x_face_spacing(h, i, j, lx);
-                let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, lx * area * hf, area);
-                if left {
-                    r[cl] += flux;
-                }
-                if right {
-                    r[cr] -= flux;
-                }
-                if let Some(a) = jac.as_deref_mut() {
-                    if left {
-                        a.diag[cl] += jl;
-                        if right {
-                            a.east[cl] += jr;
-                            a.west[cr] -= jl;
-                        }
-                    }
-                    if right {
-                        a.diag[cr] -= jr;
-                    }
-                }
-            }
-        }
-        // Faces normal to y.
         let closed = self.sides == Sides::Closed;
-        for j in 0..=ny {
-            let below = j > 0;
-            let above = j < ny;
-            if closed && !(below && above) {
-                continue;
-            }
-            for i in 0..nx {
-                let area = self.dx[i];
-                let (cl, cr) = (
-                    (j.wrapping_sub(1)).wrapping_mul(nx).wrapping_add(i),
-                    j * nx + i,
-                );
-                let (pl, gl, dgl, al) = if below {
-                    (p[cl], g[cl], dg[cl], 0.5 * self.dy[j - 1])
-                } else {
-                    (1.0, 1.0, 0.0, 0.0)
-                };
-                let (pr, gr, dgr, ar) = if above {
-                    (p[cr], g[cr], dg[cr], 0.5 * self.dy[j])
-                } else {
-                    (1.0, 1.0, 0.0, 0.0)
-                };
-                let hf = self.y_face_spacing(h, i, j, ly);
-                let (flux, jl, jr) = face(pl, pr, al, ar, gl, gr, dgl, dgr, ly * area * hf, area);
-                if below {
-                    r[cl] += flux;
+        for axis in [Axis::X, Axis::Y] {
+            // Faces in storage order: rows of faces normal to x, then rows of faces normal to y.
+            let (outer, inner) = match axis {
+                Axis::X => (ny, nx + 1),
+                Axis::Y => (ny + 1, nx),
+            };
+            for o in 0..outer {
+                if axis == Axis::Y && closed && (o == 0 || o == ny) {
+                    continue;
                 }
-                if above {
-                    r[cr] -= flux;
-                }
-                if let Some(a) = jac.as_deref_mut() {
-                    if below {
-                        a.diag[cl] += jl;
-                        if above {
-                            a.north[cl] += jr;
-                            a.south[cr] -= jl;
-                        }
+                for q in 0..inner {
+                    let (k, m) = match axis {
+                        Axis::X => (q, o),
+                        Axis::Y => (o, q),
+                    };
+                    let f = self.face_flux(axis, k, m, p, h, &g, &dg);
+                    if let Some(l) = f.low {
+                        r[l] += f.flux;
                     }
-                    if above {
-                        a.diag[cr] -= jr;
+                    if let Some(u) = f.high {
+                        r[u] -= f.flux;
+                    }
+                    if let Some(a) = jac.as_deref_mut() {
+                        if let Some(l) = f.low {
+                            a.diag[l] += f.d_low;
+                            if let Some(u) = f.high {
+                                let (up, down) = match axis {
+                                    Axis::X => (&mut a.east, &mut a.west),
+                                    Axis::Y => (&mut a.north, &mut a.south),
+                                };
+                                up[l] += f.d_high;
+                                down[u] -= f.d_low;
+                            }
+                        }
+                        if let Some(u) = f.high {
+                            a.diag[u] -= f.d_high;
+                        }
                     }
                 }
             }
         }
     }
 
-    /// Spacing on the face `i` (of `0..=nx`) of row `j` normal to `x`, for the convected mass:
-    /// see [`face_spacing`].
-    fn x_face_spacing(&self, h: &[f64], i: usize, j: usize, lambda: f64) -> f64 {
+    /// The flux through one face and its derivatives in the pressures on its two sides: the
+    /// face `k` (of `0..=n` along the axis) of line `m` (the row `j` for faces normal to `x`,
+    /// the column `i` for faces normal to `y`), positive from the cell below `k` to the one
+    /// above. A face on the slider's edge has ambient pressure on its outer side, half a
+    /// volume closer than a centre.
+    #[allow(clippy::too_many_arguments)]
+    fn face_flux(
+        &self,
+        axis: Axis,
+        k: usize,
+        m: usize,
+        p: &[f64],
+        h: &[f64],
+        g: &[f64],
+        dg: &[f64],
+    ) -> FaceFlux {
         let nx = self.grid.nx();
-        let row = &h[j * nx..(j + 1) * nx];
-        face_spacing(row, &self.dx, i, 1, lambda)
-    }
-
-    /// Spacing on the face `j` (of `0..=ny`) of column `i` normal to `y`.
-    fn y_face_spacing(&self, h: &[f64], i: usize, j: usize, lambda: f64) -> f64 {
-        let nx = self.grid.nx();
-        face_spacing(&h[i..], &self.dy, j, nx, lambda)
+        let (n, widths, lambda, area, first, stride) = match axis {
+            Axis::X => (nx, &self.dx, self.lambda[0], self.dy[m], m * nx, 1),
+            Axis::Y => (self.grid.ny(), &self.dy, self.lambda[1], self.dx[m], m, nx),
+        };
+        let low = (k > 0).then(|| first + (k - 1) * stride);
+        let high = (k < n).then(|| first + k * stride);
+        let side = |c: Option<usize>, w: usize| match c {
+            Some(c) => (p[c], g[c], dg[c], 0.5 * widths[w]),
+            None => (1.0, 1.0, 0.0, 0.0),
+        };
+        let (pl, gl, dgl, al) = side(low, k.saturating_sub(1));
+        let (pr, gr, dgr, ar) = side(high, k.min(n - 1));
+        let hf = face_spacing(&h[first..], widths, k, stride, lambda);
+        let (flux, d_low, d_high) =
+            face(pl, pr, al, ar, gl, gr, dgl, dgr, lambda * area * hf, area);
+        FaceFlux {
+            low,
+            high,
+            flux,
+            d_low,
+            d_high,
+        }
     }
 
     /// ```
@@ -458,87 +458,28 @@ impl Reynolds {
     /// Total mass flux into and out of the slider through its edges (non-dimensional, per the
     /// scale `p_a h_m L`), at the pressure `p` and spacing `h`.
     pub fn boundary_flux(&self, p: &[f64], h: &[f64]) -> (f64, f64) {
-        // The flux through a boundary face is the residual of a solve with that face alone;
-        // evaluate it directly: the net outflow of all cells is the boundary outflow, split by
-        // sign face by face from the one-cell residual of each edge cell.
         let (nx, ny) = self.size();
-        let mut inflow = 0.0;
-        let mut outflow = 0.0;
         let n = nx * ny;
         let mut g = vec![0.0; n];
         let mut dg = vec![0.0; n];
         self.conductances(p, h, &mut g, &mut dg);
-        let [lx, ly] = self.lambda;
-        let mut add = |f: f64| {
-            if f > 0.0 {
-                outflow += f;
-            } else {
-                inflow -= f;
-            }
-        };
-        for j in 0..ny {
-            let area = self.dy[j];
-            let c0 = j * nx;
-            let c1 = j * nx + nx - 1;
-            // Leading edge: flux from the boundary into cell c0 (positive = into the slider).
-            let (f, _, _) = face(
-                1.0,
-                p[c0],
-                0.0,
-                0.5 * self.dx[0],
-                1.0,
-                g[c0],
-                0.0,
-                dg[c0],
-                lx * area * self.x_face_spacing(h, 0, j, lx),
-                area,
-            );
-            add(-f);
-            let (f, _, _) = face(
-                p[c1],
-                1.0,
-                0.5 * self.dx[nx - 1],
-                0.0,
-                g[c1],
-                1.0,
-                dg[c1],
-                0.0,
-                lx * area * self.x_face_spacing(h, nx, j, lx),
-                area,
-            );
-            add(f);
-        }
+        let (mut inflow, mut outflow) = (0.0, 0.0);
+        let mut edges = vec![(Axis::X, nx, ny)];
         if self.sides == Sides::Ambient {
-            for i in 0..nx {
-                let area = self.dx[i];
-                let c0 = i;
-                let c1 = (ny - 1) * nx + i;
-                let (f, _, _) = face(
-                    1.0,
-                    p[c0],
-                    0.0,
-                    0.5 * self.dy[0],
-                    1.0,
-                    g[c0],
-                    0.0,
-                    dg[c0],
-                    ly * area * self.y_face_spacing(h, i, 0, ly),
-                    area,
-                );
-                add(-f);
-                let (f, _, _) = face(
-                    p[c1],
-                    1.0,
-                    0.5 * self.dy[ny - 1],
-                    0.0,
-                    g[c1],
-                    1.0,
-                    dg[c1],
-                    0.0,
-                    ly * area * self.y_face_spacing(h, i, ny, ly),
-                    area,
-                );
-                add(f);
+            edges.push((Axis::Y, ny, nx));
+        }
+        for (axis, n_faces, lines) in edges {
+            for m in 0..lines {
+                // Outward flux through the low edge (k = 0) and the high edge (k = n).
+                let out_low = -self.face_flux(axis, 0, m, p, h, &g, &dg).flux;
+                let out_high = self.face_flux(axis, n_faces, m, p, h, &g, &dg).flux;
+                for f in [out_low, out_high] {
+                    if f > 0.0 {
+                        outflow += f;
+                    } else {
+                        inflow -= f;
+                    }
+                }
             }
         }
         (inflow, outflow)

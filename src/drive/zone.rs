@@ -104,6 +104,22 @@ impl Zone {
                 reference_gap_m: self.nominal_clearance,
                 damping_n_s_per_m: damping_n_s_per_m * ratio.sqrt(),
             },
+            // A bearing solved from the geometry takes the zone's radius and speed; the
+            // zone's stiffness is the one it then has, not an input.
+            AirBearingModel::Reynolds {
+                ref geometry,
+                cells,
+                skew_deg,
+                preload_mn,
+                ..
+            } => AirBearingModel::Reynolds {
+                geometry: geometry.clone(),
+                cells,
+                radius_mm: Some(self.radius * 1e3),
+                rpm: Some(self.disk_speed * 60.0 / (2.0 * std::f64::consts::PI * self.radius)),
+                skew_deg,
+                preload_mn,
+            },
         };
         s.validate()?;
         Ok(s)

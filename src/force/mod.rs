@@ -36,7 +36,10 @@ mod pressure;
 mod stateful;
 mod term;
 
-pub use air_bearing::{AirBearing, AirBearingModel, CubicBearing, LinearBearing, PowerLawBearing};
+pub use air_bearing::{
+    AirBearing, AirBearingModel, CubicBearing, LinearBearing, PowerLawBearing, ReynoldsBearing,
+    DEFAULT_REYNOLDS_CELLS,
+};
 pub use averaged::AveragedTerm;
 pub use contact::{composite_modulus, GreenwoodWilliamson};
 pub use electrostatic::Electrostatic;

@@ -70,7 +70,17 @@ impl Scene {
                 })
             }
         };
-        validated(read)
+        let (mut scene, renames) = read;
+        // A bearing geometry named relative to the scene file.
+        if let crate::force::AirBearingModel::Reynolds { geometry, .. } = &mut scene.air_bearing {
+            let g = Path::new(geometry.as_str());
+            if g.is_relative() {
+                if let Some(dir) = path.parent() {
+                    *geometry = dir.join(g).display().to_string();
+                }
+            }
+        }
+        validated((scene, renames))
     }
 
     /// The scene as TOML.
