@@ -1521,4 +1521,50 @@ mod tests {
         assert_eq!(radius.to_bits(), 0.025f64.to_bits());
         assert_eq!(o, DriveOptions::default());
     }
+
+    fn message() -> String {
+        unsafe { CStr::from_ptr(hdi_last_error()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
+    /// A panic inside a call becomes a status with the panic's message; a drive that a panic
+    /// left half-stepped is refused from then on, and can still be freed.
+    #[test]
+    fn a_panic_becomes_a_status_and_retires_the_drive() {
+        assert_eq!(call(|| panic!("boom")), HdiStatus::Panic);
+        assert!(message().contains("internal error") && message().contains("boom"));
+        assert_eq!(call(|| Ok(())), HdiStatus::Ok);
+        assert_eq!(message(), "");
+
+        let (mut scene, mut drive) = (std::ptr::null_mut(), std::ptr::null_mut());
+        unsafe {
+            assert_eq!(hdi_scene_paper(&mut scene), HdiStatus::Ok);
+            assert_eq!(
+                hdi_drive_new(scene, std::ptr::null(), 1, &mut drive),
+                HdiStatus::Ok
+            );
+            assert_eq!(hdi_scene_free(scene), HdiStatus::Ok);
+        }
+        let status = call(|| {
+            let _held = acquire(drive.cast_const(), "drive", Access::Exclusive)?;
+            panic!("inside a step")
+        });
+        assert_eq!(status, HdiStatus::Panic);
+        let cmd = HdiCommand {
+            heater_power_mw: 60.0,
+            ..HdiCommand::default()
+        };
+        let mut s = HdiSensors::default();
+        assert_eq!(
+            unsafe { hdi_drive_step(drive, &cmd, 50e-6, &mut s) },
+            HdiStatus::Panic
+        );
+        assert!(message().contains("free it"), "{}", message());
+        assert_eq!(unsafe { hdi_drive_free(drive) }, HdiStatus::Ok);
+        assert_eq!(
+            unsafe { hdi_drive_step(drive, &cmd, 50e-6, &mut s) },
+            HdiStatus::InvalidHandle
+        );
+    }
 }
