@@ -140,8 +140,9 @@ typedef struct HdiPullIn {
 typedef struct HdiCycleOptions {
   // AC amplitude of the head–disk voltage (V, ≥ 0; the scene's by default).
   double ac_amplitude_v;
-  // `false`: the scene's fixed heater programme; `true`: its touchdown-triggered ramp.
-  bool triggered;
+  // 0: the scene's fixed heater programme; any other value: its touchdown-triggered ramp
+  // (an integer, so that any value C may hold is valid).
+  int32_t triggered;
 } HdiCycleOptions;
 
 // One dynamic touchdown/take-off cycle.
@@ -374,8 +375,9 @@ uint32_t hdi_abi_version(void);
 // succeeded. The string belongs to the library and stays valid until the thread's next call.
 const char *hdi_last_error(void);
 
-// The name of a status, e.g. `"HDI_STATUS_INVALID_INPUT"` (a static string).
-const char *hdi_status_name(enum HdiStatus status);
+// The name of a status (an `HdiStatus` value), e.g. `"HDI_STATUS_INVALID_INPUT"`, or
+// `"HDI_STATUS_UNKNOWN"` for a value that is none (a static string).
+const char *hdi_status_name(int32_t status);
 
 // The built-in scene of the letter the crate reproduces (`hdi` calls it `paper`).
 //

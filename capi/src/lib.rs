@@ -427,8 +427,9 @@ pub struct HdiPullIn {
 pub struct HdiCycleOptions {
     /// AC amplitude of the head–disk voltage (V, ≥ 0; the scene's by default).
     pub ac_amplitude_v: f64,
-    /// `false`: the scene's fixed heater programme; `true`: its touchdown-triggered ramp.
-    pub triggered: bool,
+    /// 0: the scene's fixed heater programme; any other value: its touchdown-triggered ramp
+    /// (an integer, so that any value C may hold is valid).
+    pub triggered: i32,
 }
 
 /// One dynamic touchdown/take-off cycle.
@@ -484,24 +485,31 @@ pub extern "C" fn hdi_last_error() -> *const c_char {
     error::last_error_ptr()
 }
 
-/// The name of a status, e.g. `"HDI_STATUS_INVALID_INPUT"` (a static string).
+/// The name of a status (an `HdiStatus` value), e.g. `"HDI_STATUS_INVALID_INPUT"`, or
+/// `"HDI_STATUS_UNKNOWN"` for a value that is none (a static string).
 #[no_mangle]
-pub extern "C" fn hdi_status_name(status: HdiStatus) -> *const c_char {
-    let s: &'static str = match status {
-        HdiStatus::Ok => "HDI_STATUS_OK\0",
-        HdiStatus::NullPointer => "HDI_STATUS_NULL_POINTER\0",
-        HdiStatus::InvalidHandle => "HDI_STATUS_INVALID_HANDLE\0",
-        HdiStatus::WrongHandleType => "HDI_STATUS_WRONG_HANDLE_TYPE\0",
-        HdiStatus::Busy => "HDI_STATUS_BUSY\0",
-        HdiStatus::InvalidInput => "HDI_STATUS_INVALID_INPUT\0",
-        HdiStatus::Scene => "HDI_STATUS_SCENE\0",
-        HdiStatus::Io => "HDI_STATUS_IO\0",
-        HdiStatus::NoConvergence => "HDI_STATUS_NO_CONVERGENCE\0",
-        HdiStatus::Analysis => "HDI_STATUS_ANALYSIS\0",
-        HdiStatus::Integration => "HDI_STATUS_INTEGRATION\0",
-        HdiStatus::Other => "HDI_STATUS_OTHER\0",
-        HdiStatus::Panic => "HDI_STATUS_PANIC\0",
-    };
+pub extern "C" fn hdi_status_name(status: i32) -> *const c_char {
+    // An integer, not the enum: a value from C outside the enum is answered, not undefined.
+    const NAMES: [&str; 13] = [
+        "HDI_STATUS_OK\0",
+        "HDI_STATUS_NULL_POINTER\0",
+        "HDI_STATUS_INVALID_HANDLE\0",
+        "HDI_STATUS_WRONG_HANDLE_TYPE\0",
+        "HDI_STATUS_BUSY\0",
+        "HDI_STATUS_INVALID_INPUT\0",
+        "HDI_STATUS_SCENE\0",
+        "HDI_STATUS_IO\0",
+        "HDI_STATUS_NO_CONVERGENCE\0",
+        "HDI_STATUS_ANALYSIS\0",
+        "HDI_STATUS_INTEGRATION\0",
+        "HDI_STATUS_OTHER\0",
+        "HDI_STATUS_PANIC\0",
+    ];
+    let s = usize::try_from(status)
+        .ok()
+        .and_then(|i| NAMES.get(i))
+        .copied()
+        .unwrap_or("HDI_STATUS_UNKNOWN\0");
     s.as_ptr().cast()
 }
 
@@ -910,7 +918,7 @@ pub unsafe extern "C" fn hdi_cycle_options_default(
         let out = unsafe { out_ref(out, "out") }?;
         *out = HdiCycleOptions {
             ac_amplitude_v: m.get().model.voltage().ac_amplitude,
-            triggered: false,
+            triggered: 0,
         };
         Ok(())
     })
@@ -936,7 +944,7 @@ pub unsafe extern "C" fn hdi_model_cycle(
         let (ac, triggered) = match options {
             Some(o) => (
                 non_negative("options.ac_amplitude_v", o.ac_amplitude_v, "V")?,
-                o.triggered,
+                o.triggered != 0,
             ),
             None => (v.ac_amplitude, false),
         };
@@ -1064,7 +1072,6 @@ unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failu
     let d = config_of(&lib, default_harmonics());
     // The library's value when `v` is the default's, else `v` converted by `si`.
     let pick = |v: f64, dv: f64, lib: f64, si: fn(f64) -> f64| if v == dv { lib } else { si(v) };
-    let same = |x: f64| x;
     let radius = pick(
         positive("config.radius_mm", c.radius_mm, "mm")?,
         d.radius_mm,
@@ -1302,11 +1309,11 @@ unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failu
         max_step,
         ..lib
     };
-    let _ = same;
     Ok((radius, opts))
 }
 
-/// The library's name of a drive option to the config's.
+/// The library's name of a drive option to the config's (`None`: not a drive option, such as a
+/// field of the scene, which keeps the scene's name).
 fn config_field(field: &str) -> Option<String> {
     let f = match field {
         "radius" => "config.radius_mm",
@@ -1319,7 +1326,14 @@ fn config_field(field: &str) -> Option<String> {
         "max_step" => "config.max_step_us",
         "disk.random_orders" => "config.disk.random_order_min, config.disk.random_order_max",
         "disk.harmonics" => "config.disk.harmonics[].order",
-        other => return Some(format!("config.{other}")),
+        other
+            if ["disk.", "ambient.", "sensors."]
+                .iter()
+                .any(|p| other.starts_with(p)) =>
+        {
+            return Some(format!("config.{other}"))
+        }
+        _ => return None,
     };
     Some(f.into())
 }

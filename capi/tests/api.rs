@@ -125,8 +125,34 @@ fn versions() {
         "hdi_version {v} is not the library's version"
     );
     assert_eq!(hdi_abi_version(), HDI_ABI_VERSION);
-    let name = unsafe { CStr::from_ptr(hdi_status_name(HdiStatus::InvalidInput)) };
+    let name = unsafe { CStr::from_ptr(hdi_status_name(HdiStatus::InvalidInput as i32)) };
     assert_eq!(name.to_str().unwrap(), "HDI_STATUS_INVALID_INPUT");
+    let all = [
+        (HdiStatus::Ok, "OK"),
+        (HdiStatus::NullPointer, "NULL_POINTER"),
+        (HdiStatus::InvalidHandle, "INVALID_HANDLE"),
+        (HdiStatus::WrongHandleType, "WRONG_HANDLE_TYPE"),
+        (HdiStatus::Busy, "BUSY"),
+        (HdiStatus::InvalidInput, "INVALID_INPUT"),
+        (HdiStatus::Scene, "SCENE"),
+        (HdiStatus::Io, "IO"),
+        (HdiStatus::NoConvergence, "NO_CONVERGENCE"),
+        (HdiStatus::Analysis, "ANALYSIS"),
+        (HdiStatus::Integration, "INTEGRATION"),
+        (HdiStatus::Other, "OTHER"),
+        (HdiStatus::Panic, "PANIC"),
+    ];
+    let name = |i: i32| {
+        unsafe { CStr::from_ptr(hdi_status_name(i)) }
+            .to_str()
+            .unwrap()
+    };
+    for (s, n) in all {
+        assert_eq!(name(s as i32), format!("HDI_STATUS_{n}"));
+    }
+    for i in [-1, all.len() as i32, i32::MAX] {
+        assert_eq!(name(i), "HDI_STATUS_UNKNOWN");
+    }
 }
 
 /// A drive with a changed disk, ambient drift and sensors, under a ramp with a dither and
@@ -299,7 +325,7 @@ fn analyses_equal_the_rust_analyses() {
     let mut c = HdiCycle::default();
     let copts = HdiCycleOptions {
         ac_amplitude_v: 0.3,
-        triggered: false,
+        triggered: 0,
     };
     ok(unsafe { hdi_model_cycle(model, &copts, &mut c) });
     let with_ac = m.with_voltage(hdi_tribology::model::Voltage {
@@ -387,7 +413,7 @@ fn a_handle_in_use_is_not_freed() {
             tx.send(()).unwrap();
             let opts = HdiCycleOptions {
                 ac_amplitude_v: 0.6,
-                triggered: false,
+                triggered: 0,
             };
             let mut c = HdiCycle::default();
             unsafe { hdi_model_cycle(addr as *const HdiModel, &opts, &mut c) }

@@ -190,3 +190,32 @@ fn misuse_gets_a_status_and_is_clean_under_valgrind() {
     assert!(out.ends_with("misuse: all checks passed\n"), "{out}");
     valgrind(&exe, &[path]);
 }
+
+/// The closed loop of docs/firmware.md compiles, runs, and finds the example's touchdown.
+#[test]
+fn the_loop_in_the_docs_runs() {
+    let doc = std::fs::read_to_string(manifest_dir().join("../docs/firmware.md")).expect("docs");
+    let start = doc.find("```c\n").expect("a C block") + 5;
+    let end = start + doc[start..].find("```").expect("its end");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let source = dir.path().join("loop.c");
+    std::fs::write(&source, &doc[start..end]).expect("write loop.c");
+    let exe = dir.path().join("loop");
+    compile(source.to_str().expect("UTF-8 path"), &exe);
+    let out = run(&mut Command::new(&exe));
+    // With --trace the Rust example stops after its loop.
+    let rust = run(
+        Command::new(profile_dir().join("examples").join("firmware_loop"))
+            .args(["1", "--trace"])
+            .arg(dir.path().join("rust.csv")),
+    );
+    let td = |text: &str, key: &str| {
+        let i = text.find(key).unwrap_or_else(|| panic!("{key} in {text}")) + key.len();
+        text[i..].split(' ').next().unwrap().to_string()
+    };
+    assert_eq!(
+        td(&out, "touchdown at "),
+        td(&rust, "AE touchdown at "),
+        "{out}"
+    );
+}
