@@ -9,7 +9,12 @@
 //! points (false alarms, missed touchdowns, the clearance error left), and the contact-sensor
 //! slope's alarms on noise alone.
 //!
-//! `cargo run --release --example firmware_loop [SEED]`
+//! `cargo run --release --example firmware_loop [SEED] [--trace FILE]`
+//!
+//! `--trace` writes every period of the user's loop (the command held and the sensors read) to
+//! FILE as CSV and stops after the loop. The C example `capi/examples/firmware_loop.c` runs the
+//! same controller through the C ABI and writes the same file; `capi/tests/c_example.rs`
+//! checks that the two agree to the bit.
 
 use hdi_tribology::analysis::{static_hysteresis, StaticOptions};
 use hdi_tribology::drive::{
@@ -18,6 +23,7 @@ use hdi_tribology::drive::{
     TrueContact,
 };
 use hdi_tribology::scene::Scene;
+use hdi_tribology::units;
 
 /// The user's controller: ramp, watch the AE, back off, hold.
 struct RampAndWatch {
@@ -33,6 +39,44 @@ struct RampAndWatch {
     mean: f64,
     touchdown_mw: Option<f64>,
     hold_left: usize,
+}
+
+/// Writes every period's sensors to a CSV text before the controller sees them.
+struct Traced<C> {
+    inner: C,
+    csv: Option<String>,
+    n: usize,
+}
+
+impl<C: Controller> Controller for Traced<C> {
+    fn start(&mut self) -> Command {
+        self.inner.start()
+    }
+
+    fn update(&mut self, s: &Sensors) -> Action {
+        self.n += 1;
+        if let Some(csv) = &mut self.csv {
+            use std::fmt::Write;
+            let t = &s.truth;
+            // The units of the C ABI's `HdiSensors`, converted as it converts them.
+            let _ = writeln!(
+                csv,
+                "{},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}",
+                self.n,
+                s.t,
+                units::to_mw(s.heater_power),
+                s.contact_resistance,
+                s.acoustic,
+                s.readback.fundamental,
+                s.readback.third,
+                units::to_nm(t.gap),
+                t.mean_contact_force * 1e6,
+                t.sensor_temperature,
+                units::to_nm(t.disk_height)
+            );
+        }
+        self.inner.update(s)
+    }
 }
 
 const DT: f64 = 50e-6;
@@ -79,26 +123,41 @@ impl Controller for RampAndWatch {
 }
 
 fn main() -> Result<(), hdi_tribology::Error> {
-    let seed: u64 = std::env::args()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
+    let mut seed: u64 = 1;
+    let mut trace = None;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--trace" => trace = args.next(),
+            s => seed = s.parse().unwrap_or(1),
+        }
+    }
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025)?;
     let plant = Plant::new(&scene, &zone, seed, DriveOptions::default())?;
     let mut drive = plant.drive()?;
-    let mut ctrl = RampAndWatch {
-        power_mw: 70.0,
-        // 1 mW/ms: 0.05 mW per 50 µs period.
-        ramp_mw: 0.05,
+    let mut traced = Traced {
+        inner: RampAndWatch {
+            power_mw: 70.0,
+            // 1 mW/ms: 0.05 mW per 50 µs period.
+            ramp_mw: 0.05,
+            n: 0,
+            base: (0.0, 0.0, 0),
+            mean: 0.0,
+            touchdown_mw: None,
+            hold_left: 0,
+        },
+        csv: trace.as_ref().map(|_| {
+            "period,time_s,heater_power_mw,contact_resistance_ohm,acoustic_v,\
+             readback_fundamental_v,readback_third_v,true_gap_nm,true_mean_contact_force_un,\
+             true_sensor_temperature_k,true_disk_height_nm\n"
+                .to_string()
+        }),
         n: 0,
-        base: (0.0, 0.0, 0),
-        mean: 0.0,
-        touchdown_mw: None,
-        hold_left: 0,
     };
     let clock = std::time::Instant::now();
-    let periods = run(&mut drive, &mut ctrl, DT, 1_000_000)?;
+    let periods = run(&mut drive, &mut traced, DT, 1_000_000)?;
+    let ctrl = &traced.inner;
     let wall = clock.elapsed().as_secs_f64();
     let h = static_hysteresis(
         plant.model(),
@@ -117,6 +176,13 @@ fn main() -> Result<(), hdi_tribology::Error> {
             td - 10.0
         ),
         None => println!("no touchdown seen"),
+    }
+    if let (Some(path), Some(csv)) = (&trace, &traced.csv) {
+        std::fs::write(path, csv).map_err(|source| hdi_tribology::Error::Io {
+            path: path.clone(),
+            source,
+        })?;
+        return Ok(());
     }
 
     // The crate's detectors on the 0.25 mW staircase from 70 mW, 20 seeds per point.

@@ -40,3 +40,9 @@ fi
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check ./python
 # The bit-for-bit tests run the `hdi` program that `cargo test --all-features` built above.
 "$venv/bin/python" -m pytest -q python/tests
+
+# The C ABI (capi/, a crate of its own with its own Cargo.lock): its tests compile the C
+# example and a program of misuses with the system C compiler, compare the example with the
+# Rust example to the bit, and run both under valgrind where it is installed
+# (docs/firmware.md, "How it is checked").
+cargo test --manifest-path capi/Cargo.toml

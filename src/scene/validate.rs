@@ -312,6 +312,7 @@ impl Scene {
                 "air_bearing.stiffness_n_per_m"
             }
             AirBearingModel::PowerLaw { .. } => "air_bearing.preload_n",
+            AirBearingModel::Reynolds { .. } => "air_bearing.geometry",
         };
         if k > MAX_AIR_BEARING_STIFFNESS_N_PER_M {
             let what = match self.air_bearing {

@@ -1,0 +1,443 @@
+//! The C ABI's calls against the Rust API they wrap: the same numbers to the bit, and the
+//! handle rules under threads.
+
+use hdi::*;
+use hdi_tribology::analysis::{self, Protocol};
+use hdi_tribology::drive::{
+    scene_zone, Ambient, Command, DiskSpec, DriveOptions, Harmonic, Plant, Sensors,
+};
+use hdi_tribology::model::SliderModel;
+use hdi_tribology::scene::Scene;
+use hdi_tribology::units;
+use std::ffi::CStr;
+use std::ptr::{null, null_mut};
+
+fn ok(s: HdiStatus) {
+    assert_eq!(s, HdiStatus::Ok, "{}", unsafe {
+        CStr::from_ptr(hdi_last_error()).to_string_lossy()
+    });
+}
+
+fn last_error() -> String {
+    unsafe { CStr::from_ptr(hdi_last_error()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn paper() -> *mut HdiScene {
+    let mut s = null_mut();
+    ok(unsafe { hdi_scene_paper(&mut s) });
+    s
+}
+
+fn same(what: &str, c: f64, rust: f64) {
+    assert_eq!(c.to_bits(), rust.to_bits(), "{what}: C {c}, Rust {rust}");
+}
+
+/// The C sensors equal the Rust sensors converted to the C units, field by field.
+fn same_sensors(k: usize, c: &HdiSensors, r: &Sensors) {
+    let t = &r.truth;
+    let pairs = [
+        ("time_s", c.time_s, r.t),
+        (
+            "heater_power_mw",
+            c.heater_power_mw,
+            units::to_mw(r.heater_power),
+        ),
+        (
+            "contact_resistance_ohm",
+            c.contact_resistance_ohm,
+            r.contact_resistance,
+        ),
+        ("acoustic_v", c.acoustic_v, r.acoustic),
+        (
+            "readback_fundamental_v",
+            c.readback_fundamental_v,
+            r.readback.fundamental,
+        ),
+        ("readback_third_v", c.readback_third_v, r.readback.third),
+        ("gap_nm", c.truth.gap_nm, units::to_nm(t.gap)),
+        ("pad_gap_nm", c.truth.pad_gap_nm, units::to_nm(t.pad_gap)),
+        (
+            "displacement_nm",
+            c.truth.displacement_nm,
+            units::to_nm(t.displacement),
+        ),
+        (
+            "velocity_mm_per_s",
+            c.truth.velocity_mm_per_s,
+            t.velocity * 1e3,
+        ),
+        (
+            "protrusion_nm",
+            c.truth.protrusion_nm,
+            units::to_nm(t.protrusion),
+        ),
+        (
+            "mean_contact_force_un",
+            c.truth.mean_contact_force_un,
+            t.mean_contact_force * 1e6,
+        ),
+        (
+            "contact_force_un",
+            c.truth.contact_force_un,
+            t.contact_force * 1e6,
+        ),
+        (
+            "interface_force_un",
+            c.truth.interface_force_un,
+            t.interface_force * 1e6,
+        ),
+        (
+            "mean_flash_temperature_k",
+            c.truth.mean_flash_temperature_k,
+            t.mean_flash_temperature,
+        ),
+        (
+            "friction_power_mw",
+            c.truth.friction_power_mw,
+            units::to_mw(t.friction_power),
+        ),
+        (
+            "sensor_temperature_k",
+            c.truth.sensor_temperature_k,
+            t.sensor_temperature,
+        ),
+        (
+            "disk_height_nm",
+            c.truth.disk_height_nm,
+            units::to_nm(t.disk_height),
+        ),
+        ("ambient_k", c.truth.ambient_k, t.ambient),
+    ];
+    for (name, a, b) in pairs {
+        same(&format!("period {k}: {name}"), a, b);
+    }
+}
+
+#[test]
+fn versions() {
+    let v = unsafe { CStr::from_ptr(hdi_version()) }.to_str().unwrap();
+    let root = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../Cargo.toml"))
+        .expect("the library's Cargo.toml");
+    assert!(
+        root.contains(&format!("\nversion = \"{v}\"\n")),
+        "hdi_version {v} is not the library's version"
+    );
+    assert_eq!(hdi_abi_version(), HDI_ABI_VERSION);
+    let name = unsafe { CStr::from_ptr(hdi_status_name(HdiStatus::InvalidInput as i32)) };
+    assert_eq!(name.to_str().unwrap(), "HDI_STATUS_INVALID_INPUT");
+    let all = [
+        (HdiStatus::Ok, "OK"),
+        (HdiStatus::NullPointer, "NULL_POINTER"),
+        (HdiStatus::InvalidHandle, "INVALID_HANDLE"),
+        (HdiStatus::WrongHandleType, "WRONG_HANDLE_TYPE"),
+        (HdiStatus::Busy, "BUSY"),
+        (HdiStatus::InvalidInput, "INVALID_INPUT"),
+        (HdiStatus::Scene, "SCENE"),
+        (HdiStatus::Io, "IO"),
+        (HdiStatus::NoConvergence, "NO_CONVERGENCE"),
+        (HdiStatus::Analysis, "ANALYSIS"),
+        (HdiStatus::Integration, "INTEGRATION"),
+        (HdiStatus::Other, "OTHER"),
+        (HdiStatus::Panic, "PANIC"),
+    ];
+    let name = |i: i32| {
+        unsafe { CStr::from_ptr(hdi_status_name(i)) }
+            .to_str()
+            .unwrap()
+    };
+    for (s, n) in all {
+        assert_eq!(name(s as i32), format!("HDI_STATUS_{n}"));
+    }
+    for i in [-1, all.len() as i32, i32::MAX] {
+        assert_eq!(name(i), "HDI_STATUS_UNKNOWN");
+    }
+}
+
+/// A drive with a changed disk, ambient drift and sensors, under a ramp with a dither and
+/// a DC voltage, steps as the Rust drive with the same options, to the bit.
+#[test]
+fn configured_drive_steps_as_the_rust_drive() {
+    let harmonics = [
+        HdiHarmonic {
+            order: 1,
+            amplitude_nm: 500.0,
+            phase_rad: 0.25,
+        },
+        HdiHarmonic {
+            order: 30,
+            amplitude_nm: 0.2,
+            phase_rad: 1.0,
+        },
+    ];
+    let mut config = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_drive_config_default(config.as_mut_ptr()) });
+    let mut config: HdiDriveConfig = unsafe { config.assume_init() };
+    config.radius_mm = 30.0;
+    config.initial_heater_power_mw = 62.0;
+    config.heater_time_constant_us = 50.0;
+    config.disk.harmonics = harmonics.as_ptr();
+    config.disk.harmonic_count = harmonics.len();
+    config.disk.random_rms_nm = 0.1;
+    config.disk.random_order_min = 10;
+    config.disk.random_order_max = 100;
+    config.ambient = HdiAmbient {
+        rate_k_per_s: 200.0,
+        amplitude_k: 0.5,
+        period_s: 0.004,
+        clearance_per_kelvin_nm: 0.05,
+    };
+    config.sensors.contact.noise_ohm = 0.01;
+    config.sensors.contact.bandwidth_khz = 20.0;
+    config.sensors.acoustic.noise_v = 1e-3;
+    config.sensors.readback.wavelength_nm = 80.0;
+    config.atol_flight_pm = 1.0;
+    let scene = paper();
+    let mut drive = null_mut();
+    ok(unsafe { hdi_drive_new(scene, &config, 42, &mut drive) });
+
+    let s = Scene::paper();
+    let mut sensors = hdi_tribology::drive::SensorSpec::default();
+    sensors.contact.noise = 0.01;
+    sensors.contact.bandwidth = units::khz(20.0);
+    sensors.acoustic.noise = 1e-3;
+    sensors.readback.wavelength = units::nm(80.0);
+    let opts = DriveOptions {
+        initial_power: units::mw(62.0),
+        heater_time_constant: 50.0 * 1e-6,
+        disk: DiskSpec {
+            harmonics: vec![
+                Harmonic {
+                    order: 1,
+                    amplitude: units::nm(500.0),
+                    phase: 0.25,
+                },
+                Harmonic {
+                    order: 30,
+                    amplitude: units::nm(0.2),
+                    phase: 1.0,
+                },
+            ],
+            random_rms: units::nm(0.1),
+            random_orders: (10, 100),
+        },
+        ambient: Ambient {
+            rate: 200.0,
+            amplitude: 0.5,
+            period: 0.004,
+            clearance_per_kelvin: units::nm(0.05),
+        },
+        sensors,
+        atol_displacement_flight: 1.0 * 1e-12,
+        ..DriveOptions::default()
+    };
+    let plant = Plant::new(&s, &scene_zone(&s, 30.0 * 1e-3).unwrap(), 42, opts).unwrap();
+    let mut rust = plant.into_drive().unwrap();
+    let mut c = HdiSensors::default();
+    for k in 0..300 {
+        let cmd = HdiCommand {
+            heater_power_mw: 62.0 + 0.05 * k as f64,
+            dc_voltage_v: 0.3,
+            ac_amplitude_v: if k > 150 { 0.2 } else { 0.0 },
+            ac_frequency_khz: 10.5,
+        };
+        ok(unsafe { hdi_drive_step(drive, &cmd, 50e-6, &mut c) });
+        let r = rust
+            .step(
+                &Command {
+                    dc_voltage: 0.3,
+                    ..Command::heater_mw(cmd.heater_power_mw)
+                }
+                .with_dither(cmd.ac_amplitude_v, units::khz(10.5)),
+                50e-6,
+            )
+            .unwrap();
+        same_sensors(k, &c, &r);
+    }
+    // The drift is in: ΔT = rate·t + amplitude·sin(2πt/period) at the last period's start.
+    let t0 = 299.0 * 50e-6;
+    let want = 200.0 * t0 + 0.5 * (2.0 * std::f64::consts::PI * t0 / 0.004).sin();
+    assert!(
+        (c.truth.ambient_k - want).abs() < 1e-9,
+        "{} K, expected {want} K",
+        c.truth.ambient_k
+    );
+    assert!(c.truth.disk_height_nm.abs() > 1.0);
+    let mut t = 0.0;
+    ok(unsafe { hdi_drive_time(drive, &mut t) });
+    same("time", t, rust.time());
+    ok(unsafe { hdi_drive_free(drive) });
+    ok(unsafe { hdi_scene_free(scene) });
+}
+
+#[test]
+fn analyses_equal_the_rust_analyses() {
+    let scene = paper();
+    let mut model = null_mut();
+    ok(unsafe { hdi_model_new(scene, &mut model) });
+    ok(unsafe { hdi_scene_free(scene) });
+    let s = Scene::paper();
+    let m = SliderModel::from_scene(&s).unwrap();
+    let p = Protocol::from_scene(&s).unwrap();
+
+    let mut h = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_model_hysteresis(model, null(), h.as_mut_ptr()) });
+    let h: HdiHysteresis = unsafe { h.assume_init() };
+    let r = analysis::static_hysteresis(&m, &p.statics).unwrap();
+    same("touchdown", h.touchdown.power_mw, r.touchdown.power_mw());
+    same(
+        "touchdown gap",
+        h.touchdown.gap_nm,
+        units::to_nm(r.touchdown.at.d),
+    );
+    same("take-off", h.takeoff.power_mw, r.takeoff.power_mw());
+    same("hysteresis", h.hysteresis_mw, r.hysteresis_mw());
+    assert_eq!(h.touchdown.cause, HdiCause::Fold);
+
+    // Take-off from where the hysteresis starts it: the same transition.
+    let mut t = std::mem::MaybeUninit::uninit();
+    let start = h.touchdown.power_mw + 30.0;
+    ok(unsafe { hdi_model_takeoff(model, null(), start, t.as_mut_ptr()) });
+    let t: HdiTransition = unsafe { t.assume_init() };
+    let rt = analysis::takeoff_power(&m, units::mw(start), &p.statics).unwrap();
+    same("take-off from start", t.power_mw, rt.power_mw());
+
+    // A threshold of 10 µN: given in µN, used in N.
+    let opts = HdiStaticOptions {
+        contact_threshold_un: 10.0,
+        takeoff_start_excess_mw: 30.0,
+    };
+    let mut td = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_model_touchdown(model, &opts, td.as_mut_ptr()) });
+    let td: HdiTransition = unsafe { td.assume_init() };
+    let rtd = analysis::touchdown_power(&m, &analysis::StaticOptions::new(10.0 * 1e-6)).unwrap();
+    same("touchdown at 10 µN", td.power_mw, rtd.power_mw());
+
+    let mut pi = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_model_pull_in(model, null(), 20.0, pi.as_mut_ptr()) });
+    let pi: HdiPullIn = unsafe { pi.assume_init() };
+    let rpi = analysis::pull_in_voltage(&m, units::mw(20.0), &p.statics).unwrap();
+    same("pull-in", pi.voltage_v, rpi.voltage);
+    same("pull-in gap", pi.gap_nm, units::to_nm(rpi.d));
+
+    // One cycle at 0.3 V.
+    let mut c = HdiCycle::default();
+    let copts = HdiCycleOptions {
+        ac_amplitude_v: 0.3,
+        triggered: 0,
+    };
+    ok(unsafe { hdi_model_cycle(model, &copts, &mut c) });
+    let with_ac = m.with_voltage(hdi_tribology::model::Voltage {
+        ac_amplitude: 0.3,
+        ..m.voltage()
+    });
+    let rc = analysis::simulate_cycle(&with_ac, &p.fixed, &p.cycle).unwrap();
+    assert!(c.touchdown_detected && c.takeoff_detected);
+    same(
+        "cycle touchdown",
+        c.touchdown_power_mw,
+        rc.touchdown.unwrap().power_mw(),
+    );
+    same(
+        "cycle take-off time",
+        c.takeoff_time_s,
+        rc.takeoff.unwrap().time,
+    );
+    same(
+        "cycle hysteresis",
+        c.hysteresis_mw,
+        rc.hysteresis_mw().unwrap(),
+    );
+    assert_eq!(c.accepted_steps, rc.stats.accepted as u64);
+    ok(unsafe { hdi_model_free(model) });
+}
+
+/// Two threads stepping one drive: each call either runs alone or is refused as busy, and the
+/// drive's time counts exactly the calls that ran.
+#[test]
+fn a_drive_takes_one_call_at_a_time() {
+    let scene = paper();
+    let mut drive = null_mut();
+    ok(unsafe { hdi_drive_new(scene, null(), 1, &mut drive) });
+    ok(unsafe { hdi_scene_free(scene) });
+    let addr = drive as usize;
+    let worker = move || {
+        let drive = addr as *mut HdiDrive;
+        let (mut ran, mut busy) = (0u64, 0u64);
+        let mut s = HdiSensors::default();
+        let cmd = HdiCommand {
+            heater_power_mw: 65.0,
+            ..HdiCommand::default()
+        };
+        for _ in 0..400 {
+            match unsafe { hdi_drive_step(drive, &cmd, 50e-6, &mut s) } {
+                HdiStatus::Ok => ran += 1,
+                HdiStatus::Busy => {
+                    assert!(last_error().contains("in use by a call on another thread"));
+                    busy += 1
+                }
+                other => panic!("{other:?}: {}", last_error()),
+            }
+        }
+        (ran, busy)
+    };
+    let a = std::thread::spawn(worker);
+    let b = std::thread::spawn(worker);
+    let (ra, ba) = a.join().unwrap();
+    let (rb, bb) = b.join().unwrap();
+    assert_eq!(ra + ba + rb + bb, 800);
+    let mut t = 0.0;
+    ok(unsafe { hdi_drive_time(drive, &mut t) });
+    let ran = (ra + rb) as f64;
+    assert!(
+        (t - ran * 50e-6).abs() < 1e-12,
+        "time {t} s after {ran} periods"
+    );
+    ok(unsafe { hdi_drive_free(drive) });
+}
+
+/// A model cannot be freed while a call on another thread reads it.
+#[test]
+fn a_handle_in_use_is_not_freed() {
+    let mut seen_busy = false;
+    for _ in 0..20 {
+        let scene = paper();
+        let mut model = null_mut();
+        ok(unsafe { hdi_model_new(scene, &mut model) });
+        ok(unsafe { hdi_scene_free(scene) });
+        let addr = model as usize;
+        let (tx, rx) = std::sync::mpsc::channel();
+        // A slow call: a cycle at 0.6 V (tens of milliseconds).
+        let reader = std::thread::spawn(move || {
+            tx.send(()).unwrap();
+            let opts = HdiCycleOptions {
+                ac_amplitude_v: 0.6,
+                triggered: 0,
+            };
+            let mut c = HdiCycle::default();
+            unsafe { hdi_model_cycle(addr as *const HdiModel, &opts, &mut c) }
+        });
+        rx.recv().unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(2));
+        let freed = match unsafe { hdi_model_free(model) } {
+            HdiStatus::Busy => {
+                assert!(last_error().contains("in use"), "{}", last_error());
+                seen_busy = true;
+                false
+            }
+            HdiStatus::Ok => true,
+            other => panic!("{other:?}: {}", last_error()),
+        };
+        let read = reader.join().unwrap();
+        if freed {
+            // Freed before the reader took it: the reader was refused, not let in.
+            assert!(matches!(read, HdiStatus::Ok | HdiStatus::InvalidHandle));
+            continue;
+        }
+        assert_eq!(read, HdiStatus::Ok);
+        ok(unsafe { hdi_model_free(model) });
+        break;
+    }
+    assert!(seen_busy, "no free was refused in 20 tries");
+}
