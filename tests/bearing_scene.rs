@@ -121,12 +121,12 @@ fn hdi_static_and_cycle_run_on_the_solved_bearing() {
     };
     let s = run(&["static", path]);
     let (td, to) = (
-        s["touchdown_power"].as_f64().unwrap(),
-        s["takeoff_power"].as_f64().unwrap(),
+        s["touchdown"]["power_w"].as_f64().unwrap(),
+        s["takeoff"]["power_w"].as_f64().unwrap(),
     );
     eprintln!("static on the solved bearing: touchdown {td:.6e} W, take-off {to:.6e} W");
     assert!(td > 0.0 && to > 0.0 && td >= to, "{s}");
     let c = run(&["cycle", path]);
-    assert!(c["touchdown_power"].as_f64().unwrap() > 0.0, "{c}");
-    assert!(c["hysteresis"].as_f64().is_some(), "{c}");
+    assert!(c["touchdown"]["power_w"].as_f64().unwrap() > 0.0, "{c}");
+    assert!(c["hysteresis_w"].as_f64().is_some(), "{c}");
 }
