@@ -24,12 +24,21 @@ fn manifest_dir() -> PathBuf {
 
 /// Compiles `source` (relative to capi/) against the static library into `out`.
 fn compile(source: &str, out: &Path) {
-    let lib = profile_dir().join("libhdi.a");
-    assert!(
-        lib.exists(),
-        "{} is missing: cargo builds it with the crate (crate-type staticlib)",
-        lib.display()
-    );
+    // The static library built for this test run sits beside the test in `deps`; `cargo build`
+    // also copies it up to the profile folder.
+    let lib = [
+        profile_dir().join("deps").join("libhdi.a"),
+        profile_dir().join("libhdi.a"),
+    ]
+    .into_iter()
+    .find(|p| p.exists())
+    .unwrap_or_else(|| {
+        panic!(
+            "libhdi.a is missing from {}/deps: cargo builds it with the crate (crate-type \
+             staticlib)",
+            profile_dir().display()
+        )
+    });
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let status = Command::new(&cc)
         .args([
