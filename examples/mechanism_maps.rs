@@ -167,11 +167,11 @@ enum Cause {
 
 impl Cause {
     fn of(e: &hdi_tribology::Error) -> Self {
-        use hdi_tribology::error::AnalysisError as A;
-        match e {
-            hdi_tribology::Error::Analysis(A::LeftTheModel { .. }) => Cause::HitTheDisk,
-            hdi_tribology::Error::Analysis(A::LeftTheTables { .. }) => Cause::LeftTheTables,
-            hdi_tribology::Error::Analysis(A::StepPace { .. }) => Cause::StepPace,
+        use hdi_tribology::analysis::cycle::CycleError as C;
+        match e.failure().and_then(|f| f.downcast_ref::<C>()) {
+            Some(C::LeftTheModel { .. }) => Cause::HitTheDisk,
+            Some(C::LeftTheTables { .. }) => Cause::LeftTheTables,
+            Some(C::StepPace { .. }) => Cause::StepPace,
             _ => Cause::Other,
         }
     }

@@ -1,13 +1,13 @@
 //! Every public constructor rejects non-finite, impossible and inconsistent input with a typed
 //! error that names the field; none panics.
 
+use hdi_tribology::analysis::cycle::CycleError;
 use hdi_tribology::analysis::cycle::{
     simulate_cycle, CycleOptions, Detector, HeaterProgramme, SolverSettings,
 };
 use hdi_tribology::analysis::{
     flying_equilibrium, pull_in_voltage, s_curve, static_hysteresis, ScanGrid, StaticOptions,
 };
-use hdi_tribology::error::AnalysisError;
 use hdi_tribology::force::{
     composite_modulus, AirBearingModel, Coulomb, CubicBearing, Electrostatic, Footprint,
     GapReference, GreenwoodWilliamson, InterfaceForces, Intermolecular, LennardJones39,
@@ -339,7 +339,7 @@ fn tables_reject_bad_ranges_and_tolerances() {
     let wiggly = |x: f64| Ok(((1e3 * x).sin(), 1e3 * (1e3 * x).cos()));
     assert!(matches!(
         Table::build(wiggly, 0.0, 1.0, &tiny),
-        Err(Error::NoConvergence { .. })
+        Err(Error::NoConvergence(_))
     ));
     let scene = Scene::paper();
     for range in [(1e-8, 1e-9), (f64::NAN, 1e-8), (0.0, f64::INFINITY)] {
@@ -531,13 +531,14 @@ fn analyses_in_power_need_a_working_heater() {
         ramp_rate: 5.0,
         overshoot: 1e-3,
     };
-    match simulate_cycle(&weak, &triggered, &copts) {
-        Err(Error::Analysis(AnalysisError::TooManySegments {
+    let e = simulate_cycle(&weak, &triggered, &copts).unwrap_err();
+    match e.failure().and_then(|f| f.downcast_ref()) {
+        Some(CycleError::TooManySegments {
             segments,
             max_segments,
             ..
-        })) => assert!(segments > max_segments, "{segments} {max_segments}"),
-        other => panic!("expected the segment bound, got {other:?}"),
+        }) => assert!(segments > max_segments, "{segments} {max_segments}"),
+        _ => panic!("expected the segment bound, got {e:?}"),
     }
 }
 
@@ -566,6 +567,6 @@ fn oversized_tables_and_zero_tolerances_are_refused() {
     };
     assert!(matches!(
         Table::build(f, 0.0, 10.0, &tight),
-        Err(Error::NoConvergence { .. })
+        Err(Error::NoConvergence(_))
     ));
 }

@@ -5,10 +5,10 @@
 use hdi_tribology::analysis::{
     flying_equilibrium, static_hysteresis, touchdown_power, ScanGrid, StaticOptions,
 };
+use hdi_tribology::calibration::CalibrationError;
 use hdi_tribology::calibration::{
     calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Zone,
 };
-use hdi_tribology::error::{AnalysisError, Stage};
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
@@ -260,12 +260,14 @@ fn bad_options_are_typed_errors_naming_the_field() {
     assert!(ContactForceRms::new(1e-5, 0.0, 1e-5).is_err());
     // No contact below max_power: an analysis error, not a panic or an endless search.
     o = CalibrationOptions::new(0.0, 5e-3, 0.01, 0.0);
-    match calibrate(&model, &mut det, &o).unwrap_err() {
-        Error::Analysis(AnalysisError::NoTouchdown {
-            stage: Stage::ClearanceCalibration,
-            max_power_mw,
-            detector: Some(_),
-        }) => assert_eq!(max_power_mw, 10.0),
-        other => panic!("unexpected {other}"),
+    let e = calibrate(&model, &mut det, &o).unwrap_err();
+    let Error::Analysis(f) = &e else {
+        panic!("unexpected {e}")
+    };
+    match f.downcast_ref() {
+        Some(CalibrationError::NoTouchdown { max_power_mw, .. }) => {
+            assert_eq!(*max_power_mw, 10.0)
+        }
+        _ => panic!("unexpected {e}"),
     }
 }

@@ -3,9 +3,12 @@
 //! scene's programme. Each gives a finite answer that holds when the tolerance is tightened
 //! tenfold, or the typed error that the table below expects — never NaN, a panic or a hang.
 
+use hdi_tribology::analysis::cycle::CycleError;
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
+use hdi_tribology::analysis::equilibrium::FlyingError;
+use hdi_tribology::analysis::touchdown::TransitionError;
 use hdi_tribology::analysis::{static_hysteresis, StaticHysteresis, StaticOptions};
-use hdi_tribology::error::AnalysisError;
+use hdi_tribology::error::Failure;
 use hdi_tribology::force::Gaps;
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
@@ -18,37 +21,37 @@ enum Expect {
     /// A finite answer.
     Finite,
     /// An analysis error of the kind this function accepts.
-    Fails(fn(&AnalysisError) -> bool),
+    Fails(fn(&Failure) -> bool),
 }
 
 /// Touchdown lies at negative power.
-fn in_contact_at_zero_power(e: &AnalysisError) -> bool {
-    matches!(e, AnalysisError::InContactAtZeroPower { power_mw, .. } if *power_mw < 0.0)
+fn in_contact_at_zero_power(e: &Failure) -> bool {
+    matches!(e.downcast_ref(), Some(TransitionError::InContactAtZeroPower { power_mw, .. }) if *power_mw < 0.0)
 }
 
 /// Take-off would need negative power: adhesion holds the head.
-fn held_in_contact(e: &AnalysisError) -> bool {
-    matches!(e, AnalysisError::NoTakeOff { power_mw, .. } if *power_mw < 0.0)
+fn held_in_contact(e: &Failure) -> bool {
+    matches!(e.downcast_ref(), Some(TransitionError::NoTakeOff { power_mw, .. }) if *power_mw < 0.0)
 }
 
 /// At exactly the pull-in voltage the touchdown fold lies at 0 W to rounding: either.
-fn either_at_zero_power(e: &AnalysisError) -> bool {
+fn either_at_zero_power(e: &Failure) -> bool {
     in_contact_at_zero_power(e) || held_in_contact(e)
 }
 
 /// The flying branch ends before the programme's start power.
-fn flying_branch_ends(e: &AnalysisError) -> bool {
-    matches!(e, AnalysisError::FlyingBranchEnds { .. })
+fn flying_branch_ends(e: &Failure) -> bool {
+    matches!(e.downcast_ref(), Some(FlyingError::FlyingBranchEnds { .. }))
 }
 
 /// The pad reached the disk, with the lag named as the cause.
-fn self_excited(e: &AnalysisError) -> bool {
+fn self_excited(e: &Failure) -> bool {
     matches!(
-        e,
-        AnalysisError::LeftTheModel {
+        e.downcast_ref(),
+        Some(CycleError::LeftTheModel {
             self_excited: Some(_),
             ..
-        }
+        })
     )
 }
 
@@ -283,10 +286,14 @@ fn equilibria_next_to_the_fold_are_found_or_refused_cleanly() {
     }
     for rel in [1e-9, 1e-6, 1e-3] {
         match flying_equilibrium(&model, td.power * (1.0 + rel), 0.0, &ScanGrid::default()) {
-            Err(Error::Analysis(AnalysisError::FlyingBranchEnds {
-                power_mw,
-                fold_gap_nm,
-            })) => {
+            Err(Error::Analysis(e)) if e.is::<FlyingError>() => {
+                let Some(&FlyingError::FlyingBranchEnds {
+                    power_mw,
+                    fold_gap_nm,
+                }) = e.downcast_ref()
+                else {
+                    panic!("{e}")
+                };
                 assert!(
                     (fold_gap_nm - td.at.d * 1e9).abs() <= 1e-9 * fold_gap_nm,
                     "{fold_gap_nm} nm vs the fold at {:e} m",

@@ -3,11 +3,11 @@
 //! with a clear "stiff" error, and the stiffness ratio of every extreme scene is measured
 //! (printed with `--nocapture`; the numbers are in `docs/validity.md`).
 
+use hdi_tribology::analysis::cycle::CycleError;
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
 use hdi_tribology::analysis::equilibrium::{
     flying_equilibrium, Equilibrium, EquilibriumSolver, ScanGrid,
 };
-use hdi_tribology::error::AnalysisError;
 use hdi_tribology::heater::Programme;
 use hdi_tribology::model::{SliderModel, SliderSystem};
 use hdi_tribology::ode::{self, Method, OdeSystem, Options, SaveAt};
@@ -155,14 +155,14 @@ fn explicit_method_on_a_stiff_scene_fails_with_a_clear_error() {
         // The cycle stops on the step budget itself, or earlier on the pace of its steps;
         // either way it names the stiffness.
         Err(Error::Analysis(e)) => {
-            let (t_ms, rate) = match &e {
-                AnalysisError::StepLimit {
+            let (t_ms, rate) = match e.downcast_ref::<CycleError>().expect("a cycle error") {
+                CycleError::StepLimit {
                     method: "tsit5",
                     max_steps: 20_000,
                     t_ms,
                     fastest_rate_per_s,
                 } => (*t_ms, *fastest_rate_per_s),
-                AnalysisError::StepPace {
+                CycleError::StepPace {
                     method: "tsit5",
                     max_steps: 20_000,
                     t_ms,

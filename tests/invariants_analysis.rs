@@ -11,8 +11,8 @@ mod seeded;
 use hdi_tribology::analysis::ac_sweep;
 #[cfg(feature = "parallel")]
 use hdi_tribology::analysis::cycle::{CycleOptions, HeaterProgramme};
+use hdi_tribology::analysis::touchdown::TransitionError;
 use hdi_tribology::analysis::{flying_equilibrium, static_hysteresis, ScanGrid, StaticOptions};
-use hdi_tribology::error::AnalysisError;
 use hdi_tribology::force::{AirBearingModel, Footprint};
 #[cfg(feature = "parallel")]
 use hdi_tribology::heater::Programme;
@@ -152,11 +152,21 @@ proptest! {
                 prop_assert!((td - td2).abs() <= 1e-9 * td, "{td} vs {td2}");
                 prop_assert!((to - to2).abs() <= 1e-9 * td, "{to} vs {to2}");
             }
-            Err(Error::Analysis(
-                AnalysisError::InContactAtZeroPower { power_mw, .. }
-                | AnalysisError::NoTakeOff { power_mw, .. },
-            )) => {
-                prop_assert!(power_mw < 0.0, "{power_mw}");
+            Err(Error::Analysis(e))
+                if matches!(
+                    e.downcast_ref(),
+                    Some(
+                        TransitionError::InContactAtZeroPower { .. }
+                            | TransitionError::NoTakeOff { .. }
+                    )
+                ) =>
+            {
+                let (TransitionError::InContactAtZeroPower { power_mw, .. }
+                | TransitionError::NoTakeOff { power_mw, .. }) = e.downcast_ref().unwrap()
+                else {
+                    unreachable!()
+                };
+                prop_assert!(*power_mw < 0.0, "{power_mw}");
             }
             Err(other) => prop_assert!(false, "{other}"),
         }

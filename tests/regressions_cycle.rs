@@ -1,7 +1,22 @@
 //! Dynamic-cycle cases that once failed, kept as regression tests.
 
+use hdi_tribology::analysis::cycle::CycleError;
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
-use hdi_tribology::error::{AnalysisError, Stage};
+use hdi_tribology::error::{Failure, Stage};
+
+/// The cycle's failure and its kind, or a panic naming what came instead.
+fn cycle_failure<T: std::fmt::Debug>(r: Result<T, Error>) -> (Failure, CycleError) {
+    match r {
+        Err(Error::Analysis(f)) => {
+            let kind = f.downcast_ref::<CycleError>().cloned();
+            (
+                f.clone(),
+                kind.unwrap_or_else(|| panic!("not a cycle error: {f}")),
+            )
+        }
+        other => panic!("expected a cycle error, got {other:?}"),
+    }
+}
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
@@ -16,18 +31,19 @@ fn self_excited_contact_stops_with_a_reason_instead_of_nan() {
     scene.slider.interface_lag_s = 1e-7;
     let model = SliderModel::from_scene(&scene).unwrap();
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
-    match simulate_cycle(
+    match cycle_failure(simulate_cycle(
         &model,
         &programme,
         &CycleOptions::from_scene(&scene).unwrap(),
-    ) {
-        Err(Error::Analysis(
-            e @ AnalysisError::LeftTheModel {
+    )) {
+        (
+            e,
+            CycleError::LeftTheModel {
                 self_excited: Some(x),
                 ..
             },
-        )) => {
-            assert_eq!(e.stage(), Stage::Cycle);
+        ) => {
+            assert_eq!(e.stage(), Stage::CYCLE);
             assert!((x.interface_lag_ns - 100.0).abs() < 1e-9, "{e}");
             assert!(x.limit_ns < x.interface_lag_ns, "{e}");
             let text = e.to_string();
@@ -72,10 +88,10 @@ fn a_cycle_spending_steps_too_fast_stops_early() {
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     let mut opts = CycleOptions::from_scene(&scene).unwrap();
     opts.solver.max_steps = 300_000;
-    match simulate_cycle(&model, &programme, &opts) {
-        Err(Error::Analysis(AnalysisError::StepPace {
+    match cycle_failure(simulate_cycle(&model, &programme, &opts)).1 {
+        CycleError::StepPace {
             steps, max_steps, ..
-        })) => {
+        } => {
             assert_eq!(max_steps, 300_000);
             // The steps spent are named: far fewer than the budget.
             assert!(steps < 100_000, "{steps}");
@@ -137,9 +153,10 @@ fn a_bounce_below_the_tables_stops_when_asked() {
     let low_nm = model.forces().table_range().0 * 1e9;
     for v_ac in [1.0, 0.8] {
         model = model.with_ac_amplitude(v_ac);
-        match simulate_cycle(&model, &programme, &opts) {
-            Err(Error::Analysis(
-                e @ AnalysisError::LeftTheTables {
+        match cycle_failure(simulate_cycle(&model, &programme, &opts)) {
+            (
+                e,
+                CycleError::LeftTheTables {
                     t_ms,
                     bulge_gap_nm,
                     table_low_nm,
@@ -149,8 +166,8 @@ fn a_bounce_below_the_tables_stops_when_asked() {
                     span_ms,
                     max_steps,
                 },
-            )) => {
-                assert_eq!(e.stage(), Stage::Cycle);
+            ) => {
+                assert_eq!(e.stage(), Stage::CYCLE);
                 assert_eq!(e.kind(), "LeftTheTables");
                 assert!((table_low_nm - low_nm).abs() <= 1e-12 * low_nm.abs(), "{e}");
                 assert!(bulge_gap_nm < table_low_nm, "{e}");

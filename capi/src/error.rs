@@ -38,7 +38,7 @@ impl From<hdi_tribology::Error> for Failure {
         let status = match &e {
             E::InvalidInput { .. } => HdiStatus::InvalidInput,
             E::Scene { .. } => HdiStatus::Scene,
-            E::NoConvergence { .. } => HdiStatus::NoConvergence,
+            E::NoConvergence(_) => HdiStatus::NoConvergence,
             E::Analysis(_) => HdiStatus::Analysis,
             E::Ode(_) => HdiStatus::Integration,
             E::Io { .. } => HdiStatus::Io,

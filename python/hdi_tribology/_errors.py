@@ -32,15 +32,19 @@ class SceneError(HdiError, ValueError):
 
 
 class NoConvergenceError(HdiError, ArithmeticError):
-    """A numerical procedure did not reach its tolerance: ``what`` and ``reason``."""
+    """A numerical procedure did not reach its tolerance: ``what`` (the procedure), ``reason``
+    and ``kind`` (the failure's name, e.g. ``IntervalBudget``)."""
 
     what: str
+    kind: str
 
 
 class AnalysisError(HdiError):
-    """An analysis cannot produce its result for this scene: ``what`` and ``reason``."""
+    """An analysis cannot produce its result for this scene: ``what`` (the analysis),
+    ``reason`` and ``kind`` (the failure's name, e.g. ``NoTakeOff``)."""
 
     what: str
+    kind: str
 
 
 class SolverError(HdiError, ArithmeticError):

@@ -57,9 +57,13 @@ fn to_py_err(e: hdi_tribology::Error) -> PyErr {
             vec![("field", field), ("reason", reason)],
         ),
         E::Scene { origin, reason } => ("SceneError", vec![("origin", origin), ("reason", reason)]),
-        E::NoConvergence { what, reason } => (
+        E::NoConvergence(f) => (
             "NoConvergenceError",
-            vec![("what", what), ("reason", reason)],
+            vec![
+                ("what", f.stage().to_string()),
+                ("reason", f.reason()),
+                ("kind", f.kind().to_string()),
+            ],
         ),
         E::Analysis(a) => (
             "AnalysisError",

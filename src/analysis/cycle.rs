@@ -10,7 +10,7 @@
 
 use super::equilibrium::{flying_equilibrium, ScanGrid};
 use super::roots::brent;
-use crate::error::{check_positive, Error, Result};
+use crate::error::{check_positive, num, Error, FailureKind, Result, Stage};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem};
 use crate::ode::{self, Method, Stats, StepStatus};
@@ -19,6 +19,226 @@ use nalgebra::{allocator::Allocator, DefaultAllocator, DimName, OVector};
 use serde::Serialize;
 use std::sync::Arc;
 use std::time::Instant;
+
+impl Stage {
+    /// A dynamic cycle under a fixed heater programme.
+    pub const CYCLE: Stage = Stage::named("cycle");
+    /// A dynamic cycle whose heater ramp reverses at touchdown.
+    pub const TRIGGERED_CYCLE: Stage = Stage::named("triggered cycle");
+}
+
+/// A contact that feeds energy into the bounce: the interface lag exceeds the time constant
+/// `c/K_contact` of the air-bearing damping against the contact stiffness.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SelfExcitation {
+    /// The interface lag `τ` (ns).
+    pub interface_lag_ns: f64,
+    /// `c/K_contact` where the trajectory stopped (ns).
+    pub limit_ns: f64,
+}
+
+/// Why a cycle could not run to its end. Numbers are in engineering units, as the field names
+/// say.
+///
+/// ```
+/// use hdi_tribology::analysis::cycle::CycleError;
+/// let e: hdi_tribology::Error = CycleError::NoTriggeredTouchdown { max_power_mw: 80.0 }.into();
+/// assert_eq!(e.to_string(), "triggered cycle: no touchdown detected up to 80.0000 mW");
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum CycleError {
+    /// Triggered cycle: the touchdown search would need too many segments of the overshoot.
+    #[error(
+        "reaching a protrusion of 2 h0 takes {} mW, {segments:.3e} segments of the overshoot {} mW \
+         (at most {max_segments:e}): raise the overshoot or the heater efficiency",
+        num(*.span_mw),
+        num(*.overshoot_mw)
+    )]
+    TooManySegments {
+        /// Heater power span searched, up to a protrusion of twice the clearance (mW).
+        span_mw: f64,
+        /// The overshoot (mW).
+        overshoot_mw: f64,
+        /// Segments needed.
+        segments: f64,
+        /// Segments allowed.
+        max_segments: f64,
+    },
+    /// Triggered cycle: the detector saw no touchdown on the whole ramp.
+    #[error("no touchdown detected up to {} mW", num(*.max_power_mw))]
+    NoTriggeredTouchdown {
+        /// The largest heater power reached (mW).
+        max_power_mw: f64,
+    },
+    /// The pad gap reached zero, so the slider body would enter the disk, outside the lumped
+    /// model.
+    #[error("{}", left_the_model_reason(*.t_ms, *.bulge_gap_nm, *.velocity_m_per_s, .self_excited))]
+    LeftTheModel {
+        /// Time (ms).
+        t_ms: f64,
+        /// Bulge gap there (nm).
+        bulge_gap_nm: f64,
+        /// Body velocity there (m/s).
+        velocity_m_per_s: f64,
+        /// Set when an interface lag makes the contact branch self-excited, the likely cause.
+        self_excited: Option<SelfExcitation>,
+    },
+    /// An explicit method used up its steps where the system is stiff.
+    #[error(
+        "the explicit method {method} used up its {max_steps} steps at t = {} ms: {}",
+        num(*.t_ms),
+        stiff_advice(*.fastest_rate_per_s)
+    )]
+    StepLimit {
+        /// The method's name, e.g. `tsit5`.
+        method: &'static str,
+        /// Its step budget.
+        max_steps: usize,
+        /// Time reached (ms).
+        t_ms: f64,
+        /// Fastest decay rate of the bearing, contact and lags (1/s).
+        fastest_rate_per_s: f64,
+    },
+    /// The steps are spent more than twice as fast as an even pace over the programme would
+    /// spend `solver.max_steps`, so the budget would run out.
+    #[error("{}", step_pace(method, *.steps, *.t_ms, *.span_ms, *.max_steps, *.stiff_rate_per_s))]
+    StepPace {
+        /// The method's name, e.g. `auto`.
+        method: &'static str,
+        /// Steps taken so far (accepted and rejected).
+        steps: usize,
+        /// Time reached (ms).
+        t_ms: f64,
+        /// Length of the heater programme (ms).
+        span_ms: f64,
+        /// The step budget.
+        max_steps: usize,
+        /// For an explicit method: the fastest decay rate of the bearing, contact and lags
+        /// (1/s), the likely cause.
+        stiff_rate_per_s: Option<f64>,
+    },
+    /// With [`CycleOptions::stop_outside_tables`]: the bulge gap of an accepted step is deeper
+    /// than the force tables reach while the steps are spent more than twice as fast as an even
+    /// pace over the programme would spend `solver.max_steps` (from the start, or since the
+    /// first step below the tables after an allowance of 1 % of the budget): a contact bouncing
+    /// deep in the disk, where the contact model is far outside its light-contact validity, at a
+    /// pace that would use up the step budget.
+    #[error(
+        "at t = {} ms the bulge gap d = {} nm is deeper than the force tables reach (down to {} \
+         nm), where the contact model is far outside its light-contact validity and every force \
+         is an exact quadrature, and the cycle spends its steps at more than twice the pace that \
+         uses solver.max_steps = {max_steps} evenly over the {} ms programme ({steps} steps, \
+         {steps_below} of them since the gap first went below the tables at {} ms): a contact \
+         bouncing below the tables that would use up the step budget",
+        num(*.t_ms),
+        num(*.bulge_gap_nm),
+        num(*.table_low_nm),
+        num(*.span_ms),
+        num(*.first_below_ms)
+    )]
+    LeftTheTables {
+        /// Time reached (ms).
+        t_ms: f64,
+        /// Bulge gap `d` there (nm).
+        bulge_gap_nm: f64,
+        /// The low end of the force tables (nm).
+        table_low_nm: f64,
+        /// Steps taken so far (accepted and rejected).
+        steps: usize,
+        /// Time of the first accepted step below the tables (ms).
+        first_below_ms: f64,
+        /// Steps taken since then.
+        steps_below: usize,
+        /// Length of the heater programme (ms).
+        span_ms: f64,
+        /// The step budget.
+        max_steps: usize,
+    },
+}
+
+impl FailureKind for CycleError {
+    fn stage(&self) -> Stage {
+        match self {
+            CycleError::TooManySegments { .. } | CycleError::NoTriggeredTouchdown { .. } => {
+                Stage::TRIGGERED_CYCLE
+            }
+            _ => Stage::CYCLE,
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            CycleError::TooManySegments { .. } => "TooManySegments",
+            CycleError::NoTriggeredTouchdown { .. } => "NoTriggeredTouchdown",
+            CycleError::LeftTheModel { .. } => "LeftTheModel",
+            CycleError::StepLimit { .. } => "StepLimit",
+            CycleError::StepPace { .. } => "StepPace",
+            CycleError::LeftTheTables { .. } => "LeftTheTables",
+        }
+    }
+}
+
+/// The reason of [`CycleError::LeftTheModel`].
+fn left_the_model_reason(
+    t_ms: f64,
+    gap_nm: f64,
+    v: f64,
+    self_excited: &Option<SelfExcitation>,
+) -> String {
+    let mut s = format!(
+        "at t = {} ms the pad gap h0 + y fell to zero (bulge gap d = {} nm, velocity {} m/s): the \
+         slider body would enter the disk, outside the lumped model",
+        num(t_ms),
+        num(gap_nm),
+        num(v)
+    );
+    if let Some(x) = self_excited {
+        s.push_str(&format!(
+            "; the interface lag {} ns exceeds c/K_contact = {} ns, so each contact feeds energy \
+             into the bounce (self-excited contact branch)",
+            num(x.interface_lag_ns),
+            num(x.limit_ns)
+        ));
+    }
+    s
+}
+
+/// Why an explicit method's step is limited on a stiff cycle, and what to use instead.
+fn stiff_advice(rate_per_s: f64) -> String {
+    format!(
+        "the system is stiff there (fastest mode about {rate_per_s:.3e} 1/s from the bearing, \
+         contact and lags), so stability, not accuracy, limits its step; use auto, rodas5p or \
+         radau5"
+    )
+}
+
+/// The reason of [`CycleError::StepPace`].
+fn step_pace(
+    method: &str,
+    steps: usize,
+    t_ms: f64,
+    span_ms: f64,
+    max_steps: usize,
+    stiff_rate_per_s: Option<f64>,
+) -> String {
+    let pace = format!(
+        "{steps} steps by t = {} ms, more than twice the pace that spends them evenly over the {} \
+         ms programme",
+        num(t_ms),
+        num(span_ms)
+    );
+    match stiff_rate_per_s {
+        Some(rate) => format!(
+            "the explicit method {method} would use up its {max_steps} steps ({pace}): {}",
+            stiff_advice(rate)
+        ),
+        None => format!(
+            "the cycle would use up solver.max_steps = {max_steps} ({pace}): a contact that \
+             bounces without bound, or a tolerance too strict for the method"
+        ),
+    }
+}
 
 /// Largest length of the touchdown-triggered search, in overshoots (`overshoot / ramp_rate` of
 /// time each; the paper scene's search spans 200).
@@ -125,7 +345,7 @@ pub struct CycleOptions {
     /// Stop a cycle whose contact bounces deep in the disk at a pace that would use up the step
     /// budget. At an accepted step whose bulge gap is below the low end of the force tables
     /// ([`InterfaceForces::table_range`](crate::force::InterfaceForces::table_range)), the cycle
-    /// ends with [`AnalysisError::LeftTheTables`](crate::error::AnalysisError) when it has spent
+    /// ends with [`CycleError::LeftTheTables`] when it has spent
     /// its steps at more than twice the even pace of [`max_steps`](SolverSettings::max_steps),
     /// either from the start without the step pace's start allowance, or since its first step
     /// below the tables after an allowance of 1 % of `max_steps`. Below the tables the few-peak
@@ -135,8 +355,7 @@ pub struct CycleOptions {
     /// on as before. Off by default ([`CycleOptions::from_scene`]).
     ///
     /// ```
-    /// use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
-    /// use hdi_tribology::error::AnalysisError;
+    /// use hdi_tribology::analysis::cycle::{simulate_cycle, CycleError, CycleOptions, HeaterProgramme};
     /// use hdi_tribology::{model::SliderModel, scene::Scene, Error};
     /// let scene = Scene::from_path(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/paper_bulge.toml"))?;
     /// // A 0.1 ns interface lag at 1 V AC: the few-peak contact bounces deep into the disk.
@@ -148,7 +367,10 @@ pub struct CycleOptions {
     /// opts.solver.max_steps = 300_000;
     /// opts.stop_outside_tables = true;
     /// match simulate_cycle(&model, &programme, &opts) {
-    ///     Err(Error::Analysis(AnalysisError::LeftTheTables { bulge_gap_nm, table_low_nm, .. })) => {
+    ///     Err(Error::Analysis(e)) => {
+    ///         let Some(CycleError::LeftTheTables { bulge_gap_nm, table_low_nm, .. }) = e.downcast_ref() else {
+    ///             panic!("{e}")
+    ///         };
     ///         assert!(bulge_gap_nm < table_low_nm);
     ///     }
     ///     other => panic!("{other:?}"),
@@ -375,7 +597,7 @@ pub fn simulate_cycle(
     // On a state vector sized at compile time: a step allocates nothing, and a scene pays only
     // for the coordinates, lags and term states it uses.
     problem.dispatch(
-        crate::error::Stage::Cycle,
+        Stage::CYCLE,
         CycleRun {
             model,
             opts,
@@ -415,7 +637,7 @@ impl Start {
                 // touchdown fails at once instead of running for ever.
                 let segments = span / overshoot;
                 if segments.is_nan() || segments > MAX_TRIGGERED_SEGMENTS {
-                    return Err(crate::error::AnalysisError::TooManySegments {
+                    return Err(CycleError::TooManySegments {
                         span_mw: crate::units::to_mw(span),
                         overshoot_mw: crate::units::to_mw(overshoot),
                         segments,
@@ -682,7 +904,7 @@ impl Observer for Guards<'_> {
                 // From the start without the step pace's start allowance, or afresh from the
                 // first step below the tables with a small one.
                 if too_fast(steps, t0, 0.0) || too_fast(steps - n1, t1, BELOW_TABLES_ALLOWANCE) {
-                    return Err(crate::error::AnalysisError::LeftTheTables {
+                    return Err(CycleError::LeftTheTables {
                         t_ms: t * 1e3,
                         bulge_gap_nm: crate::units::to_nm(d),
                         table_low_nm: crate::units::to_nm(low),
@@ -765,10 +987,8 @@ where
             });
             sim::run(&mut it, None, &mut (&mut recorder, &mut guards), ode_err)?;
             let Some(t_td) = recorder.watch.take().and_then(|w| w.found) else {
-                return Err(crate::error::AnalysisError::NoTouchdown {
-                    stage: crate::error::Stage::TriggeredCycle,
+                return Err(CycleError::NoTriggeredTouchdown {
                     max_power_mw: crate::units::to_mw(initial_programme.power(end)),
-                    detector: None,
                 }
                 .into());
             };
@@ -857,13 +1077,13 @@ fn left_the_model(model: &SliderModel, sys: &SliderSystem, t: f64, s: &[f64]) ->
         let k_contact = -model.forces().contact(g).d_bulge;
         let c = model.bearing().damping(s[0]);
         if k_contact > 0.0 && model.interface_lag() > c / k_contact {
-            self_excited = Some(crate::error::SelfExcitation {
+            self_excited = Some(SelfExcitation {
                 interface_lag_ns: model.interface_lag() * 1e9,
                 limit_ns: c / k_contact * 1e9,
             });
         }
     }
-    crate::error::AnalysisError::LeftTheModel {
+    CycleError::LeftTheModel {
         t_ms: t * 1e3,
         bulge_gap_nm: crate::units::to_nm(g.bulge),
         velocity_m_per_s: s[sys.layout().velocity(0)],
@@ -873,10 +1093,10 @@ fn left_the_model(model: &SliderModel, sys: &SliderSystem, t: f64, s: &[f64]) ->
 }
 
 /// An error of the cycle that no scene should cause.
-fn internal(detail: &str) -> Error {
-    crate::error::AnalysisError::Internal {
-        stage: crate::error::Stage::Cycle,
-        detail: detail.into(),
+fn internal(what: &'static str) -> Error {
+    crate::error::Internal {
+        stage: Stage::CYCLE,
+        what,
     }
     .into()
 }
@@ -891,7 +1111,7 @@ fn out_of_step_budget(
     span: f64,
 ) -> Error {
     let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
-    crate::error::AnalysisError::StepPace {
+    CycleError::StepPace {
         method: opts.solver.method.name(),
         steps: st.accepted + st.rejected,
         t_ms: t * 1e3,
@@ -906,15 +1126,13 @@ fn out_of_step_budget(
 fn explain_ode_error(model: &SliderModel, opts: &CycleOptions, e: ode::OdeError) -> Error {
     let explicit = matches!(opts.solver.method, Method::Tsit5 | Method::Dop853);
     match e {
-        ode::OdeError::TooManySteps { t, max_steps } if explicit => {
-            crate::error::AnalysisError::StepLimit {
-                method: opts.solver.method.name(),
-                max_steps,
-                t_ms: t * 1e3,
-                fastest_rate_per_s: model.fastest_rate(),
-            }
-            .into()
+        ode::OdeError::TooManySteps { t, max_steps } if explicit => CycleError::StepLimit {
+            method: opts.solver.method.name(),
+            max_steps,
+            t_ms: t * 1e3,
+            fastest_rate_per_s: model.fastest_rate(),
         }
+        .into(),
         other => Error::Ode(other),
     }
 }

@@ -8,11 +8,72 @@
 //! `k_ab − ∂F_if/∂y` for the rigid slider) is positive; folds are where it vanishes.
 
 use super::roots::{brent, brent_polished};
-use crate::error::{AnalysisError, Error, Result, Stage};
+use crate::error::{num, Error, FailureKind, Result, Stage};
 use crate::force::ForceEval;
 use crate::model::{Dofs, LinearBalance, Rest, SliderModel, StaticBounds};
 use crate::units::{to_mw, to_nm};
 use serde::Serialize;
+
+impl Stage {
+    /// The stable flying equilibrium at a heater power.
+    pub const FLYING_EQUILIBRIUM: Stage = Stage::named("flying equilibrium");
+}
+
+/// Why there is no stable flying equilibrium at a heater power. Numbers are in engineering
+/// units, as the field names say.
+///
+/// ```
+/// use hdi_tribology::analysis::equilibrium::FlyingError;
+/// let e: hdi_tribology::Error = FlyingError::NoFlyingEquilibrium { power_mw: 60.0 }.into();
+/// assert_eq!(e.to_string(), "flying equilibrium: no flying equilibrium at 60.0000 mW inside the table range");
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FlyingError {
+    /// The flying branch ends at a fold before the power is reached; the head is in contact at
+    /// that power.
+    #[error(
+        "the flying branch ends at a fold (d = {} nm) before the protrusion of {} mW is reached: \
+         the head is in contact there",
+        num(*.fold_gap_nm),
+        num(*.power_mw)
+    )]
+    FlyingBranchEnds {
+        /// The heater power asked for (mW).
+        power_mw: f64,
+        /// Bulge gap of the fold (nm).
+        fold_gap_nm: f64,
+    },
+    /// None inside the force tables at this power.
+    #[error("no flying equilibrium at {} mW inside the table range", num(*.power_mw))]
+    NoFlyingEquilibrium {
+        /// The heater power asked for (mW).
+        power_mw: f64,
+    },
+    /// The largest tabulated gap is already below the equilibrium.
+    #[error(
+        "the largest tabulated gap ({} nm) is already below the equilibrium: widen the table range",
+        num(*.gap_nm)
+    )]
+    TableTooNarrow {
+        /// The largest tabulated gap (nm).
+        gap_nm: f64,
+    },
+}
+
+impl FailureKind for FlyingError {
+    fn stage(&self) -> Stage {
+        Stage::FLYING_EQUILIBRIUM
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            FlyingError::FlyingBranchEnds { .. } => "FlyingBranchEnds",
+            FlyingError::NoFlyingEquilibrium { .. } => "NoFlyingEquilibrium",
+            FlyingError::TableTooNarrow { .. } => "TableTooNarrow",
+        }
+    }
+}
 
 /// One equilibrium of the slider.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -479,7 +540,7 @@ pub fn flying_equilibrium(
                     return solver.refine(fold.d, p.d, |q| q.protrusion - target);
                 }
             }
-            return Err(AnalysisError::FlyingBranchEnds {
+            return Err(FlyingError::FlyingBranchEnds {
                 power_mw: to_mw(power),
                 fold_gap_nm: to_nm(fold_d),
             }
@@ -487,11 +548,7 @@ pub fn flying_equilibrium(
         }
         if e.protrusion >= target {
             let Some(p) = prev else {
-                return Err(AnalysisError::TableTooNarrow {
-                    stage: Stage::FlyingEquilibrium,
-                    gap_nm: to_nm(d),
-                }
-                .into());
+                return Err(FlyingError::TableTooNarrow { gap_nm: to_nm(d) }.into());
             };
             let tol = fold_tolerance(e.d, p.d, model.nominal_clearance());
             let d = brent(
@@ -504,7 +561,7 @@ pub fn flying_equilibrium(
         }
         prev = Some(e);
     }
-    Err(AnalysisError::NoFlyingEquilibrium {
+    Err(FlyingError::NoFlyingEquilibrium {
         power_mw: to_mw(power),
     }
     .into())

@@ -10,9 +10,48 @@
 use super::equilibrium::EquilibriumSolver;
 use super::roots::{brent, brent_polished};
 use super::touchdown::{touchdown_at, touchdown_signed, Cause, StaticOptions};
-use crate::error::{check_finite, AnalysisError, Error, Result};
+use crate::error::{check_finite, num, Error, FailureKind, Result, Stage};
 use crate::model::{SliderModel, Voltage};
 use serde::Serialize;
+
+impl Stage {
+    /// The static pull-in voltage.
+    pub const PULL_IN: Stage = Stage::named("pull-in voltage");
+}
+
+/// Why there is no pull-in voltage.
+///
+/// ```
+/// use hdi_tribology::analysis::pull_in::PullInError;
+/// let e: hdi_tribology::Error = PullInError::NoPullIn { power_mw: 60.0 }.into();
+/// assert_eq!(e.to_string(), "pull-in voltage: no pull-in inside the table range at 60.0000 mW");
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PullInError {
+    /// No fold and no threshold crossing inside the force tables.
+    #[error("no pull-in inside the table range at {} mW", num(*.power_mw))]
+    NoPullIn {
+        /// The heater power the pull-in was sought at (mW).
+        power_mw: f64,
+    },
+    /// The scene has no electrostatic term.
+    #[error("the scene has no electrostatic term")]
+    NoElectrostatics,
+}
+
+impl FailureKind for PullInError {
+    fn stage(&self) -> Stage {
+        Stage::PULL_IN
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            PullInError::NoPullIn { .. } => "NoPullIn",
+            PullInError::NoElectrostatics => "NoElectrostatics",
+        }
+    }
+}
 
 /// The pull-in voltage at one heater power.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -96,7 +135,7 @@ impl VoltageBalance<'_> {
 pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) -> Result<PullIn> {
     check_finite("power", power)?;
     if !model.forces().has_voltage_terms() {
-        return Err(AnalysisError::NoElectrostatics.into());
+        return Err(PullInError::NoElectrostatics.into());
     }
     // Past touchdown without voltage, pull-in is at zero volts. Without any touchdown in the
     // table range (e.g. electrostatics alone) the scan below decides.
@@ -151,7 +190,7 @@ pub fn pull_in_voltage(model: &SliderModel, power: f64, opts: &StaticOptions) ->
         }
         prev = Some((d, v2, k, fc));
     }
-    Err(AnalysisError::NoPullIn {
+    Err(PullInError::NoPullIn {
         power_mw: crate::units::to_mw(power),
     }
     .into())

@@ -7,7 +7,7 @@
 //! bulge displacement.
 
 use super::equilibrium::{flying_equilibrium, Equilibrium, ScanGrid};
-use crate::error::{AnalysisError, Error, Result, Stage};
+use crate::error::{Error, FailureKind, Result, Stage};
 use crate::model::{Heater, SliderModel, SliderSystem, Voltage};
 use crate::ode::OdeSystem;
 use crate::scene::MAX_DOF;
@@ -16,6 +16,47 @@ use nalgebra::{DMatrix, DVector, Dyn};
 use num_complex::Complex64;
 use serde::Serialize;
 use std::f64::consts::PI;
+
+impl Stage {
+    /// The linear response about an equilibrium.
+    pub const LINEAR_RESPONSE: Stage = Stage::named("linear response");
+    /// The simulated response to the AC dither.
+    pub const SIMULATED_DITHER: Stage = Stage::named("simulated dither");
+}
+
+/// Why the linear or simulated response could not be given.
+///
+/// ```
+/// use hdi_tribology::analysis::response::ResponseError;
+/// let e: hdi_tribology::Error = ResponseError::NoAcVoltage.into();
+/// assert_eq!(e.to_string(), "simulated dither: the voltage has no AC part");
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ResponseError {
+    /// An eigenvalue of the linearised system is not finite.
+    #[error("non-finite eigenvalue")]
+    NonFiniteEigenvalue,
+    /// The simulated dither needs an AC voltage.
+    #[error("the voltage has no AC part")]
+    NoAcVoltage,
+}
+
+impl FailureKind for ResponseError {
+    fn stage(&self) -> Stage {
+        match self {
+            ResponseError::NonFiniteEigenvalue => Stage::LINEAR_RESPONSE,
+            ResponseError::NoAcVoltage => Stage::SIMULATED_DITHER,
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            ResponseError::NonFiniteEigenvalue => "NonFiniteEigenvalue",
+            ResponseError::NoAcVoltage => "NoAcVoltage",
+        }
+    }
+}
 
 /// One mode of the linearised slider.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -233,11 +274,7 @@ pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse
             .then(q.re.total_cmp(&p.re))
     });
     if modes.iter().any(|m| !m.re.is_finite()) {
-        return Err(AnalysisError::NotFinite {
-            stage: Stage::LinearResponse,
-            quantity: "eigenvalue",
-        }
-        .into());
+        return Err(ResponseError::NonFiniteEigenvalue.into());
     }
     let stable = modes.iter().all(|m| m.re < 0.0);
     let g = model.gaps(&eq.q, eq.protrusion);
@@ -287,7 +324,7 @@ pub fn simulated_dither(
     use crate::ode::SaveAt;
     let v = model.voltage();
     if !v.is_time_dependent() {
-        return Err(AnalysisError::NoAcVoltage.into());
+        return Err(ResponseError::NoAcVoltage.into());
     }
     if periods == 0 {
         return Err(Error::invalid("periods", "must be at least 1"));

@@ -1,6 +1,71 @@
 //! Bracketed scalar root finding (Brent's method) used by the analyses.
 
-use crate::error::{Error, Result};
+use crate::error::{FailureKind, Result, Stage};
+
+impl Stage {
+    /// Brent's bracketed root search.
+    pub const ROOT_SEARCH: Stage = Stage::named("root search");
+}
+
+/// Why a bracketed root search failed (always [`Error::NoConvergence`]).
+///
+/// ```
+/// use hdi_tribology::analysis::roots::{brent, RootError};
+/// let e = brent(|x| x * x + 1.0, 0.0, 2.0, 1e-12).unwrap_err();
+/// let kind = e.failure().and_then(|f| f.downcast_ref::<RootError>());
+/// assert_eq!(kind, Some(&RootError::NoSignChange { a: 0.0, b: 2.0 }));
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum RootError {
+    /// The function is not finite at an end of the bracket.
+    #[error("non-finite value at an end of [{a:e}, {b:e}]")]
+    NonFiniteEnd {
+        /// Low end.
+        a: f64,
+        /// High end.
+        b: f64,
+    },
+    /// The function has the same sign at both ends.
+    #[error("no sign change on [{a:e}, {b:e}]")]
+    NoSignChange {
+        /// Low end.
+        a: f64,
+        /// High end.
+        b: f64,
+    },
+    /// The function is not finite at an iterate.
+    #[error("non-finite value at {x:e}")]
+    NonFinite {
+        /// The iterate.
+        x: f64,
+    },
+    /// The iteration budget is used up.
+    #[error("{iterations} iterations without reaching the tolerance")]
+    Iterations {
+        /// The budget.
+        iterations: usize,
+    },
+}
+
+impl FailureKind for RootError {
+    fn stage(&self) -> Stage {
+        Stage::ROOT_SEARCH
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            RootError::NonFiniteEnd { .. } => "NonFiniteEnd",
+            RootError::NoSignChange { .. } => "NoSignChange",
+            RootError::NonFinite { .. } => "NonFinite",
+            RootError::Iterations { .. } => "Iterations",
+        }
+    }
+
+    fn is_convergence(&self) -> bool {
+        true
+    }
+}
 
 /// Finds a root of `f` in `[a, b]` where `f(a)` and `f(b)` differ in sign, to an interval width
 /// of `xtol` (plus a few ulps). Bounded to 200 iterations.
@@ -87,10 +152,7 @@ fn brent_from<F: FnMut(f64) -> f64>(
     let (mut a, mut b) = (a, b);
     let (mut fa, mut fb) = (fa, fb);
     if !fa.is_finite() || !fb.is_finite() {
-        return Err(Error::no_convergence(
-            "root bracket",
-            format!("non-finite value at an end of [{a:e}, {b:e}]"),
-        ));
+        return Err(RootError::NonFiniteEnd { a, b }.into());
     }
     if fa == 0.0 {
         return Ok(a);
@@ -99,10 +161,7 @@ fn brent_from<F: FnMut(f64) -> f64>(
         return Ok(b);
     }
     if fa.signum() == fb.signum() {
-        return Err(Error::no_convergence(
-            "root bracket",
-            format!("no sign change on [{a:e}, {b:e}]"),
-        ));
+        return Err(RootError::NoSignChange { a, b }.into());
     }
     let (mut c, mut fc) = (a, fa);
     let mut d = b - a;
@@ -160,16 +219,10 @@ fn brent_from<F: FnMut(f64) -> f64>(
         b += if d.abs() > tol { d } else { tol.copysign(m) };
         fb = f(b);
         if !fb.is_finite() {
-            return Err(Error::no_convergence(
-                "root search",
-                format!("non-finite value at {b:e}"),
-            ));
+            return Err(RootError::NonFinite { x: b }.into());
         }
     }
-    Err(Error::no_convergence(
-        "root search",
-        "200 iterations without reaching the tolerance",
-    ))
+    Err(RootError::Iterations { iterations: 200 }.into())
 }
 
 #[cfg(test)]

@@ -16,9 +16,54 @@
 
 use super::equilibrium::{Equilibrium, EquilibriumSolver};
 use super::touchdown::{Cause, Transition};
-use crate::error::{Error, Result};
+use crate::error::{num, Error, FailureKind, Result, Stage};
 use crate::force::{GapReference, TermKind};
 use crate::model::{Dofs, SliderModel};
+
+impl Stage {
+    /// The first-order shift of a transition power with a parameter.
+    pub const TRANSITION_SENSITIVITY: Stage = Stage::named("transition sensitivity");
+}
+
+/// Why the first-order shift of a transition power is not defined.
+///
+/// ```
+/// use hdi_tribology::analysis::sensitivity::SensitivityError;
+/// let e: hdi_tribology::Error = SensitivityError::SingularTangent { gap_nm: 1.5 }.into();
+/// assert_eq!(
+///     e.to_string(),
+///     "transition sensitivity: the balance's tangent is singular at d = 1.5000 nm"
+/// );
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SensitivityError {
+    /// The balance's tangent is singular at this gap.
+    #[error("the balance's tangent is singular at d = {} nm", num(*.gap_nm))]
+    SingularTangent {
+        /// The gap (nm).
+        gap_nm: f64,
+    },
+    /// The contact force does not change with the gap there.
+    #[error("the contact force does not change with the gap at d = {} nm", num(*.gap_nm))]
+    FlatContactForce {
+        /// The gap (nm).
+        gap_nm: f64,
+    },
+}
+
+impl FailureKind for SensitivityError {
+    fn stage(&self) -> Stage {
+        Stage::TRANSITION_SENSITIVITY
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            SensitivityError::SingularTangent { .. } => "SingularTangent",
+            SensitivityError::FlatContactForce { .. } => "FlatContactForce",
+        }
+    }
+}
 
 /// Contact force (N) at coordinates `q` and protrusion `delta`, from direct evaluation of the
 /// contact terms.
@@ -41,12 +86,8 @@ fn contact_force_exact(model: &SliderModel, q: &Dofs, delta: f64) -> Result<f64>
 /// its coordinates and protrusion, exact to first order in the difference of the models.
 fn stepped(changed: &SliderModel, d: f64, q: &Dofs) -> Result<(Dofs, f64)> {
     let (step, _) = changed.exact_balance_step(d, changed.voltage().dc_squared(), q)?;
-    let step = step.ok_or_else(|| {
-        Error::from(crate::error::AnalysisError::NoSensitivity {
-            gap_nm: d * 1e9,
-            why: "the balance's tangent is singular",
-        })
-    })?;
+    let step =
+        step.ok_or_else(|| Error::from(SensitivityError::SingularTangent { gap_nm: d * 1e9 }))?;
     let q1 = q + step;
     // d = h0 + bᵀq − δ
     let delta = changed.gaps(&q1, 0.0).bulge - d;
@@ -91,11 +132,7 @@ pub fn transition_shift(model: &SliderModel, changed: &SliderModel, t: &Transiti
             let dfc_dd = (fc(model, &hi)? - fc(model, &lo)?) / (2.0 * h);
             let dfc = contact_force_exact(changed, &q1, delta1)? - fc(model, e0)?;
             if dfc_dd == 0.0 || !dfc_dd.is_finite() {
-                return Err(crate::error::AnalysisError::NoSensitivity {
-                    gap_nm: d * 1e9,
-                    why: "the contact force does not change with the gap",
-                }
-                .into());
+                return Err(SensitivityError::FlatContactForce { gap_nm: d * 1e9 }.into());
             }
             Ok(dp_fixed_gap - dp_dd * dfc / dfc_dd)
         }

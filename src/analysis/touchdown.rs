@@ -6,10 +6,137 @@
 //! falling) until the contact force drops below `F_th` or that branch ends at a fold.
 
 use super::equilibrium::{Equilibrium, EquilibriumSolver, ScanGrid, Skipper};
-use crate::error::{AnalysisError, Result, Stage};
+use crate::error::{num, FailureKind, Result, Stage};
 use crate::model::SliderModel;
 use crate::units::{to_mw, to_nm};
 use serde::Serialize;
+
+impl Stage {
+    /// Static touchdown.
+    pub const TOUCHDOWN: Stage = Stage::named("touchdown");
+    /// Static take-off.
+    pub const TAKE_OFF: Stage = Stage::named("take-off");
+}
+
+/// Why a static touchdown or take-off could not be found. Numbers are in engineering units, as
+/// the field names say.
+///
+/// ```
+/// use hdi_tribology::analysis::touchdown::TransitionError;
+/// use hdi_tribology::error::{FailureKind, Stage};
+/// let e = TransitionError::NoTakeOff { gap_nm: 0.3, power_mw: -2.0 };
+/// assert_eq!(e.stage(), Stage::TAKE_OFF);
+/// assert!(e.to_string().contains("adhesion holds it"));
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum TransitionError {
+    /// Touchdown: the head is in contact already at zero heater power (the transition lies at
+    /// negative power).
+    #[error(
+        "the head is in contact already at zero heater power (the {} at d = {} nm lies at {} mW \
+         < 0)",
+        if *.at_fold { "fold" } else { "threshold crossing" },
+        num(*.gap_nm),
+        num(*.power_mw)
+    )]
+    InContactAtZeroPower {
+        /// `true` at a fold, `false` at a threshold crossing.
+        at_fold: bool,
+        /// Bulge gap at the transition (nm).
+        gap_nm: f64,
+        /// Heater power of the transition (mW), negative.
+        power_mw: f64,
+    },
+    /// Take-off: the head stays in contact down to zero heater power (adhesion holds it).
+    #[error(
+        "the head stays in contact down to zero heater power (the contact branch ends at d = {} \
+         nm, {} mW < 0): adhesion holds it",
+        num(*.gap_nm),
+        num(*.power_mw)
+    )]
+    NoTakeOff {
+        /// Bulge gap where the contact branch ends (nm).
+        gap_nm: f64,
+        /// Heater power there (mW), negative.
+        power_mw: f64,
+    },
+    /// Touchdown: the flying branch neither reaches the contact threshold nor folds inside the
+    /// force tables.
+    #[error(
+        "the flying branch neither reaches the contact threshold nor folds inside the table range \
+         (up to {} mW): widen the table range",
+        num(*.max_power_mw)
+    )]
+    NoTouchdown {
+        /// The largest heater power reached (mW).
+        max_power_mw: f64,
+    },
+    /// Take-off: the contact branch neither falls below the threshold nor folds inside the force
+    /// tables.
+    #[error(
+        "the contact branch neither falls below the threshold nor folds inside the table range \
+         (down to {} mW): widen the table range",
+        num(*.min_power_mw)
+    )]
+    NoTakeOffInTable {
+        /// The smallest heater power reached on the contact branch (mW).
+        min_power_mw: f64,
+    },
+    /// Touchdown: the equilibrium at the largest tabulated gap is already unstable or in contact.
+    #[error(
+        "the equilibrium at the largest tabulated gap ({} nm) is already unstable or in contact: \
+         widen the table range",
+        num(*.gap_nm)
+    )]
+    TableTooNarrow {
+        /// The largest tabulated gap (nm).
+        gap_nm: f64,
+    },
+    /// Take-off: no contact equilibrium at the start power within this interpenetration.
+    #[error(
+        "no contact equilibrium at {} mW within {} nm of interpenetration",
+        num(*.power_mw),
+        num(*.depth_nm)
+    )]
+    NoContactEquilibrium {
+        /// The start power (mW).
+        power_mw: f64,
+        /// The deepest interpenetration searched (nm).
+        depth_nm: f64,
+    },
+    /// Take-off: the contact equilibrium at the start power is unstable.
+    #[error("the equilibrium at {} mW on the contact side is unstable", num(*.power_mw))]
+    UnstableContactStart {
+        /// The start power (mW).
+        power_mw: f64,
+    },
+}
+
+impl FailureKind for TransitionError {
+    fn stage(&self) -> Stage {
+        use TransitionError as E;
+        match self {
+            E::InContactAtZeroPower { .. } | E::NoTouchdown { .. } | E::TableTooNarrow { .. } => {
+                Stage::TOUCHDOWN
+            }
+            _ => Stage::TAKE_OFF,
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        use TransitionError as E;
+        match self {
+            E::InContactAtZeroPower { .. } => "InContactAtZeroPower",
+            E::NoTakeOff { .. } => "NoTakeOff",
+            E::NoTouchdown { .. } => "NoTouchdown",
+            E::NoTakeOffInTable { .. } => "NoTakeOffInTable",
+            E::TableTooNarrow { .. } => "TableTooNarrow",
+            E::NoContactEquilibrium { .. } => "NoContactEquilibrium",
+            E::UnstableContactStart { .. } => "UnstableContactStart",
+        }
+    }
+}
 
 /// Why a transition happened.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -205,11 +332,7 @@ pub(crate) fn touchdown_signed(
                 });
             }
         } else if !e.is_stable() || e.contact_force >= th {
-            return Err(AnalysisError::TableTooNarrow {
-                stage: Stage::Touchdown,
-                gap_nm: to_nm(d),
-            }
-            .into());
+            return Err(TransitionError::TableTooNarrow { gap_nm: to_nm(d) }.into());
         }
         prev = Some(d);
     }
@@ -225,10 +348,8 @@ pub(crate) fn touchdown_signed(
         Some(p) => to_mw(solver.at_gap(p)?.power),
         None => f64::NAN,
     };
-    Err(AnalysisError::NoTouchdown {
-        stage: Stage::Touchdown,
+    Err(TransitionError::NoTouchdown {
         max_power_mw: max_power,
-        detector: None,
     }
     .into())
 }
@@ -239,13 +360,13 @@ fn transition(at: Equilibrium, cause: Cause, touchdown: bool) -> Result<Transiti
     if at.power < 0.0 {
         let (gap_nm, power_mw) = (to_nm(at.d), to_mw(at.power));
         return Err(if touchdown {
-            AnalysisError::InContactAtZeroPower {
+            TransitionError::InContactAtZeroPower {
                 at_fold: cause == Cause::Fold,
                 gap_nm,
                 power_mw,
             }
         } else {
-            AnalysisError::NoTakeOff { gap_nm, power_mw }
+            TransitionError::NoTakeOff { gap_nm, power_mw }
         }
         .into());
     }
@@ -295,7 +416,7 @@ pub(crate) fn takeoff_at(
         lo -= step;
         extended += 1;
         if extended > 50 {
-            return Err(AnalysisError::NoContactEquilibrium {
+            return Err(TransitionError::NoContactEquilibrium {
                 power_mw: to_mw(start_power),
                 depth_nm: to_nm(-lo),
             }
@@ -342,7 +463,7 @@ pub(crate) fn takeoff_at(
         let e = solver.at_gap(d)?;
         if !started {
             if !e.is_stable() {
-                return Err(AnalysisError::UnstableContactStart {
+                return Err(TransitionError::UnstableContactStart {
                     power_mw: to_mw(start_power),
                 }
                 .into());
@@ -388,7 +509,7 @@ pub(crate) fn takeoff_at(
         Some(p) => to_mw(solver.at_gap(p)?.power),
         None => f64::NAN,
     };
-    Err(AnalysisError::NoTakeOffInTable {
+    Err(TransitionError::NoTakeOffInTable {
         min_power_mw: min_power,
     }
     .into())

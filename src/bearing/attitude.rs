@@ -9,10 +9,10 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::error::BearingError;
 use super::geometry::Bearing;
 use super::grid::nudged;
 use super::reynolds::{Attitude, Factored, Reynolds, REFERENCE_SPACING};
-use crate::error::AnalysisError;
 use crate::{Error, Result};
 
 /// The smallest spacing the attitude solve lets the slider reach, m: a bearing that does not
@@ -190,13 +190,13 @@ fn solve_level(
             });
         }
         if report.iterations >= max_iterations {
-            return Err(Error::no_convergence(
-                "air-bearing attitude",
-                format!(
-                    "{} Newton steps on {}×{} control volumes, relative imbalance {:.3e}",
-                    report.iterations, report.cells.0, report.cells.1, report.imbalance
-                ),
-            ));
+            return Err(BearingError::AttitudeNewton {
+                iterations: report.iterations,
+                nx: report.cells.0,
+                ny: report.cells.1,
+                imbalance: report.imbalance,
+            }
+            .into());
         }
         if jac.is_none() || report.imbalance > FAST_CONVERGENCE * last {
             let (k, d, its) = r.sensitivities(p, &h, &fac, STEP_SENSITIVITY_RTOL)?;
@@ -210,12 +210,10 @@ fn solve_level(
         // Jacobian of the scaled imbalance.
         let fl = b.preload * b.length;
         let jm = Matrix3::from_fn(|i, j| k[i][j] / if i == 0 { b.preload } else { fl });
-        let step = jm.lu().solve(&(-f)).ok_or_else(|| {
-            Error::no_convergence(
-                "air-bearing attitude",
-                "the bearing's stiffness matrix is singular",
-            )
-        })?;
+        let step = jm
+            .lu()
+            .solve(&(-f))
+            .ok_or_else(|| Error::from(BearingError::SingularStiffness))?;
         let q = att.to_array();
         let at = |t: f64| {
             Attitude::from_array([q[0] + t * step[0], q[1] + t * step[1], q[2] + t * step[2]])
@@ -230,7 +228,7 @@ fn solve_level(
                 break;
             }
             if hmin <= SPACING_FLOOR * (1.0 + 1e-6) && loads[0] < b.preload {
-                return Err(AnalysisError::DoesNotFly {
+                return Err(BearingError::DoesNotFly {
                     preload_mn: b.preload * 1e3,
                     load_mn: loads[0] * 1e3,
                     min_spacing_nm: hmin * 1e9,
@@ -272,7 +270,7 @@ fn solve_level(
 /// Solves for the equilibrium attitude of `bearing` on its grid (`bearing.grid`).
 ///
 /// A bearing that cannot carry the preload above [`SPACING_FLOOR`] gives
-/// [`AnalysisError::DoesNotFly`].
+/// [`BearingError::DoesNotFly`].
 ///
 /// ```
 /// use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec};

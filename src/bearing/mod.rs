@@ -14,6 +14,7 @@
 //! - [`attitude`]: the attitude solve and its outputs.
 
 pub mod attitude;
+mod error;
 pub mod flow_factor;
 pub mod geometry;
 pub mod grid;
@@ -22,6 +23,7 @@ pub mod map;
 pub mod reynolds;
 
 pub use attitude::{solve_attitude, AttitudeOptions, Equilibrium};
+pub use error::{BearingError, Solve};
 pub use flow_factor::FlowModel;
 pub use geometry::{
     Bearing, BearingSpec, GridSpec, OperatingConditions, Polygon, Region, SliderGeometry, Taper,

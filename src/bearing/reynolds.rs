@@ -15,11 +15,12 @@
 //! any bearing number. The Jacobian of the residual is exact (analytic), and each Newton step
 //! is a GMRES solve preconditioned by the incomplete LU factors of that Jacobian.
 
+use super::error::{BearingError, Solve};
 use super::flow_factor::FlowModel;
 use super::geometry::Bearing;
 use super::grid::Grid;
 use super::linear::{gmres, FivePoint, KrylovStats, Multigrid};
-use crate::{Error, Result};
+use crate::Result;
 
 /// The reference spacing `h_m` of the non-dimensional variables, m.
 pub const REFERENCE_SPACING: f64 = 10e-9;
@@ -495,13 +496,11 @@ impl Reynolds {
     pub fn solve(&self, att: &Attitude, p: &mut [f64]) -> Result<NewtonStats> {
         let h = self.spacing(att);
         if let Some(c) = h.iter().position(|&v| v.is_nan() || v <= 0.0) {
-            return Err(Error::no_convergence(
-                "air-bearing pressure",
-                format!(
-                    "the slider touches the disk at control volume {c} (spacing {:.3} nm)",
-                    h[c] * REFERENCE_SPACING * 1e9
-                ),
-            ));
+            return Err(BearingError::Touches {
+                cell: c,
+                spacing_nm: h[c] * REFERENCE_SPACING * 1e9,
+            }
+            .into());
         }
         self.solve_spacing(&h, p).map(|(s, _)| s)
     }
@@ -534,15 +533,12 @@ impl Reynolds {
         let mut prev_ratio: f64 = 1.0;
         loop {
             if stats.iterations >= self.max_newton {
-                return Err(Error::no_convergence(
-                    "air-bearing pressure",
-                    format!(
-                        "{} Newton steps, last change of p/p_a {:.3e}, residual {:.3e}",
-                        stats.iterations,
-                        stats.last_update,
-                        rnorm / scale
-                    ),
-                ));
+                return Err(BearingError::PressureNewton {
+                    iterations: stats.iterations,
+                    last_change: stats.last_update,
+                    residual: rnorm / scale,
+                }
+                .into());
             }
             let ilu = Multigrid::new(&a);
             let eta = (0.1 * prev_ratio * prev_ratio).clamp(1e-10, 1e-3);
@@ -594,10 +590,7 @@ impl Reynolds {
                     break;
                 }
                 if !tnorm.is_finite() {
-                    return Err(Error::no_convergence(
-                        "air-bearing pressure",
-                        "the Newton step gives a non-finite residual",
-                    ));
+                    return Err(BearingError::NonFiniteResidual.into());
                 }
             }
             let mut upd: f64 = 0.0;
@@ -719,13 +712,12 @@ impl Reynolds {
             );
             iterations += stats.iterations;
             if stats.relative_residual > 10.0 * rtol {
-                return Err(Error::no_convergence(
-                    "air-bearing sensitivity",
-                    format!(
-                        "GMRES reached {:.3e} in {} iterations",
-                        stats.relative_residual, stats.iterations
-                    ),
-                ));
+                return Err(BearingError::Krylov {
+                    solve: Solve::Sensitivity,
+                    relative_residual: stats.relative_residual,
+                    iterations: stats.iterations,
+                }
+                .into());
             }
             for i in 0..3 {
                 k[i][q] = dps[q].iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>() * pa * l * l;
@@ -772,13 +764,12 @@ impl Reynolds {
                 MAX_KRYLOV,
             );
             if stats.relative_residual > 10.0 * DAMPING_RTOL {
-                return Err(Error::no_convergence(
-                    "air-bearing damping",
-                    format!(
-                        "GMRES reached {:.3e} in {} iterations",
-                        stats.relative_residual, stats.iterations
-                    ),
-                ));
+                return Err(BearingError::Krylov {
+                    solve: Solve::Damping,
+                    relative_residual: stats.relative_residual,
+                    iterations: stats.iterations,
+                }
+                .into());
             }
             for i in 0..3 {
                 c[i][q] = -x.iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>()

@@ -319,10 +319,9 @@ pub fn calibrate(
     let name = staircase.detector().inner.name().to_string();
 
     let Some(touchdown_power) = outcome.touchdown_power else {
-        return Err(crate::error::AnalysisError::NoTouchdown {
-            stage: crate::error::Stage::ClearanceCalibration,
+        return Err(super::CalibrationError::NoTouchdown {
+            detector: name,
             max_power_mw: crate::units::to_mw(sc.max_power),
-            detector: Some(name),
         }
         .into());
     };
@@ -330,7 +329,7 @@ pub fn calibrate(
     if up == 1 {
         // Fired at the baseline level: the slider was in contact before the staircase began, so
         // there is no touchdown power to find and no contrast to measure.
-        return Err(crate::error::AnalysisError::ContactAtStart {
+        return Err(super::CalibrationError::ContactAtStart {
             detector: name,
             start_power_mw: crate::units::to_mw(sc.start_power),
         }

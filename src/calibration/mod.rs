@@ -24,6 +24,7 @@
 
 mod calibrate;
 mod detector;
+mod error;
 mod filters;
 
 /// The zone lives with the drive it configures; it is named here too, where calibrations use it.
@@ -34,4 +35,5 @@ pub use calibrate::{
 pub use detector::{
     ContactForceRms, MeanContactForce, Relative, Sample, TouchdownDetector, VibrationRms,
 };
+pub use error::CalibrationError;
 pub use filters::{HighPass, MeanSquare};

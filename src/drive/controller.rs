@@ -44,7 +44,7 @@ pub trait Controller {
 /// returns the number of periods run.
 ///
 /// # Errors
-/// Those of [`Drive::step`]; an [`Error::Analysis`] ([`AnalysisError::NotFinished`](crate::error::AnalysisError::NotFinished)) when the controller has not stopped after
+/// Those of [`Drive::step`]; an [`Error::Analysis`] ([`DriveError::NotFinished`](super::DriveError::NotFinished)) when the controller has not stopped after
 /// `max_periods`.
 pub fn run(
     drive: &mut Drive,
@@ -60,7 +60,7 @@ pub fn run(
             Action::Stop => return Ok(n),
         }
     }
-    Err(crate::error::AnalysisError::NotFinished { max_periods }.into())
+    Err(super::DriveError::NotFinished { max_periods }.into())
 }
 
 /// Mean and standard error of one channel over a measurement window.

@@ -31,6 +31,7 @@
 
 mod controller;
 mod disk;
+mod error;
 mod plant;
 mod replay;
 mod rng;
@@ -44,6 +45,7 @@ pub use controller::{
     TrueContact,
 };
 pub use disk::{DiskSpec, Harmonic};
+pub use error::DriveError;
 pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions, Plant};
 pub use replay::{
     check_commands, read_commands, replay, replay_each, sensor_row, whole_periods, CommandRow,

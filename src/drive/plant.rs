@@ -616,7 +616,7 @@ impl Drive {
             y0: [0.0; MAX_STATE],
         };
         let integ = plant.problem.clone().start(
-            crate::error::Stage::Drive,
+            crate::error::Stage::DRIVE,
             0.0,
             &plant.start,
             HORIZON,
@@ -1032,10 +1032,12 @@ impl Observer for PeriodBudget {
             max_steps, t0, t1, ..
         } = *self;
         if self.steps >= max_steps && step.t < t1 {
-            return Err(Error::no_convergence(
-                "drive period",
-                format!("more than {max_steps} steps (solver.max_steps) in [{t0}, {t1}] s"),
-            ));
+            return Err(super::DriveError::PeriodSteps {
+                max_steps,
+                t0_s: t0,
+                t1_s: t1,
+            }
+            .into());
         }
         Ok(Flow::Continue)
     }

@@ -431,7 +431,7 @@ fn predict_indicator(m: &SliderModel, ds: &DataSet) -> Result<Vec<Vec<Predicted>
             (Some(&(p0, f0)), Some(&(p1, f1))) => f0 + (f1 - f0) * (p - p0) / (p1 - p0),
             (None, Some(&(_, f1))) => f1,
             _ => {
-                return Err(crate::error::AnalysisError::BeyondEquilibria {
+                return Err(super::FitFailure::BeyondEquilibria {
                     origin: ds.origin.clone(),
                     heater_power_mw: crate::units::to_mw(p),
                     last_power_mw: path.last().map_or(f64::NAN, |l| crate::units::to_mw(l.0)),

@@ -21,6 +21,8 @@
 //! # Ok::<(), hdi_tribology::fit::FitError>(())
 //! ```
 
+use crate::error::{num, FailureKind, Stage};
+
 mod data;
 mod forward;
 pub mod goodness;
@@ -33,6 +35,100 @@ pub use solve::{
     fit, model_curves, Direction, FitOptions, FitResult, FittedParameter, Identifiability,
     IntegrationCheck, ResidualRow, ResidualTable, StartOutcome, MIN_LINEARITY, STRONG_CORRELATION,
 };
+
+impl Stage {
+    /// A fit of scene parameters to measurements.
+    pub const FIT: Stage = Stage::named("fit");
+    /// The model curves at the measured points.
+    pub const MODEL_CURVES: Stage = Stage::named("model curves");
+}
+
+/// Why a fit, or the model curves at the measured points, could not be given. Numbers are in
+/// engineering units, as the field names say.
+///
+/// ```
+/// use hdi_tribology::fit::FitFailure;
+/// let e: hdi_tribology::Error = FitFailure::BeyondEquilibria {
+///     origin: "td.csv".into(),
+///     heater_power_mw: 95.0,
+///     last_power_mw: 80.0,
+/// }
+/// .into();
+/// assert!(e.to_string().starts_with("model curves: td.csv: the heater power 95.0000 mW"), "{e}");
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FitFailure {
+    /// Too few values settle for the free parameters once the unsettled dynamic ones are left
+    /// out.
+    #[error(
+        "only {included} of {points} values remain once the dynamic points whose detected powers \
+         do not settle within {tol_mw} mW under tighter tolerances are left out: too few for \
+         {free} free parameters (raise dynamic_power_tol_mw or tighten solver.rtol)"
+    )]
+    TooFewSettled {
+        /// Values left in the fit.
+        included: usize,
+        /// Values in the data.
+        points: usize,
+        /// The power tolerance they had to settle within (mW).
+        tol_mw: f64,
+        /// Free parameters.
+        free: usize,
+    },
+    /// The model could not be evaluated at any start.
+    #[error("the model could not be evaluated at any start: {first_error}")]
+    NoModelStart {
+        /// How the first start ended, as its outcome records it.
+        first_error: String,
+    },
+    /// A measured heater power lies beyond the equilibria the model tabulates.
+    #[error(
+        "{origin}: the heater power {} mW lies beyond the equilibria of the table range (up to {} \
+         mW)",
+        num(*.heater_power_mw),
+        num(*.last_power_mw)
+    )]
+    BeyondEquilibria {
+        /// The data set.
+        origin: String,
+        /// The measured heater power (mW).
+        heater_power_mw: f64,
+        /// The largest heater power with a tabulated equilibrium (mW).
+        last_power_mw: f64,
+    },
+    /// The model detects no transition at a measured point inside the heater programme.
+    #[error(
+        "{origin}: the model detects no {} at x = {x} inside the heater programme",
+        .quantity.stem()
+    )]
+    NotDetected {
+        /// The data set.
+        origin: String,
+        /// The quantity.
+        quantity: Quantity,
+        /// The measured point's abscissa, as in the data.
+        x: f64,
+    },
+}
+
+impl FailureKind for FitFailure {
+    fn stage(&self) -> Stage {
+        match self {
+            FitFailure::TooFewSettled { .. } | FitFailure::NoModelStart { .. } => Stage::FIT,
+            _ => Stage::MODEL_CURVES,
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            FitFailure::TooFewSettled { .. } => "TooFewSettled",
+            FitFailure::NoModelStart { .. } => "NoModelStart",
+            FitFailure::BeyondEquilibria { .. } => "BeyondEquilibria",
+            FitFailure::NotDetected { .. } => "NotDetected",
+        }
+    }
+}
 
 /// Why a fit could not be made.
 ///

@@ -646,7 +646,7 @@ pub fn fit(
                 .collect();
             let included = ev.excluded.iter().filter(|e| !**e).count();
             if included <= params.len() {
-                return Err(Error::from(crate::error::AnalysisError::TooFewSettled {
+                return Err(Error::from(super::FitFailure::TooFewSettled {
                     included,
                     points,
                     tol_mw: opts.dynamic_power_tol_mw,
@@ -698,7 +698,7 @@ pub fn fit(
         }
     }
     let Some((_, mut x, mut converged, mut termination)) = best.filter(|b| b.0.is_finite()) else {
-        return Err(Error::from(crate::error::AnalysisError::NoModelStart {
+        return Err(Error::from(super::FitFailure::NoModelStart {
             first_error: first_error.unwrap_or_default(),
         })
         .into());
@@ -963,9 +963,9 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
     }
     let svd = js.clone().svd(false, true);
     let v_t = svd.v_t.ok_or_else(|| {
-        Error::from(crate::error::AnalysisError::Internal {
-            stage: crate::error::Stage::Fit,
-            detail: "singular value decomposition failed".into(),
+        Error::from(crate::error::Internal {
+            stage: crate::error::Stage::FIT,
+            what: "singular value decomposition failed",
         })
     })?;
     let sv = svd.singular_values;
@@ -1476,9 +1476,9 @@ pub fn model_curves(scene: &Scene, data: &[DataSet]) -> Result<Vec<DataSet>, Fit
     for (ds, p) in out.iter_mut().zip(&pred) {
         for (o, pc) in ds.observed.iter_mut().zip(p) {
             if let Some(i) = pc.iter().position(|q| q.clipped) {
-                return Err(Error::from(crate::error::AnalysisError::NotDetected {
+                return Err(Error::from(super::FitFailure::NotDetected {
                     origin: ds.origin.clone(),
-                    quantity: o.quantity.stem().to_string(),
+                    quantity: o.quantity,
                     x: ds.x[i],
                 })
                 .into());

@@ -178,7 +178,11 @@ impl<L: PressureLaw> AveragedTerm<L> {
             max_intervals: 2000,
         };
         let est = integrate_with_breaks(integrand, a, b, &breaks, &opts).map_err(|e| {
-            Error::no_convergence(format!("{} at d = {d} m", self.name), e.to_string())
+            Error::from(super::ForceError::Quadrature {
+                term: self.name.clone(),
+                d_nm: d * 1e9,
+                source: e.into(),
+            })
         })?;
         Ok(est.value)
     }

@@ -102,10 +102,12 @@ impl GreenwoodWilliamson {
         if m.is_finite() {
             Ok(m)
         } else {
-            Err(Error::no_convergence(
-                "contact partial moment",
-                format!("M_{p}({d} m) = {m}"),
-            ))
+            Err(super::ForceError::PartialMoment {
+                order: p,
+                d_nm: d * 1e9,
+                value: m,
+            }
+            .into())
         }
     }
 

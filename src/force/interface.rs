@@ -150,12 +150,11 @@ impl Tabulated {
             cuts: edges[1..edges.len() - 1].to_vec(),
             segments: Vec::with_capacity(edges.len() - 1),
         };
-        let names: Vec<&str> = me.members.iter().map(|&i| terms[i].name()).collect();
-        let what = format!(
-            "{} table of [{}]",
-            if area { "contact-area" } else { "force" },
-            names.join(", ")
-        );
+        let names: Vec<String> = me
+            .members
+            .iter()
+            .map(|&i| terms[i].name().to_string())
+            .collect();
         for (k, w) in edges.windows(2).enumerate() {
             let (a, b) = (w[0], w[1]);
             // At an interior kink evaluate one ulp inside the segment, so that each piece sees the
@@ -184,8 +183,13 @@ impl Tabulated {
                     }
                 }
             };
-            let table = Table::build(f, a, b, opts)
-                .map_err(|e| Error::no_convergence(what.clone(), e.to_string()))?;
+            let table = Table::build(f, a, b, opts).map_err(|e| {
+                Error::from(super::ForceError::Table {
+                    area,
+                    terms: names.clone(),
+                    source: e.into(),
+                })
+            })?;
             me.segments.push(table);
         }
         Ok(me)

@@ -222,10 +222,12 @@ impl Meniscus {
         if f.is_finite() && df.is_finite() {
             Ok((f, df))
         } else {
-            Err(Error::no_convergence(
-                "meniscus force",
-                format!("at e = {e} m: {f} N, slope {df} N/m"),
-            ))
+            Err(super::ForceError::Meniscus {
+                e_nm: e * 1e9,
+                force_n: f,
+                slope_n_per_m: df,
+            }
+            .into())
         }
     }
 

@@ -27,6 +27,7 @@ mod air_bearing;
 mod averaged;
 mod contact;
 mod electrostatic;
+mod error;
 mod footprint;
 mod fused;
 mod interface;
@@ -43,6 +44,7 @@ pub use air_bearing::{
 pub use averaged::AveragedTerm;
 pub use contact::{composite_modulus, GreenwoodWilliamson};
 pub use electrostatic::Electrostatic;
+pub use error::ForceError;
 pub use footprint::{Footprint, Scaled};
 pub(crate) use interface::by_coupling;
 pub use interface::{Breakdown, ForceEval, Gaps, HotForces, HotValues, InterfaceForces};

@@ -4,10 +4,12 @@
 //! [`SliderSystem`] lays that physics out as an ODE for [`crate::ode`]. This is the only module
 //! that knows both the physics and the stepper.
 
+mod error;
 mod inputs;
 mod structure;
 mod system;
 
+pub use error::BalanceError;
 pub use inputs::{BaseMotion, Heater, Inputs};
 pub use structure::{Dofs, Structure};
 pub use system::{Rest, SliderSystem, StateLayout};
@@ -665,10 +667,11 @@ impl SliderModel {
             if !r.iter().all(|x| x.is_finite()) || !j.iter().all(|x| x.is_finite()) {
                 // Say which term failed rather than that no balance exists.
                 self.interface_force_exact(at(q[0]), volt2)?;
-                return Err(Error::no_convergence(
-                    "air-bearing balance",
-                    format!("the forces are not finite at d = {d:e} m, q = {:e} m", q[0]),
-                ));
+                return Err(BalanceError::NotFinite {
+                    d_nm: d * 1e9,
+                    y_nm: q[0] * 1e9,
+                }
+                .into());
             }
             if !st.is_positive(&j) {
                 break;
@@ -685,12 +688,11 @@ impl SliderModel {
             q = q_new;
         }
         let Some((mut q, mut f)) = found else {
-            return Err(Error::no_convergence(
-                "air-bearing balance",
-                format!(
-                    "no displacement balances the interface force at d = {d:e} m, V² = {volt2}"
-                ),
-            ));
+            return Err(BalanceError::NoBalance {
+                d_nm: d * 1e9,
+                volt2_v2: volt2,
+            }
+            .into());
         };
         if exact {
             // Newton on the balance with direct forces, from the tabulated solution.

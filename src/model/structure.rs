@@ -538,10 +538,7 @@ impl Structure {
                 return Ok((q, load, self.condensed(&self.tangent(k_ab, 0.0, 0.0))));
             }
         }
-        Err(Error::no_convergence(
-            "structure balance",
-            format!("no static displacement puts the bulge at {z:e} m"),
-        ))
+        Err(super::BalanceError::Structure { bulge_nm: z * 1e9 }.into())
     }
 
     /// Undamped natural frequencies (Hz) of the structure with a heave stiffness `k_heave`

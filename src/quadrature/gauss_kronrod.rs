@@ -1,7 +1,9 @@
 //! Globally adaptive 21-point Gauss–Kronrod integration (G10/K21).
 
 use super::mapping::{mapped_eval, Mapping};
+use super::QuadratureError;
 use super::{Estimate, QuadOptions};
+use crate::error::Stage;
 use crate::{Error, Result};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -52,7 +54,7 @@ pub(crate) const WG: [f64; 5] = [
     0.295_524_224_714_752_870_173_892_994_651_338,
 ];
 
-const WHAT: &str = "adaptive Gauss-Kronrod integration";
+const WHAT: Stage = Stage::GAUSS_KRONROD;
 
 /// One subinterval with its local estimate, ordered by local error.
 #[derive(Clone, Copy, Debug)]
@@ -264,18 +266,16 @@ fn adapt<F: FnMut(f64) -> f64>(
             });
         }
         if heap.len() >= opts.max_intervals {
-            return Err(Error::no_convergence(
-                WHAT,
-                format!(
-                    "max_intervals = {} reached with estimated error {error:e} for value {value:e} \
-                     (target {:e})",
-                    opts.max_intervals,
-                    opts.target(value)
-                ),
-            ));
+            return Err(QuadratureError::IntervalBudget {
+                max_intervals: opts.max_intervals,
+                error,
+                value,
+                target: opts.target(value),
+            }
+            .into());
         }
         let Some(worst) = heap.pop() else {
-            return Err(Error::no_convergence(WHAT, "no interval left to refine"));
+            return Err(QuadratureError::NoIntervalLeft.into());
         };
         let mid = 0.5 * (worst.a + worst.b);
         if !(mid > worst.a && mid < worst.b) {
@@ -287,15 +287,12 @@ fn adapt<F: FnMut(f64) -> f64>(
                     evaluations: evals,
                 });
             }
-            return Err(Error::no_convergence(
-                WHAT,
-                format!(
-                    "interval around x = {} cannot be split further; estimated error {error:e} \
-                     (target {:e})",
-                    map.apply(mid).0,
-                    opts.target(value)
-                ),
-            ));
+            return Err(QuadratureError::CannotSplit {
+                x: map.apply(mid).0,
+                error,
+                target: opts.target(value),
+            }
+            .into());
         }
         heap.push(kronrod(&mut f, &map, worst.a, mid, &mut evals)?);
         heap.push(kronrod(&mut f, &map, mid, worst.b, &mut evals)?);

@@ -1,5 +1,7 @@
 //! Rational substitutions that turn infinite integration ranges into finite ones.
 
+use super::QuadratureError;
+use crate::error::Stage;
 use crate::{Error, Result};
 
 /// How the original variable `x` is obtained from the integration variable `t`.
@@ -69,15 +71,12 @@ pub(crate) fn mapped_eval<F: FnMut(f64) -> f64>(
     f: &mut F,
     map: &Mapping,
     t: f64,
-    what: &str,
+    what: Stage,
 ) -> Result<f64> {
     let (x, jac) = map.apply(t);
     let y = f(x);
     if !y.is_finite() {
-        return Err(Error::no_convergence(
-            what,
-            format!("integrand is not finite ({y}) at x = {x}"),
-        ));
+        return Err(QuadratureError::NotFinite { stage: what, x, y }.into());
     }
     // A zero integrand far out in an infinite range must not meet an infinite Jacobian.
     Ok(if y == 0.0 { 0.0 } else { y * jac })

@@ -10,11 +10,13 @@
 //! assert!((est.value - std::f64::consts::PI.sqrt()).abs() < 1e-12);
 //! ```
 
+mod error;
 mod gauss_kronrod;
 mod mapping;
 mod table;
 mod tanh_sinh;
 
+pub use error::QuadratureError;
 pub(crate) use gauss_kronrod::integrate_best_effort;
 pub use gauss_kronrod::{integrate, integrate_with_breaks};
 pub(crate) use table::{hermite_bounds, Span};

@@ -4,6 +4,7 @@
 //! uniformly spaced nodes, so a look-up is one index-grid read, one panel read
 //! and two node reads, without search, allocation or branching on errors.
 
+use super::QuadratureError;
 use crate::{Error, Result};
 
 /// Largest bisection depth of the panel tree; deeper refinement doubles the
@@ -293,14 +294,14 @@ impl Table {
             Ok([v, d])
         };
         let too_many = |count: usize| {
-            Error::no_convergence(
-                "table build",
-                format!(
-                    "needs more than max_nodes = {} nodes (reached {count}) for rel_tol = {:e}, \
-                     abs_tol = {:e} on [{lo:e}, {hi:e}]",
-                    opts.max_nodes, opts.rel_tol, opts.abs_tol
-                ),
-            )
+            Error::from(QuadratureError::TableNodes {
+                max_nodes: opts.max_nodes,
+                reached: count,
+                rel_tol: opts.rel_tol,
+                abs_tol: opts.abs_tol,
+                lo,
+                hi,
+            })
         };
 
         let n0 = INITIAL_INTERVALS;
@@ -365,10 +366,7 @@ impl Table {
             }
             nodes.push(p.nodes[n]);
             if (p.b - p.a) / (2 * n) as f64 <= f64::EPSILON * p.a.abs().max(p.b.abs()) {
-                return Err(Error::no_convergence(
-                    "table build",
-                    format!("node spacing reaches rounding level near {}", p.a),
-                ));
+                return Err(QuadratureError::TableSpacing { x: p.a }.into());
             }
             if p.depth < MAX_DEPTH {
                 // Split the panel in two, each keeping n intervals.

@@ -2,11 +2,13 @@
 //! used to cross-check the Gauss–Kronrod results.
 
 use super::mapping::{mapped_eval, Mapping};
+use super::QuadratureError;
 use super::{Estimate, QuadOptions};
+use crate::error::Stage;
 use crate::{Error, Result};
 use std::f64::consts::FRAC_PI_2;
 
-const WHAT: &str = "tanh-sinh integration";
+const WHAT: Stage = Stage::TANH_SINH;
 /// Finest level: step 2^-MAX_LEVEL.
 const MAX_LEVEL: u32 = 12;
 /// Abscissae beyond |t| = T_MAX carry weights below 1e-300 relative.
@@ -119,15 +121,17 @@ pub fn integrate_tanh_sinh<F: FnMut(f64) -> f64>(
             });
         }
         if evals > budget {
-            return Err(Error::no_convergence(
-                WHAT,
-                format!("evaluation budget {budget} exhausted; last change {diff:e}"),
-            ));
+            return Err(QuadratureError::EvaluationBudget {
+                budget,
+                last_change: diff,
+            }
+            .into());
         }
         previous = current;
     }
-    Err(Error::no_convergence(
-        WHAT,
-        format!("no convergence after {MAX_LEVEL} halvings; value {previous:e}"),
-    ))
+    Err(QuadratureError::Halvings {
+        halvings: MAX_LEVEL as usize,
+        value: previous,
+    }
+    .into())
 }

@@ -9,7 +9,7 @@ mod run;
 
 pub use run::{run, Ended, Flow, Observer, StepView};
 
-use crate::error::{AnalysisError, Error, Result, Stage};
+use crate::error::{Error, FailureKind, Result, Stage};
 use crate::model::{Inputs, Rest, SliderModel, SliderSystem};
 use crate::ode::{Integrator, Method, OdeError, Options, SaveAt, Solution};
 use nalgebra::{
@@ -165,11 +165,7 @@ impl Problem {
     }
 
     fn no_size(stage: Stage, n: usize) -> Error {
-        AnalysisError::Internal {
-            stage,
-            detail: format!("no fixed-size state of {n} components"),
-        }
-        .into()
+        NoFixedSize { stage, states: n }.into()
     }
 
     /// Runs `job` on a state vector sized at compile time for this problem's layout (4 to 10
@@ -189,6 +185,27 @@ impl Problem {
             10 => job.run::<U10>(self),
             n => Err(Self::no_size(stage, n)),
         }
+    }
+}
+
+/// A state size with no compile-time-sized integrator: a bug (every layout a scene can have is
+/// covered), not a property of the scene.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("internal error: no fixed-size state of {states} components")]
+pub struct NoFixedSize {
+    /// The analysis that asked.
+    pub stage: Stage,
+    /// The state's size.
+    pub states: usize,
+}
+
+impl FailureKind for NoFixedSize {
+    fn stage(&self) -> Stage {
+        self.stage
+    }
+
+    fn name(&self) -> &'static str {
+        "Internal"
     }
 }
 

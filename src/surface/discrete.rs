@@ -93,9 +93,9 @@ impl Discrete {
             for _ in 0..n {
                 let q = rng.next_open01();
                 let z = parent.inverse_survival(q).ok_or_else(|| {
-                    Error::from(crate::error::AnalysisError::Internal {
-                        stage: crate::error::Stage::PeakSampling,
-                        detail: "inverse survival failed".into(),
+                    Error::from(crate::error::Internal {
+                        stage: crate::error::Stage::named("peak sampling"),
+                        what: "inverse survival failed",
                     })
                 })?;
                 out.push(z);

@@ -1,10 +1,10 @@
 //! `hdi static`: the static analyses at the scene's DC voltage.
 
 use hdi_tribology::analysis::record::StaticRecord;
+use hdi_tribology::analysis::touchdown::TransitionError;
 use hdi_tribology::analysis::{
     pull_in_voltage, s_curve, takeoff_power, touchdown_power, Fold, PullIn, ScanGrid, StaticOptions,
 };
-use hdi_tribology::error::AnalysisError;
 use hdi_tribology::model::SliderModel;
 use serde::Serialize;
 
@@ -39,9 +39,12 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let touchdown = touchdown_power(&model, &opts)?;
     let takeoff = match takeoff_power(&model, touchdown.power + opts.takeoff_start_excess, &opts) {
         Ok(t) => Some(t),
-        Err(hdi_tribology::Error::Analysis(
-            e @ (AnalysisError::NoTakeOff { .. } | AnalysisError::NoTakeOffInTable { .. }),
-        )) => {
+        Err(hdi_tribology::Error::Analysis(e))
+            if matches!(
+                e.downcast_ref(),
+                Some(TransitionError::NoTakeOff { .. } | TransitionError::NoTakeOffInTable { .. })
+            ) =>
+        {
             common::warn(&format!("no take-off: {e}"));
             None
         }

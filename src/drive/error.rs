@@ -1,0 +1,60 @@
+//! Why the drive or a controller running it could not go on.
+
+use crate::error::{FailureKind, Stage};
+
+impl Stage {
+    /// The drive plant.
+    pub const DRIVE: Stage = Stage::named("drive");
+    /// A controller running the drive.
+    pub const DRIVE_CONTROLLER: Stage = Stage::named("drive controller");
+}
+
+/// Why the drive or a controller running it could not go on.
+///
+/// ```
+/// use hdi_tribology::drive::DriveError;
+/// let e: hdi_tribology::Error = DriveError::NotFinished { max_periods: 100 }.into();
+/// assert_eq!(e.to_string(), "drive controller: did not finish within 100 periods");
+/// let e: hdi_tribology::Error = DriveError::PeriodSteps { max_steps: 10, t0_s: 0.0, t1_s: 5e-5 }.into();
+/// assert!(matches!(e, hdi_tribology::Error::NoConvergence(_)), "{e}");
+/// ```
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DriveError {
+    /// A controller did not stop within its budget of periods.
+    #[error("did not finish within {max_periods} periods")]
+    NotFinished {
+        /// The budget.
+        max_periods: usize,
+    },
+    /// One period needed more than `solver.max_steps` steps.
+    #[error("more than {max_steps} steps (solver.max_steps) in the period [{t0_s}, {t1_s}] s")]
+    PeriodSteps {
+        /// The step budget of one period.
+        max_steps: usize,
+        /// Start of the period (s).
+        t0_s: f64,
+        /// End of the period (s).
+        t1_s: f64,
+    },
+}
+
+impl FailureKind for DriveError {
+    fn stage(&self) -> Stage {
+        match self {
+            DriveError::NotFinished { .. } => Stage::DRIVE_CONTROLLER,
+            DriveError::PeriodSteps { .. } => Stage::DRIVE,
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            DriveError::NotFinished { .. } => "NotFinished",
+            DriveError::PeriodSteps { .. } => "PeriodSteps",
+        }
+    }
+
+    fn is_convergence(&self) -> bool {
+        matches!(self, DriveError::PeriodSteps { .. })
+    }
+}
