@@ -151,7 +151,7 @@ fn timed_fit(
     truth: &[f64],
     opts: &FitOptions,
     static_first: Option<usize>,
-) -> Result<(), hdi_tribology::fit::FitError> {
+) -> Result<(), hdi_tribology::Error> {
     let (one, one_wall, one_cpu) = timed(|| model_curves(baseline, data));
     one?;
     let (r, wall, cpu) = timed(|| match static_first {
@@ -174,7 +174,7 @@ fn timed_fit(
     Ok(())
 }
 
-fn main() -> Result<(), hdi_tribology::fit::FitError> {
+fn main() -> Result<(), hdi_tribology::Error> {
     let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());
     // The truth: the paper scene with a contact potential of 0.2 V.
     let mut truth = Scene::paper();

@@ -1,7 +1,8 @@
 //! Bad data files: each gives one error naming the file, the line and the column.
 
-use hdi_tribology::fit::{fit, DataError, DataSet, FitError, FitOptions, FreeParameter};
+use hdi_tribology::fit::{fit, DataError, DataSet, FitOptions, FreeParameter};
 use hdi_tribology::scene::Scene;
+use hdi_tribology::Error;
 
 fn path(name: &str) -> String {
     format!("{}/tests/data/fit/{name}", env!("CARGO_MANIFEST_DIR"))
@@ -80,7 +81,7 @@ fn too_few_points_for_the_parameters_is_refused_before_any_model_runs() {
         FreeParameter::new("efficiency_nm_per_mw"),
     ];
     match fit(&Scene::paper(), &[d], &free, &FitOptions::default()) {
-        Err(FitError::Data(e)) => {
+        Err(Error::Data(e)) => {
             assert!(e.file.ends_with("too_few_points.csv"), "{e}");
             assert!(
                 e.reason.contains("2 measured values for 2 free parameters"),

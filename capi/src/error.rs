@@ -42,6 +42,7 @@ impl From<hdi_tribology::Error> for Failure {
             E::Analysis(_) => HdiStatus::Analysis,
             E::Ode(_) => HdiStatus::Integration,
             E::Io { .. } => HdiStatus::Io,
+            E::Data(_) => HdiStatus::InvalidInput,
             _ => HdiStatus::Other,
         };
         Failure::new(status, e.to_string())

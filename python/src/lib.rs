@@ -27,7 +27,7 @@ use hdi_tribology::drive::{
     check_commands, replay_each, scene_zone, sensor_row, Command, CommandRow, DiskSpec, Drive,
     DriveOptions, Plant, SENSOR_COLUMNS,
 };
-use hdi_tribology::fit::{DataSet, FitError, FitOptions, FreeParameter};
+use hdi_tribology::fit::{DataSet, FitOptions, FreeParameter};
 use hdi_tribology::force::{Gaps, RelaxingState};
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::ode::Cancel;
@@ -52,6 +52,7 @@ fn to_py_err(e: hdi_tribology::Error) -> PyErr {
     use hdi_tribology::Error as E;
     let message = e.to_string();
     let (class, attrs): (&str, Vec<(&str, String)>) = match e {
+        E::Data(d) => return data_error(d),
         E::InvalidInput { field, reason } => (
             "InvalidInputError",
             vec![("field", field), ("reason", reason)],
@@ -1703,44 +1704,39 @@ fn replay<'py>(
 // ---------------------------------------------------------------------------------------------
 // Fit
 
-fn fit_error(e: FitError) -> PyErr {
-    match e {
-        FitError::Data(d) => {
-            let message = d.to_string();
-            Python::attach(|py| {
-                let attrs: Vec<(&str, Py<PyAny>)> = vec![
-                    (
-                        "file",
-                        d.file.into_pyobject(py).map(|o| o.into_any().unbind()),
-                    ),
-                    (
-                        "line",
-                        d.line.into_pyobject(py).map(|o| o.into_any().unbind()),
-                    ),
-                    (
-                        "column",
-                        d.column.into_pyobject(py).map(|o| o.into_any().unbind()),
-                    ),
-                    (
-                        "column_name",
-                        d.column_name
-                            .into_pyobject(py)
-                            .map(|o| o.into_any().unbind()),
-                    ),
-                    (
-                        "reason",
-                        d.reason.into_pyobject(py).map(|o| o.into_any().unbind()),
-                    ),
-                ]
-                .into_iter()
-                .filter_map(|(k, v)| v.ok().map(|v| (k, v)))
-                .collect();
-                py_error("DataFileError", &message, attrs)
-            })
-        }
-        FitError::Other(e) => to_py_err(e),
-        other => py_error("HdiError", &other.to_string(), Vec::<(&str, String)>::new()),
-    }
+/// `DataFileError` with the bad file's parts.
+fn data_error(d: hdi_tribology::error::DataError) -> PyErr {
+    let message = d.to_string();
+    Python::attach(|py| {
+        let attrs: Vec<(&str, Py<PyAny>)> = vec![
+            (
+                "file",
+                d.file.into_pyobject(py).map(|o| o.into_any().unbind()),
+            ),
+            (
+                "line",
+                d.line.into_pyobject(py).map(|o| o.into_any().unbind()),
+            ),
+            (
+                "column",
+                d.column.into_pyobject(py).map(|o| o.into_any().unbind()),
+            ),
+            (
+                "column_name",
+                d.column_name
+                    .into_pyobject(py)
+                    .map(|o| o.into_any().unbind()),
+            ),
+            (
+                "reason",
+                d.reason.into_pyobject(py).map(|o| o.into_any().unbind()),
+            ),
+        ]
+        .into_iter()
+        .filter_map(|(k, v)| v.ok().map(|v| (k, v)))
+        .collect();
+        py_error("DataFileError", &message, attrs)
+    })
 }
 
 /// Fits the `free` parameters of `scene` to measured curves (CSV files in engineering units,
@@ -1778,7 +1774,7 @@ fn fit<'py>(
     let scene_in = scene.get();
     let result = on_own_thread(
         py,
-        || -> Result<_, FitError> {
+        || -> Result<_, hdi_tribology::Error> {
             let sets = data
                 .iter()
                 .map(DataSet::from_path)
@@ -1797,7 +1793,7 @@ fn fit<'py>(
                 .collect::<Result<Vec<_>, _>>()?;
             hdi_tribology::fit::fit(&scene_in, &sets, &free, &options)
         },
-        fit_error,
+        to_py_err,
     )?;
     let out = json_to_py(py, &to_value(&result)?)?;
     out.set_item("scene", Scene::of(result.scene))?;

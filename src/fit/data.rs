@@ -1,50 +1,11 @@
 //! Measured curves read from CSV files, in engineering units, with one clear error per bad file.
 
 use std::collections::BTreeMap;
-use std::fmt;
 use std::path::Path;
 
+use crate::error::DataError;
+
 use serde::Serialize;
-
-/// A bad data file: which file, where in it, and why.
-///
-/// ```
-/// use hdi_tribology::fit::DataSet;
-/// let e = DataSet::from_csv_str("dc_voltage_v,touchdown_power_mw\n0.5,nan\n", "td.csv").unwrap_err();
-/// assert_eq!((e.line, e.column), (Some(2), Some(2)));
-/// assert_eq!(e.to_string(), "td.csv, line 2, column 2 (`touchdown_power_mw`): must be a finite number, got `nan`");
-/// ```
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct DataError {
-    /// The file (or the origin given for a string).
-    pub file: String,
-    /// Line in the file, 1-based (the header is line 1 unless comments precede it).
-    pub line: Option<u64>,
-    /// Column, 1-based.
-    pub column: Option<usize>,
-    /// The column's name as the file spells it.
-    pub column_name: Option<String>,
-    /// What is wrong, with the value as written.
-    pub reason: String,
-}
-
-impl fmt::Display for DataError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.file)?;
-        if let Some(l) = self.line {
-            write!(f, ", line {l}")?;
-        }
-        if let Some(c) = self.column {
-            write!(f, ", column {c}")?;
-        }
-        if let Some(n) = &self.column_name {
-            write!(f, " (`{n}`)")?;
-        }
-        write!(f, ": {}", self.reason)
-    }
-}
-
-impl std::error::Error for DataError {}
 
 /// What a curve measures, decided by its x column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -18,7 +18,7 @@
 //! let free: Vec<FreeParameter> = vec!["contact_potential_v".parse()?, "efficiency_nm_per_mw=0.05:0.2".parse()?];
 //! let r = fit(&Scene::paper(), &data, &free, &FitOptions::default())?;
 //! println!("{}", serde_json::to_string_pretty(&r.identifiability.statements).unwrap());
-//! # Ok::<(), hdi_tribology::fit::FitError>(())
+//! # Ok::<(), hdi_tribology::Error>(())
 //! ```
 
 use crate::error::{num, FailureKind, Stage};
@@ -29,7 +29,8 @@ pub mod goodness;
 mod params;
 mod solve;
 
-pub use data::{CurveKind, DataError, DataSet, Observed, Quantity, Unit};
+pub use crate::error::DataError;
+pub use data::{CurveKind, DataSet, Observed, Quantity, Unit};
 pub use params::FreeParameter;
 pub use solve::{
     fit, model_curves, Direction, FitOptions, FitResult, FittedParameter, Identifiability,
@@ -128,22 +129,4 @@ impl FailureKind for FitFailure {
             FitFailure::NotDetected { .. } => "NotDetected",
         }
     }
-}
-
-/// Why a fit could not be made.
-///
-/// ```
-/// use hdi_tribology::fit::{DataSet, FitError};
-/// let e: FitError = DataSet::from_csv_str("dc_voltage_kv,touchdown_power_mw\n", "a.csv").unwrap_err().into();
-/// assert!(e.to_string().starts_with("a.csv, line 1, column 1 (`dc_voltage_kv`): unknown unit `kv`"), "{e}");
-/// ```
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum FitError {
-    /// A data file is bad (names the file, line and column).
-    #[error(transparent)]
-    Data(#[from] DataError),
-    /// Anything else: a parameter name, an option, the scene or the model.
-    #[error(transparent)]
-    Other(#[from] crate::Error),
 }

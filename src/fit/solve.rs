@@ -4,16 +4,16 @@ use std::cell::RefCell;
 use std::sync::atomic::Ordering;
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use nalgebra_lm::{storage::Owned, DMatrix as LmMatrix, DVector as LmVector, Dyn};
 use serde::Serialize;
 
-use super::data::{DataError, DataSet};
+use super::data::DataSet;
 use super::forward::{weighted, weights, Evaluator, Predicted, Sets};
 use super::goodness::{self, Goodness};
 use super::params::{resolve, FreeParameter, Resolved};
-use super::FitError;
 use crate::analysis::sweep::Refinement;
+use crate::error::DataError;
 use crate::numerics::rng::Xoshiro256;
 use crate::scene::Scene;
 use crate::Error;
@@ -582,18 +582,21 @@ fn start_points(params: &[Resolved], starts: usize, seed: u64) -> Vec<Vec<f64>> 
 /// for p in &r.parameters {
 ///     println!("{} = {} ± {:?} {}", p.name, p.value, p.standard_error, p.unit);
 /// }
-/// # Ok::<(), hdi_tribology::fit::FitError>(())
+/// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 pub fn fit(
     scene: &Scene,
     data: &[DataSet],
     free: &[FreeParameter],
     opts: &FitOptions,
-) -> Result<FitResult, FitError> {
+) -> crate::Result<FitResult> {
     opts.validate()?;
     scene.validate()?;
     if free.is_empty() {
-        return Err(Error::invalid("--free", "name at least one parameter to fit").into());
+        return Err(Error::invalid(
+            "--free",
+            "name at least one parameter to fit",
+        ));
     }
     let base = serde_json::to_value(scene)
         .map_err(|e| Error::invalid("scene", format!("cannot be represented: {e}")))?;
@@ -609,14 +612,13 @@ pub fn fit(
             return Err(Error::invalid(
                 format!("--free {}", p.name()),
                 format!("sets the same field as `{}`", q.name()),
-            )
-            .into());
+            ));
         }
     }
     let points: usize = data.iter().map(DataSet::len).sum();
     if points <= params.len() {
         let files: Vec<&str> = data.iter().map(|d| d.origin.as_str()).collect();
-        return Err(FitError::Data(DataError {
+        return Err(Error::Data(DataError {
             file: if files.is_empty() {
                 "(no data file)".into()
             } else {
@@ -646,12 +648,12 @@ pub fn fit(
                 .collect();
             let included = ev.excluded.iter().filter(|e| !**e).count();
             if included <= params.len() {
-                return Err(Error::from(super::FitFailure::TooFewSettled {
+                return Err(super::FitFailure::TooFewSettled {
                     included,
                     points,
                     tol_mw: opts.dynamic_power_tol_mw,
                     free: params.len(),
-                })
+                }
                 .into());
             }
         }
@@ -698,9 +700,9 @@ pub fn fit(
         }
     }
     let Some((_, mut x, mut converged, mut termination)) = best.filter(|b| b.0.is_finite()) else {
-        return Err(Error::from(super::FitFailure::NoModelStart {
+        return Err(super::FitFailure::NoModelStart {
             first_error: first_error.unwrap_or_default(),
-        })
+        }
         .into());
     };
     let best_start = outcomes
@@ -784,7 +786,7 @@ fn check_starts(
     x: &[f64],
     active: &[usize],
     chi2: f64,
-) -> Result<Vec<Vec<f64>>, FitError> {
+) -> crate::Result<Vec<Vec<f64>>> {
     let params = ev.params;
     let cols = jacobian_columns(ev, x, opts, false, active)?;
     let m = cols.first().map_or(0, Vec::len);
@@ -932,7 +934,7 @@ fn run_start(
 }
 
 /// Errors, correlations, identifiability and residual tables at the optimum `x`.
-fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<FitResult, FitError> {
+fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> crate::Result<FitResult> {
     let Optimum {
         x,
         start,
@@ -952,106 +954,275 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
     let chi2: f64 = r0.iter().map(|v| v * v).sum();
     let s = (chi2 / (m - n) as f64).sqrt();
 
-    // Central differences, in each parameter's scale: J_s = J · diag(scale).
+    let js = scaled_jacobian(ev, &x, opts, r0.len())?;
+    let tol = opts.undetermined_rel_error;
+    let spectrum = Spectrum::of(&js, s, params, tol)?;
+    let mut parameters = spectrum.parameters(params, &x, &start, tol);
+    let elsewhere = undetermined_by_other_minima(&mut parameters, &starts, &x, chi2, s);
+    let correlation = spectrum.correlation();
+    let mut statements = Vec::new();
+    if !elsewhere.is_empty() {
+        statements.push(format!(
+            "starts that ended elsewhere fit as well (χ² within {n}·s² of the best): {} differ(s) \
+             between them by more than three error bars, so the data do not determine {}",
+            elsewhere.join(", "),
+            if elsewhere.len() == 1 { "it" } else { "them" }
+        ));
+    }
+    let strong = strongly_correlated(&parameters, &correlation);
+    statements.extend(identifiability_words(
+        &parameters,
+        &spectrum.directions,
+        params,
+        tol,
+        !strong.is_empty(),
+    ));
+
+    let residuals = residual_tables(data, &pred, &ev.excluded);
+    let clipped = residuals
+        .iter()
+        .flat_map(|t| t.rows.iter())
+        .filter(|r| r.clipped && !r.excluded)
+        .count();
+    let mut warnings = fit_warnings(
+        &parameters,
+        held,
+        &strong,
+        escaped,
+        converged.then_some(()).ok_or(termination.as_str()),
+        clipped,
+    );
+    let integration = if data.iter().any(DataSet::is_dynamic) {
+        // Detected transitions of cycles are not smooth in the parameters at the scale of the
+        // integration tolerance: check that χ² rises over an error bar as the Jacobian says.
+        check_linearity(ev, &js, &x, chi2, &mut parameters, &mut warnings)?;
+        let check = integration_check(data, &pred, &ev.excluded, s, opts);
+        warnings.extend(integration_warnings(&residuals, &check, opts));
+        Some(check)
+    } else {
+        None
+    };
+    let stated: Vec<bool> = data
+        .iter()
+        .flat_map(|d| d.observed.iter().map(|o| o.errors.is_some()))
+        .collect();
+    let goodness = goodness::assess(&residuals, &stated, n);
+    warnings.extend(goodness.failures.iter().cloned());
+    let linear = parameters
+        .iter()
+        .all(|p| p.linearity.is_none_or(|r| r >= MIN_LINEARITY));
+    let trusted = converged
+        && linear
+        && strong.is_empty()
+        && escaped.is_none()
+        && parameters.iter().all(|p| p.determined && !p.at_bound)
+        && clipped == 0
+        && integration.as_ref().is_none_or(|i| i.ok)
+        && goodness.passed();
+    Ok(FitResult {
+        scene: ev.scene(&x)?,
+        parameters,
+        correlation,
+        residuals,
+        identifiability: Identifiability {
+            directions: spectrum.directions,
+            condition: spectrum.condition,
+            statements,
+        },
+        points: m,
+        chi2,
+        residual_scale: s,
+        converged,
+        termination,
+        evaluations: ev.evaluations.load(Ordering::Relaxed),
+        starts,
+        integration,
+        goodness,
+        trusted,
+        warnings,
+    })
+}
+
+/// The Jacobian of the weighted residuals at `x` by central differences, in each parameter's
+/// scale: `J_s = J · diag(scale)`.
+fn scaled_jacobian(
+    ev: &Evaluator<'_>,
+    x: &[f64],
+    opts: &FitOptions,
+    rows: usize,
+) -> crate::Result<DMatrix<f64>> {
+    let n = ev.params.len();
     let all: Vec<usize> = (0..n).collect();
-    let cols = jacobian_columns(ev, &x, opts, true, &all)?;
-    let mut js = DMatrix::<f64>::zeros(r0.len(), n);
+    let cols = jacobian_columns(ev, x, opts, true, &all)?;
+    let mut js = DMatrix::<f64>::zeros(rows, n);
     for (c, col) in cols.into_iter().enumerate() {
         for (i, v) in col.into_iter().enumerate() {
-            js[(i, c)] = v * params[c].scale;
+            js[(i, c)] = v * ev.params[c].scale;
         }
     }
-    let svd = js.clone().svd(false, true);
-    let v_t = svd.v_t.ok_or_else(|| {
-        Error::from(crate::error::Internal {
-            stage: crate::error::Stage::FIT,
-            what: "singular value decomposition failed",
-        })
-    })?;
-    let sv = svd.singular_values;
-    let s_max = sv.iter().copied().fold(0.0, f64::max);
-    // Singular values below this are treated as zero (their directions are not determined).
-    let floor = s_max * 1e-10;
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| sv[b].total_cmp(&sv[a]));
-    let tol = opts.undetermined_rel_error;
-    let names: Vec<&str> = params.iter().map(Resolved::name).collect();
-    let directions: Vec<Direction> = order
-        .iter()
-        .map(|&k| {
-            let rel_error = if sv[k] > floor {
-                s / sv[k]
-            } else {
-                f64::INFINITY
-            };
-            let mut components: Vec<(String, f64)> = (0..n)
-                .map(|j| (names[j].to_string(), v_t[(k, j)]))
-                .filter(|(_, w)| w.abs() >= 0.05)
-                .collect();
-            components.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-            // Sign convention: the largest component positive.
-            if components.first().is_some_and(|c| c.1 < 0.0) {
-                components.iter_mut().for_each(|c| c.1 = -c.1);
-            }
-            Direction {
-                singular_value: sv[k],
-                rel_error,
-                determined: rel_error <= tol,
-                components,
-            }
-        })
-        .collect();
-    // Covariance in scaled units, C = s² V Σ⁻² Vᵀ, with vanishing singular values floored so
-    // that the correlations of an undetermined pair still show (±1).
-    let mut cov = DMatrix::<f64>::zeros(n, n);
-    for k in 0..n {
-        let w = s * s / sv[k].max(floor).max(f64::MIN_POSITIVE).powi(2);
-        for a in 0..n {
-            for b in 0..n {
-                cov[(a, b)] += w * v_t[(k, a)] * v_t[(k, b)];
+    Ok(js)
+}
+
+/// The singular value decomposition of the scaled Jacobian and what follows from it: the
+/// directions in parameter space with their relative errors, the covariance and the condition.
+struct Spectrum {
+    /// Singular values.
+    sv: DVector<f64>,
+    /// Right singular vectors, one per row.
+    v_t: DMatrix<f64>,
+    /// Singular values at or below this count as zero (their directions are not determined).
+    floor: f64,
+    /// Covariance in scaled units.
+    cov: DMatrix<f64>,
+    /// The directions, largest singular value first.
+    directions: Vec<Direction>,
+    /// The ratio of the largest to the smallest singular value.
+    condition: f64,
+}
+
+impl Spectrum {
+    /// The spectrum of `js` for residual scale `s`; directions with a relative error above `tol`
+    /// are not determined.
+    fn of(js: &DMatrix<f64>, s: f64, params: &[Resolved], tol: f64) -> crate::Result<Self> {
+        let n = params.len();
+        let svd = js.clone().svd(false, true);
+        let v_t = svd.v_t.ok_or_else(|| {
+            Error::from(crate::error::Internal {
+                stage: crate::error::Stage::FIT,
+                what: "singular value decomposition failed",
+            })
+        })?;
+        let sv = svd.singular_values;
+        let s_max = sv.iter().copied().fold(0.0, f64::max);
+        let floor = s_max * 1e-10;
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| sv[b].total_cmp(&sv[a]));
+        let names: Vec<&str> = params.iter().map(Resolved::name).collect();
+        let directions: Vec<Direction> = order
+            .iter()
+            .map(|&k| {
+                let rel_error = if sv[k] > floor {
+                    s / sv[k]
+                } else {
+                    f64::INFINITY
+                };
+                let mut components: Vec<(String, f64)> = (0..n)
+                    .map(|j| (names[j].to_string(), v_t[(k, j)]))
+                    .filter(|(_, w)| w.abs() >= 0.05)
+                    .collect();
+                components.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+                // Sign convention: the largest component positive.
+                if components.first().is_some_and(|c| c.1 < 0.0) {
+                    components.iter_mut().for_each(|c| c.1 = -c.1);
+                }
+                Direction {
+                    singular_value: sv[k],
+                    rel_error,
+                    determined: rel_error <= tol,
+                    components,
+                }
+            })
+            .collect();
+        // Covariance in scaled units, C = s² V Σ⁻² Vᵀ, with vanishing singular values floored
+        // so that the correlations of an undetermined pair still show (±1).
+        let mut cov = DMatrix::<f64>::zeros(n, n);
+        for k in 0..n {
+            let w = s * s / sv[k].max(floor).max(f64::MIN_POSITIVE).powi(2);
+            for a in 0..n {
+                for b in 0..n {
+                    cov[(a, b)] += w * v_t[(k, a)] * v_t[(k, b)];
+                }
             }
         }
-    }
-    let rank_deficient = |j: usize| (0..n).any(|k| sv[k] <= floor && v_t[(k, j)].abs() > 1e-6);
-    let parameters: Vec<FittedParameter> = params
-        .iter()
-        .enumerate()
-        .map(|(j, p)| {
-            let rel = if rank_deficient(j) {
-                f64::INFINITY
-            } else {
-                cov[(j, j)].sqrt()
-            };
-            let determined = rel <= tol;
-            // Within a thousandth of the range (or of the scale, for a one-sided bound).
-            let width = match (p.lower, p.upper) {
-                (Some(lo), Some(hi)) => hi - lo,
-                _ => p.scale,
-            };
-            let at_bound = [p.lower, p.upper]
-                .iter()
-                .flatten()
-                .any(|b| (x[j] - b).abs() <= 1e-3 * width);
-            FittedParameter {
-                name: p.name().to_string(),
-                unit: p.field.unit().to_string(),
-                field: p.field.keys().join("."),
-                value: x[j],
-                start: start[j],
-                standard_error: determined.then_some(rel * p.scale),
-                linear_error: rel * p.scale,
-                determined,
-                lower: p.lower,
-                upper: p.upper,
-                at_bound,
-                linearity: None,
-            }
+        let condition = if sv.iter().any(|&v| v <= 0.0) {
+            f64::INFINITY
+        } else {
+            s_max / sv.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        Ok(Spectrum {
+            sv,
+            v_t,
+            floor,
+            cov,
+            directions,
+            condition,
         })
-        .collect();
-    // Other starts that ended as good a fit (χ² within n·s² of the best) but elsewhere: the
-    // linearisation at one minimum cannot see them, so the parameters that differ by more than
-    // three of their error bars are not determined.
-    let mut parameters = parameters;
+    }
+
+    /// `true` when parameter `j` has a part in a direction the data do not determine.
+    fn rank_deficient(&self, j: usize) -> bool {
+        (0..self.sv.len()).any(|k| self.sv[k] <= self.floor && self.v_t[(k, j)].abs() > 1e-6)
+    }
+
+    /// The fitted parameters at `x` with their linear errors (determined when at most `tol`).
+    fn parameters(
+        &self,
+        params: &[Resolved],
+        x: &[f64],
+        start: &[f64],
+        tol: f64,
+    ) -> Vec<FittedParameter> {
+        params
+            .iter()
+            .enumerate()
+            .map(|(j, p)| {
+                let rel = if self.rank_deficient(j) {
+                    f64::INFINITY
+                } else {
+                    self.cov[(j, j)].sqrt()
+                };
+                let determined = rel <= tol;
+                // Within a thousandth of the range (or of the scale, for a one-sided bound).
+                let width = match (p.lower, p.upper) {
+                    (Some(lo), Some(hi)) => hi - lo,
+                    _ => p.scale,
+                };
+                let at_bound = [p.lower, p.upper]
+                    .iter()
+                    .flatten()
+                    .any(|b| (x[j] - b).abs() <= 1e-3 * width);
+                FittedParameter {
+                    name: p.name().to_string(),
+                    unit: p.field.unit().to_string(),
+                    field: p.field.keys().join("."),
+                    value: x[j],
+                    start: start[j],
+                    standard_error: determined.then_some(rel * p.scale),
+                    linear_error: rel * p.scale,
+                    determined,
+                    lower: p.lower,
+                    upper: p.upper,
+                    at_bound,
+                    linearity: None,
+                }
+            })
+            .collect()
+    }
+
+    /// The correlation matrix.
+    fn correlation(&self) -> Vec<Vec<f64>> {
+        let (n, cov) = (self.cov.nrows(), &self.cov);
+        (0..n)
+            .map(|a| {
+                (0..n)
+                    .map(|b| cov[(a, b)] / (cov[(a, a)] * cov[(b, b)]).sqrt())
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// Other starts that ended as good a fit (χ² within n·s² of the best) but elsewhere: the
+/// linearisation at one minimum cannot see them, so the parameters that differ by more than
+/// three of their error bars are not determined. Returns their names.
+fn undetermined_by_other_minima(
+    parameters: &mut [FittedParameter],
+    starts: &[StartOutcome],
+    x: &[f64],
+    chi2: f64,
+    s: f64,
+) -> Vec<String> {
+    let n = parameters.len();
     let mut elsewhere: Vec<String> = Vec::new();
     for o in starts
         .iter()
@@ -1068,37 +1239,20 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
             }
         }
     }
-    let correlation: Vec<Vec<f64>> = (0..n)
-        .map(|a| {
-            (0..n)
-                .map(|b| cov[(a, b)] / (cov[(a, a)] * cov[(b, b)]).sqrt())
-                .collect()
-        })
-        .collect();
-    let mut statements = Vec::new();
-    if !elsewhere.is_empty() {
-        statements.push(format!(
-            "starts that ended elsewhere fit as well (χ² within {n}·s² of the best): {} differ(s) \
-             between them by more than three error bars, so the data do not determine {}",
-            elsewhere.join(", "),
-            if elsewhere.len() == 1 { "it" } else { "them" }
-        ));
-    }
-    let strong = strongly_correlated(&parameters, &correlation);
-    statements.extend(identifiability_words(
-        &parameters,
-        &directions,
-        params,
-        tol,
-        !strong.is_empty(),
-    ));
-    let condition = if sv.iter().any(|&v| v <= 0.0) {
-        f64::INFINITY
-    } else {
-        s_max / sv.iter().copied().fold(f64::INFINITY, f64::min)
-    };
+    elsewhere
+}
 
-    let residuals = residual_tables(data, &pred, &ev.excluded);
+/// The warnings of the optimum itself: a false minimum escaped, the optimiser's termination
+/// (`Err` with its words when it did not converge), transitions the model does not detect,
+/// bounds, undetermined parameters (`held` at their start or not) and strong correlations.
+fn fit_warnings(
+    parameters: &[FittedParameter],
+    held: &[&str],
+    strong: &[(String, String, f64)],
+    escaped: Option<(f64, f64)>,
+    converged: std::result::Result<(), &str>,
+    clipped: usize,
+) -> Vec<String> {
     let mut warnings = Vec::new();
     if let Some((first, better)) = escaped {
         warnings.push(format!(
@@ -1108,14 +1262,9 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
              curves first"
         ));
     }
-    if !converged {
+    if let Err(termination) = converged {
         warnings.push(format!("the optimiser did not converge: {termination}"));
     }
-    let clipped = residuals
-        .iter()
-        .flat_map(|t| t.rows.iter())
-        .filter(|r| r.clipped && !r.excluded)
-        .count();
     if clipped > 0 {
         warnings.push(format!(
             "{clipped} transition(s) not detected by the model inside the heater programme \
@@ -1146,7 +1295,7 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
             )
         });
     }
-    for (a, b, rho) in &strong {
+    for (a, b, rho) in strong {
         warnings.push(format!(
             "{a} and {b} are correlated at ρ = {rho:+.4} (|ρ| > {STRONG_CORRELATION}): the data \
              fix a combination of them, along a valley {:.0} times longer than it is wide; \
@@ -1158,105 +1307,84 @@ fn analyse(ev: &Evaluator<'_>, opts: &FitOptions, opt: Optimum<'_>) -> Result<Fi
                 .min(1e6)
         ));
     }
-    let integration = if data.iter().any(DataSet::is_dynamic) {
-        // Detected transitions of cycles are not smooth in the parameters at the scale of the
-        // integration tolerance: check that χ² rises over an error bar as the Jacobian says.
-        for (j, p) in parameters.iter_mut().enumerate() {
-            let Some(se) = p.standard_error else { continue };
-            let rel = se / params[j].scale;
-            let predicted: f64 = (0..r0.len()).map(|i| (js[(i, j)] * rel).powi(2)).sum();
-            let mut rise = 0.0;
-            for sign in [1.0, -1.0] {
-                let mut xs = x.clone();
-                xs[j] += sign * se;
-                let inside = params[j].lower.is_none_or(|lo| xs[j] >= lo)
-                    && params[j].upper.is_none_or(|hi| xs[j] <= hi);
-                if !inside {
-                    xs[j] -= 2.0 * sign * se;
-                }
-                let r = weighted(data, &ev.predict(&xs)?, &ev.excluded);
-                rise += 0.5 * (r.iter().map(|v| v * v).sum::<f64>() - chi2);
+    warnings
+}
+
+/// Sets each determined parameter's linearity: the rise of χ² over one error bar either side
+/// against the rise the Jacobian `js` predicts, with a warning where they disagree.
+fn check_linearity(
+    ev: &Evaluator<'_>,
+    js: &DMatrix<f64>,
+    x: &[f64],
+    chi2: f64,
+    parameters: &mut [FittedParameter],
+    warnings: &mut Vec<String>,
+) -> crate::Result<()> {
+    let params = ev.params;
+    for (j, p) in parameters.iter_mut().enumerate() {
+        let Some(se) = p.standard_error else { continue };
+        let rel = se / params[j].scale;
+        let predicted: f64 = (0..js.nrows()).map(|i| (js[(i, j)] * rel).powi(2)).sum();
+        let mut rise = 0.0;
+        for sign in [1.0, -1.0] {
+            let mut xs = x.to_vec();
+            xs[j] += sign * se;
+            let inside = params[j].lower.is_none_or(|lo| xs[j] >= lo)
+                && params[j].upper.is_none_or(|hi| xs[j] <= hi);
+            if !inside {
+                xs[j] -= 2.0 * sign * se;
             }
-            let ratio = rise / predicted.max(f64::MIN_POSITIVE);
-            p.linearity = Some(ratio);
-            if let Some(w) = linearity_warning(&p.name, ratio) {
-                warnings.push(w);
-            }
+            let r = weighted(ev.data, &ev.predict(&xs)?, &ev.excluded);
+            rise += 0.5 * (r.iter().map(|v| v * v).sum::<f64>() - chi2);
         }
-        let check = integration_check(data, &pred, &ev.excluded, s, opts);
-        let left_out: Vec<String> = residuals
-            .iter()
-            .flat_map(|t| t.rows.iter().map(move |r| (t, r)))
-            .filter(|(_, r)| r.excluded)
-            .map(|(t, r)| format!("{} line {} ({})", t.file, r.line, t.column))
-            .collect();
-        if !left_out.is_empty() {
-            warnings.push(format!(
-                "{} dynamic value(s) left out of the fit: their detected powers did not settle \
-                 within {} mW under tenfold tighter tolerances (at the start, or at an optimum \
-                 the fit was then resumed from): {}",
-                left_out.len(),
-                opts.dynamic_power_tol_mw,
-                left_out.join(", ")
-            ));
+        let ratio = rise / predicted.max(f64::MIN_POSITIVE);
+        p.linearity = Some(ratio);
+        if let Some(w) = linearity_warning(&p.name, ratio) {
+            warnings.push(w);
         }
-        if check.unconverged > 0 {
-            warnings.push(format!(
-                "{} dynamic value(s) in the fit did not settle within {} mW at the optimum: \
-                 their residuals carry integration noise",
-                check.unconverged, opts.dynamic_power_tol_mw
-            ));
-        }
-        if check.ratio_to_scatter > 0.1 {
-            warnings.push(format!(
-                "integration noise {:.3e} (weighted) is {:.2} of the scatter: lower \
-                 dynamic_power_tol_mw or tighten solver.rtol",
-                check.max_weighted_change, check.ratio_to_scatter
-            ));
-        }
-        Some(check)
-    } else {
-        None
-    };
-    let stated: Vec<bool> = data
+    }
+    Ok(())
+}
+
+/// The warnings of the dynamic values: those left out of the fit, those unsettled at the
+/// optimum, and integration noise against the scatter.
+fn integration_warnings(
+    residuals: &[ResidualTable],
+    check: &IntegrationCheck,
+    opts: &FitOptions,
+) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let left_out: Vec<String> = residuals
         .iter()
-        .flat_map(|d| d.observed.iter().map(|o| o.errors.is_some()))
+        .flat_map(|t| t.rows.iter().map(move |r| (t, r)))
+        .filter(|(_, r)| r.excluded)
+        .map(|(t, r)| format!("{} line {} ({})", t.file, r.line, t.column))
         .collect();
-    let goodness = goodness::assess(&residuals, &stated, n);
-    warnings.extend(goodness.failures.iter().cloned());
-    let linear = parameters
-        .iter()
-        .all(|p| p.linearity.is_none_or(|r| r >= MIN_LINEARITY));
-    let trusted = converged
-        && linear
-        && strong.is_empty()
-        && escaped.is_none()
-        && parameters.iter().all(|p| p.determined && !p.at_bound)
-        && clipped == 0
-        && integration.as_ref().is_none_or(|i| i.ok)
-        && goodness.passed();
-    Ok(FitResult {
-        scene: ev.scene(&x)?,
-        parameters,
-        correlation,
-        residuals,
-        identifiability: Identifiability {
-            directions,
-            condition,
-            statements,
-        },
-        points: m,
-        chi2,
-        residual_scale: s,
-        converged,
-        termination,
-        evaluations: ev.evaluations.load(Ordering::Relaxed),
-        starts,
-        integration,
-        goodness,
-        trusted,
-        warnings,
-    })
+    if !left_out.is_empty() {
+        warnings.push(format!(
+            "{} dynamic value(s) left out of the fit: their detected powers did not settle \
+             within {} mW under tenfold tighter tolerances (at the start, or at an optimum \
+             the fit was then resumed from): {}",
+            left_out.len(),
+            opts.dynamic_power_tol_mw,
+            left_out.join(", ")
+        ));
+    }
+    if check.unconverged > 0 {
+        warnings.push(format!(
+            "{} dynamic value(s) in the fit did not settle within {} mW at the optimum: \
+             their residuals carry integration noise",
+            check.unconverged, opts.dynamic_power_tol_mw
+        ));
+    }
+    if check.ratio_to_scatter > 0.1 {
+        warnings.push(format!(
+            "integration noise {:.3e} (weighted) is {:.2} of the scatter: lower \
+             dynamic_power_tol_mw or tighten solver.rtol",
+            check.max_weighted_change, check.ratio_to_scatter
+        ));
+    }
+    warnings
 }
 
 /// Correlations beyond this (in magnitude) make a fit untrusted: the pair is then fixed by the
@@ -1458,9 +1586,9 @@ fn residual_tables(
 /// let grid = DataSet::from_csv_str("dc_voltage_v,touchdown_power_mw\n-0.5,0\n0,0\n0.5,0\n", "grid")?;
 /// let curves = model_curves(&hdi_tribology::scene::Scene::paper(), &[grid])?;
 /// println!("{:?} W", curves[0].observed[0].values);
-/// # Ok::<(), hdi_tribology::fit::FitError>(())
+/// # Ok::<(), hdi_tribology::Error>(())
 /// ```
-pub fn model_curves(scene: &Scene, data: &[DataSet]) -> Result<Vec<DataSet>, FitError> {
+pub fn model_curves(scene: &Scene, data: &[DataSet]) -> crate::Result<Vec<DataSet>> {
     let base = serde_json::to_value(scene)
         .map_err(|e| Error::invalid("scene", format!("cannot be represented: {e}")))?;
     let o = FitOptions::default();
@@ -1476,11 +1604,11 @@ pub fn model_curves(scene: &Scene, data: &[DataSet]) -> Result<Vec<DataSet>, Fit
     for (ds, p) in out.iter_mut().zip(&pred) {
         for (o, pc) in ds.observed.iter_mut().zip(p) {
             if let Some(i) = pc.iter().position(|q| q.clipped) {
-                return Err(Error::from(super::FitFailure::NotDetected {
+                return Err(super::FitFailure::NotDetected {
                     origin: ds.origin.clone(),
                     quantity: o.quantity,
                     x: ds.x[i],
-                })
+                }
                 .into());
             }
             o.values = pc.iter().map(|q| q.value).collect();

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use hdi_tribology::fit::{fit, DataSet, FitError, FitOptions, FitResult, FreeParameter};
+use hdi_tribology::fit::{fit, DataSet, FitOptions, FitResult, FreeParameter};
 use hdi_tribology::Error;
 
 use crate::common::{self, CliError, Output, SceneArgs};
@@ -90,7 +90,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         check_plot_dir(dir)?;
     }
     let scene = a.scene.load()?;
-    let failed = |e: FitError| CliError::Failed(e.to_string());
+    let failed = |e: hdi_tribology::Error| CliError::Failed(e.to_string());
     let data = a
         .data
         .iter()
