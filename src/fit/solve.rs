@@ -664,20 +664,7 @@ pub fn fit(
     // analysis at the optimum reports them as not determined.
     let x0: Vec<f64> = params.iter().map(|p| p.start).collect();
     let all: Vec<usize> = (0..params.len()).collect();
-    let held: Vec<usize> = match jacobian_columns(&ev, &x0, opts, false, &all) {
-        Ok(cols) => {
-            let norms: Vec<f64> = cols
-                .iter()
-                .zip(&params)
-                .map(|(c, p)| p.scale * c.iter().map(|v| v * v).sum::<f64>().sqrt())
-                .collect();
-            let top = norms.iter().copied().fold(0.0, f64::max);
-            (0..params.len())
-                .filter(|&j| top > 0.0 && norms[j] <= UNTOUCHED_COLUMN * top)
-                .collect()
-        }
-        Err(_) => Vec::new(),
-    };
+    let held = untouched_parameters(&ev, &x0, opts);
     let active: Vec<usize> = all.iter().copied().filter(|j| !held.contains(j)).collect();
     let active = if active.is_empty() { all } else { active };
 
@@ -699,7 +686,7 @@ pub fn fit(
             }
         }
     }
-    let Some((_, mut x, mut converged, mut termination)) = best.filter(|b| b.0.is_finite()) else {
+    let Some((_, x, converged, termination)) = best.filter(|b| b.0.is_finite()) else {
         return Err(super::FitFailure::NoModelStart {
             first_error: first_error.unwrap_or_default(),
         }
@@ -712,56 +699,17 @@ pub fn fit(
         .unwrap_or_else(|| params.iter().map(|p| p.start).collect());
     // Dynamic values that settled at the start but not at the optimum are left out too, and
     // the fit is resumed from the optimum without them (at most twice).
-    for _ in 0..2 {
-        let Ok(pred) = ev.predict(&x) else { break };
-        let newly: Vec<usize> = flatten(&pred)
-            .iter()
-            .enumerate()
-            .filter(|(i, q)| {
-                !ev.excluded.get(*i).copied().unwrap_or(false)
-                    && q.refined.is_some_and(|r| !r.converged)
-            })
-            .map(|(i, _)| i)
-            .collect();
-        let included = ev.excluded.iter().filter(|e| !**e).count();
-        if newly.is_empty() || included - newly.len() <= params.len() {
-            break;
-        }
-        if ev.excluded.is_empty() {
-            ev.excluded = vec![false; points];
-        }
-        for i in newly {
-            ev.excluded[i] = true;
-        }
-        let (outcome, end) = run_start(&ev, opts, x.clone(), &active);
-        outcomes.push(outcome);
-        let Some((_, x1, c1, t1)) = end else { break };
-        (x, converged, termination) = (x1, c1, t1);
-    }
+    let mut optimum = (x, converged, termination);
+    resume_without_unsettled(&mut ev, opts, &active, points, &mut optimum, &mut outcomes);
     // Curves with cycles: the detected powers are not smooth in the parameters, and a single
     // start can end in a false minimum whose residuals pass every test. Starts from the optimum
     // moved out along the least determined directions look for a better one.
-    let mut escaped = None;
-    if data.iter().any(DataSet::is_dynamic) && opts.cycle_check_starts > 0 {
-        let best_cost = outcomes
-            .iter()
-            .filter(|o| o.end == x)
-            .map(|o| o.cost)
-            .fold(f64::INFINITY, f64::min);
-        let checks = check_starts(&ev, opts, &x, &active, best_cost)?;
-        for start in checks {
-            let (outcome, end) = run_start(&ev, opts, start, &active);
-            outcomes.push(outcome);
-            if let Some((c, x1, c1, t1)) = end {
-                // Lower by more than the optimiser's tolerance and one unit of χ².
-                if c1 && c < best_cost - 1.0 - opts.tolerance * best_cost {
-                    escaped = Some((best_cost, c));
-                    (x, converged, termination) = (x1, c1, t1);
-                    break;
-                }
-            }
-        }
-    }
+    let escaped = if data.iter().any(DataSet::is_dynamic) && opts.cycle_check_starts > 0 {
+        escape_false_minimum(&ev, opts, &active, &mut optimum, &mut outcomes)?
+    } else {
+        None
+    };
+    let (x, converged, termination) = optimum;
     let held: Vec<&str> = held.iter().map(|&j| params[j].name()).collect();
     analyse(
         &ev,
@@ -776,6 +724,103 @@ pub fn fit(
             escaped,
         },
     )
+}
+
+/// The parameters no fitted value depends on at `x0`: their Jacobian column (in their scale) is
+/// at most [`UNTOUCHED_COLUMN`] of the largest. The optimiser holds them at their start (a
+/// column of zeros would only stall its trust region).
+fn untouched_parameters(ev: &Evaluator<'_>, x0: &[f64], opts: &FitOptions) -> Vec<usize> {
+    let params = ev.params;
+    let all: Vec<usize> = (0..params.len()).collect();
+    match jacobian_columns(ev, x0, opts, false, &all) {
+        Ok(cols) => {
+            let norms: Vec<f64> = cols
+                .iter()
+                .zip(params)
+                .map(|(c, p)| p.scale * c.iter().map(|v| v * v).sum::<f64>().sqrt())
+                .collect();
+            let top = norms.iter().copied().fold(0.0, f64::max);
+            (0..params.len())
+                .filter(|&j| top > 0.0 && norms[j] <= UNTOUCHED_COLUMN * top)
+                .collect()
+        }
+        Err(_) => Vec::new(),
+    }
+}
+
+/// The optimum: the parameters, whether the optimiser converged, and why it stopped.
+type Found = (Vec<f64>, bool, String);
+
+/// Leaves out the dynamic values that settled at the start but not at the `optimum`, and
+/// resumes the fit from it without them (at most twice, and never below one more value than
+/// parameters).
+fn resume_without_unsettled(
+    ev: &mut Evaluator<'_>,
+    opts: &FitOptions,
+    active: &[usize],
+    points: usize,
+    optimum: &mut Found,
+    outcomes: &mut Vec<StartOutcome>,
+) {
+    for _ in 0..2 {
+        let Ok(pred) = ev.predict(&optimum.0) else {
+            break;
+        };
+        let newly: Vec<usize> = flatten(&pred)
+            .iter()
+            .enumerate()
+            .filter(|(i, q)| {
+                !ev.excluded.get(*i).copied().unwrap_or(false)
+                    && q.refined.is_some_and(|r| !r.converged)
+            })
+            .map(|(i, _)| i)
+            .collect();
+        let included = ev.excluded.iter().filter(|e| !**e).count();
+        if newly.is_empty() || included - newly.len() <= ev.params.len() {
+            break;
+        }
+        if ev.excluded.is_empty() {
+            ev.excluded = vec![false; points];
+        }
+        for i in newly {
+            ev.excluded[i] = true;
+        }
+        let (outcome, end) = run_start(ev, opts, optimum.0.clone(), active);
+        outcomes.push(outcome);
+        let Some((_, x1, c1, t1)) = end else { break };
+        *optimum = (x1, c1, t1);
+    }
+}
+
+/// Curves with cycles: the detected powers are not smooth in the parameters, and a single start
+/// can end in a false minimum whose residuals pass every test. Starts from the `optimum` moved
+/// out along the least determined directions look for a better one; the first that is lower by
+/// more than the optimiser's tolerance and one unit of χ² replaces it. Returns (χ² of the first,
+/// χ² of the better) when one did.
+fn escape_false_minimum(
+    ev: &Evaluator<'_>,
+    opts: &FitOptions,
+    active: &[usize],
+    optimum: &mut Found,
+    outcomes: &mut Vec<StartOutcome>,
+) -> crate::Result<Option<(f64, f64)>> {
+    let best_cost = outcomes
+        .iter()
+        .filter(|o| o.end == optimum.0)
+        .map(|o| o.cost)
+        .fold(f64::INFINITY, f64::min);
+    let checks = check_starts(ev, opts, &optimum.0, active, best_cost)?;
+    for start in checks {
+        let (outcome, end) = run_start(ev, opts, start, active);
+        outcomes.push(outcome);
+        if let Some((c, x1, c1, t1)) = end {
+            if c1 && c < best_cost - 1.0 - opts.tolerance * best_cost {
+                *optimum = (x1, c1, t1);
+                return Ok(Some((best_cost, c)));
+            }
+        }
+    }
+    Ok(None)
 }
 
 /// Check starts around the optimum `x` (cost `chi2`): pairs ± along the least determined

@@ -16,7 +16,10 @@ impl Stage {
 /// ```
 /// use hdi_tribology::force::ForceError;
 /// let e: hdi_tribology::Error = ForceError::Meniscus { e_nm: 0.5, force_n: f64::NAN, slope_n_per_m: 1.0 }.into();
-/// assert_eq!(e.to_string(), "interface force: the meniscus force at e = 0.5000 nm is NaN N (slope 1 N/m)");
+/// assert_eq!(
+///     e.to_string(),
+///     "interface force did not converge: the meniscus force at e = 0.5000 nm is NaN N (slope 1 N/m)"
+/// );
 /// ```
 #[derive(Clone, Debug, thiserror::Error)]
 #[non_exhaustive]

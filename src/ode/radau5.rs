@@ -243,61 +243,34 @@ where
         self.lu_h = if ok { h } else { f64::NAN };
         ok
     }
-}
 
-impl<D: Dim, S: OdeSystem<D> + ?Sized> Stepper<D, S> for Radau5<D>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    fn error_order(&self) -> f64 {
-        4.0
-    }
-
-    fn is_stiff(&self) -> bool {
-        true
-    }
-
-    fn restart(&mut self, sys: &S, t: f64, y: &OVector<f64, D>, ctx: &mut Ctx<D>) {
-        sys.rhs(t, y, &mut self.f0);
-        ctx.stats.rhs_evals += 1;
-        self.f0_valid = true;
-        self.jac_stale = true;
-        self.h_prev = None;
-        self.first = true;
-    }
-
-    fn f0(&self) -> &OVector<f64, D> {
-        &self.f0
-    }
-
-    fn attempt(
+    /// The start of a step: `f(t, y)`, a fresh Jacobian when the last is stale, and the
+    /// factored iteration matrices for `h`; the failed trial otherwise.
+    fn prepare<S: OdeSystem<D> + ?Sized>(
         &mut self,
         sys: &S,
         t: f64,
         y: &OVector<f64, D>,
         h: f64,
-        y_new: &mut OVector<f64, D>,
         ctx: &mut Ctx<D>,
-    ) -> Trial {
-        let k = consts();
-        let n = y.len();
+    ) -> Result<(), Trial> {
         if !self.f0_valid {
             sys.rhs(t, y, &mut self.f0);
             ctx.stats.rhs_evals += 1;
             self.f0_valid = true;
         }
         if !all_finite(&self.f0) {
-            return Trial::Failed {
+            return Err(Trial::Failed {
                 factor: 0.5,
                 kind: FailKind::NonFinite,
-            };
+            });
         }
         if self.jac_stale {
             if !eval_jacobian(sys, t, y, &self.f0, &mut self.jac, &mut self.tmp, ctx) {
-                return Trial::Failed {
+                return Err(Trial::Failed {
                     factor: 0.5,
                     kind: FailKind::NonFinite,
-                };
+                });
             }
             self.jac_stale = false;
             self.jac_fresh = true;
@@ -307,12 +280,17 @@ where
             }
         }
         if self.lu_h != h && !self.factor(h, ctx) {
-            return Trial::Failed {
+            return Err(Trial::Failed {
                 factor: 0.5,
                 kind: FailKind::Singular,
-            };
+            });
         }
+        Ok(())
+    }
 
+    /// The Newton iteration's starting guess for the stage increments `Z` (and `W = T⁻¹Z`).
+    fn starting_guess(&mut self, h: f64) {
+        let k = consts();
         // Starting guess: the previous collocation polynomial extrapolated, else zero.
         match self.h_prev {
             Some(hp) => {
@@ -339,7 +317,20 @@ where
                 self.w[i].axpy(k.t_inv[(i, j)], &self.z[j], 1.0);
             }
         }
+    }
 
+    /// The simplified Newton iteration on the collocation equations, in the variables `W`
+    /// that decouple the real and complex blocks; the failed trial when it does not converge.
+    fn newton<S: OdeSystem<D> + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &OVector<f64, D>,
+        h: f64,
+        ctx: &mut Ctx<D>,
+    ) -> Result<(), Trial> {
+        let k = consts();
+        let n = y.len();
         // Inverse weights of the increment's norm, fixed over the iteration (no division in it).
         for r in 0..n {
             self.newton_weights[r] = 1.0 / ((ctx.atol[r] + ctx.rtol * y[r].abs()) * self.tol_scale);
@@ -357,10 +348,10 @@ where
             ctx.stats.newton_iters += 1;
             if !self.f.iter().all(all_finite) {
                 ctx.stats.newton_failures += 1;
-                return Trial::Failed {
+                return Err(Trial::Failed {
                     factor: 0.5,
                     kind: FailKind::NonFinite,
-                };
+                });
             }
             // Right-hand sides in transformed variables: T⁻¹F − (Λ/h) W.
             let (g, al, be) = (k.gamma / h, k.alpha / h, k.beta / h);
@@ -423,21 +414,26 @@ where
             if !self.jac_fresh {
                 self.jac_stale = true;
             }
-            return Trial::Failed {
+            return Err(Trial::Failed {
                 factor: 0.5,
                 kind: FailKind::Newton,
-            };
+            });
         }
+        Ok(())
+    }
 
-        y_new.copy_from(y);
-        *y_new += &self.z[2];
-        if !all_finite(y_new) {
-            return Trial::Failed {
-                factor: 0.5,
-                kind: FailKind::NonFinite,
-            };
-        }
-
+    /// The scaled error of the step from `y` to `y_new`; marks the Jacobian stale after a
+    /// rejection.
+    fn error_estimate<S: OdeSystem<D> + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &OVector<f64, D>,
+        y_new: &OVector<f64, D>,
+        h: f64,
+        ctx: &mut Ctx<D>,
+    ) -> f64 {
+        let k = consts();
         // Error estimate: (γ/h − J)⁻¹ (f0 + Σ dd_i Z_i / h), a second filtered pass when the
         // first is large after a rejection (it can be unreliable for very stiff components).
         self.f2.fill(0.0);
@@ -464,6 +460,60 @@ where
         if err > 1.0 && !self.jac_fresh {
             self.jac_stale = true;
         }
+        err
+    }
+}
+
+impl<D: Dim, S: OdeSystem<D> + ?Sized> Stepper<D, S> for Radau5<D>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    fn error_order(&self) -> f64 {
+        4.0
+    }
+
+    fn is_stiff(&self) -> bool {
+        true
+    }
+
+    fn restart(&mut self, sys: &S, t: f64, y: &OVector<f64, D>, ctx: &mut Ctx<D>) {
+        sys.rhs(t, y, &mut self.f0);
+        ctx.stats.rhs_evals += 1;
+        self.f0_valid = true;
+        self.jac_stale = true;
+        self.h_prev = None;
+        self.first = true;
+    }
+
+    fn f0(&self) -> &OVector<f64, D> {
+        &self.f0
+    }
+
+    fn attempt(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &OVector<f64, D>,
+        h: f64,
+        y_new: &mut OVector<f64, D>,
+        ctx: &mut Ctx<D>,
+    ) -> Trial {
+        if let Err(failed) = self.prepare(sys, t, y, h, ctx) {
+            return failed;
+        }
+        self.starting_guess(h);
+        if let Err(failed) = self.newton(sys, t, y, h, ctx) {
+            return failed;
+        }
+        y_new.copy_from(y);
+        *y_new += &self.z[2];
+        if !all_finite(y_new) {
+            return Trial::Failed {
+                factor: 0.5,
+                kind: FailKind::NonFinite,
+            };
+        }
+        let err = self.error_estimate(sys, t, y, y_new, h, ctx);
         Trial::Done { err }
     }
 
