@@ -310,6 +310,33 @@ pub trait FailureKind: CloneKind + Any + fmt::Display + fmt::Debug + Send + Sync
     }
 }
 
+/// Implements [`FailureKind`] for an enum from a table of its variants and their stages (the
+/// variant's name is its identifier); `convergence` decides, for a value of the enum, whether it
+/// is a convergence failure ([`Error::NoConvergence`]).
+macro_rules! failure_kind {
+    ($ty:ident, convergence = $conv:expr, { $($variant:ident => $stage:expr),+ $(,)? }) => {
+        impl $crate::error::FailureKind for $ty {
+            fn stage(&self) -> $crate::error::Stage {
+                match self {
+                    $( $ty::$variant { .. } => $stage, )+
+                }
+            }
+
+            fn name(&self) -> &'static str {
+                match self {
+                    $( $ty::$variant { .. } => stringify!($variant), )+
+                }
+            }
+
+            fn is_convergence(&self) -> bool {
+                let convergence: fn(&$ty) -> bool = $conv;
+                convergence(self)
+            }
+        }
+    };
+}
+pub(crate) use failure_kind;
+
 /// Cloning a boxed [`FailureKind`]; implemented for every `Clone` kind.
 #[doc(hidden)]
 pub trait CloneKind {

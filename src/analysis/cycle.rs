@@ -10,7 +10,7 @@
 
 use super::equilibrium::{flying_equilibrium, ScanGrid};
 use super::roots::brent;
-use crate::error::{check_positive, num, Error, FailureKind, Result, Stage};
+use crate::error::{check_positive, failure_kind, num, Error, Result, Stage};
 use crate::heater::Programme;
 use crate::model::{SliderModel, SliderSystem};
 use crate::ode::{self, Method, Stats, StepStatus};
@@ -157,27 +157,14 @@ pub enum CycleError {
     },
 }
 
-impl FailureKind for CycleError {
-    fn stage(&self) -> Stage {
-        match self {
-            CycleError::TooManySegments { .. } | CycleError::NoTriggeredTouchdown { .. } => {
-                Stage::TRIGGERED_CYCLE
-            }
-            _ => Stage::CYCLE,
-        }
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            CycleError::TooManySegments { .. } => "TooManySegments",
-            CycleError::NoTriggeredTouchdown { .. } => "NoTriggeredTouchdown",
-            CycleError::LeftTheModel { .. } => "LeftTheModel",
-            CycleError::StepLimit { .. } => "StepLimit",
-            CycleError::StepPace { .. } => "StepPace",
-            CycleError::LeftTheTables { .. } => "LeftTheTables",
-        }
-    }
-}
+failure_kind!(CycleError, convergence = |_| false, {
+        TooManySegments => Stage::TRIGGERED_CYCLE,
+        NoTriggeredTouchdown => Stage::TRIGGERED_CYCLE,
+        LeftTheModel => Stage::CYCLE,
+        StepLimit => Stage::CYCLE,
+        StepPace => Stage::CYCLE,
+        LeftTheTables => Stage::CYCLE,
+});
 
 /// The reason of [`CycleError::LeftTheModel`].
 fn left_the_model_reason(

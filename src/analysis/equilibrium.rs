@@ -8,7 +8,7 @@
 //! `k_ab − ∂F_if/∂y` for the rigid slider) is positive; folds are where it vanishes.
 
 use super::roots::{brent, brent_polished};
-use crate::error::{num, Error, FailureKind, Result, Stage};
+use crate::error::{failure_kind, num, Error, Result, Stage};
 use crate::force::ForceEval;
 use crate::model::{Dofs, LinearBalance, Rest, SliderModel, StaticBounds};
 use crate::units::{to_mw, to_nm};
@@ -61,19 +61,11 @@ pub enum FlyingError {
     },
 }
 
-impl FailureKind for FlyingError {
-    fn stage(&self) -> Stage {
-        Stage::FLYING_EQUILIBRIUM
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            FlyingError::FlyingBranchEnds { .. } => "FlyingBranchEnds",
-            FlyingError::NoFlyingEquilibrium { .. } => "NoFlyingEquilibrium",
-            FlyingError::TableTooNarrow { .. } => "TableTooNarrow",
-        }
-    }
-}
+failure_kind!(FlyingError, convergence = |_| false, {
+        FlyingBranchEnds => Stage::FLYING_EQUILIBRIUM,
+        NoFlyingEquilibrium => Stage::FLYING_EQUILIBRIUM,
+        TableTooNarrow => Stage::FLYING_EQUILIBRIUM,
+});
 
 /// One equilibrium of the slider.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

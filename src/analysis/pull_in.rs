@@ -10,7 +10,7 @@
 use super::equilibrium::EquilibriumSolver;
 use super::roots::{brent, brent_polished};
 use super::touchdown::{touchdown_at, touchdown_signed, Cause, StaticOptions};
-use crate::error::{check_finite, num, Error, FailureKind, Result, Stage};
+use crate::error::{check_finite, failure_kind, num, Error, Result, Stage};
 use crate::model::{SliderModel, Voltage};
 use serde::Serialize;
 
@@ -40,18 +40,10 @@ pub enum PullInError {
     NoElectrostatics,
 }
 
-impl FailureKind for PullInError {
-    fn stage(&self) -> Stage {
-        Stage::PULL_IN
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            PullInError::NoPullIn { .. } => "NoPullIn",
-            PullInError::NoElectrostatics => "NoElectrostatics",
-        }
-    }
-}
+failure_kind!(PullInError, convergence = |_| false, {
+        NoPullIn => Stage::PULL_IN,
+        NoElectrostatics => Stage::PULL_IN,
+});
 
 /// The pull-in voltage at one heater power.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

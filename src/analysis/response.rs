@@ -7,7 +7,7 @@
 //! bulge displacement.
 
 use super::equilibrium::{flying_equilibrium, Equilibrium, ScanGrid};
-use crate::error::{Error, FailureKind, Result, Stage};
+use crate::error::{failure_kind, Error, Result, Stage};
 use crate::model::{Heater, SliderModel, SliderSystem, Voltage};
 use crate::ode::OdeSystem;
 use crate::scene::MAX_DOF;
@@ -42,21 +42,10 @@ pub enum ResponseError {
     NoAcVoltage,
 }
 
-impl FailureKind for ResponseError {
-    fn stage(&self) -> Stage {
-        match self {
-            ResponseError::NonFiniteEigenvalue => Stage::LINEAR_RESPONSE,
-            ResponseError::NoAcVoltage => Stage::SIMULATED_DITHER,
-        }
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            ResponseError::NonFiniteEigenvalue => "NonFiniteEigenvalue",
-            ResponseError::NoAcVoltage => "NoAcVoltage",
-        }
-    }
-}
+failure_kind!(ResponseError, convergence = |_| false, {
+        NonFiniteEigenvalue => Stage::LINEAR_RESPONSE,
+        NoAcVoltage => Stage::SIMULATED_DITHER,
+});
 
 /// One mode of the linearised slider.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -1,6 +1,6 @@
 //! Bracketed scalar root finding (Brent's method) used by the analyses.
 
-use crate::error::{FailureKind, Result, Stage};
+use crate::error::{failure_kind, Result, Stage};
 
 impl Stage {
     /// Brent's bracketed root search.
@@ -48,24 +48,12 @@ pub enum RootError {
     },
 }
 
-impl FailureKind for RootError {
-    fn stage(&self) -> Stage {
-        Stage::ROOT_SEARCH
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            RootError::NonFiniteEnd { .. } => "NonFiniteEnd",
-            RootError::NoSignChange { .. } => "NoSignChange",
-            RootError::NonFinite { .. } => "NonFinite",
-            RootError::Iterations { .. } => "Iterations",
-        }
-    }
-
-    fn is_convergence(&self) -> bool {
-        true
-    }
-}
+failure_kind!(RootError, convergence = |_| true, {
+        NonFiniteEnd => Stage::ROOT_SEARCH,
+        NoSignChange => Stage::ROOT_SEARCH,
+        NonFinite => Stage::ROOT_SEARCH,
+        Iterations => Stage::ROOT_SEARCH,
+});
 
 /// Finds a root of `f` in `[a, b]` where `f(a)` and `f(b)` differ in sign, to an interval width
 /// of `xtol` (plus a few ulps). Bounded to 200 iterations.

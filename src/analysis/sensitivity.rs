@@ -16,7 +16,7 @@
 
 use super::equilibrium::{Equilibrium, EquilibriumSolver};
 use super::touchdown::{Cause, Transition};
-use crate::error::{num, Error, FailureKind, Result, Stage};
+use crate::error::{failure_kind, num, Error, Result, Stage};
 use crate::force::{GapReference, TermKind};
 use crate::model::{Dofs, SliderModel};
 
@@ -52,18 +52,10 @@ pub enum SensitivityError {
     },
 }
 
-impl FailureKind for SensitivityError {
-    fn stage(&self) -> Stage {
-        Stage::TRANSITION_SENSITIVITY
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            SensitivityError::SingularTangent { .. } => "SingularTangent",
-            SensitivityError::FlatContactForce { .. } => "FlatContactForce",
-        }
-    }
-}
+failure_kind!(SensitivityError, convergence = |_| false, {
+        SingularTangent => Stage::TRANSITION_SENSITIVITY,
+        FlatContactForce => Stage::TRANSITION_SENSITIVITY,
+});
 
 /// Contact force (N) at coordinates `q` and protrusion `delta`, from direct evaluation of the
 /// contact terms.

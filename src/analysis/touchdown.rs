@@ -6,7 +6,7 @@
 //! falling) until the contact force drops below `F_th` or that branch ends at a fold.
 
 use super::equilibrium::{Equilibrium, EquilibriumSolver, ScanGrid, Skipper};
-use crate::error::{num, FailureKind, Result, Stage};
+use crate::error::{failure_kind, num, Result, Stage};
 use crate::model::SliderModel;
 use crate::units::{to_mw, to_nm};
 use serde::Serialize;
@@ -113,30 +113,15 @@ pub enum TransitionError {
     },
 }
 
-impl FailureKind for TransitionError {
-    fn stage(&self) -> Stage {
-        use TransitionError as E;
-        match self {
-            E::InContactAtZeroPower { .. } | E::NoTouchdown { .. } | E::TableTooNarrow { .. } => {
-                Stage::TOUCHDOWN
-            }
-            _ => Stage::TAKE_OFF,
-        }
-    }
-
-    fn name(&self) -> &'static str {
-        use TransitionError as E;
-        match self {
-            E::InContactAtZeroPower { .. } => "InContactAtZeroPower",
-            E::NoTakeOff { .. } => "NoTakeOff",
-            E::NoTouchdown { .. } => "NoTouchdown",
-            E::NoTakeOffInTable { .. } => "NoTakeOffInTable",
-            E::TableTooNarrow { .. } => "TableTooNarrow",
-            E::NoContactEquilibrium { .. } => "NoContactEquilibrium",
-            E::UnstableContactStart { .. } => "UnstableContactStart",
-        }
-    }
-}
+failure_kind!(TransitionError, convergence = |_| false, {
+        InContactAtZeroPower => Stage::TOUCHDOWN,
+        NoTakeOff => Stage::TAKE_OFF,
+        NoTouchdown => Stage::TOUCHDOWN,
+        NoTakeOffInTable => Stage::TAKE_OFF,
+        TableTooNarrow => Stage::TOUCHDOWN,
+        NoContactEquilibrium => Stage::TAKE_OFF,
+        UnstableContactStart => Stage::TAKE_OFF,
+});
 
 /// Why a transition happened.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -1,6 +1,6 @@
 //! Why the air bearing could not be solved.
 
-use crate::error::{num, FailureKind, Stage};
+use crate::error::{failure_kind, num, Stage};
 
 impl Stage {
     /// The air bearing's pressure, attitude, stiffness or damping from the slider's geometry.
@@ -104,25 +104,12 @@ pub enum BearingError {
     SingularStiffness,
 }
 
-impl FailureKind for BearingError {
-    fn stage(&self) -> Stage {
-        Stage::AIR_BEARING
-    }
-
-    fn name(&self) -> &'static str {
-        use BearingError as E;
-        match self {
-            E::DoesNotFly { .. } => "DoesNotFly",
-            E::Touches { .. } => "Touches",
-            E::PressureNewton { .. } => "PressureNewton",
-            E::NonFiniteResidual => "NonFiniteResidual",
-            E::Krylov { .. } => "Krylov",
-            E::AttitudeNewton { .. } => "AttitudeNewton",
-            E::SingularStiffness => "SingularStiffness",
-        }
-    }
-
-    fn is_convergence(&self) -> bool {
-        !matches!(self, BearingError::DoesNotFly { .. })
-    }
-}
+failure_kind!(BearingError, convergence = |e| !matches!(e, BearingError::DoesNotFly { .. }), {
+        DoesNotFly => Stage::AIR_BEARING,
+        Touches => Stage::AIR_BEARING,
+        PressureNewton => Stage::AIR_BEARING,
+        NonFiniteResidual => Stage::AIR_BEARING,
+        Krylov => Stage::AIR_BEARING,
+        AttitudeNewton => Stage::AIR_BEARING,
+        SingularStiffness => Stage::AIR_BEARING,
+});

@@ -1,6 +1,6 @@
 //! Why a clearance calibration could not give its result.
 
-use crate::error::{num, FailureKind, Stage};
+use crate::error::{failure_kind, num, Stage};
 
 impl Stage {
     /// The firmware clearance calibration.
@@ -44,15 +44,7 @@ pub enum CalibrationError {
     },
 }
 
-impl FailureKind for CalibrationError {
-    fn stage(&self) -> Stage {
-        Stage::CLEARANCE_CALIBRATION
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            CalibrationError::NoTouchdown { .. } => "NoTouchdown",
-            CalibrationError::ContactAtStart { .. } => "ContactAtStart",
-        }
-    }
-}
+failure_kind!(CalibrationError, convergence = |_| false, {
+        NoTouchdown => Stage::CLEARANCE_CALIBRATION,
+        ContactAtStart => Stage::CLEARANCE_CALIBRATION,
+});

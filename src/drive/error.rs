@@ -1,6 +1,6 @@
 //! Why the drive or a controller running it could not go on.
 
-use crate::error::{FailureKind, Stage};
+use crate::error::{failure_kind, Stage};
 
 impl Stage {
     /// The drive plant.
@@ -39,22 +39,7 @@ pub enum DriveError {
     },
 }
 
-impl FailureKind for DriveError {
-    fn stage(&self) -> Stage {
-        match self {
-            DriveError::NotFinished { .. } => Stage::DRIVE_CONTROLLER,
-            DriveError::PeriodSteps { .. } => Stage::DRIVE,
-        }
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            DriveError::NotFinished { .. } => "NotFinished",
-            DriveError::PeriodSteps { .. } => "PeriodSteps",
-        }
-    }
-
-    fn is_convergence(&self) -> bool {
-        matches!(self, DriveError::PeriodSteps { .. })
-    }
-}
+failure_kind!(DriveError, convergence = |e| matches!(e, DriveError::PeriodSteps { .. }), {
+        NotFinished => Stage::DRIVE_CONTROLLER,
+        PeriodSteps => Stage::DRIVE,
+});

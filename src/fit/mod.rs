@@ -21,7 +21,7 @@
 //! # Ok::<(), hdi_tribology::Error>(())
 //! ```
 
-use crate::error::{num, FailureKind, Stage};
+use crate::error::{failure_kind, num, Stage};
 
 mod data;
 mod forward;
@@ -113,20 +113,9 @@ pub enum FitFailure {
     },
 }
 
-impl FailureKind for FitFailure {
-    fn stage(&self) -> Stage {
-        match self {
-            FitFailure::TooFewSettled { .. } | FitFailure::NoModelStart { .. } => Stage::FIT,
-            _ => Stage::MODEL_CURVES,
-        }
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            FitFailure::TooFewSettled { .. } => "TooFewSettled",
-            FitFailure::NoModelStart { .. } => "NoModelStart",
-            FitFailure::BeyondEquilibria { .. } => "BeyondEquilibria",
-            FitFailure::NotDetected { .. } => "NotDetected",
-        }
-    }
-}
+failure_kind!(FitFailure, convergence = |_| false, {
+        TooFewSettled => Stage::FIT,
+        NoModelStart => Stage::FIT,
+        BeyondEquilibria => Stage::MODEL_CURVES,
+        NotDetected => Stage::MODEL_CURVES,
+});

@@ -1,6 +1,6 @@
 //! Why the slider's static balance could not be found.
 
-use crate::error::{num, FailureKind, Stage};
+use crate::error::{failure_kind, num, Stage};
 
 impl Stage {
     /// The slider's static balance on its air bearing and structure.
@@ -57,20 +57,8 @@ pub enum BalanceError {
     },
 }
 
-impl FailureKind for BalanceError {
-    fn stage(&self) -> Stage {
-        Stage::BALANCE
-    }
-
-    fn name(&self) -> &'static str {
-        match self {
-            BalanceError::Structure { .. } => "Structure",
-            BalanceError::NotFinite { .. } => "NotFinite",
-            BalanceError::NoBalance { .. } => "NoBalance",
-        }
-    }
-
-    fn is_convergence(&self) -> bool {
-        true
-    }
-}
+failure_kind!(BalanceError, convergence = |_| true, {
+        Structure => Stage::BALANCE,
+        NotFinite => Stage::BALANCE,
+        NoBalance => Stage::BALANCE,
+});
