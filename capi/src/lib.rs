@@ -810,6 +810,25 @@ fn transition(t: &Transition) -> HdiTransition {
     }
 }
 
+/// One static analysis: the model taken, its options in SI, the result written to `out`.
+///
+/// # Safety
+/// `options` is `NULL` or valid for reads; `out` is `NULL` or valid for writes.
+unsafe fn static_analysis<T>(
+    model: *const HdiModel,
+    options: *const HdiStaticOptions,
+    out: *mut T,
+    f: impl FnOnce(&SliderModel, &StaticOptions) -> Result<T, Failure>,
+) -> HdiStatus {
+    call(|| {
+        let m = acquire(model, "model", Access::Shared)?;
+        // SAFETY: the caller's contract.
+        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
+        *out = f(&m.get().model, &opts)?;
+        Ok(())
+    })
+}
+
 /// Static touchdown at the model's DC voltage. `options`: `NULL` for the model's defaults.
 ///
 /// # Safety
@@ -820,13 +839,12 @@ pub unsafe extern "C" fn hdi_model_touchdown(
     options: *const HdiStaticOptions,
     out: *mut HdiTransition,
 ) -> HdiStatus {
-    call(|| {
-        let m = acquire(model, "model", Access::Shared)?;
-        // SAFETY: the caller's contract.
-        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
-        *out = transition(&touchdown_power(&m.get().model, &opts)?);
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        static_analysis(model, options, out, |m, o| {
+            Ok(transition(&touchdown_power(m, o)?))
+        })
+    }
 }
 
 /// Static take-off at the model's DC voltage, following the contact branch down from
@@ -841,14 +859,13 @@ pub unsafe extern "C" fn hdi_model_takeoff(
     start_power_mw: f64,
     out: *mut HdiTransition,
 ) -> HdiStatus {
-    call(|| {
-        let m = acquire(model, "model", Access::Shared)?;
-        // SAFETY: the caller's contract.
-        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
-        let start = units::mw(finite("start_power_mw", start_power_mw, "mW")?);
-        *out = transition(&takeoff_power(&m.get().model, start, &opts)?);
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        static_analysis(model, options, out, |m, o| {
+            let start = units::mw(finite("start_power_mw", start_power_mw, "mW")?);
+            Ok(transition(&takeoff_power(m, start, o)?))
+        })
+    }
 }
 
 /// Static touchdown and take-off (the take-off search starts `takeoff_start_excess_mw` above
@@ -862,18 +879,17 @@ pub unsafe extern "C" fn hdi_model_hysteresis(
     options: *const HdiStaticOptions,
     out: *mut HdiHysteresis,
 ) -> HdiStatus {
-    call(|| {
-        let m = acquire(model, "model", Access::Shared)?;
-        // SAFETY: the caller's contract.
-        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
-        let h = static_hysteresis(&m.get().model, &opts)?;
-        *out = HdiHysteresis {
-            touchdown: transition(&h.touchdown),
-            takeoff: transition(&h.takeoff),
-            hysteresis_mw: h.hysteresis_mw(),
-        };
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        static_analysis(model, options, out, |m, o| {
+            let h = static_hysteresis(m, o)?;
+            Ok(HdiHysteresis {
+                touchdown: transition(&h.touchdown),
+                takeoff: transition(&h.takeoff),
+                hysteresis_mw: h.hysteresis_mw(),
+            })
+        })
+    }
 }
 
 /// The static pull-in voltage `|V_dc − φ|` at heater power `heater_power_mw` (0 V when the head
@@ -888,19 +904,18 @@ pub unsafe extern "C" fn hdi_model_pull_in(
     heater_power_mw: f64,
     out: *mut HdiPullIn,
 ) -> HdiStatus {
-    call(|| {
-        let m = acquire(model, "model", Access::Shared)?;
-        // SAFETY: the caller's contract.
-        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
-        let p = units::mw(finite("heater_power_mw", heater_power_mw, "mW")?);
-        let r = analysis::pull_in_voltage(&m.get().model, p, &opts)?;
-        *out = HdiPullIn {
-            voltage_v: r.voltage,
-            gap_nm: units::to_nm(r.d),
-            cause: cause(r.cause),
-        };
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        static_analysis(model, options, out, |m, o| {
+            let p = units::mw(finite("heater_power_mw", heater_power_mw, "mW")?);
+            let r = analysis::pull_in_voltage(m, p, o)?;
+            Ok(HdiPullIn {
+                voltage_v: r.voltage,
+                gap_nm: units::to_nm(r.d),
+                cause: cause(r.cause),
+            })
+        })
+    }
 }
 
 /// The default cycle options of a model: its scene's AC amplitude, the fixed programme.
