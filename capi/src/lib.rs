@@ -1161,6 +1161,7 @@ unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failu
             la.clearance_per_kelvin,
             units::nm,
         ),
+        ..*la
     };
     let (ls, ds, cs) = (&lib.sensors, &d.sensors, &c.sensors);
     let kilo = |x: f64| x * 1e3;
@@ -1414,42 +1415,36 @@ pub unsafe extern "C" fn hdi_drive_free(drive: *mut HdiDrive) -> HdiStatus {
     call(|| free(drive, "drive"))
 }
 
-/// The library's name of a command field to the C struct's.
+/// The library's name of a step argument to the C call's (the command's fields have the same
+/// names in both).
 fn command_field(field: &str) -> Option<String> {
-    let f = match field {
-        "command.heater_power" => "command.heater_power_mw",
-        "command.dc_voltage" => "command.dc_voltage_v",
-        "command.ac_amplitude" => "command.ac_amplitude_v",
-        "command.ac_frequency" => "command.ac_frequency_khz",
-        "dt" => "period_s",
-        _ => return None,
-    };
-    Some(f.into())
+    (field == "dt").then(|| "period_s".to_string())
 }
 
+/// The library's sensors, field by field: the same units and names.
 fn sensors_of(s: &Sensors) -> HdiSensors {
     let t = &s.truth;
     HdiSensors {
-        time_s: s.t,
-        heater_power_mw: units::to_mw(s.heater_power),
-        contact_resistance_ohm: s.contact_resistance,
-        acoustic_v: s.acoustic,
-        readback_fundamental_v: s.readback.fundamental,
-        readback_third_v: s.readback.third,
+        time_s: s.time_s,
+        heater_power_mw: s.heater_power_mw,
+        contact_resistance_ohm: s.contact_resistance_ohm,
+        acoustic_v: s.acoustic_v,
+        readback_fundamental_v: s.readback.fundamental_v,
+        readback_third_v: s.readback.third_v,
         truth: HdiTruth {
-            gap_nm: units::to_nm(t.gap),
-            pad_gap_nm: units::to_nm(t.pad_gap),
-            displacement_nm: units::to_nm(t.displacement),
-            velocity_mm_per_s: t.velocity * 1e3,
-            protrusion_nm: units::to_nm(t.protrusion),
-            mean_contact_force_un: to_micro(t.mean_contact_force),
-            contact_force_un: to_micro(t.contact_force),
-            interface_force_un: to_micro(t.interface_force),
-            mean_flash_temperature_k: t.mean_flash_temperature,
-            friction_power_mw: units::to_mw(t.friction_power),
-            sensor_temperature_k: t.sensor_temperature,
-            disk_height_nm: units::to_nm(t.disk_height),
-            ambient_k: t.ambient,
+            gap_nm: t.gap_nm,
+            pad_gap_nm: t.pad_gap_nm,
+            displacement_nm: t.displacement_nm,
+            velocity_mm_per_s: t.velocity_mm_per_s,
+            protrusion_nm: t.protrusion_nm,
+            mean_contact_force_un: t.mean_contact_force_un,
+            contact_force_un: t.contact_force_un,
+            interface_force_un: t.interface_force_un,
+            mean_flash_temperature_k: t.mean_flash_temperature_k,
+            friction_power_mw: t.friction_power_mw,
+            sensor_temperature_k: t.sensor_temperature_k,
+            disk_height_nm: t.disk_height_nm,
+            ambient_k: t.ambient_k,
         },
     }
 }
@@ -1476,10 +1471,10 @@ pub unsafe extern "C" fn hdi_drive_step(
         non_negative("command.ac_frequency_khz", c.ac_frequency_khz, "kHz")?;
         positive("period_s", period_s, "s")?;
         let cmd = Command {
-            dc_voltage: c.dc_voltage_v,
-            ac_amplitude: c.ac_amplitude_v,
-            ac_frequency: units::khz(c.ac_frequency_khz),
-            ..Command::heater_mw(c.heater_power_mw)
+            heater_power_mw: c.heater_power_mw,
+            dc_voltage_v: c.dc_voltage_v,
+            ac_amplitude_v: c.ac_amplitude_v,
+            ac_frequency_khz: c.ac_frequency_khz,
         };
         // SAFETY: the guard holds the handle exclusively: no other reference to the drive.
         let drive = unsafe { &mut *d.get().drive.get() };
