@@ -43,8 +43,7 @@ fn main() {
             for (state, mw) in [("flight", 70.0), ("contact", 80.0)] {
                 // Held commands, with and without dither; then a command that changes every period
                 // (a heater dithered by ±1 µW, alternating): the worst case, a restart per period.
-                for (dither, alternate) in
-                    [(None, false), (Some((0.5, 10.5e3)), false), (None, true)]
+                for (dither, alternate) in [(None, false), (Some((0.5, 10.5)), false), (None, true)]
                 {
                     let mut d = plant.drive().expect("drive");
                     let mut cmd = Command::heater_mw(mw);
@@ -63,7 +62,7 @@ fn main() {
                             let mut c = cmd;
                             if alternate {
                                 k += 1;
-                                c.heater_power += if k.is_multiple_of(2) { 1e-6 } else { -1e-6 };
+                                c.heater_power_mw += if k.is_multiple_of(2) { 1e-3 } else { -1e-3 };
                             }
                             s = Some(d.step(&c, DT).expect("step"));
                         }
@@ -73,7 +72,7 @@ fn main() {
                     let steps = (d.stats().accepted - s0) as f64 / periods;
                     let last = last.expect("ran");
                     // The state the case claims: in contact the true contact force is far above F_th.
-                    let in_contact = last.truth.mean_contact_force > 5e-5;
+                    let in_contact = (last.truth.mean_contact_force_un * 1e-6) > 5e-5;
                     assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
                     let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
                     println!(

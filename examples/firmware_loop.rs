@@ -23,7 +23,6 @@ use hdi_tribology::drive::{
     TrueContact,
 };
 use hdi_tribology::scene::Scene;
-use hdi_tribology::units;
 
 /// The user's controller: ramp, watch the AE, back off, hold.
 struct RampAndWatch {
@@ -58,21 +57,21 @@ impl<C: Controller> Controller for Traced<C> {
         if let Some(csv) = &mut self.csv {
             use std::fmt::Write;
             let t = &s.truth;
-            // The units of the C ABI's `HdiSensors`, converted as it converts them.
+            // The units of the C ABI's `HdiSensors`, the same as the Rust `Sensors`.
             let _ = writeln!(
                 csv,
                 "{},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}",
                 self.n,
-                s.t,
-                units::to_mw(s.heater_power),
-                s.contact_resistance,
-                s.acoustic,
-                s.readback.fundamental,
-                s.readback.third,
-                units::to_nm(t.gap),
-                t.mean_contact_force * 1e6,
-                t.sensor_temperature,
-                units::to_nm(t.disk_height)
+                s.time_s,
+                s.heater_power_mw,
+                s.contact_resistance_ohm,
+                s.acoustic_v,
+                s.readback.fundamental_v,
+                s.readback.third_v,
+                t.gap_nm,
+                t.mean_contact_force_un,
+                t.sensor_temperature_k,
+                t.disk_height_nm
             );
         }
         self.inner.update(s)
@@ -99,14 +98,14 @@ impl Controller for RampAndWatch {
             return Action::Continue(Command::heater_mw(td - 10.0));
         }
         if self.n <= BASELINE_PERIODS {
-            self.base.0 += s.acoustic;
-            self.base.1 += s.acoustic * s.acoustic;
+            self.base.0 += s.acoustic_v;
+            self.base.1 += s.acoustic_v * s.acoustic_v;
             self.base.2 += 1;
-            self.mean = s.acoustic;
+            self.mean = s.acoustic_v;
             return Action::Continue(Command::heater_mw(self.power_mw));
         }
         let a = 1.0 / MEAN_PERIODS;
-        self.mean += a * (s.acoustic - self.mean);
+        self.mean += a * (s.acoustic_v - self.mean);
         let k = self.base.2 as f64;
         let m = self.base.0 / k;
         let sd = (self.base.1 / k - m * m).max(0.0).sqrt();
@@ -187,7 +186,7 @@ fn main() -> Result<(), hdi_tribology::Error> {
 
     // The crate's detectors on the 0.25 mW staircase from 70 mW, 20 seeds per point.
     let settings = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
-    let th = scene.detector.contact_threshold_n;
+    let th = scene.detector.contact_threshold_n * 1e6; // µN
     let seeds = 1..21;
     println!("\n| detector | n_sigma | runs | false alarm | one step early | missed | mean P_det − P_TD (mW) | rms clearance error (nm) |");
     println!("|---|---|---|---|---|---|---|---|");

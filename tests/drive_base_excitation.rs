@@ -91,11 +91,11 @@ fn drive_response(plant: &Plant, omega: f64, phase: f64) -> (f64, f64) {
     let mut b = DVector::zeros(n);
     for k in 0..n {
         let s = d.step(&cmd, dt).unwrap();
-        let th = omega * s.t + phase;
+        let th = omega * s.time_s + phase;
         a[(k, 0)] = th.sin();
         a[(k, 1)] = th.cos();
         a[(k, 2)] = 1.0;
-        b[k] = s.truth.gap;
+        b[k] = s.truth.gap_nm * 1e-9;
     }
     let x = (a.transpose() * &a)
         .lu()

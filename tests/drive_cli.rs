@@ -88,3 +88,136 @@ fn hdi_drive_tolerance_flags_that_do_not_fit_write_nothing() {
         }
     }
 }
+
+fn hdi(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_hdi"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// The drive settings as flags and as a scene's `[drive]` section give the same CSV, byte for
+/// byte, and a different one from the default drive.
+#[test]
+fn hdi_drive_flags_and_the_scene_drive_section_agree() {
+    let cmds = tmp("settings_commands.csv");
+    std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,62,0\n0.001,66,0\n").unwrap();
+    let scene = hdi_tribology::scene::Scene::paper()
+        .to_toml_string()
+        .unwrap();
+    let with_drive = tmp("drive_scene.toml");
+    std::fs::write(
+        &with_drive,
+        format!(
+            "{scene}\n[drive]\nrpm = 7200\ninitial_heater_power_mw = 62\n\
+             [drive.disk]\nrunout_nm = 500\nwaviness_rms_nm = 0.2\n\
+             [drive.ambient]\nrate_k_per_s = 50\n\
+             [drive.sensors]\nreadback_wavelength_nm = 80\nae_bandwidth_khz = 10\n\
+             ae_gain_v_per_sqrt_w = 2\ncontact_noise_ohm = 0.01\n"
+        ),
+    )
+    .unwrap();
+    let plain = tmp("plain_scene.toml");
+    std::fs::write(&plain, &scene).unwrap();
+    let c = cmds.to_str().unwrap();
+    let run = |extra: &[&str], out: &str| {
+        let out = tmp(out);
+        let mut args = vec!["drive", "--commands", c, "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = hdi(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(out).unwrap()
+    };
+    let from_scene = run(&[with_drive.to_str().unwrap()], "a.csv");
+    let from_flags = run(
+        &[
+            plain.to_str().unwrap(),
+            "--rpm",
+            "7200",
+            "--initial-heater-power-mw",
+            "62",
+            "--runout-nm",
+            "500",
+            "--waviness-rms-nm",
+            "0.2",
+            "--ambient-rate-k-per-s",
+            "50",
+            "--readback-wavelength-nm",
+            "80",
+            "--ae-bandwidth-khz",
+            "10",
+            "--ae-gain-v-per-sqrt-w",
+            "2",
+            "--contact-noise-ohm",
+            "0.01",
+        ],
+        "b.csv",
+    );
+    let default = run(&[plain.to_str().unwrap()], "c.csv");
+    assert_eq!(from_scene, from_flags);
+    assert_ne!(from_scene, default);
+}
+
+/// A bad drive setting names the flag as written, with the value in its unit; a bad one in the
+/// scene names the field as written.
+#[test]
+fn hdi_drive_bad_settings_name_the_flag_in_its_unit() {
+    let cmds = tmp("bad_settings_commands.csv");
+    std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,62,0\n0.001,66,0\n").unwrap();
+    let c = cmds.to_str().unwrap();
+    for (flag, value, unit) in [
+        ("--initial-heater-power-mw", "-5", "mW"),
+        ("--initial-heater-power-mw", "2000", "mW"),
+        ("--radius-mm", "0", "mm"),
+        ("--rpm", "-1", "rpm"),
+        ("--heater-time-constant-us", "-1", "µs"),
+        ("--runout-nm", "-3", "nm"),
+        ("--waviness-rms-nm", "-0.5", "nm"),
+        ("--ambient-rate-k-per-s", "inf", "K/s"),
+        ("--ambient-period-s", "0", "s"),
+        ("--ambient-step-time-s", "-1", "s"),
+        ("--ae-gain-v-per-sqrt-w", "-1", "V/√W"),
+        ("--ae-bandwidth-khz", "0", "kHz"),
+        ("--contact-noise-ohm", "-0.1", "Ω"),
+        ("--readback-wavelength-nm", "0", "nm"),
+        ("--heads", "0", ""),
+        ("--heads", "2.5", ""),
+    ] {
+        let out = tmp("never.csv");
+        let o = hdi(&[
+            "drive",
+            "--paper",
+            "--commands",
+            c,
+            "--out",
+            out.to_str().unwrap(),
+            flag,
+            value,
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{flag} {value} was taken");
+        assert!(err.contains(flag), "{flag} {value}: {err}");
+        assert!(
+            err.contains(&format!("got {value} {unit}").trim_end().to_string())
+                || err.contains(&format!("got {value}")),
+            "{flag} {value}: {err}"
+        );
+        assert!(!out.exists(), "{flag} {value} wrote a file");
+    }
+    let scene = hdi_tribology::scene::Scene::paper()
+        .to_toml_string()
+        .unwrap();
+    let bad = tmp("bad_drive_scene.toml");
+    std::fs::write(
+        &bad,
+        format!("{scene}\n[drive.sensors]\nreadback_wavelength_nm = -80\n"),
+    )
+    .unwrap();
+    let o = hdi(&["drive", bad.to_str().unwrap(), "--commands", c]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("drive.sensors.readback_wavelength_nm") && err.contains("-80 nm"),
+        "{err}"
+    );
+}

@@ -23,10 +23,10 @@ fn calibrate<D: LevelDetector>(d: &mut Drive, settings: StaircaseSettings, det: 
     st
 }
 
-/// Static touchdown and take-off of the drive's model (the paper scene: 74.324 / 68.317 mW).
+/// Static touchdown and take-off of the drive's model (mW; the paper scene: 74.324 / 68.317 mW).
 fn static_td_to(d: &Drive) -> (f64, f64) {
     let h = static_hysteresis(d.model(), &StaticOptions::new(5e-5)).unwrap();
-    (h.touchdown.power, h.takeoff.power)
+    (h.touchdown.power * 1e3, h.takeoff.power * 1e3)
 }
 
 #[test]
@@ -34,27 +34,27 @@ fn staircase_through_the_drive_agrees_with_the_static_model() {
     let p = plant(5, DriveOptions::default());
     let mut d = p.drive().unwrap();
     let (td, to) = static_td_to(&d);
-    assert!((td * 1e3 - 74.324).abs() < 1e-3, "static touchdown {td}");
-    let step = 0.25e-3;
+    assert!((td - 74.324).abs() < 1e-3, "static touchdown {td}");
+    let step = 0.25;
     let st = calibrate(
         &mut d,
         StaircaseSettings::from_mw(66.0, 0.25, 80.0, 10.0),
-        TrueContact::new(5e-5).unwrap(),
+        TrueContact::new(50.0).unwrap(),
     );
     let out = st.outcome();
-    let cal_td = out.touchdown_power.unwrap();
+    let cal_td = out.touchdown_power_mw.unwrap();
     // The first level at or above the static touchdown.
     assert!(
-        cal_td >= td - 1e-9 && cal_td < td + step,
+        cal_td >= td - 1e-6 && cal_td < td + step,
         "touchdown {cal_td} vs static {td}"
     );
-    let cal_to = out.takeoff_power.unwrap();
+    let cal_to = out.takeoff_power_mw.unwrap();
     // Stepping down, the first level below the static take-off flies.
     assert!(
-        cal_to <= to + 1e-9 && cal_to > to - step,
+        cal_to <= to + 1e-6 && cal_to > to - step,
         "take-off {cal_to} vs static {to}"
     );
-    assert!((out.set_power.unwrap() - (cal_td - 0.010)).abs() < 1e-15);
+    assert!((out.set_power_mw.unwrap() - (cal_td - 10.0)).abs() < 1e-12);
 }
 
 #[test]
@@ -68,17 +68,15 @@ fn contact_sensor_touchdown_within_1_mw_of_static() {
         let st = calibrate(&mut d, s, ContactSensorSlope::new(5.0, 6).unwrap());
         let p = st
             .outcome()
-            .touchdown_power
+            .touchdown_power_mw
             .expect("contact sensor saw no touchdown");
         assert!(
             st.outcome().levels.len() > 8,
             "the line was fitted before touchdown"
         );
         assert!(
-            (p - td).abs() <= 1e-3,
-            "seed {seed}: {} mW vs static {} mW",
-            p * 1e3,
-            td * 1e3
+            (p - td).abs() <= 1.0,
+            "seed {seed}: {p} mW vs static {td} mW"
         );
     }
 }
@@ -97,9 +95,9 @@ fn contact_sensor_slope_false_alarms_are_rare() {
     let (mut judged, mut fired3, mut fired5) = (0usize, 0usize, 0usize);
     for seed in 1..=10 {
         let mut d = base.with_seed(seed).unwrap().drive().unwrap();
-        let st = calibrate(&mut d, flying, TrueContact::new(5e-5).unwrap());
+        let st = calibrate(&mut d, flying, TrueContact::new(50.0).unwrap());
         let levels = &st.outcome().levels;
-        assert!(levels.iter().all(|l| l.true_contact_force.mean < 1e-6));
+        assert!(levels.iter().all(|l| l.true_contact_force_un.mean < 1.0));
         let (mut d3, mut d5) = (
             ContactSensorSlope::new(3.0, 6).unwrap(),
             ContactSensorSlope::new(5.0, 6).unwrap(),
@@ -132,7 +130,7 @@ fn contact_sensor_slope_false_alarms_are_rare() {
     let roc = touchdown_roc(
         &base,
         StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0),
-        scene.detector.contact_threshold_n,
+        scene.detector.contact_threshold_n * 1e6,
         1..11,
         || ContactSensorSlope::new(5.0, 6),
     )
@@ -151,12 +149,13 @@ fn acoustic_touchdown_within_1_mw_of_static() {
         let mut s = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
         s.find_takeoff = false;
         let st = calibrate(&mut d, s, AcousticLevel::new(5.0, 3).unwrap());
-        let p = st.outcome().touchdown_power.expect("AE saw no touchdown");
+        let p = st
+            .outcome()
+            .touchdown_power_mw
+            .expect("AE saw no touchdown");
         assert!(
-            (p - td).abs() <= 1e-3,
-            "seed {seed}: {} mW vs static {} mW",
-            p * 1e3,
-            td * 1e3
+            (p - td).abs() <= 1.0,
+            "seed {seed}: {p} mW vs static {td} mW"
         );
     }
 }
@@ -177,18 +176,19 @@ fn harmonic_ratio_clearance_change_matches_the_true_one_within_the_noise() {
         for _ in 0..n {
             let s = d.step(&Command::heater_mw(mw), DT).unwrap();
             lr += s.readback.log_ratio();
-            gap += s.truth.gap;
+            gap += s.truth.gap_nm;
         }
         (lr / n as f64, gap / n as f64)
     };
     let (lr0, g0) = window(&mut d, 62.0);
     let (lr1, g1) = window(&mut d, 70.0);
-    let est = Readback::clearance_change(lr0, lr1, rb.wavelength);
+    let est = Readback::clearance_change_nm(lr0, lr1, rb.wavelength * 1e9);
     let truth = g1 - g0;
     // Each log ratio carries √2·noise per sample; a difference of two means of n samples has
     // standard deviation λ/(4π)·2·noise/√n.
-    let sigma = rb.wavelength / (4.0 * std::f64::consts::PI) * 2.0 * rb.noise / (n as f64).sqrt();
-    assert!(truth < -0.5e-9, "the heater closed the gap: {truth}");
+    let sigma =
+        rb.wavelength * 1e9 / (4.0 * std::f64::consts::PI) * 2.0 * rb.noise / (n as f64).sqrt();
+    assert!(truth < -0.5, "the heater closed the gap: {truth} nm");
     assert!(
         (est - truth).abs() < 4.0 * sigma,
         "HR {est:e} vs true {truth:e} (σ {sigma:e})"
@@ -198,7 +198,7 @@ fn harmonic_ratio_clearance_change_matches_the_true_one_within_the_noise() {
 #[test]
 fn clearance_hold_follows_an_ambient_drift() {
     use hdi_tribology::drive::{
-        Action, Ambient, ClearanceHold, Controller, HoldPhase, HoldSettings,
+        Action, Ambient, ClearanceHold, Controller, HoldPhase, HoldSettings, HoldTarget,
     };
     // A fast drift (200 K/s at 0.03 nm/K: 6 nm/s) so that a 60 ms run moves the clearance by
     // about 0.3 nm.
@@ -209,18 +209,21 @@ fn clearance_hold_follows_an_ambient_drift() {
         },
         ..DriveOptions::default()
     };
-    let wavelength = opts.sensors.readback.wavelength;
+    let wavelength_nm = opts.sensors.readback.wavelength * 1e9;
     let p = plant(4, opts);
-    let eta = p.model().efficiency();
+    let eta = p.model().efficiency() * 1e6; // nm/mW
     let mut stair = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
     stair.find_takeoff = false;
+    // The integral correction around the calibrated operating power.
     let settings = HoldSettings {
         staircase: stair,
-        wavelength,
-        efficiency: eta,
+        target: HoldTarget::SetPower,
+        wavelength_nm,
+        efficiency_nm_per_mw: eta,
         average: 20,
-        gain: 0.5,
-        recalibrate_after: 0.02,
+        integral_gain: 0.5,
+        proportional_gain: 0.0,
+        recalibrate_after_mw: 20.0,
     };
     let mut hold =
         ClearanceHold::new(settings, ContactSensorSlope::new(5.0, 4).unwrap(), DT).unwrap();
@@ -234,12 +237,12 @@ fn clearance_hold_follows_an_ambient_drift() {
         let phase = hold.phase();
         match phase {
             HoldPhase::Referencing => {
-                ref_gap += s.truth.gap;
+                ref_gap += s.truth.gap_nm;
                 n_ref += 1;
             }
             HoldPhase::Holding => {
-                hold_start.get_or_insert(s.t);
-                errors.push((s.t, s.truth.gap - ref_gap / n_ref as f64));
+                hold_start.get_or_insert(s.time_s);
+                errors.push((s.time_s, s.truth.gap_nm - ref_gap / n_ref as f64));
             }
             HoldPhase::Calibrating => {}
         }
@@ -252,8 +255,8 @@ fn clearance_hold_follows_an_ambient_drift() {
     let t0 = hold_start.expect("never held");
     let span = d.time() - t0;
     assert!(span > 0.05, "held for {span} s");
-    // Open loop the clearance would have grown by the drift over the span.
-    let drift = 200.0 * 0.03e-9 * span;
+    // Open loop the clearance would have grown by the drift over the span (nm).
+    let drift = 200.0 * 0.03 * span;
     // Closed loop: after the first 5 ms the error stays within 10 % of that drift.
     let late: Vec<f64> = errors
         .iter()
@@ -263,8 +266,148 @@ fn clearance_hold_follows_an_ambient_drift() {
     let rms = (late.iter().map(|e| e * e).sum::<f64>() / late.len() as f64).sqrt();
     assert!(
         rms < 0.1 * drift,
-        "rms clearance error {rms:e} m against a drift of {drift:e} m"
+        "rms clearance error {rms} nm against a drift of {drift} nm"
     );
     // The heater took up the drift: about drift/η more power.
-    assert!(hold.power() - hold.set_power() > 0.5 * drift / eta);
+    assert!(hold.power_mw() - hold.set_power_mw() > 0.5 * drift / eta);
+}
+
+/// A PI hold on a clearance above touchdown, on the default wavy disk, with an ambient step of
+/// `step_k` at `step_time_s`; returns the hold and, per period held, (time, true clearance above
+/// the touchdown level's mean gap, heater mW).
+fn pi_hold(
+    step_k: f64,
+    step_time_s: f64,
+    target_nm: f64,
+    periods: usize,
+) -> (
+    hdi_tribology::drive::ClearanceHold<ContactSensorSlope>,
+    Vec<(f64, f64, f64)>,
+) {
+    use hdi_tribology::drive::{
+        Action, Ambient, ClearanceHold, Controller, HoldPhase, HoldSettings, HoldTarget,
+    };
+    let opts = DriveOptions {
+        ambient: Ambient {
+            step: step_k,
+            step_time: step_time_s,
+            ..Ambient::default()
+        },
+        ..DriveOptions::default()
+    };
+    let wavelength_nm = opts.sensors.readback.wavelength * 1e9;
+    let p = plant(6, opts);
+    let eta = p.model().efficiency() * 1e6;
+    let mut stair = StaircaseSettings::from_mw(70.0, 0.25, 80.0, 10.0);
+    stair.find_takeoff = false;
+    let settings = HoldSettings {
+        staircase: stair,
+        target: HoldTarget::AboveTouchdownNm(target_nm),
+        wavelength_nm,
+        efficiency_nm_per_mw: eta,
+        average: 20,
+        integral_gain: 0.3,
+        proportional_gain: 0.5,
+        recalibrate_after_mw: 20.0,
+    };
+    let mut hold =
+        ClearanceHold::new(settings, ContactSensorSlope::new(5.0, 4).unwrap(), DT).unwrap();
+    let mut d = p.drive().unwrap();
+    let mut cmd = hold.start();
+    let mut held = Vec::new();
+    for _ in 0..periods {
+        let s = d.step(&cmd, DT).unwrap();
+        if hold.phase() == HoldPhase::Holding {
+            let td = hold.calibration().touchdown_power_mw.unwrap();
+            let level = hold
+                .calibration()
+                .levels
+                .iter()
+                .find(|l| l.heater_power_mw == td)
+                .unwrap();
+            held.push((
+                s.time_s,
+                s.truth.gap_nm - level.true_gap_nm.mean,
+                s.heater_power_mw,
+            ));
+        }
+        match hold.update(&s) {
+            Action::Continue(c) => cmd = c,
+            Action::Stop => panic!("the hold stopped"),
+        }
+    }
+    assert_eq!(hold.calibrations(), 1);
+    (hold, held)
+}
+
+/// Mean of the true clearance over `[t0, t1)`.
+fn mean_clearance(held: &[(f64, f64, f64)], t0: f64, t1: f64) -> f64 {
+    let w: Vec<f64> = held
+        .iter()
+        .filter(|h| h.0 >= t0 && h.0 < t1)
+        .map(|h| h.1)
+        .collect();
+    assert!(w.len() > 50, "{} periods in [{t0}, {t1})", w.len());
+    w.iter().sum::<f64>() / w.len() as f64
+}
+
+/// The PI hold brings the true clearance above touchdown (the true gap less the touchdown
+/// level's mean gap) to its target: within 0.1 nm over 10 ms once settled, from a feed-forward
+/// start that the heater-efficiency estimate alone would leave off by more.
+#[test]
+fn pi_hold_settles_to_its_clearance_target() {
+    let target = 1.5;
+    let (hold, held) = pi_hold(0.0, 0.0, target, 1400);
+    let t0 = held.first().expect("never held").0;
+    let end = held.last().unwrap().0;
+    assert!(end - t0 > 0.03, "held for {} s", end - t0);
+    let settled = mean_clearance(&held, end - 0.01, end + 1.0);
+    println!(
+        "target {target} nm: true clearance {settled:.4} nm, estimate {:.4} nm, heater {:.3} mW (feed-forward {:.3} mW)",
+        hold.estimate_nm(),
+        hold.power_mw(),
+        hold.set_power_mw()
+    );
+    assert!(
+        (settled - target).abs() < 0.1,
+        "clearance {settled} nm against a target of {target} nm"
+    );
+    assert!((hold.estimate_nm() - target).abs() < 0.1);
+}
+
+/// An ambient step of 10 K (0.3 nm of clearance at 0.03 nm/K) after the hold has settled: open
+/// loop the clearance would stay 0.3 nm off; the PI hold brings it back within 0.1 nm of the
+/// target within 10 ms, by about 0.3 nm/η more heater.
+#[test]
+fn pi_hold_rejects_an_ambient_step() {
+    let target = 1.5;
+    let step_time = 0.045;
+    let (hold, held) = pi_hold(10.0, step_time, target, 1600);
+    let before = mean_clearance(&held, step_time - 0.01, step_time);
+    let just_after = held
+        .iter()
+        .find(|h| h.0 > step_time + 1e-3)
+        .map(|h| h.1)
+        .unwrap();
+    let after = mean_clearance(&held, step_time + 0.01, step_time + 0.04);
+    let p_before = held.iter().rev().find(|h| h.0 < step_time).unwrap().2;
+    let p_after = held.last().unwrap().2;
+    println!(
+        "clearance {before:.4} nm before the step, {just_after:.4} nm 1 ms after, {after:.4} nm          10–40 ms after; heater {p_before:.3} → {p_after:.3} mW"
+    );
+    assert!(
+        (before - target).abs() < 0.1,
+        "before the step: {before} nm"
+    );
+    // The step reached the head: the clearance jumped by most of 0.3 nm.
+    assert!(
+        just_after - before > 0.2,
+        "the step did not act: {just_after} nm"
+    );
+    assert!((after - target).abs() < 0.1, "after the step: {after} nm");
+    // About 0.3 nm/η ≈ 3 mW more heater (η ≈ 0.1 nm/mW).
+    assert!(
+        p_after - p_before > 0.5 * 0.3 / hold.efficiency_nm_per_mw(),
+        "heater {p_before} → {p_after} mW"
+    );
 }

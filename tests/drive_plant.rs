@@ -36,9 +36,9 @@ fn steady_gap_is_the_static_flying_equilibrium() {
         let s = *hold(&mut d, p_mw, 80).last().unwrap();
         let eq = flying_equilibrium(&model, p_mw * 1e-3, 0.0, &ScanGrid::default()).unwrap();
         assert!(
-            (s.truth.gap - eq.d).abs() < 1e-13,
+            ((s.truth.gap_nm * 1e-9) - eq.d).abs() < 1e-13,
             "{p_mw} mW: drive {} nm, static {} nm",
-            s.truth.gap * 1e9,
+            s.truth.gap_nm,
             eq.d * 1e9
         );
     }
@@ -58,11 +58,11 @@ fn same_seed_same_stream_bit_for_bit() {
         v.iter()
             .flat_map(|s| {
                 [
-                    s.contact_resistance,
-                    s.acoustic,
-                    s.readback.fundamental,
-                    s.readback.third,
-                    s.truth.gap,
+                    s.contact_resistance_ohm,
+                    s.acoustic_v,
+                    s.readback.fundamental_v,
+                    s.readback.third_v,
+                    (s.truth.gap_nm * 1e-9),
                 ]
             })
             .map(f64::to_bits)
@@ -78,7 +78,7 @@ fn bad_commands_are_typed_errors() {
     let mut d = p.drive().unwrap();
     let e = d.step(&Command::heater_mw(-1.0), DT).unwrap_err();
     assert!(
-        matches!(e, Error::InvalidInput { ref field, .. } if field == "command.heater_power"),
+        matches!(e, Error::InvalidInput { ref field, .. } if field == "command.heater_power_mw"),
         "{e}"
     );
     let e = d.step(&Command::heater_mw(60.0), 0.0).unwrap_err();
@@ -171,7 +171,7 @@ fn deviation(opts: DriveOptions) -> Deviation {
     for mw in [62.0, 68.0, 72.0, 76.0, 78.0, 74.0, 70.0] {
         programme.extend(std::iter::repeat_n(Command::heater_mw(mw), 60));
     }
-    let dithered = Command::heater_mw(72.0).with_dither(0.5, 10.5e3);
+    let dithered = Command::heater_mw(72.0).with_dither(0.5, 10.5);
     programme.extend(std::iter::repeat_n(dithered, 40));
     // A controller that changes the command every period.
     programme.extend((0..40).map(|k| Command::heater_mw(70.0 + 0.05 * k as f64)));
@@ -189,17 +189,17 @@ fn deviation(opts: DriveOptions) -> Deviation {
     let mut ms_r = 0.0;
     for c in &programme {
         let (x, y) = (a.step(c, DT).unwrap(), b.step(c, DT).unwrap());
-        let gap = (x.truth.gap - y.truth.gap).abs();
-        if y.truth.mean_contact_force > 5e-5 {
+        let gap = ((x.truth.gap_nm * 1e-9) - (y.truth.gap_nm * 1e-9)).abs();
+        if (y.truth.mean_contact_force_un * 1e-6) > 5e-5 {
             dev.contact_periods += 1;
             dev.gap_contact = dev.gap_contact.max(gap);
         } else {
             dev.gap_flight = dev.gap_flight.max(gap);
         }
-        dev.force = dev
-            .force
-            .max((x.truth.mean_contact_force - y.truth.mean_contact_force).abs());
-        let dr = (x.contact_resistance - y.contact_resistance).abs();
+        dev.force = dev.force.max(
+            ((x.truth.mean_contact_force_un * 1e-6) - (y.truth.mean_contact_force_un * 1e-6)).abs(),
+        );
+        let dr = (x.contact_resistance_ohm - y.contact_resistance_ohm).abs();
         dev.sensor = dev.sensor.max(dr);
         ms_r += dr * dr / programme.len() as f64;
         dev.readback = dev
@@ -305,5 +305,5 @@ fn a_drive_is_owned() {
         t
     }
     let mut d = owned(plant(1, DiskSpec::flat()).into_drive().unwrap());
-    assert!(d.step(&Command::heater_mw(60.0), DT).unwrap().truth.gap > 0.0);
+    assert!(d.step(&Command::heater_mw(60.0), DT).unwrap().truth.gap_nm > 0.0);
 }

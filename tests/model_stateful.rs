@@ -76,7 +76,7 @@ fn a_relaxing_state_decays_in_closed_form_through_the_drive() {
         // A new command every fifth period: restarts must carry the state as it is.
         let p = if (k / 5) % 2 == 0 { 60.0 } else { 62.0 };
         let s = drive.step(&Command::heater_mw(p), dt).unwrap();
-        let exact = (-s.t / TAU).exp();
+        let exact = (-s.time_s / TAU).exp();
         let x = drive.term_states()[0];
         worst = worst.max((x - exact).abs() / (1e-5 + 1e-6 * exact));
     }
@@ -120,9 +120,9 @@ fn a_stateful_force_enters_the_statics_at_its_equilibrium() {
         s = drive.step(&Command::heater_mw(60.0), 50e-6).unwrap();
     }
     assert!(
-        (s.truth.gap - eq.d).abs() < 1e-13,
+        ((s.truth.gap_nm * 1e-9) - eq.d).abs() < 1e-13,
         "drive {} m, static {} m",
-        s.truth.gap,
+        (s.truth.gap_nm * 1e-9),
         eq.d
     );
     assert!((drive.term_states()[0] - a * eq.d).abs() < 1e-4 * a * eq.d);

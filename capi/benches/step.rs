@@ -45,7 +45,9 @@ impl Pair {
         (0..n)
             .map(|i| {
                 let cmd = Command::heater_mw(heater_mw(base, alternate, self.k + i));
-                black_box(self.rust.step(&cmd, DT).expect("step")).truth.gap
+                black_box(self.rust.step(&cmd, DT).expect("step"))
+                    .truth
+                    .gap_nm
             })
             .collect()
     }

@@ -810,6 +810,25 @@ fn transition(t: &Transition) -> HdiTransition {
     }
 }
 
+/// One static analysis: the model taken, its options in SI, the result written to `out`.
+///
+/// # Safety
+/// `options` is `NULL` or valid for reads; `out` is `NULL` or valid for writes.
+unsafe fn static_analysis<T>(
+    model: *const HdiModel,
+    options: *const HdiStaticOptions,
+    out: *mut T,
+    f: impl FnOnce(&SliderModel, &StaticOptions) -> Result<T, Failure>,
+) -> HdiStatus {
+    call(|| {
+        let m = acquire(model, "model", Access::Shared)?;
+        // SAFETY: the caller's contract.
+        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
+        *out = f(&m.get().model, &opts)?;
+        Ok(())
+    })
+}
+
 /// Static touchdown at the model's DC voltage. `options`: `NULL` for the model's defaults.
 ///
 /// # Safety
@@ -820,13 +839,12 @@ pub unsafe extern "C" fn hdi_model_touchdown(
     options: *const HdiStaticOptions,
     out: *mut HdiTransition,
 ) -> HdiStatus {
-    call(|| {
-        let m = acquire(model, "model", Access::Shared)?;
-        // SAFETY: the caller's contract.
-        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
-        *out = transition(&touchdown_power(&m.get().model, &opts)?);
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        static_analysis(model, options, out, |m, o| {
+            Ok(transition(&touchdown_power(m, o)?))
+        })
+    }
 }
 
 /// Static take-off at the model's DC voltage, following the contact branch down from
@@ -841,14 +859,13 @@ pub unsafe extern "C" fn hdi_model_takeoff(
     start_power_mw: f64,
     out: *mut HdiTransition,
 ) -> HdiStatus {
-    call(|| {
-        let m = acquire(model, "model", Access::Shared)?;
-        // SAFETY: the caller's contract.
-        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
-        let start = units::mw(finite("start_power_mw", start_power_mw, "mW")?);
-        *out = transition(&takeoff_power(&m.get().model, start, &opts)?);
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        static_analysis(model, options, out, |m, o| {
+            let start = units::mw(finite("start_power_mw", start_power_mw, "mW")?);
+            Ok(transition(&takeoff_power(m, start, o)?))
+        })
+    }
 }
 
 /// Static touchdown and take-off (the take-off search starts `takeoff_start_excess_mw` above
@@ -862,18 +879,17 @@ pub unsafe extern "C" fn hdi_model_hysteresis(
     options: *const HdiStaticOptions,
     out: *mut HdiHysteresis,
 ) -> HdiStatus {
-    call(|| {
-        let m = acquire(model, "model", Access::Shared)?;
-        // SAFETY: the caller's contract.
-        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
-        let h = static_hysteresis(&m.get().model, &opts)?;
-        *out = HdiHysteresis {
-            touchdown: transition(&h.touchdown),
-            takeoff: transition(&h.takeoff),
-            hysteresis_mw: h.hysteresis_mw(),
-        };
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        static_analysis(model, options, out, |m, o| {
+            let h = static_hysteresis(m, o)?;
+            Ok(HdiHysteresis {
+                touchdown: transition(&h.touchdown),
+                takeoff: transition(&h.takeoff),
+                hysteresis_mw: h.hysteresis_mw(),
+            })
+        })
+    }
 }
 
 /// The static pull-in voltage `|V_dc − φ|` at heater power `heater_power_mw` (0 V when the head
@@ -888,19 +904,18 @@ pub unsafe extern "C" fn hdi_model_pull_in(
     heater_power_mw: f64,
     out: *mut HdiPullIn,
 ) -> HdiStatus {
-    call(|| {
-        let m = acquire(model, "model", Access::Shared)?;
-        // SAFETY: the caller's contract.
-        let (opts, out) = unsafe { (static_options(m.get(), options)?, out_ref(out, "out")?) };
-        let p = units::mw(finite("heater_power_mw", heater_power_mw, "mW")?);
-        let r = analysis::pull_in_voltage(&m.get().model, p, &opts)?;
-        *out = HdiPullIn {
-            voltage_v: r.voltage,
-            gap_nm: units::to_nm(r.d),
-            cause: cause(r.cause),
-        };
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        static_analysis(model, options, out, |m, o| {
+            let p = units::mw(finite("heater_power_mw", heater_power_mw, "mW")?);
+            let r = analysis::pull_in_voltage(m, p, o)?;
+            Ok(HdiPullIn {
+                voltage_v: r.voltage,
+                gap_nm: units::to_nm(r.d),
+                cause: cause(r.cause),
+            })
+        })
+    }
 }
 
 /// The default cycle options of a model: its scene's AC amplitude, the fixed programme.
@@ -1146,6 +1161,7 @@ unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failu
             la.clearance_per_kelvin,
             units::nm,
         ),
+        ..*la
     };
     let (ls, ds, cs) = (&lib.sensors, &d.sensors, &c.sensors);
     let kilo = |x: f64| x * 1e3;
@@ -1399,42 +1415,36 @@ pub unsafe extern "C" fn hdi_drive_free(drive: *mut HdiDrive) -> HdiStatus {
     call(|| free(drive, "drive"))
 }
 
-/// The library's name of a command field to the C struct's.
+/// The library's name of a step argument to the C call's (the command's fields have the same
+/// names in both).
 fn command_field(field: &str) -> Option<String> {
-    let f = match field {
-        "command.heater_power" => "command.heater_power_mw",
-        "command.dc_voltage" => "command.dc_voltage_v",
-        "command.ac_amplitude" => "command.ac_amplitude_v",
-        "command.ac_frequency" => "command.ac_frequency_khz",
-        "dt" => "period_s",
-        _ => return None,
-    };
-    Some(f.into())
+    (field == "dt").then(|| "period_s".to_string())
 }
 
+/// The library's sensors, field by field: the same units and names.
 fn sensors_of(s: &Sensors) -> HdiSensors {
     let t = &s.truth;
     HdiSensors {
-        time_s: s.t,
-        heater_power_mw: units::to_mw(s.heater_power),
-        contact_resistance_ohm: s.contact_resistance,
-        acoustic_v: s.acoustic,
-        readback_fundamental_v: s.readback.fundamental,
-        readback_third_v: s.readback.third,
+        time_s: s.time_s,
+        heater_power_mw: s.heater_power_mw,
+        contact_resistance_ohm: s.contact_resistance_ohm,
+        acoustic_v: s.acoustic_v,
+        readback_fundamental_v: s.readback.fundamental_v,
+        readback_third_v: s.readback.third_v,
         truth: HdiTruth {
-            gap_nm: units::to_nm(t.gap),
-            pad_gap_nm: units::to_nm(t.pad_gap),
-            displacement_nm: units::to_nm(t.displacement),
-            velocity_mm_per_s: t.velocity * 1e3,
-            protrusion_nm: units::to_nm(t.protrusion),
-            mean_contact_force_un: to_micro(t.mean_contact_force),
-            contact_force_un: to_micro(t.contact_force),
-            interface_force_un: to_micro(t.interface_force),
-            mean_flash_temperature_k: t.mean_flash_temperature,
-            friction_power_mw: units::to_mw(t.friction_power),
-            sensor_temperature_k: t.sensor_temperature,
-            disk_height_nm: units::to_nm(t.disk_height),
-            ambient_k: t.ambient,
+            gap_nm: t.gap_nm,
+            pad_gap_nm: t.pad_gap_nm,
+            displacement_nm: t.displacement_nm,
+            velocity_mm_per_s: t.velocity_mm_per_s,
+            protrusion_nm: t.protrusion_nm,
+            mean_contact_force_un: t.mean_contact_force_un,
+            contact_force_un: t.contact_force_un,
+            interface_force_un: t.interface_force_un,
+            mean_flash_temperature_k: t.mean_flash_temperature_k,
+            friction_power_mw: t.friction_power_mw,
+            sensor_temperature_k: t.sensor_temperature_k,
+            disk_height_nm: t.disk_height_nm,
+            ambient_k: t.ambient_k,
         },
     }
 }
@@ -1461,10 +1471,10 @@ pub unsafe extern "C" fn hdi_drive_step(
         non_negative("command.ac_frequency_khz", c.ac_frequency_khz, "kHz")?;
         positive("period_s", period_s, "s")?;
         let cmd = Command {
-            dc_voltage: c.dc_voltage_v,
-            ac_amplitude: c.ac_amplitude_v,
-            ac_frequency: units::khz(c.ac_frequency_khz),
-            ..Command::heater_mw(c.heater_power_mw)
+            heater_power_mw: c.heater_power_mw,
+            dc_voltage_v: c.dc_voltage_v,
+            ac_amplitude_v: c.ac_amplitude_v,
+            ac_frequency_khz: c.ac_frequency_khz,
         };
         // SAFETY: the guard holds the handle exclusively: no other reference to the drive.
         let drive = unsafe { &mut *d.get().drive.get() };

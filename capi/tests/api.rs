@@ -34,81 +34,69 @@ fn same(what: &str, c: f64, rust: f64) {
     assert_eq!(c.to_bits(), rust.to_bits(), "{what}: C {c}, Rust {rust}");
 }
 
-/// The C sensors equal the Rust sensors converted to the C units, field by field.
+/// The C sensors equal the Rust sensors, field by field: the same names and units.
 fn same_sensors(k: usize, c: &HdiSensors, r: &Sensors) {
     let t = &r.truth;
     let pairs = [
-        ("time_s", c.time_s, r.t),
-        (
-            "heater_power_mw",
-            c.heater_power_mw,
-            units::to_mw(r.heater_power),
-        ),
+        ("time_s", c.time_s, r.time_s),
+        ("heater_power_mw", c.heater_power_mw, r.heater_power_mw),
         (
             "contact_resistance_ohm",
             c.contact_resistance_ohm,
-            r.contact_resistance,
+            r.contact_resistance_ohm,
         ),
-        ("acoustic_v", c.acoustic_v, r.acoustic),
+        ("acoustic_v", c.acoustic_v, r.acoustic_v),
         (
             "readback_fundamental_v",
             c.readback_fundamental_v,
-            r.readback.fundamental,
+            r.readback.fundamental_v,
         ),
-        ("readback_third_v", c.readback_third_v, r.readback.third),
-        ("gap_nm", c.truth.gap_nm, units::to_nm(t.gap)),
-        ("pad_gap_nm", c.truth.pad_gap_nm, units::to_nm(t.pad_gap)),
+        ("readback_third_v", c.readback_third_v, r.readback.third_v),
+        ("gap_nm", c.truth.gap_nm, t.gap_nm),
+        ("pad_gap_nm", c.truth.pad_gap_nm, t.pad_gap_nm),
         (
             "displacement_nm",
             c.truth.displacement_nm,
-            units::to_nm(t.displacement),
+            t.displacement_nm,
         ),
         (
             "velocity_mm_per_s",
             c.truth.velocity_mm_per_s,
-            t.velocity * 1e3,
+            t.velocity_mm_per_s,
         ),
-        (
-            "protrusion_nm",
-            c.truth.protrusion_nm,
-            units::to_nm(t.protrusion),
-        ),
+        ("protrusion_nm", c.truth.protrusion_nm, t.protrusion_nm),
         (
             "mean_contact_force_un",
             c.truth.mean_contact_force_un,
-            t.mean_contact_force * 1e6,
+            t.mean_contact_force_un,
         ),
         (
             "contact_force_un",
             c.truth.contact_force_un,
-            t.contact_force * 1e6,
+            t.contact_force_un,
         ),
         (
             "interface_force_un",
             c.truth.interface_force_un,
-            t.interface_force * 1e6,
+            t.interface_force_un,
         ),
         (
             "mean_flash_temperature_k",
             c.truth.mean_flash_temperature_k,
-            t.mean_flash_temperature,
+            t.mean_flash_temperature_k,
         ),
         (
             "friction_power_mw",
             c.truth.friction_power_mw,
-            units::to_mw(t.friction_power),
+            t.friction_power_mw,
         ),
         (
             "sensor_temperature_k",
             c.truth.sensor_temperature_k,
-            t.sensor_temperature,
+            t.sensor_temperature_k,
         ),
-        (
-            "disk_height_nm",
-            c.truth.disk_height_nm,
-            units::to_nm(t.disk_height),
-        ),
-        ("ambient_k", c.truth.ambient_k, t.ambient),
+        ("disk_height_nm", c.truth.disk_height_nm, t.disk_height_nm),
+        ("ambient_k", c.truth.ambient_k, t.ambient_k),
     ];
     for (name, a, b) in pairs {
         same(&format!("period {k}: {name}"), a, b);
@@ -227,6 +215,7 @@ fn configured_drive_steps_as_the_rust_drive() {
             amplitude: 0.5,
             period: 0.004,
             clearance_per_kelvin: units::nm(0.05),
+            ..Ambient::default()
         },
         sensors,
         atol_displacement_flight: 1.0 * 1e-12,
@@ -246,10 +235,10 @@ fn configured_drive_steps_as_the_rust_drive() {
         let r = rust
             .step(
                 &Command {
-                    dc_voltage: 0.3,
+                    dc_voltage_v: 0.3,
                     ..Command::heater_mw(cmd.heater_power_mw)
                 }
-                .with_dither(cmd.ac_amplitude_v, units::khz(10.5)),
+                .with_dither(cmd.ac_amplitude_v, 10.5),
                 50e-6,
             )
             .unwrap();

@@ -12,11 +12,20 @@ class Drive:
     run-out and waviness (or a flat one), with a heater, a head–disk voltage and the sensors
     firmware reads, stepped at the controller's rate (``docs/clearance.md``).
 
-    Starts at rest in the flying equilibrium at ``initial_power_mw``. ``atol_pm`` (default
-    0.01) and ``atol_flight_pm`` (default ``atol_pm``, at least ``atol_pm``) are the
-    integration's displacement tolerances near contact and in flight (pm). The same seed gives
-    the same disk and the same sensor noise, bit for bit; stepping it with the commands of a
-    command file gives the rows ``replay`` (and ``hdi drive``) gives.
+    The drive is the scene's ``[drive]`` section (docs/scene_format.md), with the keyword
+    ``settings`` over it, each in the unit its name carries: ``radius_mm``, ``rpm``,
+    ``initial_heater_power_mw`` (the start: at rest in the flying equilibrium there),
+    ``heater_time_constant_us``, ``runout_nm``, ``waviness_rms_nm``, ``waviness_orders``
+    (``(lowest, highest)``), ``ambient_rate_k_per_s``, ``ambient_amplitude_k``,
+    ``ambient_period_s``, ``ambient_clearance_per_kelvin_nm``, ``ambient_step_k``,
+    ``ambient_step_time_s``, ``ae_gain_v_per_sqrt_w``, ``ae_bandwidth_khz``, ``ae_noise_v``,
+    ``contact_noise_ohm``, ``readback_wavelength_nm`` (``heads`` must be 1: one ``Drive`` is
+    one head). ``flat_disk`` drops the run-out and waviness. ``atol_pm`` (default 0.01) and
+    ``atol_flight_pm`` (default ``atol_pm``, at least ``atol_pm``) are the integration's
+    displacement tolerances near contact and in flight (pm). The same seed gives the same disk
+    and the same sensor noise, bit for bit; stepping it with the commands of a command file
+    gives the rows ``replay`` (and ``hdi drive``) gives. A bad setting raises
+    ``InvalidInputError`` naming it, with the value in its unit.
 
     A ``Drive`` belongs to the thread that made it: a call from another thread raises
     ``RuntimeError`` (make one drive per thread; ``replay`` may run on any thread).
@@ -25,13 +34,11 @@ class Drive:
     __slots__ = ("_core", "_thread")
 
     def __init__(self, scene: Union["_core.Scene", "_core.Model"], *, seed: int = 1,
-                 radius_mm: float = 25.0, flat_disk: bool = False,
-                 initial_power_mw: float = 60.0, atol_pm: Optional[float] = None,
-                 atol_flight_pm: Optional[float] = None) -> None:
+                 flat_disk: bool = False, atol_pm: Optional[float] = None,
+                 atol_flight_pm: Optional[float] = None, **settings: Any) -> None:
         self._thread = threading.get_ident()
-        self._core = _core.Drive(scene, seed=seed, radius_mm=radius_mm, flat_disk=flat_disk,
-                                 initial_power_mw=initial_power_mw, atol_pm=atol_pm,
-                                 atol_flight_pm=atol_flight_pm)
+        self._core = _core.Drive(scene, seed=seed, flat_disk=flat_disk, atol_pm=atol_pm,
+                                 atol_flight_pm=atol_flight_pm, **settings)
 
     def _native(self) -> Any:
         if threading.get_ident() != self._thread:
@@ -39,12 +46,16 @@ class Drive:
                 "a Drive belongs to the thread that made it: make one Drive per thread")
         return self._core
 
-    def step(self, heater_mw: float, *, dc_v: float = 0.0, ac_v: float = 0.0,
-             ac_khz: float = 0.0, dt_us: float = 50.0) -> Sensors:
-        """Holds the heater at ``heater_mw`` (mW) and the voltage at ``dc_v`` (V) plus an AC
-        dither of ``ac_v`` (V) at ``ac_khz`` (kHz) for one period of ``dt_us`` (µs); returns
-        the sensors at its end: the columns of ``SENSOR_COLUMNS``, as ``replay`` gives them."""
-        return self._native().step(heater_mw, dc_v=dc_v, ac_v=ac_v, ac_khz=ac_khz, dt_us=dt_us)
+    def step(self, heater_power_mw: float, *, dc_voltage_v: float = 0.0,
+             ac_amplitude_v: float = 0.0, ac_frequency_khz: float = 0.0,
+             period_s: float = 50e-6) -> Sensors:
+        """Holds the command (the names of the Rust ``Command`` and the C ``HdiCommand``):
+        heater power ``heater_power_mw`` (mW), DC voltage ``dc_voltage_v`` (V), AC dither
+        ``ac_amplitude_v`` (V) at ``ac_frequency_khz`` (kHz), for one period of ``period_s``
+        (s); returns the ``Sensors`` at its end (the fields of the C ``HdiSensors``)."""
+        return self._native().step(heater_power_mw, dc_voltage_v=dc_voltage_v,
+                                   ac_amplitude_v=ac_amplitude_v,
+                                   ac_frequency_khz=ac_frequency_khz, period_s=period_s)
 
     @property
     def time_s(self) -> float:

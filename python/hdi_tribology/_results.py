@@ -165,6 +165,19 @@ class Calibration(Result):
     ``stats``, ``wall_seconds``, ``status``, ``flags``."""
 
 
+class Truth(Result):
+    """The true values behind one period's sensors, for test oracles: the fields of the Rust
+    ``Truth`` and the C ``HdiTruth`` (``gap_nm``, ``pad_gap_nm``, ``displacement_nm``,
+    ``velocity_mm_per_s``, ``protrusion_nm``, ``mean_contact_force_un``, ``contact_force_un``,
+    ``interface_force_un``, ``mean_flash_temperature_k``, ``friction_power_mw``,
+    ``sensor_temperature_k``, ``disk_height_nm``, ``ambient_k``)."""
+
+
 class Sensors(Result):
-    """One controller period's sensors and the true values behind them: the columns of
-    ``SENSOR_COLUMNS`` (``replay``, ``hdi drive``), in the units their names carry."""
+    """One controller period's sensors, the fields of the Rust ``Sensors`` and the C
+    ``HdiSensors`` in the units their names carry (``time_s``, ``heater_power_mw``,
+    ``contact_resistance_ohm``, ``acoustic_v``, ``readback_fundamental_v``,
+    ``readback_third_v``), ``hr_clearance_change_nm`` (the harmonic-ratio clearance change
+    since the drive's first period) and the true values in ``truth`` (a ``Truth``)."""
+
+    _nested = {"truth": Truth}

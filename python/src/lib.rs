@@ -24,14 +24,14 @@ use hdi_tribology::calibration::{
     VibrationRms,
 };
 use hdi_tribology::drive::{
-    check_commands, replay_each, scene_zone, sensor_row, Command, CommandRow, DiskSpec, Drive,
-    DriveOptions, Plant, SENSOR_COLUMNS,
+    check_commands, replay_each, sensor_row, spec_zone, Command, CommandRow, DiskSpec, Drive,
+    DriveOptions, Plant, Sensors, DEFAULT_RADIUS, SENSOR_COLUMNS,
 };
 use hdi_tribology::fit::{DataSet, FitOptions, FreeParameter};
 use hdi_tribology::force::{Gaps, RelaxingState};
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::ode::Cancel;
-use hdi_tribology::scene::{FieldPath, PathError};
+use hdi_tribology::scene::{DriveSpec, FieldPath, PathError};
 use hdi_tribology::units;
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyTypeError};
@@ -1436,57 +1436,126 @@ fn calibrate<'py>(
 // ---------------------------------------------------------------------------------------------
 // Drive
 
-/// The plant of a `Drive` or a replay: the scene in the zone at `radius_mm`, the disk and the
-/// seed, with the drive's default sensors, heater lag and solver.
+/// The plant of a `Drive` or a replay: the scene in its zone with its `[drive]` section, the
+/// keyword `settings` (the names of `DriveSpec::settings`, in their engineering units) over
+/// it, the seed, and the tolerances.
 fn plant_of(
     py: Python<'_>,
     scene: &Bound<'_, PyAny>,
     seed: u64,
-    radius_mm: f64,
     flat_disk: bool,
-    initial_power_mw: f64,
+    settings: Option<&Bound<'_, PyDict>>,
     atol_pm: [Option<f64>; 2],
 ) -> PyResult<Plant> {
-    if !(radius_mm.is_finite() && radius_mm > 0.0 && radius_mm <= MAX_RADIUS_MM) {
+    let model = scene.cast::<Model>().ok().map(|m| m.get().model.clone());
+    let scene = match model {
+        Some(_) => None,
+        None => Some(
+            scene
+                .cast::<Scene>()
+                .map_err(|_| PyTypeError::new_err("scene: expected a Scene or a Model"))?
+                .get()
+                .get(),
+        ),
+    };
+    let mut spec = scene
+        .as_ref()
+        .and_then(|s| s.drive.clone())
+        .unwrap_or_default();
+    if let Some(kw) = settings {
+        for (k, v) in kw.iter() {
+            let key: String = k.extract()?;
+            if key == "waviness_orders" {
+                let o: [u32; 2] = v.extract()?;
+                spec.set_waviness_orders(o, &key).py()?;
+                continue;
+            }
+            if !DriveSpec::settings().any(|(n, _)| n == key) {
+                return Err(PyTypeError::new_err(format!(
+                    "unexpected keyword argument '{key}'; the drive settings are {}",
+                    DriveSpec::settings()
+                        .map(|(n, _)| n)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )));
+            }
+            let x: f64 = v.extract().map_err(|_| invalid(&key, "must be a number"))?;
+            spec.set(&key, x, &key).py()?;
+        }
+    }
+    if spec.heads != 1 {
         return Err(invalid(
-            "radius_mm",
-            format!(
-                "must be a radius on a disk, in (0, {MAX_RADIUS_MM}] mm (a 3.5-inch disk ends \
-                 at 47.5 mm), got {radius_mm} mm"
-            ),
+            "heads",
+            "a Drive is one head: make one Drive per head (each with its own seed)",
         ));
     }
-    non_negative("initial_power_mw", initial_power_mw, "mW")?;
-    let opts = DriveOptions {
-        initial_power: units::mw(initial_power_mw),
-        disk: if flat_disk {
-            DiskSpec::flat()
-        } else {
-            DiskSpec::default()
-        },
-        ..DriveOptions::default()
+    let mut opts = DriveOptions::from_spec(&spec);
+    if flat_disk {
+        opts.disk = DiskSpec::flat();
     }
-    .with_tolerances_pm(atol_pm[0], atol_pm[1], ["atol_pm", "atol_flight_pm"])
-    .py()?;
+    let opts = opts
+        .with_tolerances_pm(atol_pm[0], atol_pm[1], ["atol_pm", "atol_flight_pm"])
+        .py()?;
+    let radius = spec.radius_m.unwrap_or(DEFAULT_RADIUS);
     // A `Model` drives as it is (its terms with memory included), a `Scene` at its own zone.
-    if let Ok(m) = scene.cast::<Model>() {
-        let model = m.get().model.clone();
-        return interruptible(py, || {
-            Plant::from_model(&model, radius_mm * 1e-3, seed, opts)
-        });
+    match (model, scene) {
+        (Some(model), _) => interruptible(py, || Plant::from_model(&model, radius, seed, opts)),
+        (None, Some(scene)) => interruptible(py, || {
+            Plant::new(&scene, &spec_zone(&scene, &spec)?, seed, opts)
+        }),
+        (None, None) => Err(PyTypeError::new_err("scene: expected a Scene or a Model")),
     }
-    let scene = scene
-        .cast::<Scene>()
-        .map_err(|_| PyTypeError::new_err("scene: expected a Scene or a Model"))?
-        .get()
-        .get();
-    interruptible(py, || {
-        Plant::new(&scene, &scene_zone(&scene, radius_mm * 1e-3)?, seed, opts)
-    })
 }
 
-/// The largest zone radius a `Drive` takes (mm).
-const MAX_RADIUS_MM: f64 = 100.0;
+/// One period of a drive, the command and period checked as a command file's row (in the
+/// argument names of `Drive.step`).
+fn step_checked(drive: &mut Drive, c: &Command, period_s: f64) -> PyResult<Sensors> {
+    let row = CommandRow {
+        time_s: 0.0,
+        heater_mw: c.heater_power_mw,
+        voltage_dc_v: c.dc_voltage_v,
+        voltage_ac_v: c.ac_amplitude_v,
+        ac_frequency_khz: c.ac_frequency_khz,
+    };
+    let arg = |name: &str| {
+        match name {
+            "heater_mw" => "heater_power_mw",
+            "voltage_dc_v" => "dc_voltage_v",
+            "voltage_ac_v" => "ac_amplitude_v",
+            other => other,
+        }
+        .to_string()
+    };
+    check_commands(&[row, CommandRow { time_s: 1.0, ..row }], "step", |_, n| {
+        arg(n)
+    })
+    .py()?;
+    if !(period_s.is_finite() && period_s > 0.0 && period_s <= 1.0) {
+        return Err(invalid(
+            "period_s",
+            format!("must be a period in (0, 1] s, got {period_s} s"),
+        ));
+    }
+    drive.step(c, period_s).py()
+}
+
+/// A `Sensors` record: the drive's sensors as the crate serializes them, the read-back
+/// amplitudes flat as in the C ABI, and the harmonic-ratio clearance change against the first
+/// period's log ratio `lr0`.
+fn sensors_value(s: &Sensors, lr0: f64, wavelength_m: f64) -> PyResult<Value> {
+    let row = sensor_row(s, lr0, wavelength_m);
+    let mut v = to_value(s)?;
+    if let Value::Object(m) = &mut v {
+        m.remove("readback");
+        m.insert(
+            "readback_fundamental_v".into(),
+            to_value(&s.readback.fundamental_v)?,
+        );
+        m.insert("readback_third_v".into(), to_value(&s.readback.third_v)?);
+        m.insert("hr_clearance_change_nm".into(), to_value(&row[6])?);
+    }
+    Ok(v)
+}
 
 /// A simulated drive for firmware prototyping (the native half of `hdi_tribology.Drive`, which
 /// checks that it is used from the thread that made it: the integrator's event closures are not
@@ -1502,20 +1571,19 @@ struct PyDrive {
 #[pymethods]
 impl PyDrive {
     #[new]
-    #[pyo3(signature = (scene, *, seed = 1, radius_mm = 25.0, flat_disk = false, initial_power_mw = 60.0, atol_pm = None, atol_flight_pm = None))]
+    #[pyo3(signature = (scene, *, seed = 1, flat_disk = false, atol_pm = None, atol_flight_pm = None, **settings))]
     fn new(
         py: Python<'_>,
         scene: &Bound<'_, PyAny>,
         seed: i128,
-        radius_mm: f64,
         flat_disk: bool,
-        initial_power_mw: f64,
         atol_pm: Option<f64>,
         atol_flight_pm: Option<f64>,
+        settings: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         let seed = seed_of("seed", seed)?;
         let tol = [atol_pm, atol_flight_pm];
-        let plant = plant_of(py, scene, seed, radius_mm, flat_disk, initial_power_mw, tol)?;
+        let plant = plant_of(py, scene, seed, flat_disk, settings, tol)?;
         let wavelength = plant.sensor_spec().readback.wavelength;
         Ok(PyDrive {
             inner: plant.into_drive().py()?,
@@ -1524,64 +1592,31 @@ impl PyDrive {
         })
     }
 
-    /// Holds the heater at `heater_mw` (mW) and the voltage at `dc_v` (V) plus an AC dither of
-    /// amplitude `ac_v` (V) at `ac_khz` (kHz) for one controller period of `dt_us` (µs), and
-    /// returns the `Sensors` at its end: the columns of `SENSOR_COLUMNS`, as `replay` gives them.
-    #[pyo3(signature = (heater_mw, *, dc_v = 0.0, ac_v = 0.0, ac_khz = 0.0, dt_us = 50.0))]
+    /// Holds the command — heater power `heater_power_mw` (mW), DC voltage `dc_voltage_v` (V),
+    /// AC dither `ac_amplitude_v` (V) at `ac_frequency_khz` (kHz), the names of the Rust
+    /// `Command` and the C `HdiCommand` — for one controller period of `period_s` (s), and
+    /// returns the `Sensors` at its end (the fields of the C `HdiSensors`, the truth in
+    /// `truth`, and `hr_clearance_change_nm`, the harmonic-ratio clearance change since the
+    /// drive's first period).
+    #[pyo3(signature = (heater_power_mw, *, dc_voltage_v = 0.0, ac_amplitude_v = 0.0, ac_frequency_khz = 0.0, period_s = 50e-6))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
-        heater_mw: f64,
-        dc_v: f64,
-        ac_v: f64,
-        ac_khz: f64,
-        dt_us: f64,
+        heater_power_mw: f64,
+        dc_voltage_v: f64,
+        ac_amplitude_v: f64,
+        ac_frequency_khz: f64,
+        period_s: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let row = CommandRow {
-            time_s: 0.0,
-            heater_mw,
-            voltage_dc_v: dc_v,
-            voltage_ac_v: ac_v,
-            ac_frequency_khz: ac_khz,
-        };
-        let arg = |name: &str| {
-            match name {
-                "heater_mw" => "heater_mw",
-                "voltage_dc_v" => "dc_v",
-                "voltage_ac_v" => "ac_v",
-                "ac_frequency_khz" => "ac_khz",
-                other => other,
-            }
-            .to_string()
-        };
-        check_commands(&[row, CommandRow { time_s: 1.0, ..row }], "step", |_, n| {
-            arg(n)
-        })
-        .py()?;
-        if !(dt_us.is_finite() && dt_us > 0.0 && dt_us <= 1e6) {
-            return Err(invalid(
-                "dt_us",
-                format!("must be a period in (0, 1e6] µs, got {dt_us} µs"),
-            ));
-        }
         let command = Command {
-            heater_power: units::mw(heater_mw),
-            dc_voltage: dc_v,
-            ac_amplitude: ac_v,
-            ac_frequency: ac_khz * 1e3,
+            heater_power_mw,
+            dc_voltage_v,
+            ac_amplitude_v,
+            ac_frequency_khz,
         };
-        let s = self.inner.step(&command, dt_us / 1e6).py()?;
-        let lr = s.readback.log_ratio();
-        let lr0 = *self.reference.get_or_insert(lr);
-        let row = sensor_row(&s, lr0, self.wavelength);
-        let v = Value::Object(
-            SENSOR_COLUMNS
-                .iter()
-                .zip(row)
-                .map(|(k, x)| Ok(((*k).to_string(), to_value(&x)?)))
-                .collect::<PyResult<_>>()?,
-        );
-        record(py, "Sensors", &v)
+        let s = step_checked(&mut self.inner, &command, period_s)?;
+        let lr0 = *self.reference.get_or_insert(s.readback.log_ratio());
+        record(py, "Sensors", &sensors_value(&s, lr0, self.wavelength)?)
     }
 
     /// Simulated time so far (s).
@@ -1625,7 +1660,7 @@ impl PyDrive {
 /// `atol_flight_pm` are the tolerances of `Drive`. The GIL is released while the drive runs,
 /// and Ctrl-C stops it.
 #[pyfunction]
-#[pyo3(signature = (scene, time_s, heater_mw, voltage_dc_v, voltage_ac_v = None, ac_frequency_khz = None, *, rate_khz = 20.0, seed = 1, radius_mm = 25.0, flat_disk = false, atol_pm = None, atol_flight_pm = None))]
+#[pyo3(signature = (scene, time_s, heater_mw, voltage_dc_v, voltage_ac_v = None, ac_frequency_khz = None, *, rate_khz = 20.0, seed = 1, flat_disk = false, atol_pm = None, atol_flight_pm = None, **settings))]
 fn replay<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -1636,10 +1671,10 @@ fn replay<'py>(
     ac_frequency_khz: Option<Vec<f64>>,
     rate_khz: f64,
     seed: i128,
-    radius_mm: f64,
     flat_disk: bool,
     atol_pm: Option<f64>,
     atol_flight_pm: Option<f64>,
+    settings: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let seed = seed_of("seed", seed)?;
     let n = time_s.len();
@@ -1678,9 +1713,8 @@ fn replay<'py>(
         py,
         scene,
         seed,
-        radius_mm,
         flat_disk,
-        units::to_mw(DriveOptions::default().initial_power),
+        settings,
         [atol_pm, atol_flight_pm],
     )?;
     let dt = 1e-3 / rate_khz;

@@ -43,8 +43,16 @@ def test_stepping_equals_replay(paper_scene):
     ref = hdi.replay(paper_scene, TIMES, HEATER, DC, seed=3)
     drive = hdi.Drive(paper_scene, seed=3)
     rows = [drive.step(60.0 if k < 20 else 66.0) for k in range(40)]
+    # The CSV's columns and the sensors' fields (the Rust `Sensors`, the C `HdiSensors`).
+    field = {"heater_mw": lambda s: s.heater_power_mw,
+             "true_gap_nm": lambda s: s.truth.gap_nm,
+             "true_contact_force_un": lambda s: s.truth.mean_contact_force_un,
+             "true_sensor_temperature_k": lambda s: s.truth.sensor_temperature_k,
+             "true_disk_height_nm": lambda s: s.truth.disk_height_nm,
+             "true_ambient_k": lambda s: s.truth.ambient_k}
     for name in hdi.SENSOR_COLUMNS:
-        assert [getattr(s, name) for s in rows] == ref[name].tolist(), name
+        get = field.get(name, lambda s, name=name: getattr(s, name))
+        assert [get(s) for s in rows] == ref[name].tolist(), name
     assert drive.time_s == rows[-1].time_s
     assert drive.stats["accepted"] > 0
     assert "Drive(" in repr(drive) and "Sensors(" in repr(rows[0])
@@ -72,7 +80,7 @@ def test_a_firmware_loop_in_python_finds_touchdown(paper_scene):
     """A staircase with an acoustic-emission detector, written in Python against `Drive.step`:
     touchdown within 1 mW of the static touchdown power (74.324 mW)."""
     static_td = hdi.static_hysteresis(paper_scene).touchdown.power_mw
-    drive = hdi.Drive(paper_scene, seed=11, flat_disk=True, initial_power_mw=71.0)
+    drive = hdi.Drive(paper_scene, seed=11, flat_disk=True, initial_heater_power_mw=71.0)
     levels = np.arange(71.0, 78.0, 0.5)
     hold, read = 30, 20  # periods per level; the last `read` are averaged
     means, errors, touchdown = [], [], None
@@ -109,11 +117,11 @@ def test_replay_releases_the_gil(paper_scene):
 
 
 @pytest.mark.parametrize("kwargs, field", [
-    (dict(heater_mw=-1.0), "heater_mw"),
-    (dict(heater_mw=float("nan")), "heater_mw"),
-    (dict(heater_mw=60.0, dc_v=float("inf")), "dc_v"),
-    (dict(heater_mw=60.0, ac_khz=-2.0), "ac_khz"),
-    (dict(heater_mw=60.0, dt_us=0.0), "dt_us"),
+    (dict(heater_power_mw=-1.0), "heater_power_mw"),
+    (dict(heater_power_mw=float("nan")), "heater_power_mw"),
+    (dict(heater_power_mw=60.0, dc_voltage_v=float("inf")), "dc_voltage_v"),
+    (dict(heater_power_mw=60.0, ac_frequency_khz=-2.0), "ac_frequency_khz"),
+    (dict(heater_power_mw=60.0, period_s=0.0), "period_s"),
 ])
 def test_step_errors_name_the_argument(paper_scene, kwargs, field):
     drive = hdi.Drive(paper_scene)

@@ -289,16 +289,21 @@ pub fn calibrate(
     let mut drive = Plant::from_model(model, 0.025, 0, drive_opts)?.into_drive()?;
     let v = model.voltage();
     let settings = StaircaseSettings {
-        start_power: sc.start_power,
-        step: sc.step,
-        max_power: sc.max_power,
-        settle_time: sc.settle_time,
-        measure_time: sc.measure_time,
+        start_power_mw: sc.start_power * 1e3,
+        step_mw: sc.step * 1e3,
+        max_power_mw: sc.max_power * 1e3,
+        settle_time_s: sc.settle_time,
+        measure_time_s: sc.measure_time,
         find_takeoff: opts.find_takeoff,
-        margin: opts.margin,
-        dither: (v.ac_amplitude != 0.0).then_some((v.ac_amplitude, v.frequency)),
-        dc_voltage: v.dc,
-        rise_time: sc.rise_time,
+        margin_mw: opts.margin * 1e3,
+        dither_amplitude_v: v.ac_amplitude,
+        dither_frequency_khz: if v.ac_amplitude != 0.0 {
+            v.frequency * 1e-3
+        } else {
+            0.0
+        },
+        dc_voltage_v: v.dc,
+        rise_time_s: sc.rise_time,
     };
     detector.reset();
     let mut staircase = DriveStaircase::new(
@@ -315,10 +320,19 @@ pub fn calibrate(
     let per_level = (sc.dwell() / dt).round() as usize + 1;
     run(&mut drive, &mut staircase, dt, 2 * (levels + 1) * per_level)?;
     let outcome = staircase.outcome().clone();
-    let steps = std::mem::take(&mut staircase.detector_mut().steps);
+    let mut steps = std::mem::take(&mut staircase.detector_mut().steps);
+    // The staircase counts in mW; the powers reported are those of the levels in W, as
+    // `Staircase` defines them.
+    let level_power = |p_mw: f64| {
+        let k = ((p_mw - settings.start_power_mw) / settings.step_mw).round();
+        sc.start_power + k * sc.step
+    };
+    for s in &mut steps {
+        s.power = level_power(s.power * 1e3);
+    }
     let name = staircase.detector().inner.name().to_string();
 
-    let Some(touchdown_power) = outcome.touchdown_power else {
+    let Some(touchdown_power) = outcome.touchdown_power_mw.map(level_power) else {
         return Err(super::CalibrationError::NoTouchdown {
             detector: name,
             max_power_mw: crate::units::to_mw(sc.max_power),
@@ -358,7 +372,7 @@ pub fn calibrate(
     Ok(Calibration {
         detector: name,
         touchdown_power,
-        takeoff_power: outcome.takeoff_power,
+        takeoff_power: outcome.takeoff_power_mw.map(level_power),
         set_power,
         clearance,
         contrast,
@@ -389,14 +403,15 @@ impl LevelDetector for PerSample<'_> {
 
     fn observe(&mut self, s: &Sensors, measuring: bool) {
         let tr = &s.truth;
+        // The detectors read SI.
         let fired = self.inner.update(&Sample {
-            t: s.t,
-            power: s.heater_power,
-            displacement: tr.displacement,
-            velocity: tr.velocity,
-            gap: tr.gap,
-            contact_force: tr.contact_force,
-            interface_force: tr.interface_force,
+            t: s.time_s,
+            power: s.heater_power_mw * 1e-3,
+            displacement: tr.displacement_nm * 1e-9,
+            velocity: tr.velocity_mm_per_s * 1e-3,
+            gap: tr.gap_nm * 1e-9,
+            contact_force: tr.contact_force_un * 1e-6,
+            interface_force: tr.interface_force_un * 1e-6,
         });
         let rec = self.record.get_or_insert(StepRecord {
             power: 0.0,
@@ -405,7 +420,7 @@ impl LevelDetector for PerSample<'_> {
             min_gap: f64::INFINITY,
             contact: false,
         });
-        rec.min_gap = rec.min_gap.min(tr.gap);
+        rec.min_gap = rec.min_gap.min(tr.gap_nm * 1e-9);
         if measuring {
             rec.contact |= fired;
             rec.peak_level = rec.peak_level.max(self.inner.level());
@@ -420,7 +435,7 @@ impl LevelDetector for PerSample<'_> {
             min_gap: f64::INFINITY,
             contact: false,
         });
-        rec.power = level.power;
+        rec.power = level.heater_power_mw * 1e-3;
         rec.descending = level.descending;
         self.steps.push(rec);
         rec.contact

@@ -21,7 +21,7 @@
 //! let mut power_mw = 60.0;
 //! for _ in 0..100 {
 //!     let s = drive.step(&Command::heater_mw(power_mw), 50e-6)?;
-//!     if s.acoustic < 0.01 {
+//!     if s.acoustic_v < 0.01 {
 //!         power_mw += 0.05;
 //!     }
 //! }
@@ -41,12 +41,14 @@ mod zone;
 
 pub use controller::{
     run, AcousticLevel, Action, Channel, ClearanceHold, ContactSensorSlope, Controller, HoldPhase,
-    HoldSettings, LevelDetector, LevelStats, Staircase, StaircaseOutcome, StaircaseSettings,
-    TrueContact,
+    HoldSettings, HoldTarget, LevelDetector, LevelStats, RunningMean, Staircase, StaircaseOutcome,
+    StaircaseSettings, TrueContact,
 };
 pub use disk::{DiskSpec, Harmonic};
 pub use error::DriveError;
-pub use plant::{scene_zone, Ambient, Command, Drive, DriveOptions, Plant};
+pub use plant::{
+    scene_zone, spec_zone, Ambient, Command, Drive, DriveOptions, Plant, DEFAULT_RADIUS,
+};
 pub use replay::{
     check_commands, read_commands, replay, replay_each, sensor_row, whole_periods, CommandRow,
     ReplaySummary, MAX_REPLAY_PERIODS, SENSOR_COLUMNS,

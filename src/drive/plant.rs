@@ -1,71 +1,77 @@
 //! The simulated drive: the slider of a scene in a zone, stepped at the controller's rate.
 
 use super::disk::{Disk, DiskSpec};
-use super::sensors::{Physical, SensorSpec, SensorState, Sensors, Truth};
+use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
 use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
 use crate::error::{check_finite, check_non_negative, Error, Result};
 use crate::model::{Heater, Inputs, Rest, SliderModel, SliderSystem, StateLayout, Voltage};
 use crate::ode::{Integrator, Method, Stats};
-use crate::scene::Scene;
+use crate::scene::{DriveSpec, Scene};
 use crate::sim::{with_sized, Flow, Observer, Problem, SizedIntegrator, StepView};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-/// What the controller sets for the next period.
+/// What the controller sets for the next period, in engineering units (the unit in each name,
+/// as in the C ABI's `HdiCommand`).
 ///
 /// ```
 /// use hdi_tribology::drive::Command;
-/// let c = Command::heater_mw(72.5).with_dither(0.5, 10.5e3);
-/// assert_eq!(c.heater_power, 0.0725);
-/// assert_eq!(c.ac_amplitude, 0.5);
+/// let c = Command::heater_mw(72.5).with_dither(0.5, 10.5);
+/// assert_eq!(c.heater_power_mw, 72.5);
+/// assert_eq!((c.ac_amplitude_v, c.ac_frequency_khz), (0.5, 10.5));
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Command {
-    /// Heater power (W, ≥ 0); the protrusion follows through the heater's thermal lag.
-    pub heater_power: f64,
+    /// Heater power (mW, ≥ 0); the protrusion follows through the heater's thermal lag.
+    pub heater_power_mw: f64,
     /// DC head–disk voltage (V).
-    pub dc_voltage: f64,
+    pub dc_voltage_v: f64,
     /// AC dither amplitude (V).
-    pub ac_amplitude: f64,
-    /// AC dither frequency (Hz).
-    pub ac_frequency: f64,
+    pub ac_amplitude_v: f64,
+    /// AC dither frequency (kHz).
+    pub ac_frequency_khz: f64,
 }
 
 impl Command {
     /// Heater power in milliwatts, no voltage.
     pub fn heater_mw(p_mw: f64) -> Self {
         Command {
-            heater_power: crate::units::mw(p_mw),
+            heater_power_mw: p_mw,
             ..Command::default()
         }
     }
 
-    /// The same command with an AC dither of `amplitude` (V) at `frequency` (Hz).
-    pub fn with_dither(self, amplitude: f64, frequency: f64) -> Self {
+    /// The same command with an AC dither of `amplitude_v` (V) at `frequency_khz` (kHz).
+    pub fn with_dither(self, amplitude_v: f64, frequency_khz: f64) -> Self {
         Command {
-            ac_amplitude: amplitude,
-            ac_frequency: frequency,
+            ac_amplitude_v: amplitude_v,
+            ac_frequency_khz: frequency_khz,
             ..self
         }
     }
 
+    /// The heater power in W (the drive's unit inside).
+    pub(crate) fn heater_power(&self) -> f64 {
+        crate::units::mw(self.heater_power_mw)
+    }
+
     fn validate(&self) -> Result<()> {
-        check_non_negative("command.heater_power", self.heater_power)?;
-        if self.heater_power > MAX_HEATER_POWER {
+        check_non_negative("command.heater_power_mw", self.heater_power_mw)?;
+        if self.heater_power() > MAX_HEATER_POWER {
             return Err(Error::invalid(
-                "command.heater_power",
+                "command.heater_power_mw",
                 format!(
                     "must not exceed {} mW, got {} mW",
                     MAX_HEATER_POWER * 1e3,
-                    self.heater_power * 1e3
+                    self.heater_power_mw
                 ),
             ));
         }
-        check_finite("command.dc_voltage", self.dc_voltage)?;
-        check_finite("command.ac_amplitude", self.ac_amplitude)?;
-        check_non_negative("command.ac_frequency", self.ac_frequency)?;
+        check_finite("command.dc_voltage_v", self.dc_voltage_v)?;
+        check_finite("command.ac_amplitude_v", self.ac_amplitude_v)?;
+        check_non_negative("command.ac_frequency_khz", self.ac_frequency_khz)?;
         Ok(())
     }
 }
@@ -75,7 +81,8 @@ pub const MAX_HEATER_POWER: f64 = 1.0;
 
 /// Ambient temperature drift and what it does to the clearance.
 ///
-/// `ΔT_amb(t) = rate · t + amplitude · sin(2π t / period)`; the nominal clearance moves by
+/// `ΔT_amb(t) = rate · t + amplitude · sin(2π t / period) + step · H(t − step_time)`; the
+/// nominal clearance moves by
 /// `clearance_per_kelvin · ΔT_amb` (the slider and suspension expand; drives see a few hundredths
 /// of a nanometre per kelvin) and the contact sensor reads the ambient change too.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -88,6 +95,11 @@ pub struct Ambient {
     pub period: f64,
     /// Clearance change per kelvin (m/K).
     pub clearance_per_kelvin: f64,
+    /// A step of the ambient temperature (K; 0: none), from `step_time` on: a disturbance to
+    /// test a clearance loop against.
+    pub step: f64,
+    /// When the step comes (s, ≥ 0).
+    pub step_time: f64,
 }
 
 impl Default for Ambient {
@@ -98,14 +110,28 @@ impl Default for Ambient {
             amplitude: 0.0,
             period: 1.0,
             clearance_per_kelvin: 0.03e-9,
+            step: 0.0,
+            step_time: 0.0,
         }
     }
 }
 
 impl Ambient {
     /// Temperature change at `t` (K).
+    ///
+    /// ```
+    /// use hdi_tribology::drive::Ambient;
+    /// let a = Ambient { rate: 2.0, step: 10.0, step_time: 0.5, ..Ambient::default() };
+    /// assert_eq!(a.temperature(0.25), 0.5);
+    /// assert_eq!(a.temperature(0.5), 11.0);
+    /// ```
     pub fn temperature(&self, t: f64) -> f64 {
-        self.rate * t + self.amplitude * (2.0 * PI * t / self.period).sin()
+        let drift = self.rate * t + self.amplitude * (2.0 * PI * t / self.period).sin();
+        if self.step != 0.0 && t >= self.step_time {
+            drift + self.step
+        } else {
+            drift
+        }
     }
 }
 
@@ -240,6 +266,93 @@ impl DriveOptions {
     }
 }
 
+impl DriveOptions {
+    /// The options a scene's `[drive]` section ([`DriveSpec`]) sets, the defaults elsewhere:
+    /// the start power, the heater lag, the run-out (a once-around harmonic of phase 0) and the
+    /// random waviness, the ambient drift and step, and the sensor options it names.
+    ///
+    /// ```
+    /// use hdi_tribology::drive::DriveOptions;
+    /// use hdi_tribology::scene::DriveSpec;
+    /// assert_eq!(DriveOptions::from_spec(&DriveSpec::default()), DriveOptions::default());
+    /// let mut spec = DriveSpec::default();
+    /// spec.set("runout_nm", 0.0, "runout_nm")?;
+    /// spec.set("ae_gain_v_per_sqrt_w", 2.0, "ae_gain_v_per_sqrt_w")?;
+    /// let o = DriveOptions::from_spec(&spec);
+    /// assert!(o.disk.harmonics.is_empty());
+    /// assert_eq!(o.sensors.acoustic.gain, 2.0);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_spec(spec: &DriveSpec) -> Self {
+        let mut o = DriveOptions::default();
+        let set = |slot: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *slot = v;
+            }
+        };
+        set(&mut o.initial_power, spec.initial_heater_power_w);
+        set(&mut o.heater_time_constant, spec.heater_time_constant_s);
+        if let Some(r) = spec.disk.runout_m {
+            o.disk.harmonics.retain(|h| h.order != 1);
+            if r != 0.0 {
+                o.disk.harmonics.insert(
+                    0,
+                    super::Harmonic {
+                        order: 1,
+                        amplitude: r,
+                        phase: 0.0,
+                    },
+                );
+            }
+        }
+        set(&mut o.disk.random_rms, spec.disk.waviness_rms_m);
+        if let Some([lo, hi]) = spec.disk.waviness_orders {
+            o.disk.random_orders = (lo, hi);
+        }
+        let (a, sa) = (&mut o.ambient, &spec.ambient);
+        set(&mut a.rate, sa.rate_k_per_s);
+        set(&mut a.amplitude, sa.amplitude_k);
+        set(&mut a.period, sa.period_s);
+        set(&mut a.clearance_per_kelvin, sa.clearance_per_kelvin_m);
+        set(&mut a.step, sa.step_k);
+        set(&mut a.step_time, sa.step_time_s);
+        let (sn, ss) = (&mut o.sensors, &spec.sensors);
+        set(&mut sn.acoustic.gain, ss.ae_gain_v_per_sqrt_w);
+        set(&mut sn.acoustic.bandwidth, ss.ae_bandwidth_hz);
+        set(&mut sn.acoustic.noise, ss.ae_noise_v);
+        set(&mut sn.contact.noise, ss.contact_noise_ohm);
+        set(&mut sn.readback.wavelength, ss.readback_wavelength_m);
+        o
+    }
+}
+
+/// The zone of a scene's `[drive]` section: its radius (default 25 mm) and, with `rpm`, the disk
+/// speed there (`2π r · rpm / 60`); otherwise the scene's own disk speed ([`scene_zone`]).
+///
+/// ```
+/// use hdi_tribology::{drive::spec_zone, scene::{DriveSpec, Scene}};
+/// let mut spec = DriveSpec::default();
+/// spec.set("rpm", 7200.0, "rpm")?;
+/// let z = spec_zone(&Scene::paper(), &spec)?;
+/// assert_eq!(z.radius, 0.025);
+/// assert!((z.disk_speed - 2.0 * std::f64::consts::PI * 0.025 * 120.0).abs() < 1e-12);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+///
+/// # Errors
+/// An invalid scene or spec (named field).
+pub fn spec_zone(scene: &Scene, spec: &DriveSpec) -> Result<Zone> {
+    spec.validate()?;
+    let mut zone = scene_zone(scene, spec.radius_m.unwrap_or(DEFAULT_RADIUS))?;
+    if let Some(rpm) = spec.rpm {
+        zone.disk_speed = 2.0 * PI * zone.radius * rpm / 60.0;
+    }
+    Ok(zone)
+}
+
+/// The zone radius of a drive that names none (m): 25 mm, a 3.5-inch disk's middle diameter.
+pub const DEFAULT_RADIUS: f64 = 0.025;
+
 /// The zone a scene describes by itself: its own clearance, air-bearing stiffness and disk speed,
 /// at `radius` (m).
 ///
@@ -276,8 +389,8 @@ pub fn scene_zone(scene: &Scene, radius: f64) -> Result<Zone> {
 ///     s = drive.step(&Command::heater_mw(65.0), 50e-6)?;
 /// }
 /// // 5 mW more heater closes the gap by about η·5 mW = 0.5 nm.
-/// println!("gap {:.3} nm, sensor {:.4} Ω", s.truth.gap * 1e9, s.contact_resistance);
-/// assert!(s.truth.gap < 4.5e-9);
+/// println!("gap {:.3} nm, sensor {:.4} Ω", s.truth.gap_nm, s.contact_resistance_ohm);
+/// assert!(s.truth.gap_nm < 4.5);
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 #[derive(Clone)]
@@ -345,10 +458,10 @@ impl Plant {
     /// let opts = DriveOptions { disk: DiskSpec::flat(), ..DriveOptions::default() };
     /// let mut drive = Plant::from_model(&model, 0.025, 1, opts)?.into_drive()?;
     /// // The commands carry the model's own DC voltage.
-    /// let cmd = Command { dc_voltage: model.voltage().dc, ..Command::heater_mw(60.0) };
+    /// let cmd = Command { dc_voltage_v: model.voltage().dc, ..Command::heater_mw(60.0) };
     /// let s = drive.step(&cmd, 50e-6)?;
     /// // Flying: the heater has closed part of the nominal clearance.
-    /// assert!(s.truth.gap > 1e-9 && s.truth.gap < model.nominal_clearance());
+    /// assert!(s.truth.gap_nm > 1.0 && s.truth.gap_nm < model.nominal_clearance() * 1e9);
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
     ///
@@ -396,6 +509,8 @@ impl Plant {
             "ambient.clearance_per_kelvin",
             opts.ambient.clearance_per_kelvin,
         )?;
+        check_finite("ambient.step", opts.ambient.step)?;
+        check_non_negative("ambient.step_time", opts.ambient.step_time)?;
         opts.sensors.validate()?;
         crate::error::check_positive("rtol", opts.rtol)?;
         crate::error::check_positive("atol_displacement", opts.atol_displacement)?;
@@ -688,26 +803,29 @@ impl Drive {
         self.t = t1;
         let friction_power =
             plant.base.friction().coefficient * plant.zone.disk_speed * truth.mean_contact_force;
+        let heater_power = command.heater_power();
         let phys = Physical {
             gap: truth.gap,
-            heater_power: command.heater_power,
+            heater_power,
             friction_power,
             ambient,
         };
         let (r, ae, readback, temp) = self.sensors.sample(t1, dt, &phys);
+        let truth = TrueState {
+            friction_power,
+            sensor_temperature: temp,
+            disk_height: plant.disk.height(t1).0,
+            ambient,
+            ..truth
+        };
+        // SI inside; the firmware's units at the edge.
         Ok(Sensors {
-            t: t1,
-            contact_resistance: r,
-            acoustic: ae,
+            time_s: t1,
+            contact_resistance_ohm: r,
+            acoustic_v: ae,
             readback,
-            heater_power: command.heater_power,
-            truth: Truth {
-                friction_power,
-                sensor_temperature: temp,
-                disk_height: plant.disk.height(t1).0,
-                ambient,
-                ..truth
-            },
+            heater_power_mw: heater_power * 1e3,
+            truth: truth.truth(),
         })
     }
 
@@ -767,11 +885,11 @@ impl Held<'_> {
     /// The inputs of the command, the disk's motion kept.
     fn apply(&self, sys: &mut SliderSystem) {
         let inputs = Inputs {
-            heater: Heater::Power(self.command.heater_power),
+            heater: Heater::Power(self.command.heater_power()),
             voltage: Voltage {
-                dc: self.command.dc_voltage,
-                ac_amplitude: self.command.ac_amplitude,
-                frequency: self.command.ac_frequency,
+                dc: self.command.dc_voltage_v,
+                ac_amplitude: self.command.ac_amplitude_v,
+                frequency: crate::units::khz(self.command.ac_frequency_khz),
                 contact_potential: self.contact_potential,
             },
             clearance_offset: self.clearance,
@@ -1075,14 +1193,14 @@ fn observe<D: Dim>(
     t: f64,
     dt: f64,
     integrals0: (f64, f64),
-) -> Truth
+) -> TrueState
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     let m = sys.model();
     let g = sys.gaps(t, y);
     let mean = |i: Option<usize>, i0: f64| i.map_or(0.0, |i| (y[i] - i0) / dt);
-    Truth {
+    TrueState {
         gap: g.bulge,
         pad_gap: g.pad,
         displacement: y[0],
@@ -1092,6 +1210,6 @@ where
         contact_force: m.contact_force(g),
         interface_force: m.interface_force(g, sys.inputs().voltage.squared(t)).value,
         mean_flash_temperature: mean(layout.heat, integrals0.1),
-        ..Truth::default()
+        ..TrueState::default()
     }
 }

@@ -1,7 +1,7 @@
 //! Replaying a command file through a drive: the way in for tools that are not Rust.
 
 use super::plant::{Command, Plant};
-use super::sensors::{Readback, Sensors};
+use super::sensors::{clearance_change, Sensors};
 use crate::error::{Error, Result};
 use std::io::{Read, Write};
 
@@ -417,10 +417,10 @@ pub fn replay_each(
         }
         let r = rows[k];
         let cmd = Command {
-            heater_power: r.heater_mw * 1e-3,
-            dc_voltage: r.voltage_dc_v,
-            ac_amplitude: r.voltage_ac_v,
-            ac_frequency: r.ac_frequency_khz * 1e3,
+            heater_power_mw: r.heater_mw,
+            dc_voltage_v: r.voltage_dc_v,
+            ac_amplitude_v: r.voltage_ac_v,
+            ac_frequency_khz: r.ac_frequency_khz,
         };
         let s = drive.step(&cmd, dt)?;
         let lr0 = *reference.get_or_insert(s.readback.log_ratio());
@@ -434,8 +434,9 @@ pub fn replay_each(
 
 /// One period's [`Sensors`] as a row of the sensor file, in the columns and units of
 /// [`SENSOR_COLUMNS`]. The harmonic-ratio clearance change is taken against
-/// `reference_log_ratio`, the read-back `ln(A_1/A_3)` of the first period (with `wavelength`
-/// the read-back's bit wavelength, m).
+/// `reference_log_ratio`, the read-back `ln(A_1/A_3)` of the first period, with `wavelength_m`
+/// the read-back's bit wavelength (m, as the drive's [`ReadbackSpec`](super::ReadbackSpec)
+/// holds it).
 ///
 /// ```
 /// use hdi_tribology::drive::{scene_zone, sensor_row, Command, DriveOptions, Plant};
@@ -447,22 +448,24 @@ pub fn replay_each(
 /// let row = sensor_row(&s, s.readback.log_ratio(), plant.sensor_spec().readback.wavelength);
 /// assert_eq!(row[1], 60.0); // heater, mW
 /// assert_eq!(row[6], 0.0); // no clearance change against itself
+/// assert_eq!(row[7], s.truth.gap_nm);
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
-pub fn sensor_row(s: &Sensors, reference_log_ratio: f64, wavelength: f64) -> [f64; 12] {
+pub fn sensor_row(s: &Sensors, reference_log_ratio: f64, wavelength_m: f64) -> [f64; 12] {
     let tr = &s.truth;
+    let change_m = clearance_change(reference_log_ratio, s.readback.log_ratio(), wavelength_m);
     [
-        s.t,
-        s.heater_power * 1e3,
-        s.contact_resistance,
-        s.acoustic,
-        s.readback.fundamental,
-        s.readback.third,
-        Readback::clearance_change(reference_log_ratio, s.readback.log_ratio(), wavelength) * 1e9,
-        tr.gap * 1e9,
-        tr.mean_contact_force * 1e6,
-        tr.sensor_temperature,
-        tr.disk_height * 1e9,
-        tr.ambient,
+        s.time_s,
+        s.heater_power_mw,
+        s.contact_resistance_ohm,
+        s.acoustic_v,
+        s.readback.fundamental_v,
+        s.readback.third_v,
+        change_m * 1e9,
+        tr.gap_nm,
+        tr.mean_contact_force_un,
+        tr.sensor_temperature_k,
+        tr.disk_height_nm,
+        tr.ambient_k,
     ]
 }

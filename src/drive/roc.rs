@@ -53,18 +53,18 @@ impl RocPoint {
 
 /// Runs the staircase `settings` (take-off search off) on `plant` with seeds `seeds`, a fresh
 /// detector from `detector` per run, judging each against the truth with contact threshold
-/// `threshold` (N).
+/// `threshold_un` (µN).
 ///
 /// # Errors
 /// Invalid settings or threshold (named field); no static touchdown; drive failures.
 pub fn touchdown_roc<D: LevelDetector>(
     plant: &Plant,
     settings: StaircaseSettings,
-    threshold: f64,
+    threshold_un: f64,
     seeds: std::ops::Range<u64>,
     detector: impl Fn() -> Result<D>,
 ) -> Result<RocPoint> {
-    check_positive("threshold", threshold)?;
+    check_positive("threshold_un", threshold_un)?;
     if seeds.is_empty() {
         return Err(Error::invalid("seeds", "needs at least one seed"));
     }
@@ -72,16 +72,18 @@ pub fn touchdown_roc<D: LevelDetector>(
     st.find_takeoff = false;
     let dt = 50e-6;
     let model = plant.model();
+    let threshold = threshold_un * 1e-6;
     let p_td = touchdown_power(model, &StaticOptions::new(threshold))?.power;
     let grid = ScanGrid::default();
     let dc2 = model.voltage().dc_squared();
     let clearance = |p: f64| flying_equilibrium(model, p.max(0.0), dc2, &grid).map(|e| e.d);
-    let d_ref = clearance(p_td - st.margin)?;
+    let (margin, step) = (st.margin_mw * 1e-3, st.step_mw * 1e-3);
+    let d_ref = clearance(p_td - margin)?;
     let (mut runs, mut fa, mut early, mut missed, mut fired) = (0, 0, 0, 0, 0);
     let (mut err_sum, mut cl_sum2) = (0.0, 0.0);
     let mut name = String::new();
-    let levels = ((st.max_power - st.start_power) / st.step).ceil() as usize + 2;
-    let periods = levels * ((st.settle_time + st.measure_time) / dt).ceil() as usize + 10;
+    let levels = ((st.max_power_mw - st.start_power_mw) / st.step_mw).ceil() as usize + 2;
+    let periods = levels * ((st.settle_time_s + st.measure_time_s) / dt).ceil() as usize + 10;
     for seed in seeds {
         let p = plant.with_seed(seed)?;
         let mut drive = p.drive()?;
@@ -93,12 +95,13 @@ pub fn touchdown_roc<D: LevelDetector>(
         let first_true = out
             .levels
             .iter()
-            .position(|l| l.true_contact_force.mean >= threshold);
+            .position(|l| l.true_contact_force_un.mean >= threshold_un);
         match out.levels.iter().position(|l| l.contact) {
             Some(i) => {
                 fired += 1;
-                if out.levels[i].true_contact_force.mean < threshold {
-                    if out.levels[i].power < p_td - st.step * (1.0 + 1e-9) {
+                let p_det = out.levels[i].heater_power_mw * 1e-3;
+                if out.levels[i].true_contact_force_un.mean < threshold_un {
+                    if p_det < p_td - step * (1.0 + 1e-9) {
                         fa += 1;
                     } else {
                         early += 1;
@@ -106,9 +109,8 @@ pub fn touchdown_roc<D: LevelDetector>(
                 } else if first_true != Some(i) {
                     missed += 1;
                 }
-                let p_det = out.levels[i].power;
                 err_sum += (p_det - p_td) * 1e3;
-                cl_sum2 += ((clearance(p_det - st.margin)? - d_ref) * 1e9).powi(2);
+                cl_sum2 += ((clearance(p_det - margin)? - d_ref) * 1e9).powi(2);
             }
             None => missed += 1,
         }

@@ -172,79 +172,125 @@ impl SensorSpec {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Readback {
     /// Fundamental (V).
-    pub fundamental: f64,
+    pub fundamental_v: f64,
     /// Third harmonic (V).
-    pub third: f64,
+    pub third_v: f64,
 }
 
 impl Readback {
     /// `ln(A_1/A_3)`.
     pub fn log_ratio(&self) -> f64 {
-        (self.fundamental / self.third).ln()
+        (self.fundamental_v / self.third_v).ln()
     }
 
-    /// Magnetic-spacing change from a reference log ratio to `log_ratio` (m):
-    /// `Δd = λ/(4π) (ln(A_1/A_3) − ln(A_1/A_3)_ref)`.
+    /// Magnetic-spacing change from a reference log ratio to `log_ratio` (nm), for a pattern of
+    /// wavelength `wavelength_nm`: `Δd = λ/(4π) (ln(A_1/A_3) − ln(A_1/A_3)_ref)`.
     ///
     /// ```
     /// use hdi_tribology::drive::Readback;
-    /// let lambda = 100e-9;
-    /// let at = |d: f64| Readback {
-    ///     fundamental: (-2.0 * std::f64::consts::PI * d / lambda).exp(),
-    ///     third: (-6.0 * std::f64::consts::PI * d / lambda).exp() / 3.0,
+    /// let lambda_nm = 100.0;
+    /// let at = |d_nm: f64| Readback {
+    ///     fundamental_v: (-2.0 * std::f64::consts::PI * d_nm / lambda_nm).exp(),
+    ///     third_v: (-6.0 * std::f64::consts::PI * d_nm / lambda_nm).exp() / 3.0,
     /// };
-    /// let dd = Readback::clearance_change(at(5e-9).log_ratio(), at(6e-9).log_ratio(), lambda);
-    /// assert!((dd - 1e-9).abs() < 1e-18);
+    /// let dd = Readback::clearance_change_nm(at(5.0).log_ratio(), at(6.0).log_ratio(), lambda_nm);
+    /// assert!((dd - 1.0).abs() < 1e-9);
     /// ```
-    pub fn clearance_change(reference: f64, log_ratio: f64, wavelength: f64) -> f64 {
-        wavelength / (4.0 * PI) * (log_ratio - reference)
+    pub fn clearance_change_nm(reference: f64, log_ratio: f64, wavelength_nm: f64) -> f64 {
+        clearance_change(reference, log_ratio, wavelength_nm)
     }
 }
 
-/// The true state behind the sensors, for test oracles (SI units).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct Truth {
-    /// Bulge gap `d` at the end of the period (m).
+/// `λ/(4π) (log_ratio − reference)`, in the unit of `wavelength`.
+pub(crate) fn clearance_change(reference: f64, log_ratio: f64, wavelength: f64) -> f64 {
+    wavelength / (4.0 * PI) * (log_ratio - reference)
+}
+
+/// The true state behind the sensors, in SI: what the drive computes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct TrueState {
     pub gap: f64,
-    /// Pad gap at the end of the period (m).
     pub pad_gap: f64,
-    /// Slider displacement relative to the disk surface (m).
     pub displacement: f64,
-    /// Its rate (m/s).
     pub velocity: f64,
-    /// Protrusion `δ` (m).
     pub protrusion: f64,
-    /// Contact force averaged over the period (N).
     pub mean_contact_force: f64,
-    /// Contact force at the end of the period (N).
     pub contact_force: f64,
-    /// Interface force at the end of the period (N, positive pushes the head away).
     pub interface_force: f64,
-    /// Flash temperature rise averaged over the period (K).
     pub mean_flash_temperature: f64,
-    /// Frictional power `μ F̄_c v` over the period (W).
     pub friction_power: f64,
-    /// Contact-sensor temperature (K above the reference).
     pub sensor_temperature: f64,
-    /// Disk surface height under the head (m).
     pub disk_height: f64,
-    /// Ambient temperature change since the start (K).
     pub ambient: f64,
 }
 
-/// What the drive reports after one controller period.
+impl TrueState {
+    /// In the firmware-facing units of [`Truth`] (each value times a power of ten).
+    pub(crate) fn truth(&self) -> Truth {
+        Truth {
+            gap_nm: self.gap * 1e9,
+            pad_gap_nm: self.pad_gap * 1e9,
+            displacement_nm: self.displacement * 1e9,
+            velocity_mm_per_s: self.velocity * 1e3,
+            protrusion_nm: self.protrusion * 1e9,
+            mean_contact_force_un: self.mean_contact_force * 1e6,
+            contact_force_un: self.contact_force * 1e6,
+            interface_force_un: self.interface_force * 1e6,
+            mean_flash_temperature_k: self.mean_flash_temperature,
+            friction_power_mw: self.friction_power * 1e3,
+            sensor_temperature_k: self.sensor_temperature,
+            disk_height_nm: self.disk_height * 1e9,
+            ambient_k: self.ambient,
+        }
+    }
+}
+
+/// The true state behind the sensors, for test oracles, in engineering units (the unit in each
+/// name, as in the C ABI's `HdiTruth`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Truth {
+    /// Bulge gap `d` at the end of the period (nm).
+    pub gap_nm: f64,
+    /// Pad gap at the end of the period (nm).
+    pub pad_gap_nm: f64,
+    /// Slider displacement relative to the disk surface (nm).
+    pub displacement_nm: f64,
+    /// Its rate (mm/s).
+    pub velocity_mm_per_s: f64,
+    /// Protrusion `δ` (nm).
+    pub protrusion_nm: f64,
+    /// Contact force averaged over the period (µN).
+    pub mean_contact_force_un: f64,
+    /// Contact force at the end of the period (µN).
+    pub contact_force_un: f64,
+    /// Interface force at the end of the period (µN, positive pushes the head away).
+    pub interface_force_un: f64,
+    /// Flash temperature rise averaged over the period (K).
+    pub mean_flash_temperature_k: f64,
+    /// Frictional power `μ F̄_c v` over the period (mW).
+    pub friction_power_mw: f64,
+    /// Contact-sensor temperature (K above the reference).
+    pub sensor_temperature_k: f64,
+    /// Disk surface height under the head (nm).
+    pub disk_height_nm: f64,
+    /// Ambient temperature change since the start (K).
+    pub ambient_k: f64,
+}
+
+/// What the drive reports after one controller period, in engineering units (the unit in each
+/// name, as in the C ABI's `HdiSensors`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Sensors {
     /// Time at the end of the period (s).
-    pub t: f64,
+    pub time_s: f64,
     /// Contact-sensor resistance (Ω).
-    pub contact_resistance: f64,
+    pub contact_resistance_ohm: f64,
     /// Acoustic-emission RMS (V).
-    pub acoustic: f64,
+    pub acoustic_v: f64,
     /// Read-back amplitudes.
     pub readback: Readback,
-    /// The heater power in effect over the period (W).
-    pub heater_power: f64,
+    /// The heater power in effect over the period (mW).
+    pub heater_power_mw: f64,
     /// The true values.
     pub truth: Truth,
 }
@@ -331,11 +377,11 @@ impl SensorState {
         let dm = self.spacing + rb.magnetic_offset;
         let k = 2.0 * PI * dm / rb.wavelength;
         let readback = Readback {
-            fundamental: gain
+            fundamental_v: gain
                 * rb.amplitude
                 * (-k).exp()
                 * (1.0 + rb.noise * self.rb_noise.normal()),
-            third: gain * rb.amplitude / 3.0
+            third_v: gain * rb.amplitude / 3.0
                 * (-3.0 * k).exp()
                 * (1.0 + rb.noise * self.rb_noise.normal()),
         };

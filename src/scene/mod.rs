@@ -65,6 +65,7 @@
 //! `scene[...]` and `Scene.with_values` go through it.
 
 mod build;
+mod drive_spec;
 mod eng_units;
 mod io;
 mod paper;
@@ -74,6 +75,7 @@ mod structure;
 mod toml_text;
 mod validate;
 
+pub use drive_spec::{DriveAmbientSpec, DriveDiskSpec, DriveSensorsSpec, DriveSpec, MAX_HEADS};
 pub use eng_units::engineering_unit;
 pub use path::{FieldPath, PathError};
 

@@ -99,6 +99,7 @@ impl Scene {
             sweep: SweepSpec {
                 ac_amplitudes_v: vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0],
             },
+            drive: None,
         }
     }
 }

@@ -52,6 +52,10 @@ pub struct Scene {
     /// Parameter sweep (empty by default).
     #[serde(default)]
     pub sweep: SweepSpec,
+    /// The simulated drive (`hdi drive`, `drive::Plant::from_scene`); absent: the library's
+    /// default drive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drive: Option<super::DriveSpec>,
 }
 
 /// Roughness statistics.

@@ -136,6 +136,9 @@ impl Scene {
         }
         self.validate_lubricant()?;
         self.validate_air_bearing()?;
+        if let Some(d) = &self.drive {
+            d.validate()?;
+        }
         check_positive("slider.mass_kg", self.slider.mass_kg)?;
         check_non_negative("slider.interface_lag_s", self.slider.interface_lag_s)?;
         self.validate_structure()?;

@@ -3,8 +3,10 @@
 use std::path::PathBuf;
 
 use hdi_tribology::drive::{
-    read_commands, replay, scene_zone, whole_periods, DiskSpec, DriveOptions, Plant,
+    read_commands, replay, spec_zone, whole_periods, DiskSpec, DriveOptions, Plant,
 };
+
+use hdi_tribology::scene::DriveSpec;
 
 use crate::common::{self, positive, CliError, CountLines, Output, SceneArgs};
 
@@ -33,10 +35,61 @@ pub struct Args {
     /// Seed of the disk's random waviness and of the sensor noise.
     #[arg(long, default_value = "1")]
     seed: u64,
-    /// Radius of the zone (mm); the scene gives its clearance, stiffness and disk speed.
-    #[arg(long, value_name = "MM", default_value = "25", value_parser = positive,
-          allow_hyphen_values = true)]
-    radius_mm: f64,
+    /// Radius of the zone (mm; scene `drive.radius_m`, default 25); the scene gives its
+    /// clearance, stiffness and disk speed.
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    radius_mm: Option<f64>,
+    /// Heads on the disk (scene `drive.heads`; the replay runs one).
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    heads: Option<f64>,
+    /// Spindle speed (rpm) [default: the scene's disk speed at the radius].
+    #[arg(long, value_name = "RPM", allow_hyphen_values = true)]
+    rpm: Option<f64>,
+    /// Heater power at the start (mW) [default: 60].
+    #[arg(long, value_name = "MW", allow_hyphen_values = true)]
+    initial_heater_power_mw: Option<f64>,
+    /// Heater time constant where the scene's heater has none (µs) [default: 100].
+    #[arg(long, value_name = "US", allow_hyphen_values = true)]
+    heater_time_constant_us: Option<f64>,
+    /// Once-around run-out amplitude (nm) [default: 1000].
+    #[arg(long, value_name = "NM", allow_hyphen_values = true)]
+    runout_nm: Option<f64>,
+    /// Random waviness, root-mean-square height (nm) [default: 0.3].
+    #[arg(long, value_name = "NM", allow_hyphen_values = true)]
+    waviness_rms_nm: Option<f64>,
+    /// Ambient drift rate (K/s) [default: 0].
+    #[arg(long, value_name = "K_PER_S", allow_hyphen_values = true)]
+    ambient_rate_k_per_s: Option<f64>,
+    /// Ambient periodic amplitude (K) [default: 0].
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    ambient_amplitude_k: Option<f64>,
+    /// Ambient period (s) [default: 1].
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    ambient_period_s: Option<f64>,
+    /// Clearance change per kelvin of ambient (nm/K) [default: 0.03].
+    #[arg(long, value_name = "NM_PER_K", allow_hyphen_values = true)]
+    ambient_clearance_per_kelvin_nm: Option<f64>,
+    /// Ambient temperature step (K) [default: 0].
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    ambient_step_k: Option<f64>,
+    /// Time of the ambient step (s) [default: 0].
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    ambient_step_time_s: Option<f64>,
+    /// Acoustic-emission gain (V/√W) [default: 1].
+    #[arg(long, value_name = "G", allow_hyphen_values = true)]
+    ae_gain_v_per_sqrt_w: Option<f64>,
+    /// Acoustic-emission RMS detector band (kHz) [default: 5].
+    #[arg(long, value_name = "KHZ", allow_hyphen_values = true)]
+    ae_bandwidth_khz: Option<f64>,
+    /// Acoustic-emission noise per quadrature (V) [default: 0.002].
+    #[arg(long, value_name = "V", allow_hyphen_values = true)]
+    ae_noise_v: Option<f64>,
+    /// Contact-sensor noise per sample (Ω) [default: 0.005].
+    #[arg(long, value_name = "OHM", allow_hyphen_values = true)]
+    contact_noise_ohm: Option<f64>,
+    /// Read-back wavelength (nm) [default: 100].
+    #[arg(long, value_name = "NM", allow_hyphen_values = true)]
+    readback_wavelength_nm: Option<f64>,
     /// A flat disk (no run-out, no waviness).
     #[arg(long)]
     flat_disk: bool,
@@ -51,23 +104,65 @@ pub struct Args {
     atol_flight_pm: Option<f64>,
 }
 
+/// The drive of the scene's `[drive]` section with the flags over it (each flag checked and
+/// named as written, in its unit).
+fn drive_spec(a: &Args, scene: &hdi_tribology::scene::Scene) -> Result<DriveSpec, CliError> {
+    let mut spec = scene.drive.clone().unwrap_or_default();
+    let flags = [
+        ("heads", a.heads),
+        ("radius_mm", a.radius_mm),
+        ("rpm", a.rpm),
+        ("initial_heater_power_mw", a.initial_heater_power_mw),
+        ("heater_time_constant_us", a.heater_time_constant_us),
+        ("runout_nm", a.runout_nm),
+        ("waviness_rms_nm", a.waviness_rms_nm),
+        ("ambient_rate_k_per_s", a.ambient_rate_k_per_s),
+        ("ambient_amplitude_k", a.ambient_amplitude_k),
+        ("ambient_period_s", a.ambient_period_s),
+        (
+            "ambient_clearance_per_kelvin_nm",
+            a.ambient_clearance_per_kelvin_nm,
+        ),
+        ("ambient_step_k", a.ambient_step_k),
+        ("ambient_step_time_s", a.ambient_step_time_s),
+        ("ae_gain_v_per_sqrt_w", a.ae_gain_v_per_sqrt_w),
+        ("ae_bandwidth_khz", a.ae_bandwidth_khz),
+        ("ae_noise_v", a.ae_noise_v),
+        ("contact_noise_ohm", a.contact_noise_ohm),
+        ("readback_wavelength_nm", a.readback_wavelength_nm),
+    ];
+    for (name, v) in flags {
+        if let Some(v) = v {
+            let flag = format!("--{}", name.replace('_', "-"));
+            spec.set(name, v, &flag)
+                .map_err(|e| CliError::Usage(e.to_string()))?;
+        }
+    }
+    if spec.heads != 1 {
+        return Err(CliError::Usage(format!(
+            "--heads: a replay runs one head, got {} (run one replay per head, each with its \
+             own --seed)",
+            spec.heads
+        )));
+    }
+    Ok(spec)
+}
+
 pub fn run(a: Args) -> Result<(), CliError> {
     let scene = a.scene.load()?;
-    let opts = DriveOptions {
-        disk: if a.flat_disk {
-            DiskSpec::flat()
-        } else {
-            DiskSpec::default()
-        },
-        ..DriveOptions::default()
+    let spec = drive_spec(&a, &scene)?;
+    let mut opts = DriveOptions::from_spec(&spec);
+    if a.flat_disk {
+        opts.disk = DiskSpec::flat();
     }
-    .with_tolerances_pm(
-        a.atol_pm,
-        a.atol_flight_pm,
-        ["--atol-pm", "--atol-flight-pm"],
-    )
-    // Both are positive numbers by now: what is left is a flag that does not fit the other.
-    .map_err(|e| CliError::Usage(e.to_string()))?;
+    let opts = opts
+        .with_tolerances_pm(
+            a.atol_pm,
+            a.atol_flight_pm,
+            ["--atol-pm", "--atol-flight-pm"],
+        )
+        // Both are positive numbers by now: what is left is a flag that does not fit the other.
+        .map_err(|e| CliError::Usage(e.to_string()))?;
     let shown = a.commands.display().to_string();
     let file = std::fs::File::open(&a.commands)
         .map_err(|e| CliError::Failed(format!("--commands {shown}: {e}")))?;
@@ -80,12 +175,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .as_deref()
         .map(|p| Output::prepare(p, "--out"))
         .transpose()?;
-    let plant = Plant::new(
-        &scene,
-        &scene_zone(&scene, a.radius_mm * 1e-3)?,
-        a.seed,
-        opts,
-    )?;
+    let plant = Plant::new(&scene, &spec_zone(&scene, &spec)?, a.seed, opts)?;
     // One line per period, and the header.
     let progress = common::Progress::bar("drive", periods as u64 + 1, "lines");
     match out {
