@@ -55,7 +55,7 @@ enum Command {
     Scene(scene::Args),
     /// A command file (time, heater power, voltage) replayed through the simulated drive; the
     /// sensor CSV written.
-    Drive(drive::Args),
+    Drive(Box<drive::Args>),
     /// The air bearing of a slider's geometry: attitude, stiffness and damping as JSON, and the
     /// pressure map.
     Bearing(bearing::Args),
@@ -73,7 +73,7 @@ fn main() -> ExitCode {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Fit(a) => fit::run(a),
         Command::Scene(a) => scene::run(a),
-        Command::Drive(a) => drive::run(a),
+        Command::Drive(a) => drive::run(*a),
         Command::Bearing(a) => bearing::run(a),
     };
     match result {
