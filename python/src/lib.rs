@@ -15,10 +15,11 @@
 use std::sync::{Arc, RwLock};
 use std::time::Duration;
 
-use hdi_tribology::analysis::record::{CalibrationRecord, CycleRecord, StaticRecord};
+use hdi_tribology::analysis::record::{CycleRecord, StaticRecord};
 use hdi_tribology::analysis::{
     self, CycleOptions, HeaterProgramme, Refinement, ScanGrid, StaticOptions,
 };
+use hdi_tribology::calibration::CalibrationRecord;
 use hdi_tribology::calibration::{
     self, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
     VibrationRms,

@@ -26,6 +26,7 @@ mod calibrate;
 mod detector;
 mod error;
 mod filters;
+mod record;
 
 /// The zone lives with the drive it configures; it is named here too, where calibrations use it.
 pub use crate::drive::Zone;
@@ -37,3 +38,4 @@ pub use detector::{
 };
 pub use error::CalibrationError;
 pub use filters::{HighPass, MeanSquare};
+pub use record::CalibrationRecord;

@@ -1,7 +1,7 @@
 //! `hdi calibrate`: touchdown calibration as drive firmware does it.
 
-use hdi_tribology::analysis::record::CalibrationRecord;
 use hdi_tribology::analysis::sweep::Flag;
+use hdi_tribology::calibration::CalibrationRecord;
 use hdi_tribology::calibration::{
     calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
     VibrationRms, MAX_LEVELS,
