@@ -28,7 +28,7 @@ pub const MAX_HEADS: u32 = 32;
 /// assert!(e.contains("drive.initial_heater_power_mw") && e.contains("-5 mW"), "{e}");
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveSpec {
     /// Heads, one per disk surface (1 to [`MAX_HEADS`]; default 1).
@@ -55,6 +55,27 @@ pub struct DriveSpec {
     /// The sensors.
     #[serde(default, skip_serializing_if = "DriveSensorsSpec::is_default")]
     pub sensors: DriveSensorsSpec,
+}
+
+/// One head, and every other setting the drive's own default (as an empty `[drive]` section).
+///
+/// ```
+/// use hdi_tribology::scene::DriveSpec;
+/// assert_eq!(DriveSpec::default().heads, 1);
+/// ```
+impl Default for DriveSpec {
+    fn default() -> Self {
+        DriveSpec {
+            heads: one_head(),
+            radius_m: None,
+            rpm: None,
+            initial_heater_power_w: None,
+            heater_time_constant_s: None,
+            disk: DriveDiskSpec::default(),
+            ambient: DriveAmbientSpec::default(),
+            sensors: DriveSensorsSpec::default(),
+        }
+    }
 }
 
 /// `[drive.disk]`: each surface's run-out and waviness (each surface draws its own random
