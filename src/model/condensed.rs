@@ -327,7 +327,7 @@ mod tests {
     #[test]
     fn settle_finds_the_linear_root() {
         let q = QuasiStaticBulge::new(1e-13, 4e5, 1e-5);
-        for (a, s) in [(1e-4, 2e5), (-3e-4, -1e5), (0.0, 0.0), (2e-4, 3.9e5 * -1.0)] {
+        for (a, s) in [(1e-4, 2e5), (-3e-4, -1e5), (0.0, 0.0), (2e-4, -3.9e5)] {
             let d_r = 1.3e-9;
             let r = q.settle(d_r, |d| (d, a - s * d, -s)).expect("a root");
             let exact = (4e5 * d_r + a) / (4e5 + s);
