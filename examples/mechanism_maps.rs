@@ -31,7 +31,7 @@
 
 use hdi_tribology::analysis::cycle::{CycleOptions, CycleResult, HeaterProgramme};
 use hdi_tribology::analysis::{ac_sweep_refined, simulate_cycle, Refinement};
-use hdi_tribology::model::{SliderModel, Structure};
+use hdi_tribology::model::{ForceSlopes, SliderModel, Structure};
 use hdi_tribology::ode::Method;
 use hdi_tribology::report::write_csv;
 use hdi_tribology::scene::{Scene, StructureSpec};
@@ -75,6 +75,9 @@ struct Checks {
     /// A third run with the other stiff method where the first two agree (on unless
     /// `--no-method-check`).
     method: bool,
+    /// The bulge mode condensed to its quasi-static equilibrium where
+    /// `QuasiStaticBulge::check` passes (`--quasi-static`).
+    quasi_static: bool,
 }
 
 /// What a map varies along its vertical axis (log scale).
@@ -137,6 +140,28 @@ const MAPS: [MapSpec; 4] = [
         label: "τ (s)",
     },
 ];
+
+/// Which model gave a map point's values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Model {
+    /// The full structure.
+    Full,
+    /// The quasi-static bulge, run for this point.
+    QuasiStatic,
+    /// The quasi-static bulge, the run of another point with the same reduced model (on the
+    /// `zeta` map the condensation drops the damping, so every row where it holds shares it).
+    Shared,
+}
+
+impl Model {
+    fn code(self) -> f64 {
+        match self {
+            Model::Full => 0.0,
+            Model::QuasiStatic => 1.0,
+            Model::Shared => 2.0,
+        }
+    }
+}
 
 /// How a map point ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -212,6 +237,8 @@ struct Point {
     steps: usize,
     /// Cycles run for the point (1 without a check run, 2 with one).
     runs: usize,
+    /// Which model gave the values.
+    model: Model,
 }
 
 impl Point {
@@ -228,6 +255,8 @@ struct Setup {
     body_mass: f64,
     /// Start and end of the hold at the highest power (s).
     hold: (f64, f64),
+    /// The interface force's slopes, for the quasi-static bulge's check at every point.
+    slopes: ForceSlopes,
 }
 
 impl Setup {
@@ -251,8 +280,10 @@ impl Setup {
         // A bounce below the force tables at more than twice the even step pace stops at once,
         // not after the step pace's start allowance of exact-quadrature steps.
         opts.stop_outside_tables = true;
+        let base = SliderModel::from_scene(scene)?;
         Ok(Setup {
-            base: SliderModel::from_scene(scene)?,
+            slopes: ForceSlopes::of(base.forces()),
+            base,
             programme: HeaterProgramme::Fixed(SliderModel::programme_from_knots(knots)?),
             opts,
             bulge: Bulge {
@@ -297,8 +328,32 @@ impl Setup {
     /// `checks.full` runs the check everywhere and reports the tighter run instead (the earlier
     /// scheme, for comparison); `checks.method` runs one more cycle where the two agree, at the
     /// scene's tolerance with the other stiff method, which must agree with the values shown.
-    fn run(&self, axis: Axis, param: f64, v_ac: f64, checks: Checks) -> Res<Point> {
+    /// Where the quasi-static bulge holds at a point (`QuasiStaticBulge::check`), what its reduced
+    /// model is made of: the bulge spring, the interface lag and the AC amplitude (the bulge's
+    /// mass and damping enter only the check). `None` where it does not hold, or on `rigid`.
+    fn quasi_static_key(&self, axis: Axis, param: f64, v_ac: f64) -> Res<Option<[u64; 3]>> {
+        if axis == (Axis::Lag { bulge: false }) {
+            return Ok(None);
+        }
         let m = self.model(axis, param, v_ac)?;
+        let q = m
+            .structure()
+            .quasi_static_bulge()
+            .ok_or("the bulge maps need a bulge structure")?;
+        Ok(q.check_on(&m, &self.slopes).passes().then(|| {
+            [
+                q.stiffness().to_bits(),
+                m.interface_lag().to_bits(),
+                v_ac.to_bits(),
+            ]
+        }))
+    }
+
+    fn run(&self, axis: Axis, param: f64, v_ac: f64, checks: Checks, quasi: bool) -> Res<Point> {
+        let mut m = self.model(axis, param, v_ac)?;
+        if quasi {
+            m = m.with_quasi_static_bulge()?;
+        }
         let cpu0 = thread_cpu_seconds();
         let mut p = Point {
             v_ac,
@@ -311,6 +366,11 @@ impl Setup {
             cpu: 0.0,
             steps: 0,
             runs: 1,
+            model: if quasi {
+                Model::QuasiStatic
+            } else {
+                Model::Full
+            },
         };
         let power = |r: &CycleResult| (r.touchdown.map(|d| d.power), r.takeoff.map(|d| d.power));
         let moved = |a: Option<f64>, b: Option<f64>| match (a, b) {
@@ -415,6 +475,11 @@ fn log_grid((lo, hi): (f64, f64), n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Every point of a map, on rayon's pool. Each point's values are those of its own runs, which
+/// depend on nothing but the point: the map is the same to the bit on any number of threads.
+/// With `checks.quasi_static` the points where the quasi-static bulge holds run on it, each
+/// reduced model once (points that share one take its values, `Model::Shared`), and a point
+/// whose reduced run fails runs again on the full model.
 fn run_map(setup: &Setup, spec: &MapSpec, n: usize, checks: Checks) -> Res<Vec<Point>> {
     let volts = log_grid((0.0, 1.0), n);
     let params = log_grid(spec.range, n);
@@ -422,15 +487,68 @@ fn run_map(setup: &Setup, spec: &MapSpec, n: usize, checks: Checks) -> Res<Vec<P
         .iter()
         .flat_map(|&y| volts.iter().map(move |&v| (v, 10f64.powf(y))))
         .collect();
-    cells
+    let keys: Vec<Option<[u64; 3]>> = if checks.quasi_static {
+        cells
+            .par_iter()
+            .map(|&(v, p)| {
+                setup
+                    .quasi_static_key(spec.axis, p, v)
+                    .map_err(|e| e.to_string())
+            })
+            .collect::<Result<_, String>>()?
+    } else {
+        vec![None; cells.len()]
+    };
+    // One job per cell, except that cells with the same reduced model share the first one's.
+    let mut jobs: Vec<(usize, bool)> = Vec::new();
+    let mut job_of = Vec::with_capacity(cells.len());
+    let mut first = std::collections::HashMap::new();
+    for (i, key) in keys.iter().enumerate() {
+        let j = match key {
+            Some(k) => *first.entry(*k).or_insert_with(|| {
+                jobs.push((i, true));
+                jobs.len() - 1
+            }),
+            None => {
+                jobs.push((i, false));
+                jobs.len() - 1
+            }
+        };
+        job_of.push(j);
+    }
+    let done: Vec<Point> = jobs
         .par_iter()
-        .map(|&(v, p)| {
-            setup
-                .run(spec.axis, p, v, checks)
-                .map_err(|e| e.to_string())
+        .map(|&(i, quasi)| {
+            let (v, p) = cells[i];
+            let run = |quasi| {
+                setup
+                    .run(spec.axis, p, v, checks, quasi)
+                    .map_err(|e| e.to_string())
+            };
+            let mut point = run(quasi)?;
+            if quasi && point.status == Status::Runaway {
+                let (cpu, steps, runs) = (point.cpu, point.steps, point.runs);
+                point = run(false)?;
+                point.cpu += cpu;
+                point.steps += steps;
+                point.runs += runs;
+            }
+            Ok(point)
         })
-        .collect::<Result<Vec<_>, String>>()
-        .map_err(Into::into)
+        .collect::<Result<_, String>>()?;
+    Ok(cells
+        .iter()
+        .enumerate()
+        .map(|(i, &(v, p))| {
+            let (j, mut point) = (job_of[i], done[job_of[i]]);
+            if jobs[j].0 != i {
+                // The values of the cell that ran this reduced model; its cost is counted there.
+                (point.v_ac, point.param, point.model) = (v, p, Model::Shared);
+                (point.cpu, point.steps, point.runs) = (0.0, 0, 0);
+            }
+            point
+        })
+        .collect())
 }
 
 /// Viridis, from its published anchor colours (colour-blind safe, sequential).
@@ -605,6 +723,7 @@ fn write_points(path: &Path, points: &[Point]) -> Res<()> {
             "steps",
             "runs",
             "cause",
+            "model",
         ],
         &[
             &col(&|p| p.v_ac),
@@ -618,6 +737,7 @@ fn write_points(path: &Path, points: &[Point]) -> Res<()> {
             &col(&|p| p.steps as f64),
             &col(&|p| p.runs as f64),
             &col(&|p| p.cause.map_or(0.0, Cause::code)),
+            &col(&|p| p.model.code()),
         ],
     )?;
     Ok(())
@@ -676,6 +796,21 @@ fn cost(spec: &MapSpec, points: &[Point], wall: f64) {
     }
 }
 
+/// Which model gave the points, with their CPU time.
+fn models(spec: &MapSpec, points: &[Point]) {
+    for m in [Model::Full, Model::QuasiStatic, Model::Shared] {
+        let these: Vec<&Point> = points.iter().filter(|p| p.model == m).collect();
+        if !these.is_empty() {
+            println!(
+                "{:<10}   model {m:?}: {} points, CPU {:.1} s",
+                spec.name,
+                these.len(),
+                these.iter().map(|p| p.cpu).sum::<f64>()
+            );
+        }
+    }
+}
+
 /// Per map: inside the plausible band, the largest shift of `P_TO` and `P_TD` from their value
 /// at `V_ac = 0` on the same row, over converged points (mW).
 fn summarise(spec: &MapSpec, points: &[Point]) {
@@ -721,8 +856,9 @@ fn check(setup: &Setup, spec: &MapSpec, points: &[Point]) -> Res<()> {
         let full = Checks {
             full: true,
             method: false,
+            quasi_static: false,
         };
-        let p = setup.run(spec.axis, mid, v, full)?;
+        let p = setup.run(spec.axis, mid, v, full, false)?;
         let m = setup.model(spec.axis, mid, v)?;
         let mut o = setup.opts;
         o.keep_series = false;
@@ -888,6 +1024,7 @@ fn main() -> Res<()> {
     let checks = Checks {
         full: args.iter().any(|a| a == "--full-check"),
         method: !args.iter().any(|a| a == "--no-method-check"),
+        quasi_static: args.iter().any(|a| a == "--quasi-static"),
     };
     println!(
         "# {} ({} × {} grid, {} threads); scene bulge {:.3e} kg, {:.3e} N/m ({:.1} MHz), ζ = {}",
@@ -908,6 +1045,7 @@ fn main() -> Res<()> {
         let points = run_map(&setup, spec, n, checks)?;
         let wall = clock.elapsed().as_secs_f64();
         cost(spec, &points, wall);
+        models(spec, &points);
         draw_map(&out.join(format!("{}.svg", spec.name)), spec, &points, n)?;
         write_points(&out.join(format!("{}.csv", spec.name)), &points)?;
         println!(
@@ -944,6 +1082,7 @@ mod tests {
         let checks = Checks {
             full: false,
             method: true,
+            quasi_static: false,
         };
         let points = run_map(&setup, &spec, 3, checks)?;
         assert_eq!(points.len(), 9);
@@ -967,6 +1106,47 @@ mod tests {
         std::fs::create_dir_all(&dir)?;
         draw_map(&dir.join("m.svg"), &spec, &points, 3)?;
         assert!(std::fs::metadata(dir.join("m.svg"))?.len() > 1000);
+        Ok(())
+    }
+
+    /// A map is the same to the bit on one thread and on two: every point's values come from
+    /// its own runs (here the `freq` map with the quasi-static bulge where it holds, so both
+    /// models and the fallback run).
+    #[test]
+    fn the_map_does_not_depend_on_the_thread_count() -> Res<()> {
+        let scene = Scene::from_path(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenes/paper_bulge.toml"
+        ))?;
+        let setup = Setup::from_scene(&scene)?;
+        let spec = MAPS[0];
+        let checks = Checks {
+            full: false,
+            method: true,
+            quasi_static: true,
+        };
+        let on = |threads: usize| -> Res<Vec<Point>> {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()?;
+            pool.install(|| run_map(&setup, &spec, 3, checks).map_err(|e| e.to_string()))
+                .map_err(Into::into)
+        };
+        let (one, two) = (on(1)?, on(2)?);
+        // Everything but the CPU time.
+        let key = |p: &Point| {
+            (
+                (p.v_ac.to_bits(), p.param.to_bits()),
+                (p.td.map(f64::to_bits), p.to.map(f64::to_bits)),
+                (p.status, p.cause, p.bounce),
+                (p.steps, p.runs, p.model),
+            )
+        };
+        let (a, b): (Vec<_>, Vec<_>) =
+            (one.iter().map(key).collect(), two.iter().map(key).collect());
+        assert_eq!(a, b);
+        assert!(one.iter().any(|p| p.model == Model::QuasiStatic));
+        assert!(one.iter().any(|p| p.model == Model::Full));
         Ok(())
     }
 }

@@ -21,13 +21,21 @@ fn contact_state(sys: &SliderSystem, t: f64, gap: f64, speed: f64) -> DVector<f6
     let m = sys.model();
     let lay = sys.layout();
     let delta = m.protrusion(sys.inputs().heater.power(t));
-    let at = |x: f64| {
+    // With a quasi-static bulge, the gap of the undeformed bulge spring (the settled gap is
+    // within F/k_b of it).
+    let reduced = m.quasi_static_bulge().is_some();
+    let gaps_at = |x: f64| {
         let mut q = Dofs::zeros();
         for i in 0..lay.dofs {
             q[i] = x;
         }
-        m.gaps(&q, delta).bulge
+        if reduced {
+            m.undeformed_gaps(x, delta, 0.0)
+        } else {
+            m.gaps(&q, delta)
+        }
     };
+    let at = |x: f64| gaps_at(x).bulge;
     // The bulge gap is affine in a common displacement of every coordinate.
     let (g0, g1) = (at(0.0), at(1e-9));
     let x = (gap - g0) / (g1 - g0) * 1e-9;
@@ -40,12 +48,7 @@ fn contact_state(sys: &SliderSystem, t: f64, gap: f64, speed: f64) -> DVector<f6
         s[i] = delta * 0.999;
     }
     if let Some(i) = lay.lagged_force {
-        let mut q = Dofs::zeros();
-        for k in 0..lay.dofs {
-            q[k] = x;
-        }
-        let g = m.gaps(&q, delta);
-        s[i] = 0.9 * m.interface_force(g, m.voltage().squared(t)).value;
+        s[i] = 0.9 * m.interface_force(gaps_at(x), m.voltage().squared(t)).value;
     }
     s
 }
@@ -180,4 +183,29 @@ fn rigid_slider_with_a_stateful_term() {
         .with_stateful_term(RelaxingState::new(1e-6, 1e9, -2e-5, None).unwrap())
         .unwrap();
     check(&model, ramp(0.080), 1.1e-3, 0.5e-9, 1e-4);
+}
+
+/// The quasi-static bulge: the chain rule through the settled bulge gap, without and with an
+/// interface lag (a bulge stiff enough for the check to pass at 0.5 V).
+#[test]
+fn quasi_static_bulge_in_contact() {
+    use hdi_tribology::model::Structure;
+    let scene = Scene::from_path(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/paper_bulge.toml"
+    ))
+    .unwrap();
+    let full = SliderModel::from_scene(&scene)
+        .unwrap()
+        .with_structure(Structure::bulge(scene.slider.mass_kg, 5e-13, 2e6, 0.05).unwrap())
+        .with_ac_amplitude(0.5);
+    for lag in [0.0, 1e-6] {
+        let model = full
+            .with_interface_lag(lag)
+            .with_quasi_static_bulge()
+            .unwrap();
+        for gap in [1.6e-9, 1.4e-9, 0.6e-9] {
+            check(&model, ramp(0.080), 1.1e-3, gap, 1e-4);
+        }
+    }
 }

@@ -210,6 +210,7 @@ fn mode_shape(b: &DMatrix<f64>, scale: &DVector<f64>, l: Complex64, dofs: usize)
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse> {
+    model.require_full_structure("the linear response")?;
     let v = model.voltage();
     let mean_volt2 = v.mean_squared();
     let eq = flying_equilibrium(model, power, mean_volt2, &ScanGrid::default())?;
@@ -311,6 +312,7 @@ pub fn simulated_dither(
     periods: usize,
 ) -> Result<f64> {
     use crate::ode::SaveAt;
+    model.require_full_structure("the simulated dither")?;
     let v = model.voltage();
     if !v.is_time_dependent() {
         return Err(ResponseError::NoAcVoltage.into());

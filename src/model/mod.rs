@@ -4,11 +4,13 @@
 //! [`SliderSystem`] lays that physics out as an ODE for [`crate::ode`]. This is the only module
 //! that knows both the physics and the stepper.
 
+mod condensed;
 mod error;
 mod inputs;
 mod structure;
 mod system;
 
+pub use condensed::{CondensationCheck, ForceSlopes, QuasiStaticBulge, SEPARATION};
 pub use error::BalanceError;
 pub use inputs::{BaseMotion, Heater, Inputs};
 pub use structure::{Dofs, Structure};
@@ -209,6 +211,8 @@ pub struct SliderModel {
     stateful: Arc<[Arc<dyn StatefulTerm>]>,
     /// Whether the bearing is the linear spring (its stiffness does not depend on `y`).
     linear_bearing: bool,
+    /// The bulge mode condensed to its quasi-static equilibrium (none: the full structure).
+    quasi_static: Option<QuasiStaticBulge>,
 }
 
 impl SliderModel {
@@ -263,6 +267,7 @@ impl SliderModel {
             },
             stateful: Arc::new([]),
             linear_bearing: matches!(scene.air_bearing, AirBearingModel::Linear { .. }),
+            quasi_static: None,
         }
         .with_scene_terms(scene)
     }
@@ -352,6 +357,12 @@ impl SliderModel {
     /// More than [`crate::force::MAX_TERM_STATES`] states over all terms, or a term with none.
     pub fn with_stateful_term(&self, term: impl StatefulTerm + 'static) -> Result<Self> {
         let (n, total) = (term.states(), self.term_states() + term.states());
+        if self.quasi_static.is_some() {
+            return Err(Error::invalid(
+                term.name(),
+                "a model with a quasi-static bulge takes no stateful terms",
+            ));
+        }
         if n == 0 || total > crate::force::MAX_TERM_STATES {
             return Err(Error::invalid(
                 term.name(),
@@ -427,11 +438,87 @@ impl SliderModel {
     /// assert_eq!(bulge.structure().dofs(), 2);
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
+    ///
+    /// The new structure is the full one: a quasi-static bulge of the model before is not kept
+    /// ([`SliderModel::with_quasi_static_bulge`]).
     pub fn with_structure(&self, structure: Structure) -> Self {
         SliderModel {
             structure,
+            quasi_static: None,
             ..self.clone()
         }
+    }
+
+    /// The same model with its bulge mode condensed to its quasi-static equilibrium
+    /// ([`QuasiStaticBulge`]): the dynamic analyses then integrate the body alone, with the
+    /// bulge gap where the bulge spring balances the interface force. The static analyses are
+    /// the same as the full model's (a static equilibrium has no inertia to condense). This does
+    /// not check that the condensation holds: [`SliderModel::quasi_static_check`] does, and a
+    /// cycle stops with a non-finite right-hand side where the bulge on a frozen body has no
+    /// stable equilibrium. The full model is the default; the linear response refuses a
+    /// condensed model.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{model::SliderModel, scene::Scene};
+    /// let full = SliderModel::from_scene(&Scene::from_path("scenes/paper_bulge.toml")?)?;
+    /// assert!(full.quasi_static_check()?.passes());
+    /// let reduced = full.with_quasi_static_bulge()?;
+    /// assert!(reduced.quasi_static_bulge().is_some());
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] on `structure` for a structure without a bulge of its own on one
+    /// spring ([`Structure::quasi_static_bulge`]), and for a model with stateful terms.
+    pub fn with_quasi_static_bulge(&self) -> Result<Self> {
+        let q = self.bulge_mode()?;
+        if !self.stateful.is_empty() {
+            return Err(Error::invalid(
+                "structure",
+                "a quasi-static bulge is not offered with stateful terms (their forces would \
+                 enter the bulge's balance)",
+            ));
+        }
+        Ok(SliderModel {
+            quasi_static: Some(q),
+            ..self.clone()
+        })
+    }
+
+    /// The condensed bulge mode, where the model has one ([`SliderModel::with_quasi_static_bulge`]).
+    pub fn quasi_static_bulge(&self) -> Option<QuasiStaticBulge> {
+        self.quasi_static
+    }
+
+    /// Whether the bulge mode of this model's structure may be condensed
+    /// ([`QuasiStaticBulge::check`]), at the model's voltage and lags.
+    ///
+    /// # Errors
+    /// As [`SliderModel::with_quasi_static_bulge`] for a structure without such a mode.
+    pub fn quasi_static_check(&self) -> Result<CondensationCheck> {
+        Ok(self.bulge_mode()?.check(self))
+    }
+
+    /// An error naming `analysis` where the model has a quasi-static bulge: for the analyses
+    /// that read the structure's coordinates, which the condensation removes.
+    pub(crate) fn require_full_structure(&self, analysis: &str) -> Result<()> {
+        match self.quasi_static {
+            Some(_) => Err(Error::invalid(
+                "structure",
+                format!("{analysis} needs the full structure, not a quasi-static bulge"),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    fn bulge_mode(&self) -> Result<QuasiStaticBulge> {
+        self.structure.quasi_static_bulge().ok_or_else(|| {
+            Error::invalid(
+                "structure",
+                "a quasi-static bulge needs a body and a bulge of its own on one spring and \
+                 damper (the `bulge` preset)",
+            )
+        })
     }
 
     /// The tabulated interface forces.
@@ -469,6 +556,18 @@ impl SliderModel {
         Gaps {
             bulge: h0 + self.structure.bulge_displacement(q) - delta,
             pad: self.pad_gap(q[0], offset),
+        }
+    }
+
+    /// The gaps at body heave `y` (m) with the bulge spring of a quasi-static bulge undeformed:
+    /// the bulge gap `d_r = h0 + offset + y − δ` and the pad gap `h0 + offset + y`
+    /// ([`QuasiStaticBulge`] moves the bulge from there).
+    #[inline]
+    pub fn undeformed_gaps(&self, y: f64, delta: f64, offset: f64) -> Gaps {
+        let pad = self.pad_gap(y, offset);
+        Gaps {
+            bulge: pad - delta,
+            pad,
         }
     }
 

@@ -8,6 +8,7 @@
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 
+use super::condensed::QuasiStaticBulge;
 use crate::error::{check_finite, check_non_negative, check_positive};
 use crate::scene::{StructureSpec, MAX_DOF};
 use crate::{Error, Result};
@@ -267,6 +268,23 @@ impl Structure {
             length_scale,
             base: Dofs::zeros(),
         })
+    }
+
+    /// The bulge mode as a [`QuasiStaticBulge`] where the structure is a body and a bulge of its
+    /// own on a spring and damper (the `bulge` preset, or a `general` structure of that form):
+    /// two coordinates, the bulge at coordinate 1, a diagonal mass, and the stiffness and
+    /// damping of one spring and damper between them. `None` for any other structure.
+    pub fn quasi_static_bulge(&self) -> Option<QuasiStaticBulge> {
+        let pair = |a: &DofMatrix| {
+            let x = a[(1, 1)];
+            (a[(0, 0)] == x && a[(0, 1)] == -x && a[(1, 0)] == -x).then_some(x)
+        };
+        if self.n != 2 || self.bulge[0] != 0.0 || self.bulge[1] != 1.0 || !self.diagonal_mass {
+            return None;
+        }
+        let k = pair(&self.stiffness).filter(|&k| k > 0.0)?;
+        let c = pair(&self.damping)?;
+        Some(QuasiStaticBulge::new(self.mass[(1, 1)], k, c))
     }
 
     /// Number of mechanical degrees of freedom.

@@ -1,6 +1,6 @@
 //! The slider as an ODE: state layout, right-hand side and analytic Jacobian.
 
-use super::{Dofs, Inputs, SliderModel};
+use super::{Dofs, Inputs, QuasiStaticBulge, SliderModel};
 use crate::force::{Gaps, MAX_TERM_STATES};
 use crate::ode::OdeSystem;
 use crate::scene::MAX_DOF;
@@ -97,8 +97,13 @@ impl StateLayout {
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
     pub fn of(model: &SliderModel, integrals: bool) -> Self {
+        // A quasi-static bulge leaves the body alone to integrate.
+        let dofs = match model.quasi_static {
+            Some(_) => 1,
+            None => model.structure().dofs(),
+        };
         Self::with_term_states(
-            model.structure().dofs(),
+            dofs,
             model.thermal_lag() > 0.0,
             model.interface_lag() > 0.0,
             model.term_states(),
@@ -158,6 +163,7 @@ pub struct SliderSystem {
 }
 
 /// Forces and their derivatives at one state.
+#[derive(Clone, Copy)]
 struct Local {
     g: Gaps,
     /// `F_if` and partials.
@@ -178,7 +184,8 @@ impl SliderSystem {
         let layout = StateLayout::of(&model, integrals);
         let mut base = [(0usize, 0.0); MAX_DOF];
         let mut n_base = 0;
-        for (i, &r) in model.structure().base_influence().iter().enumerate() {
+        let moved = model.structure().base_influence().iter().take(layout.dofs);
+        for (i, &r) in moved.enumerate() {
             if r != 0.0 {
                 base[n_base] = (layout.velocity(i), r);
                 n_base += 1;
@@ -289,8 +296,12 @@ impl SliderSystem {
         }
     }
 
-    /// Gaps at time `t` and state `s`.
+    /// Gaps at time `t` and state `s`. With a quasi-static bulge, the bulge gap where the bulge
+    /// spring balances the interface force (NaN where the bulge has no stable equilibrium).
     pub fn gaps<S: Index<usize, Output = f64> + ?Sized>(&self, t: f64, s: &S) -> Gaps {
+        if let Some(q) = self.model.quasi_static {
+            return self.settled_gaps(&q, t, s).unwrap_or(Gaps::same(f64::NAN));
+        }
         self.model.gaps_offset(
             &self.coordinates(s),
             self.protrusion(t, s),
@@ -592,6 +603,9 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
+        if let Some(q) = self.model.quasi_static {
+            return self.condensed_rhs(&q, t, s, ds);
+        }
         let m = &*self.model;
         let st = &m.structure;
         let lay = self.layout;
@@ -634,12 +648,24 @@ where
     }
 
     fn jacobian(&self, t: f64, s: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
+        if let Some(q) = self.model.quasi_static {
+            let mut dfdt =
+                OVector::<f64, D>::zeros_generic(s.shape_generic().0, nalgebra::Const::<1>);
+            self.condensed_jacobian(&q, t, s, j, &mut dfdt);
+            return true;
+        }
         let l = self.local(t, s);
         self.jacobian_at(&l, self.heat_slope_if_kept(&l), s, j);
         true
     }
 
     fn time_derivative(&self, t: f64, s: &OVector<f64, D>, dfdt: &mut OVector<f64, D>) -> bool {
+        if let Some(q) = self.model.quasi_static {
+            let n = s.shape_generic().0;
+            let mut j = OMatrix::<f64, D, D>::zeros_generic(n, n);
+            self.condensed_jacobian(&q, t, s, &mut j, dfdt);
+            return true;
+        }
         let l = self.local(t, s);
         self.time_derivative_at(t, &l, self.heat_slope_if_kept(&l), s, dfdt);
         true
@@ -653,6 +679,10 @@ where
         j: &mut OMatrix<f64, D, D>,
         dfdt: &mut OVector<f64, D>,
     ) -> (bool, bool) {
+        if let Some(q) = self.model.quasi_static {
+            self.condensed_jacobian(&q, t, s, j, dfdt);
+            return (true, true);
+        }
         let l = self.local(t, s);
         let dd = self.heat_slope_if_kept(&l);
         self.jacobian_at(&l, dd, s, j);
@@ -686,7 +716,13 @@ impl SliderModel {
         let m = st.mass_matrix();
         let w = self.angular_frequencies();
         let mut r = 0.0f64;
-        for i in 0..st.dofs() {
+        // A quasi-static bulge has left only the body's rates.
+        let dofs = if self.quasi_static.is_some() {
+            1
+        } else {
+            st.dofs()
+        };
+        for i in 0..dofs {
             r = r.max(w[i]).max(c[(i, i)] / m[(i, i)]);
         }
         for tau in [self.interface_lag, self.thermal_lag] {
@@ -745,4 +781,197 @@ impl SliderSystem {
         });
         atol
     }
+}
+
+/// The slider with a quasi-static bulge ([`super::QuasiStaticBulge`]): the body alone, the bulge
+/// gap settled where the bulge spring balances the interface force (or, with an interface lag,
+/// carries the lagged force).
+impl SliderSystem {
+    /// The gaps at time `t` and state `s` with the bulge settled: where the bulge spring balances
+    /// the interface force (by [`QuasiStaticBulge::settle`]) or, with an interface lag, carries
+    /// the lagged force. `None` where the bulge on a frozen body has no stable equilibrium.
+    fn settled_gaps<S: Index<usize, Output = f64> + ?Sized>(
+        &self,
+        q: &QuasiStaticBulge,
+        t: f64,
+        s: &S,
+    ) -> Option<Gaps> {
+        let m = &*self.model;
+        let k = q.stiffness();
+        let rigid = m.undeformed_gaps(s[0], self.protrusion(t, s), self.inputs.clearance_offset);
+        let bulge = match self.layout.lagged_force {
+            Some(i) => rigid.bulge + s[i] / k,
+            None => {
+                let volt2 = self.inputs.voltage.squared(t);
+                let pad = rigid.pad;
+                q.settle(rigid.bulge, |bulge| {
+                    let f = m.interface_force(Gaps { bulge, pad }, volt2);
+                    (bulge, f.value, f.d_bulge)
+                })?
+            }
+        };
+        Some(Gaps {
+            bulge,
+            pad: rigid.pad,
+        })
+    }
+
+    /// [`Self::settled_gaps`] with the forces there and how the settled bulge gap moves.
+    fn settled<S: Index<usize, Output = f64> + ?Sized>(
+        &self,
+        q: &QuasiStaticBulge,
+        t: f64,
+        s: &S,
+    ) -> Option<SettledBulge> {
+        let g = self.settled_gaps(q, t, s)?;
+        let k = q.stiffness();
+        let (f, hot) = self.model.hot_forces(g, self.inputs.voltage.squared(t));
+        let fast = k - f.d_bulge;
+        let along = match self.layout.lagged_force {
+            Some(_) => [1.0, 1.0 / k, -1.0],
+            None => {
+                // k (d − d_r) = F(d, pad): ∂d/∂d_r = k/k_f, ∂d/∂pad = F_pad/k_f.
+                let rigid = k / fast;
+                [rigid + f.d_pad / fast, 0.0, -rigid]
+            }
+        };
+        Some(SettledBulge {
+            local: Local { g, f, hot },
+            along,
+            fast,
+        })
+    }
+
+    fn condensed_rhs<D: Dim>(
+        &self,
+        q: &QuasiStaticBulge,
+        t: f64,
+        s: &OVector<f64, D>,
+        ds: &mut OVector<f64, D>,
+    ) where
+        DefaultAllocator: Allocator<D>,
+    {
+        let m = &*self.model;
+        let lay = self.layout;
+        let Some(g) = self.settled_gaps(q, t, s) else {
+            ds.fill(f64::NAN);
+            return;
+        };
+        let hot = m.hot_values(g, self.inputs.voltage.squared(t));
+        let v = s[lay.velocity(0)];
+        let drive = match lay.lagged_force {
+            Some(i) => s[i],
+            None => hot.interface,
+        };
+        ds[0] = v;
+        ds[lay.velocity(0)] = (m.bearing().force(s[0], v) + drive) / m.structure.body_mass();
+        if let Some(i) = lay.delta {
+            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - s[i]) / m.thermal_lag;
+        }
+        if let Some(i) = lay.lagged_force {
+            ds[i] = (hot.interface - s[i]) / m.interface_lag;
+        }
+        if let Some(i) = lay.contact_impulse {
+            ds[i] = hot.contact;
+        }
+        if let Some(i) = lay.heat {
+            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
+        }
+        if let Some(motion) = &self.inputs.base_motion {
+            ds[lay.velocity(0)] -= motion.acceleration_value(t);
+        }
+    }
+
+    /// The Jacobian and `∂f/∂t` of the condensed system, by the chain rule through the settled
+    /// bulge gap.
+    fn condensed_jacobian<D: Dim>(
+        &self,
+        q: &QuasiStaticBulge,
+        t: f64,
+        s: &OVector<f64, D>,
+        j: &mut OMatrix<f64, D, D>,
+        dfdt: &mut OVector<f64, D>,
+    ) where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let m = &*self.model;
+        let lay = self.layout;
+        j.fill(0.0);
+        dfdt.fill(0.0);
+        let Some(b) = self.settled(q, t, s) else {
+            j.fill(f64::NAN);
+            dfdt.fill(f64::NAN);
+            return;
+        };
+        let l = &b.local;
+        let dd = self.heat_slope_if_kept(l);
+        let mass = m.structure.body_mass();
+        let (v, y0) = (lay.velocity(0), s[0]);
+        // Columns of the body heave, the lagged force and the protrusion.
+        let cols = [Some(0), lay.lagged_force, lay.delta];
+        // A quantity X(d, pad) along those columns: X′ ∂d/∂col, plus X_pad on the heave.
+        let along = |x: &crate::force::ForceEval, c: usize| {
+            x.d_bulge * b.along[c] + if c == 0 { x.d_pad } else { 0.0 }
+        };
+        j[(0, v)] = 1.0;
+        j[(v, 0)] = -m.bearing().stiffness(y0) / mass;
+        j[(v, v)] = -m.bearing().damping(y0) / mass;
+        // The protrusion's and the voltage's explicit rates, and the gap's rate they make.
+        let (_, p_rate) = self.inputs.heater.power_and_rate(t);
+        let delta_rate = match lay.delta {
+            Some(_) => 0.0,
+            None => m.protrusion(p_rate),
+        };
+        let f_t = self.inputs.voltage.squared_rate(t) * l.hot.per_volt2.value;
+        let d_t = match lay.lagged_force {
+            Some(_) => -delta_rate,
+            None => (f_t - q.stiffness() * delta_rate) / b.fast,
+        };
+        let force_t = l.f.d_bulge * d_t + f_t;
+        for (c, col) in cols.iter().enumerate() {
+            let Some(col) = *col else { continue };
+            match lay.lagged_force {
+                Some(i) => j[(i, col)] = along(&l.f, c) / m.interface_lag,
+                None => j[(v, col)] += along(&l.f, c) / mass,
+            }
+            if let Some(i) = lay.contact_impulse {
+                j[(i, col)] = along(&l.hot.contact, c);
+            }
+            if let Some(i) = lay.heat {
+                j[(i, col)] = dd * b.along[c];
+            }
+        }
+        match lay.lagged_force {
+            Some(i) => {
+                j[(v, i)] = 1.0 / mass;
+                j[(i, i)] -= 1.0 / m.interface_lag;
+                dfdt[i] = force_t / m.interface_lag;
+            }
+            None => dfdt[v] = force_t / mass,
+        }
+        if let Some(k) = lay.delta {
+            j[(k, k)] = -1.0 / m.thermal_lag;
+            dfdt[k] = m.protrusion(p_rate) / m.thermal_lag;
+        }
+        if let Some(i) = lay.contact_impulse {
+            dfdt[i] = l.hot.contact.d_bulge * d_t;
+        }
+        if let Some(i) = lay.heat {
+            dfdt[i] = dd * d_t;
+        }
+        if let Some(motion) = &self.inputs.base_motion {
+            dfdt[v] -= motion.acceleration(t).1;
+        }
+    }
+}
+
+/// The bulge of a quasi-static bulge at one state ([`SliderSystem::settled`]).
+struct SettledBulge {
+    /// The gaps and forces at the settled bulge gap.
+    local: Local,
+    /// `∂d/∂y`, `∂d/∂F_lag` and `∂d/∂δ`: how the settled bulge gap moves with the body heave,
+    /// the lagged force and the protrusion.
+    along: [f64; 3],
+    /// `k_b − ∂F/∂d` at the settled gap (N/m).
+    fast: f64,
 }
