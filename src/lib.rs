@@ -71,6 +71,7 @@
 //! - [`heater`]: heater power programmes;
 //! - [`model`]: the slider model of a scene (never rewritten), the [`model::Inputs`] that drive
 //!   it, and the two as an ODE system ([`model::SliderSystem`]);
+//! - [`cache`]: a disk cache of a scene's force tables (a warm start; off unless asked for);
 //! - [`sim`]: the one simulation path: a problem built from a model and its inputs (tolerances,
 //!   method, options, fixed-size state);
 //! - [`analysis`]: the analyses (touchdown, take-off, hysteresis, pull-in, temperature rise,
@@ -96,6 +97,7 @@
 
 pub mod analysis;
 pub mod bearing;
+pub mod cache;
 pub mod calibration;
 pub mod drive;
 pub mod error;

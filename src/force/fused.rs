@@ -2,7 +2,9 @@
 //! and the real contact area), so that an evaluation costs a single index computation and two
 //! node reads, and the values alone (an ODE's right-hand side) skip the slopes.
 
+use crate::cache::codec::{malformed, Reader, Writer};
 use crate::quadrature::{hermite_bounds, Span};
+use crate::Result;
 
 /// Panels of equal width; each holds a uniform grid refined until every function agrees with its
 /// source at every interval midpoint.
@@ -221,6 +223,76 @@ impl<const N: usize> Fused<N> {
     /// Number of nodes.
     pub(crate) fn len(&self) -> usize {
         self.nodes.len()
+    }
+
+    /// Appends the table to a cache payload, every number as its bits.
+    pub(crate) fn encode(&self, w: &mut Writer) {
+        w.f64(self.lo);
+        w.f64(self.hi);
+        w.f64(self.inv_panel);
+        w.usize(self.panels.len());
+        for p in &self.panels {
+            w.f64(p.a);
+            w.f64(p.h);
+            w.f64(p.inv_h);
+            w.usize(p.start);
+            w.usize(p.n);
+        }
+        w.usize(self.nodes.len());
+        for node in &self.nodes {
+            for &(v, m) in node {
+                w.f64(v);
+                w.f64(m);
+            }
+        }
+    }
+
+    /// A table written by [`Fused::encode`], checked so that every look-up stays inside it.
+    pub(crate) fn decode(r: &mut Reader<'_>) -> Result<Self> {
+        let (lo, hi, inv_panel) = (r.finite()?, r.finite()?, r.finite()?);
+        if !(lo < hi && inv_panel > 0.0) {
+            return Err(malformed(format!("a fused table on [{lo:e}, {hi:e}]")));
+        }
+        let count = r.count(40)?;
+        if count != PANELS {
+            return Err(malformed(format!("a fused table of {count} panels")));
+        }
+        let panels = (0..count)
+            .map(|_| {
+                Ok(Panel {
+                    a: r.finite()?,
+                    h: r.finite()?,
+                    inv_h: r.finite()?,
+                    start: r.usize()?,
+                    n: r.usize()?,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let len = r.count(16 * N)?;
+        let mut nodes = Vec::with_capacity(len);
+        for _ in 0..len {
+            let mut node = [(0.0, 0.0); N];
+            for x in &mut node {
+                *x = (r.finite()?, r.finite()?);
+            }
+            nodes.push(node);
+        }
+        // A look-up reads nodes start + j and start + j + 1 for j < n.
+        for p in &panels {
+            if p.n == 0 || p.start.checked_add(p.n).is_none_or(|e| e >= len) {
+                return Err(malformed(format!(
+                    "a fused panel of nodes {}..={}+{}, {len} nodes",
+                    p.start, p.start, p.n
+                )));
+            }
+        }
+        Ok(Fused {
+            lo,
+            hi,
+            inv_panel,
+            panels,
+            nodes,
+        })
     }
 }
 

@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use super::fused::Fused;
 use super::{Coupling, GapReference, InterfaceTerm, TermKind};
+use crate::cache::codec::{malformed, Reader, Writer};
 use crate::quadrature::{Span, Table, TableOptions};
 use crate::{Error, Result};
 
@@ -343,6 +344,29 @@ fn next_toward(x: f64, toward: f64) -> f64 {
 }
 
 type ArcGap = [Option<Arc<Tabulated>>; 2];
+
+/// The codes of a term's kind, coupling and gap in a cache payload: their place in these lists.
+const KINDS: [TermKind; 4] = [
+    TermKind::Intermolecular,
+    TermKind::Contact,
+    TermKind::Electrostatic,
+    TermKind::Other,
+];
+const COUPLINGS: [Coupling; 2] = [Coupling::Static, Coupling::PerVoltSquared];
+const GAPS: [GapReference; 2] = [GapReference::Bulge, GapReference::Pad];
+
+/// The code of `x` in `list` (which holds it).
+fn code<T: PartialEq>(list: &[T], x: &T) -> u8 {
+    list.iter().position(|y| y == x).unwrap_or(0) as u8
+}
+
+/// The item of `list` of a code read from `r`.
+fn decode_code<T: Copy>(list: &[T], r: &mut Reader<'_>) -> Result<T> {
+    let c = r.u8()?;
+    list.get(usize::from(c))
+        .copied()
+        .ok_or_else(|| malformed(format!("a code {c} of {} choices", list.len())))
+}
 type PerGap = [Option<Slot>; 2];
 
 /// All enabled terms, tabulated over the separation.
@@ -419,13 +443,7 @@ impl InterfaceForces {
             abs_tol: opts.abs_tol * 1e-8,
             ..*opts
         };
-        let gaps = [GapReference::Bulge, GapReference::Pad];
-        let kinds = [
-            TermKind::Intermolecular,
-            TermKind::Contact,
-            TermKind::Electrostatic,
-            TermKind::Other,
-        ];
+        let (gaps, kinds) = (GAPS, KINDS);
         let select = |f: &dyn Fn(&dyn InterfaceTerm) -> bool| -> Vec<usize> {
             (0..terms.len()).filter(|&i| f(terms[i].as_ref())).collect()
         };
@@ -449,7 +467,7 @@ impl InterfaceForces {
         let mut by_kind = Vec::new();
         for gap in gaps {
             for kind in kinds {
-                for coupling in [Coupling::Static, Coupling::PerVoltSquared] {
+                for coupling in COUPLINGS {
                     let m =
                         select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
                     if !m.is_empty() {
@@ -807,6 +825,184 @@ impl InterfaceForces {
         b.real_contact_area = self.real_contact_area(g);
         b.total = b.intermolecular + b.contact + b.electrostatic + b.other;
         b
+    }
+
+    /// Every distinct table set, each once (a merged sum of one kind is that kind's table).
+    fn distinct_tables(&self) -> Vec<&Arc<Tabulated>> {
+        let mut out: Vec<&Arc<Tabulated>> = Vec::new();
+        let slots = [
+            &self.static_part,
+            &self.per_volt2,
+            &self.contact,
+            &self.area,
+        ];
+        let all = self
+            .by_kind
+            .iter()
+            .map(|(_, _, _, t)| t)
+            .chain(slots.into_iter().flatten().flatten().map(|s| &s.tab));
+        for t in all {
+            if !out.iter().any(|o| Arc::ptr_eq(o, t)) {
+                out.push(t);
+            }
+        }
+        out
+    }
+
+    /// Appends the tables (not the terms) to a cache payload: every stored number as its bits, a
+    /// table shared between sums once.
+    pub(crate) fn encode_tables(&self, w: &mut Writer) {
+        w.f64(self.range.0);
+        w.f64(self.range.1);
+        let tables = self.distinct_tables();
+        let index = |t: &Arc<Tabulated>| tables.iter().position(|o| Arc::ptr_eq(o, t));
+        w.usize(tables.len());
+        for t in &tables {
+            w.usize(t.members.len());
+            for &m in &t.members {
+                w.usize(m);
+            }
+            w.bool(t.area);
+            w.f64s(&t.cuts);
+            w.usize(t.segments.len());
+            for s in &t.segments {
+                s.encode(w);
+            }
+        }
+        w.usize(self.by_kind.len());
+        for (kind, coupling, gap, t) in &self.by_kind {
+            w.u8(code(&KINDS, kind));
+            w.u8(code(&COUPLINGS, coupling));
+            w.u8(code(&GAPS, gap));
+            w.usize(index(t).unwrap_or(0));
+        }
+        for slots in [
+            &self.static_part,
+            &self.per_volt2,
+            &self.contact,
+            &self.area,
+        ] {
+            for slot in slots {
+                let i = slot.as_ref().and_then(|s| index(&s.tab));
+                w.bool(i.is_some());
+                w.usize(i.unwrap_or(0));
+            }
+        }
+        w.bool(self.fused.is_some());
+        if let Some(f) = &self.fused {
+            f.encode(w);
+        }
+        w.bool(self.fused_area);
+    }
+
+    /// The forces of `terms` over `range` from tables written by
+    /// [`InterfaceForces::encode_tables`] for the same terms and range: the same numbers, to the
+    /// bit, as [`InterfaceForces::build`] gives. Every index read is checked.
+    pub(crate) fn decode_tables(
+        terms: Vec<Box<dyn InterfaceTerm>>,
+        range: (f64, f64),
+        r: &mut Reader<'_>,
+    ) -> Result<Self> {
+        let stored = (r.f64()?, r.f64()?);
+        if stored.0.to_bits() != range.0.to_bits() || stored.1.to_bits() != range.1.to_bits() {
+            return Err(malformed(format!(
+                "tables over {stored:?}, wanted over {range:?}"
+            )));
+        }
+        let count = r.count(1)?;
+        let mut tables = Vec::with_capacity(count);
+        for _ in 0..count {
+            let n = r.count(8)?;
+            let members = (0..n)
+                .map(|_| r.index(terms.len()))
+                .collect::<Result<Vec<_>>>()?;
+            let area = r.bool()?;
+            let cuts = r.finite_f64s()?;
+            let n = r.count(1)?;
+            if n != cuts.len() + 1 {
+                return Err(malformed(format!(
+                    "{n} table segments between {} cuts",
+                    cuts.len()
+                )));
+            }
+            let segments = (0..n)
+                .map(|_| Table::decode(r))
+                .collect::<Result<Vec<_>>>()?;
+            tables.push(Arc::new(Tabulated {
+                members,
+                area,
+                cuts,
+                segments,
+            }));
+        }
+        let n = r.count(4)?;
+        let mut by_kind = Vec::with_capacity(n);
+        for _ in 0..n {
+            let kind = decode_code(&KINDS, r)?;
+            let coupling = decode_code(&COUPLINGS, r)?;
+            let gap = decode_code(&GAPS, r)?;
+            by_kind.push((kind, coupling, gap, Arc::clone(&tables[r.index(count)?])));
+        }
+        let mut sums: [PerGap; 4] = Default::default();
+        for slots in &mut sums {
+            for slot in slots.iter_mut() {
+                let present = r.bool()?;
+                let i = r.usize()?;
+                if present {
+                    let t = tables
+                        .get(i)
+                        .ok_or_else(|| malformed(format!("index {i} of {count} table sets")))?;
+                    *slot = Some(Slot::new(Arc::clone(t)));
+                }
+            }
+        }
+        let fused = if r.bool()? {
+            Some(Arc::new(Fused::decode(r)?))
+        } else {
+            None
+        };
+        let fused_area = r.bool()?;
+        // Each table sums terms of the kind, coupling and gap it stands for.
+        let fits = |t: &Tabulated, area: bool, f: &dyn Fn(&dyn InterfaceTerm) -> bool| {
+            t.area == area && !t.members.is_empty() && t.members.iter().all(|&m| f(&*terms[m]))
+        };
+        let mut ok = by_kind.iter().all(|(k, c, g, t)| {
+            fits(t, false, &|x| {
+                x.kind() == *k && x.coupling() == *c && x.gap() == *g
+            })
+        });
+        for (g, gap) in GAPS.into_iter().enumerate() {
+            let [s, v, c, a] = sums.each_ref().map(|p| p[g].as_ref().map(|x| &*x.tab));
+            ok &= s.is_none_or(|t| {
+                fits(t, false, &|x| {
+                    x.gap() == gap && x.coupling() == Coupling::Static
+                })
+            }) && v.is_none_or(|t| {
+                fits(t, false, &|x| {
+                    x.gap() == gap && x.coupling() == Coupling::PerVoltSquared
+                })
+            }) && c.is_none_or(|t| {
+                fits(t, false, &|x| {
+                    x.gap() == gap && x.kind() == TermKind::Contact
+                })
+            }) && a
+                .is_none_or(|t| fits(t, true, &|x| x.gap() == gap && x.has_contact_area()));
+        }
+        if !ok {
+            return Err(malformed("tables that do not fit the terms"));
+        }
+        let [static_part, per_volt2, contact, area] = sums;
+        Ok(InterfaceForces {
+            terms: Arc::new(terms),
+            range,
+            static_part,
+            per_volt2,
+            contact,
+            area,
+            by_kind,
+            fused,
+            fused_area,
+        })
     }
 
     /// Whether any term depends on the voltage.

@@ -178,13 +178,30 @@ impl Meniscus {
     /// for discrete peak ensembles (whose survival has steps), it evaluates the partial moments
     /// directly.
     pub fn tabulated(mut self, (lo, hi): (f64, f64), opts: &TableOptions) -> Result<Self> {
-        if self.peaks.atoms().is_some() {
+        if !self.tabulates() {
             return Ok(self);
         }
         let (t_m, s_r) = (self.params.mobile_thickness, self.rupture);
         let table = Table::build(|e| self.direct(e), lo - t_m - s_r, hi - t_m, opts)?;
         self.table = Some(Arc::new(table));
         Ok(self)
+    }
+
+    /// Whether [`Meniscus::tabulated`] gives the term a table (not for discrete peak ensembles).
+    pub(crate) fn tabulates(&self) -> bool {
+        self.peaks.atoms().is_none()
+    }
+
+    /// The force table of [`Meniscus::tabulated`], if any.
+    pub(crate) fn table(&self) -> Option<&Table> {
+        self.table.as_deref()
+    }
+
+    /// The same term with a table that [`Meniscus::tabulated`] built for it before (read back
+    /// from the table cache).
+    pub(crate) fn with_table(mut self, table: Table) -> Self {
+        self.table = Some(Arc::new(table));
+        self
     }
 
     /// The parameters.

@@ -16,10 +16,11 @@ pub use inputs::{BaseMotion, Heater, Inputs};
 pub use structure::{Dofs, Structure};
 pub use system::{Rest, SliderSystem, StateLayout};
 
+use crate::cache::{CacheReport, TableCache};
 use crate::error::{Error, Result};
 use crate::force::{
     by_coupling, AirBearing, AirBearingModel, Breakdown, ForceEval, Gaps, HotForces, HotValues,
-    InterfaceForces, StatefulTerm,
+    InterfaceForces, Meniscus, StatefulTerm,
 };
 use crate::heater::Programme;
 use crate::quadrature::Span;
@@ -220,7 +221,34 @@ impl SliderModel {
     /// the air bearing.
     pub fn from_scene(scene: &Scene) -> Result<Self> {
         scene.validate()?;
-        Self::assemble(scene, scene.build_interface()?)
+        Self::assemble(scene, scene.build_interface()?, scene.meniscus()?)
+    }
+
+    /// [`SliderModel::from_scene`] with its tables read from `cache` when it holds them for this
+    /// scene's inputs (else built and stored there): a warm start. The model is the same, to the
+    /// bit, either way. `None` builds the tables afresh, as [`SliderModel::from_scene`] does. The
+    /// report says whether the cache was hit and any entry that was found bad and rebuilt (see
+    /// [`crate::cache`]).
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{cache::TableCache, model::SliderModel, scene::Scene};
+    /// let cache = TableCache::from_env()?; // None when HDI_CACHE=off
+    /// let (model, report) = SliderModel::from_scene_with_cache(&Scene::paper(), cache.as_ref())?;
+    /// for n in &report.notices {
+    ///     eprintln!("warning: {n}");
+    /// }
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_scene_with_cache(
+        scene: &Scene,
+        cache: Option<&TableCache>,
+    ) -> Result<(Self, CacheReport)> {
+        let Some(cache) = cache else {
+            return Ok((Self::from_scene(scene)?, CacheReport::default()));
+        };
+        scene.validate()?;
+        let (forces, meniscus, report) = scene.tables_cached(cache)?;
+        Ok((Self::assemble(scene, forces, meniscus)?, report))
     }
 
     /// Builds the model of a scene with interface forces assembled by the caller, e.g. the scene's
@@ -237,10 +265,16 @@ impl SliderModel {
     /// ```
     pub fn from_scene_with_forces(scene: &Scene, forces: InterfaceForces) -> Result<Self> {
         scene.validate()?;
-        Self::assemble(scene, forces)
+        Self::assemble(scene, forces, scene.meniscus()?)
     }
 
-    fn assemble(scene: &Scene, forces: InterfaceForces) -> Result<Self> {
+    /// The model of `scene` with its tables: the interface forces and the scene's lubricant
+    /// menisci, if any.
+    fn assemble(
+        scene: &Scene,
+        forces: InterfaceForces,
+        meniscus: Option<Meniscus>,
+    ) -> Result<Self> {
         let bearing: Arc<dyn AirBearing> = Arc::from(scene.build_air_bearing()?);
         let contact_potential = scene
             .electrostatic
@@ -269,13 +303,13 @@ impl SliderModel {
             linear_bearing: matches!(scene.air_bearing, AirBearingModel::Linear { .. }),
             quasi_static: None,
         }
-        .with_scene_terms(scene)
+        .with_scene_terms(meniscus)
     }
 
     /// The model with the stateful terms its scene enables (the lubricant menisci); itself when
     /// there are none.
-    fn with_scene_terms(self, scene: &Scene) -> Result<Self> {
-        match scene.meniscus()? {
+    fn with_scene_terms(self, meniscus: Option<Meniscus>) -> Result<Self> {
+        match meniscus {
             Some(m) => self.with_stateful_term(m),
             None => Ok(self),
         }

@@ -5,6 +5,7 @@
 //! and two node reads, without search, allocation or branching on errors.
 
 use super::QuadratureError;
+use crate::cache::codec::{malformed, Reader, Writer};
 use crate::{Error, Result};
 
 /// Largest bisection depth of the panel tree; deeper refinement doubles the
@@ -578,6 +579,83 @@ impl Table {
     /// Number of panels of uniform spacing.
     pub fn panels(&self) -> usize {
         self.panel_count
+    }
+
+    /// Appends the table to a cache payload: every stored number as its bits, each panel once
+    /// with the number of index cells it covers.
+    pub(crate) fn encode(&self, w: &mut Writer) {
+        w.f64(self.lo);
+        w.f64(self.hi);
+        w.f64(self.inv_cell);
+        w.usize(self.panel_count);
+        for run in self.cells.chunk_by(|x, y| x.start == y.start) {
+            let p = run[0];
+            w.f64(p.a);
+            w.f64(p.inv_h);
+            w.f64(p.h);
+            w.usize(p.start as usize);
+            w.usize(p.last as usize);
+            w.usize(run.len());
+        }
+        w.usize(self.nodes.len());
+        for &[y, m] in &self.nodes {
+            w.f64(y);
+            w.f64(m);
+        }
+    }
+
+    /// A table written by [`Table::encode`], checked so that every look-up stays inside it.
+    pub(crate) fn decode(r: &mut Reader<'_>) -> Result<Table> {
+        let (lo, hi, inv_cell) = (r.finite()?, r.finite()?, r.finite()?);
+        if !(lo < hi && inv_cell > 0.0) {
+            return Err(malformed(format!(
+                "a table on [{lo:e}, {hi:e}] with {inv_cell:e} cells per unit"
+            )));
+        }
+        let panel_count = r.count(48)?;
+        let mut panels = Vec::with_capacity(panel_count);
+        for _ in 0..panel_count {
+            let (a, inv_h, h) = (r.finite()?, r.finite()?, r.finite()?);
+            let (start, last) = (r.usize()?, r.usize()?);
+            let span = r.usize()?;
+            panels.push((a, inv_h, h, start, last, span));
+        }
+        let n = r.count(16)?;
+        let nodes = (0..n)
+            .map(|_| Ok([r.finite()?, r.finite()?]))
+            .collect::<Result<Vec<[f64; 2]>>>()?;
+        let mut cells = Vec::new();
+        for (a, inv_h, h, start, last, span) in panels {
+            // A look-up reads nodes start + j and start + j + 1 for j ≤ last.
+            let fits = start
+                .checked_add(last)
+                .and_then(|e| e.checked_add(1))
+                .is_some_and(|e| e < n && e <= u32::MAX as usize);
+            if !fits || span == 0 || cells.len() + span > 1 << MAX_DEPTH {
+                return Err(malformed(format!(
+                    "a panel of nodes {start}..={start}+{last}+1 over {span} cells, {n} nodes"
+                )));
+            }
+            let panel = Panel {
+                a,
+                inv_h,
+                h,
+                start: start as u32,
+                last: last as u32,
+            };
+            cells.extend(std::iter::repeat_n(panel, span));
+        }
+        if !cells.len().is_power_of_two() {
+            return Err(malformed(format!("a table of {} cells", cells.len())));
+        }
+        Ok(Table {
+            lo,
+            hi,
+            inv_cell,
+            cells,
+            panel_count,
+            nodes,
+        })
     }
 }
 

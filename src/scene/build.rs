@@ -2,14 +2,33 @@
 
 use std::sync::Arc;
 
-use super::{Scene, WettingSpec};
+use serde::Serialize;
+
+use super::{ContactSpec, IntermolecularSpec, LubricantSpec, Scene, WettingSpec};
+use crate::cache::codec::{malformed, Reader, Writer};
+use crate::cache::{CacheReport, TableCache};
 use crate::force::{
-    lj_zero, AirBearing, Electrostatic, GreenwoodWilliamson, InterfaceForces, InterfaceTerm,
-    Intermolecular, Meniscus, MeniscusParams, Wetting,
+    lj_zero, AirBearing, Electrostatic, Footprint, GapReference, GreenwoodWilliamson,
+    InterfaceForces, InterfaceTerm, Intermolecular, Meniscus, MeniscusParams, Wetting,
 };
-use crate::quadrature::TableOptions;
+use crate::quadrature::{Table, TableOptions};
 use crate::surface::{Discrete, GaussianHeights, PeakDistribution, PeakModel};
 use crate::{Error, Result};
+
+/// Every table of a scene: its interface forces and its lubricant menisci.
+pub(crate) type SceneTables = (InterfaceForces, Option<Meniscus>);
+
+/// The payload of a table-cache entry for `tables`.
+pub(crate) fn encode_tables((forces, meniscus): &SceneTables) -> Vec<u8> {
+    let mut w = Writer::new();
+    forces.encode_tables(&mut w);
+    let table = meniscus.as_ref().and_then(Meniscus::table);
+    w.bool(table.is_some());
+    if let Some(t) = table {
+        t.encode(&mut w);
+    }
+    w.into_bytes()
+}
 
 /// Prefixes the field of an input error with `prefix`.
 fn in_field(e: Error, prefix: &str) -> Error {
@@ -141,6 +160,16 @@ impl Scene {
     /// tabulated over [`Scene::table_range`]; `None` when the section is absent or the mobile
     /// thickness is zero (the model is then exactly that of the scene without it).
     pub fn meniscus(&self) -> Result<Option<Meniscus>> {
+        match self.meniscus_term()? {
+            Some(m) => Ok(Some(
+                m.tabulated(self.table_range(), &self.table_options())?,
+            )),
+            None => Ok(None),
+        }
+    }
+
+    /// The menisci of [`Scene::meniscus`] before tabulation.
+    fn meniscus_term(&self) -> Result<Option<Meniscus>> {
         self.validate()?;
         let (Some(l), Some(c)) = (&self.lubricant, &self.contact) else {
             return Ok(None);
@@ -161,10 +190,6 @@ impl Scene {
             healing_time: l.healing_time_s,
             formation_time: l.formation_time_s,
         };
-        let opts = TableOptions {
-            rel_tol: self.table.rel_tol,
-            ..TableOptions::default()
-        };
         let m = Meniscus::new(
             params,
             c.asperity_radius_m,
@@ -172,9 +197,16 @@ impl Scene {
             self.peaks()?,
             c.footprint,
         )
-        .map_err(|e| in_field(e, "lubricant."))?
-        .tabulated(self.table_range(), &opts)?;
+        .map_err(|e| in_field(e, "lubricant."))?;
         Ok(Some(m))
+    }
+
+    /// The accuracy and size limits of every table of the scene.
+    fn table_options(&self) -> TableOptions {
+        TableOptions {
+            rel_tol: self.table.rel_tol,
+            ..TableOptions::default()
+        }
     }
 
     /// Range of separations `d` (m) that the force tables cover.
@@ -207,15 +239,247 @@ impl Scene {
     /// Validates the scene and tabulates its enabled interface terms.
     pub fn build_interface(&self) -> Result<InterfaceForces> {
         let terms = self.interface_terms()?;
-        let opts = TableOptions {
-            rel_tol: self.table.rel_tol,
-            ..TableOptions::default()
+        InterfaceForces::build(terms, self.table_range(), &self.table_options())
+    }
+
+    /// [`Scene::build_interface`] through a table cache: the tables read from `cache` when it
+    /// holds them for this scene's inputs, else built and stored (see [`crate::cache`]). The
+    /// forces are the same, to the bit, either way.
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{cache::TableCache, scene::Scene};
+    /// let cache = TableCache::in_dir("/tmp/hdi-cache");
+    /// let (forces, report) = Scene::paper().build_interface_cached(&cache)?;
+    /// for n in &report.notices {
+    ///     eprintln!("warning: {n}");
+    /// }
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn build_interface_cached(
+        &self,
+        cache: &TableCache,
+    ) -> Result<(InterfaceForces, CacheReport)> {
+        let (forces, _, report) = self.tables_cached(cache)?;
+        Ok((forces, report))
+    }
+
+    /// Every table of the scene (the interface forces and the lubricant menisci) through
+    /// `cache`: one entry holds them all.
+    pub(crate) fn tables_cached(
+        &self,
+        cache: &TableCache,
+    ) -> Result<(InterfaceForces, Option<Meniscus>, CacheReport)> {
+        let key = self.table_key()?;
+        let build = || -> Result<SceneTables> { Ok((self.build_interface()?, self.meniscus()?)) };
+        let decode = |payload: &[u8]| self.decode_tables(payload);
+        let ((forces, meniscus), report) =
+            cache.get_or_build(&key, decode, build, encode_tables)?;
+        Ok((forces, meniscus, report))
+    }
+
+    /// The scene's tables from a payload of [`encode_tables`], every index checked.
+    pub(crate) fn decode_tables(&self, payload: &[u8]) -> Result<SceneTables> {
+        let mut r = Reader::new(payload);
+        let terms = self.interface_terms()?;
+        let forces = InterfaceForces::decode_tables(terms, self.table_range(), &mut r)?;
+        let meniscus = match (r.bool()?, self.meniscus_term()?) {
+            (true, Some(m)) if m.tabulates() => Some(m.with_table(Table::decode(&mut r)?)),
+            (false, None) => None,
+            (false, Some(m)) if !m.tabulates() => Some(m),
+            _ => return Err(malformed("a meniscus table that does not fit the menisci")),
         };
-        InterfaceForces::build(terms, self.table_range(), &opts)
+        if !r.is_done() {
+            return Err(malformed("bytes left over after the tables"));
+        }
+        Ok((forces, meniscus))
+    }
+
+    /// The key of the scene's tables in a [`TableCache`]: exactly the fields the tabulated
+    /// functions, the table range and the table options are made from, as JSON (each number
+    /// written so that it reads back to the same bits).
+    fn table_key(&self) -> Result<String> {
+        self.validate()?;
+        #[derive(Serialize)]
+        struct Electrostatic<'a> {
+            dielectric_thickness_m: f64,
+            cutoff_m: Option<f64>,
+            footprint: &'a Footprint,
+            gap: GapReference,
+        }
+        #[derive(Serialize)]
+        struct Inputs<'a> {
+            table_range_m: (f64, f64),
+            rel_tol: f64,
+            abs_tol: f64,
+            max_nodes: usize,
+            height_sigma_m: Option<f64>,
+            peaks: Option<&'a PeakModel>,
+            intermolecular: Option<&'a IntermolecularSpec>,
+            electrostatic: Option<Electrostatic<'a>>,
+            contact: Option<&'a ContactSpec>,
+            lubricant: Option<&'a LubricantSpec>,
+        }
+        let opts = self.table_options();
+        let non_contact = self.intermolecular.is_some() || self.electrostatic.is_some();
+        let inputs = Inputs {
+            table_range_m: self.table_range(),
+            rel_tol: opts.rel_tol,
+            abs_tol: opts.abs_tol,
+            max_nodes: opts.max_nodes,
+            height_sigma_m: non_contact.then_some(self.surface.height_sigma_m),
+            peaks: self.contact.as_ref().map(|_| &self.surface.peaks),
+            intermolecular: self.intermolecular.as_ref(),
+            // The contact potential only shifts the voltage: not in the tables.
+            electrostatic: self.electrostatic.as_ref().map(|e| Electrostatic {
+                dielectric_thickness_m: e.dielectric_thickness_m,
+                cutoff_m: self.electrostatic_cutoff(),
+                footprint: &e.footprint,
+                gap: e.gap,
+            }),
+            contact: self.contact.as_ref(),
+            lubricant: self.meniscus_term()?.and(self.lubricant.as_ref()),
+        };
+        serde_json::to_string(&inputs).map_err(|e| Error::invalid("table cache key", e.to_string()))
     }
 
     /// The air bearing.
     pub fn build_air_bearing(&self) -> Result<Box<dyn AirBearing>> {
         self.air_bearing.build()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::force::{Gaps, StatefulTerm};
+    use crate::scene::LubricantSpec;
+
+    /// The paper scene with the intermolecular term on the pad gap (separate, merged tables, no
+    /// fused one) and lubricant menisci (a table of their own).
+    fn every_kind_of_table() -> Scene {
+        let mut s = Scene::paper();
+        if let Some(m) = s.intermolecular.as_mut() {
+            m.gap = GapReference::Pad;
+        }
+        s.lubricant = Some(LubricantSpec {
+            total_thickness_m: 1.5e-9,
+            bonded_thickness_m: 0.5e-9,
+            surface_tension_n_per_m: 0.025,
+            contact_angle_deg: 0.0,
+            wetting: WettingSpec::Disk,
+            healing_time_s: 1e-5,
+            formation_time_s: 1e-7,
+            rupture_distance_m: None,
+        });
+        s
+    }
+
+    /// Every value the tables give on a grid over and beyond the table range, as text (Rust
+    /// prints each number so that it reads back to the same bits).
+    fn fingerprint(scene: &Scene, (forces, meniscus): &SceneTables) -> String {
+        let (lo, hi) = scene.table_range();
+        let mut out = String::new();
+        for i in 0..=400 {
+            let d = lo - 0.05 * (hi - lo) + 1.1 * (hi - lo) * f64::from(i) / 400.0;
+            let g = Gaps {
+                bulge: d,
+                pad: d + 0.3e-9,
+            };
+            out += &format!(
+                "{:?}{:?}{:?}{:?}",
+                forces.evaluate(g),
+                forces.values(g, 0.7),
+                forces.breakdown(g, 0.7),
+                forces.real_contact_area(g)
+            );
+            if let Some(m) = meniscus {
+                let mut x = vec![0.0; m.states()];
+                m.equilibrium(g, &mut x);
+                out += &format!("{:?}", m.force(g, &x));
+            }
+        }
+        out + &forces.table_nodes().to_string()
+    }
+
+    #[test]
+    fn tables_read_back_are_the_tables_built_and_bad_payloads_fail_cleanly() {
+        let scene = every_kind_of_table();
+        let built = (scene.build_interface().unwrap(), scene.meniscus().unwrap());
+        assert!(built.1.as_ref().is_some_and(|m| m.table().is_some()));
+        let payload = encode_tables(&built);
+        let read = scene.decode_tables(&payload).unwrap();
+        assert_eq!(encode_tables(&read), payload);
+        assert_eq!(fingerprint(&scene, &read), fingerprint(&scene, &built));
+
+        // Every cut short is refused.
+        for k in 0..64 {
+            let len = payload.len() * k / 64;
+            assert!(
+                scene.decode_tables(&payload[..len]).is_err(),
+                "cut at {len}"
+            );
+        }
+        // A flipped bit (as if the checksum had been fooled) either fails to decode or gives
+        // tables whose every look-up stays inside them: no panic.
+        let mut refused = 0;
+        let step = payload.len() / 397;
+        for (n, at) in (0..payload.len()).step_by(step).enumerate() {
+            let mut bad = payload.clone();
+            bad[at] ^= 1 << (n % 8);
+            match scene.decode_tables(&bad) {
+                Err(_) => refused += 1,
+                Ok(t) => drop(fingerprint(&scene, &t)),
+            }
+        }
+        assert!(refused > 0);
+        // Tables of another scene do not decode for this one (other terms, other range).
+        let paper = Scene::paper();
+        let other = encode_tables(&(paper.build_interface().unwrap(), None));
+        assert!(scene.decode_tables(&other).is_err());
+    }
+
+    #[test]
+    fn the_key_holds_what_the_tables_depend_on_and_nothing_else() {
+        let paper = Scene::paper();
+        let key = paper.table_key().unwrap();
+        let same = |f: &dyn Fn(&mut Scene)| {
+            let mut s = paper.clone();
+            s.surface.independent_peak_sigma = true;
+            f(&mut s);
+            s.table_key().unwrap() == key
+        };
+        // Not in the tables: voltages, heater, structure, solver, names.
+        assert!(same(&|s| s.voltage.dc_v = 3.0));
+        assert!(same(&|s| s
+            .electrostatic
+            .as_mut()
+            .unwrap()
+            .contact_potential_v = 0.4));
+        assert!(same(&|s| s.heater.efficiency_m_per_w = 2e-7));
+        assert!(same(&|s| s.solver.rtol = 1e-8));
+        assert!(same(&|s| s.name = "other".into()));
+        // In them: every term's parameters, the surface, the range and the accuracy.
+        assert!(!same(&|s| s.nominal_clearance_m = 1.1e-8));
+        assert!(!same(&|s| s.surface.height_sigma_m = 0.8e-9));
+        assert!(!same(&|s| s.table.rel_tol = 1e-8));
+        assert!(!same(&|s| s.table.d_max_m = Some(2e-8)));
+        assert!(!same(
+            &|s| s.contact.as_mut().unwrap().asperity_radius_m = 2e-7
+        ));
+        assert!(!same(
+            &|s| s.intermolecular.as_mut().unwrap().gap = GapReference::Pad
+        ));
+        assert!(!same(&|s| s
+            .electrostatic
+            .as_mut()
+            .unwrap()
+            .dielectric_thickness_m = 1e-9));
+        assert!(!same(&|s| s.contact = None));
+        assert!(!same(&|s| *s = every_kind_of_table()));
+        // A number one ulp away is another key.
+        assert!(!same(&|s| {
+            s.contact.as_mut().unwrap().composite_modulus_pa =
+                f64::from_bits(s.contact.as_ref().unwrap().composite_modulus_pa.to_bits() + 1)
+        }));
     }
 }

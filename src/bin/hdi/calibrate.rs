@@ -6,7 +6,7 @@ use hdi_tribology::calibration::{
     calibrate, CalibrationOptions, ContactForceRms, MeanContactForce, Relative, TouchdownDetector,
     VibrationRms, MAX_LEVELS,
 };
-use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::model::Voltage;
 use hdi_tribology::units::fmt_short;
 
 use crate::common::{self, non_negative, positive, volts, CliError, SceneArgs};
@@ -74,7 +74,7 @@ impl DetectorKind {
 
 pub fn run(a: Args) -> Result<(), CliError> {
     let scene = a.scene.load()?;
-    let mut model = SliderModel::from_scene(&scene)?;
+    let mut model = common::model(&scene)?;
     let start_mw = a
         .start_mw
         .unwrap_or_else(|| 1e3 * model.power_for(model.nominal_clearance() - 5e-9).max(0.0));

@@ -3,6 +3,9 @@
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
+use hdi_tribology::cache::{CacheReport, TableCache};
+use hdi_tribology::force::InterfaceForces;
+use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::units::{fmt_short, to_mw, to_nm};
 use serde::Serialize;
@@ -439,6 +442,47 @@ static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new
 /// Sets `--quiet` for the whole run.
 pub fn set_quiet(quiet: bool) {
     QUIET.store(quiet, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// `--no-cache`: no table cache for the whole run.
+static NO_CACHE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Sets `--no-cache` for the whole run.
+pub fn set_no_cache(off: bool) {
+    NO_CACHE.store(off, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The table cache of this run: none with `--no-cache` or `HDI_CACHE=off`, else the one of
+/// [`TableCache::from_env`].
+fn table_cache() -> Result<Option<TableCache>, CliError> {
+    if NO_CACHE.load(std::sync::atomic::Ordering::Relaxed) {
+        return Ok(None);
+    }
+    Ok(TableCache::from_env()?)
+}
+
+/// Warns about each notice of a cached build.
+fn warn_cache(report: &CacheReport) {
+    for n in &report.notices {
+        warn(n);
+    }
+}
+
+/// The model of `scene`, its tables through the run's table cache.
+pub fn model(scene: &Scene) -> Result<SliderModel, CliError> {
+    let (model, report) = SliderModel::from_scene_with_cache(scene, table_cache()?.as_ref())?;
+    warn_cache(&report);
+    Ok(model)
+}
+
+/// The interface forces of `scene`, their tables through the run's table cache.
+pub fn interface(scene: &Scene) -> Result<InterfaceForces, CliError> {
+    let Some(cache) = table_cache()? else {
+        return Ok(scene.build_interface()?);
+    };
+    let (forces, report) = scene.build_interface_cached(&cache)?;
+    warn_cache(&report);
+    Ok(forces)
 }
 
 /// How long a run goes before its progress shows.

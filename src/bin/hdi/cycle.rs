@@ -87,7 +87,7 @@ impl CycleArgs {
         &self,
         scene: &Scene,
     ) -> Result<(SliderModel, HeaterProgramme, CycleOptions), CliError> {
-        let model = SliderModel::from_scene(scene)?;
+        let model = common::model(scene)?;
         let mut opts = CycleOptions::from_scene(scene)?;
         if let Some(m) = &self.method {
             opts.solver.method = m.parse().map_err(|e: hdi_tribology::ode::OdeError| {

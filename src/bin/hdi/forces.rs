@@ -56,7 +56,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         (None, None) => 0.0,
     };
     let scene = a.scene.load()?;
-    let interface = scene.build_interface()?;
+    let interface = common::interface(&scene)?;
     let (lo, hi) = interface.table_range();
     let volt2 = scene.dc_volt2();
     let mut rows = Vec::with_capacity(gaps.len());

@@ -35,6 +35,12 @@ struct Cli {
     /// terminal, never otherwise). Warnings and results are unaffected.
     #[arg(long, short, global = true)]
     quiet: bool,
+    /// Build the force tables afresh, without reading or writing the table cache (as
+    /// HDI_CACHE=off does). The cache lives in $HDI_CACHE_DIR, else
+    /// $XDG_CACHE_HOME/hdi-tribology, else ~/.cache/hdi-tribology; results are the same either
+    /// way.
+    #[arg(long, global = true)]
+    no_cache: bool,
 }
 
 #[derive(Subcommand)]
@@ -65,6 +71,7 @@ fn main() -> ExitCode {
     // clap prints help and --version on stdout with exit 0, usage errors on stderr with exit 2.
     let cli = Cli::parse();
     common::set_quiet(cli.quiet);
+    common::set_no_cache(cli.no_cache);
     let result = match cli.command {
         Command::Forces(a) => forces::run(a),
         Command::Static(a) => static_cmd::run(a),

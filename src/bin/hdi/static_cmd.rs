@@ -5,7 +5,6 @@ use hdi_tribology::analysis::touchdown::TransitionError;
 use hdi_tribology::analysis::{
     pull_in_voltage, s_curve, takeoff_power, touchdown_power, Fold, PullIn, ScanGrid, StaticOptions,
 };
-use hdi_tribology::model::SliderModel;
 use serde::Serialize;
 
 use crate::common::{self, CliError, SceneArgs};
@@ -33,7 +32,7 @@ struct Report {
 
 pub fn run(a: Args) -> Result<(), CliError> {
     let scene = a.scene.load()?;
-    let model = SliderModel::from_scene(&scene)?;
+    let model = common::model(&scene)?;
     let opts = StaticOptions::new(scene.detector.contact_threshold_n);
     let progress = common::Progress::spinner("static: touchdown, take-off, pull-in, folds");
     let touchdown = touchdown_power(&model, &opts)?;
