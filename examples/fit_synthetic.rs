@@ -306,8 +306,9 @@ impl Setup {
 #[allow(dead_code)]
 /// The numbers of the dynamic fits that docs/fit.md quotes, keyed `fit.<run>.…` (`run`:
 /// `dynamic`, `direct`, `from_truth`): χ² and its p value against the stated uncertainties, the
-/// smallest and largest distance of a fitted value from the truth in error bars, the first
-/// stage's evaluations, and each parameter's linearity figure.
+/// smallest and largest distance of a fitted value from the truth in error bars, the largest
+/// deviation from the truth in per cent, the first stage's evaluations, and each parameter's
+/// linearity figure.
 pub fn doc_numbers(
     run: &str,
     r: &FitResult,
@@ -337,6 +338,14 @@ pub fn doc_numbers(
         q.push(Quoted::new(&at("se_distance_min"), lo));
         q.push(Quoted::new(&at("se_distance_max"), hi));
     }
+    // The largest deviation of a fitted value from the truth, relative to the truth (%).
+    let rel = r
+        .parameters
+        .iter()
+        .zip(truth)
+        .map(|(p, t)| 100.0 * ((p.value - t) / t).abs())
+        .fold(0.0, f64::max);
+    q.push(Quoted::new(&at("max_rel_dev_pct"), rel));
     for p in &r.parameters {
         if let Some(l) = p.linearity {
             q.push(Quoted::new(&at(&format!("linearity.{}", p.name)), l));

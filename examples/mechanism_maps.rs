@@ -476,12 +476,12 @@ fn draw_map_svg(out: &mut String, spec: &MapSpec, points: &[Point], n: usize) ->
     let (tick, axis) = (map_font(8.5), map_font(9.0));
     let root = SVGBackend::with_string(out, MAP_SIZE).into_drawing_area();
     root.fill(&WHITE)?;
-    let (top, bottom) = root.split_vertically(MAP_SIZE.1 - (2.6 * tick) as u32);
+    let (top, bottom) = root.split_vertically(MAP_SIZE.1 - (4.4 * tick) as u32);
     let panels = top.split_evenly((1, 3));
     let dv = 1.0 / (n.max(2) - 1) as f64;
     let dy = (spec.range.1 - spec.range.0) / (n.max(2) - 1) as f64;
     for (panel, (name, value)) in panels.iter().zip(QUANTITIES) {
-        let (plot, bar) = panel.split_horizontally(panel.dim_in_pixel().0 - (4.2 * tick) as u32);
+        let (plot, bar) = panel.split_horizontally(panel.dim_in_pixel().0 - (3.6 * tick) as u32);
         let shown: Vec<f64> = points
             .iter()
             .filter(|p| p.status == Status::Fine)
@@ -510,7 +510,7 @@ fn draw_map_svg(out: &mut String, spec: &MapSpec, points: &[Point], n: usize) ->
             .disable_mesh()
             .x_desc("V_{ac} (V)")
             .y_desc(spec.label)
-            .x_labels(6)
+            .x_labels(3)
             .x_label_formatter(&|v| hdi_tribology::report::snapped_tick_label(*v, 1.0))
             .label_style(("sans-serif", tick))
             .axis_desc_style(("sans-serif", axis))
@@ -550,12 +550,12 @@ fn draw_map_svg(out: &mut String, spec: &MapSpec, points: &[Point], n: usize) ->
                 c.stroke_width(w),
             )))?;
         }
-        // Colour bar, level with the plot.
+        // Colour bar, level with the plot, its labels on the right.
         let mut cb = ChartBuilder::on(&bar)
             .margin_top((axis * 1.1) as u32 + 8)
             .margin_bottom((2.4 * tick) as u32 + 8)
-            .margin_right(4)
-            .y_label_area_size((3.0 * tick) as u32)
+            .margin_left(6)
+            .right_y_label_area_size((2.2 * tick) as u32)
             .build_cartesian_2d(0.0..1.0, lo..hi)?;
         cb.configure_mesh()
             .disable_mesh()
@@ -574,36 +574,41 @@ fn draw_map_svg(out: &mut String, spec: &MapSpec, points: &[Point], n: usize) ->
             )
         }))?;
     }
-    // The legend in one row under the panels: swatches of the statuses, the outline, the dot.
+    // The legend in two rows under the panels: swatches of the statuses, then the outline and
+    // the dot.
     let legend = [
-        (Some(UNCONVERGED), "not converged"),
-        (Some(UNDETECTED), "no touchdown or take-off"),
-        (Some(BLACK), "runaway"),
-        (Some(NEGATIVE), "ΔP < 0"),
-        (None, "outline: plausible band"),
+        (UNCONVERGED, "not converged"),
+        (UNDETECTED, "no touchdown or take-off"),
+        (BLACK, "runaway"),
+        (NEGATIVE, "ΔP < 0 (ΔP panel)"),
     ];
     let style = ("sans-serif", tick).into_font();
-    let (h, y) = ((tick / 1.24) as i32, (0.8 * tick) as i32);
+    let h = (tick / 1.24) as i32;
+    let (row1, row2) = ((0.6 * tick) as i32, (2.2 * tick) as i32);
     let mut x = 20;
     for (c, text) in legend {
-        if let Some(c) = c {
-            bottom.draw(&Rectangle::new([(x, y), (x + h, y + h)], c.filled()))?;
-            bottom.draw(&Rectangle::new(
-                [(x, y), (x + h, y + h)],
-                BLACK.stroke_width(1),
-            ))?;
-            x += h + 8;
-        }
-        bottom.draw(&Text::new(text, (x, y), style.clone()))?;
-        x += (text.chars().count() as f64 * 0.46 * tick) as i32 + 36;
+        bottom.draw(&Rectangle::new([(x, row1), (x + h, row1 + h)], c.filled()))?;
+        bottom.draw(&Rectangle::new(
+            [(x, row1), (x + h, row1 + h)],
+            BLACK.stroke_width(1),
+        ))?;
+        bottom.draw(&Text::new(text, (x + h + 8, row1), style.clone()))?;
+        x += h + 8 + (text.chars().count() as f64 * 0.46 * tick) as i32 + 40;
     }
-    bottom.draw(&Circle::new((x + h / 2, y + h / 2), h / 3, WHITE.filled()))?;
+    let outlined = "outlined: physically plausible band";
+    bottom.draw(&Text::new(outlined, (20, row2), style.clone()))?;
+    let x = 20 + (outlined.chars().count() as f64 * 0.46 * tick) as i32 + 40;
     bottom.draw(&Circle::new(
-        (x + h / 2, y + h / 2),
+        (x + h / 2, row2 + h / 2),
+        h / 3,
+        WHITE.filled(),
+    ))?;
+    bottom.draw(&Circle::new(
+        (x + h / 2, row2 + h / 2),
         h / 3,
         BLACK.stroke_width(1),
     ))?;
-    bottom.draw(&Text::new("bounces in the hold", (x + h + 8, y), style))?;
+    bottom.draw(&Text::new("bounces in the hold", (x + h + 8, row2), style))?;
     root.present()?;
     Ok(())
 }

@@ -889,10 +889,24 @@ fn fig3d_chart<'a>(
         |c, h| (c.v_ac, mw(h)),
         false,
     ));
+    // With both programmes, their markers are set a little either side of the amplitude, so
+    // that equal values do not hide one another.
+    let dodge = 0.012;
+    if sweeps.len() > 1 {
+        for s in series.iter_mut().filter(|s| s.markers) {
+            let dx = if s.colour == Some(TRIGGERED.0) {
+                dodge
+            } else {
+                -dodge
+            };
+            s.points.iter_mut().for_each(|p| p.0 += dx);
+        }
+    }
     let mut notes = vec![if sweeps.len() > 1 {
         format!(
             "The letter's Fig. 3(d) uses the fixed programme ({}); the experiment's protocol \
-             is the touchdown-triggered programme ({}).",
+             is the touchdown-triggered programme ({}). Their markers sit {dodge} V either side \
+             of the amplitude.",
             marker_name(FIXED.1),
             marker_name(TRIGGERED.1)
         )

@@ -210,11 +210,7 @@ fn parameter_notes(result: &FitResult) -> Vec<String> {
             .unwrap_or(&p.name);
         let unit = unit_symbol(&p.unit);
         notes.push(match p.standard_error {
-            Some(se) => format!(
-                "{name} = {} ± {} {unit}",
-                tick_label(p.value, false),
-                tick_label(se, false)
-            ),
+            Some(se) => format!("{name} = {} {unit}", with_error(p.value, se)),
             None => format!(
                 "{name} = {} {unit} (not determined)",
                 tick_label(p.value, false)
@@ -225,6 +221,28 @@ fn parameter_notes(result: &FitResult) -> Vec<String> {
 }
 
 #[cfg_attr(not(feature = "plot"), allow(dead_code))]
+/// `value ± error` with the error to two significant digits and the value to the same place:
+/// `0.70204 ± 0.00069`, or `(1.0056 ± 0.0018)·10^{-19}` where that would need more than six
+/// decimals or the value is large.
+fn with_error(value: f64, error: f64) -> String {
+    if !(value.is_finite() && error.is_finite() && error > 0.0) {
+        return format!("{value} ± {error}");
+    }
+    let place = error.log10().floor() as i32 - 1;
+    if (-6..=0).contains(&place) && value.abs() < 1e5 {
+        let d = (-place) as usize;
+        return format!("{value:.d$} ± {error:.d$}");
+    }
+    let e = if value != 0.0 {
+        value.abs().log10().floor() as i32
+    } else {
+        place + 1
+    };
+    let scale = 10f64.powi(e);
+    let d = (e - place).max(0) as usize;
+    format!("({:.d$} ± {:.d$})·10^{{{e}}}", value / scale, error / scale)
+}
+
 /// The fitted model along a fine grid of the x range of `data` (static and indicator curves:
 /// `(x, value)` in the file's units per measured column); `None` for cycles (one cycle per
 /// point: the model is drawn at the measured amplitudes) or where the model cannot give it.
@@ -327,15 +345,16 @@ fn write_plots(
                     .marker(Marker::Circle),
             ],
             notes: notes.clone(),
+            legend_width: Some(260),
             ..Chart::default()
         }
-        .to_svg(&path, 860, 500)?;
+        .to_svg(&path, 1000, 560)?;
         written.push(path);
         let unit = t
             .column
             .rsplit_once('_')
             .map_or(String::new(), |(_, u)| unit_symbol(u));
-        let r_label = format!("model − measured ({unit})");
+        let r_label = format!("residual ({unit})");
         let path = dir.join(format!("{name}_residuals.svg"));
         let xs = t.rows.iter().map(|r| r.x);
         let zero = vec![
@@ -348,8 +367,11 @@ fn write_plots(
                 .colour(palette::BLACK)
                 .width(1)
                 .dashed(),
-            Series::markers("residual", kept.iter().map(|r| (r.x, r.residual)).collect())
-                .colour(palette::BLUE),
+            Series::markers(
+                "residual = model − measured",
+                kept.iter().map(|r| (r.x, r.residual)).collect(),
+            )
+            .colour(palette::BLUE),
         ];
         if !left_out.is_empty() {
             series.push(
@@ -368,7 +390,7 @@ fn write_plots(
             series,
             ..Chart::default()
         }
-        .to_svg(&path, 860, 360)?;
+        .to_svg(&path, 1000, 420)?;
         written.push(path);
     }
     Ok(written)
@@ -400,5 +422,11 @@ mod tests {
             "take-off power P_{TO} (mW)"
         );
         assert_eq!(column_label("odd"), "odd");
+        assert_eq!(with_error(0.702043, 0.000689), "0.70204 ± 0.00069");
+        assert_eq!(
+            with_error(1.0056e-19, 1.787e-22),
+            "(1.0056 ± 0.0018)·10^{-19}"
+        );
+        assert_eq!(with_error(74.3, 2.5), "74.3 ± 2.5");
     }
 }
