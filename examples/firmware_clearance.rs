@@ -23,6 +23,10 @@ use hdi_tribology::scene::Scene;
 use hdi_tribology::units::{mw, to_mw};
 use std::time::Instant;
 
+#[path = "common/doc_numbers.rs"]
+#[allow(dead_code)]
+pub mod doc_numbers;
+
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
 const STEP_MW: f64 = 0.5; // heater increment: 0.05 nm of protrusion at 0.1 nm/mW
@@ -31,7 +35,42 @@ const DITHER_V: f64 = 0.5; // AC dither amplitude (V)
 const DITHER_HZ: f64 = 10.5e3; // dither frequency (Hz): the force acts at 21 kHz
 
 fn main() -> Res<()> {
+    run().map(|_| ())
+}
+
+/// One calibration of a zone: the zone, the detector's short name (`mean`, `ae`, `ae_slow`,
+/// `vibration`), whether the dither was on, and the result (`None`: no contact seen).
+pub struct Row {
+    /// The zone's name.
+    pub zone: String,
+    /// The detector's short name.
+    pub detector: &'static str,
+    /// With the AC dither.
+    pub dither: bool,
+    /// The calibration, `None` when the detector saw no contact.
+    pub calibration: Option<Calibration>,
+}
+
+/// A zone's static model: touchdown, take-off, the clearance at touchdown − margin and the
+/// touchdown at the dither's peak `V²` (W, W, m, W).
+pub struct ZoneStatics {
+    /// The zone's name.
+    pub zone: String,
+    /// Static touchdown, take-off (W).
+    pub touchdown: f64,
+    /// Static take-off (W).
+    pub takeoff: f64,
+    /// Clearance at the static touchdown minus the margin (m).
+    pub clearance: f64,
+    /// Static touchdown at the dither's peak `V²` (W).
+    pub touchdown_peak: f64,
+}
+
+/// Runs every zone with every detector, printing the tables; returns the statics and the rows.
+pub fn run() -> Res<(Vec<ZoneStatics>, Vec<Row>)> {
     let clock = Instant::now();
+    let mut statics = Vec::new();
+    let mut rows = Vec::new();
     let base = Scene::paper();
     let zones = [
         Zone::at_rpm("ID", 0.018, 5400.0, 10e-9, 3.0e5),
@@ -86,6 +125,13 @@ fn main() -> Res<()> {
             set * 1e3,
             target * 1e9
         );
+        statics.push(ZoneStatics {
+            zone: zone.name.clone(),
+            touchdown: stat.touchdown.power,
+            takeoff: stat.takeoff.power,
+            clearance: target,
+            touchdown_peak: td_peak.power,
+        });
         // The search starts where the nominal clearance minus the protrusion would leave 5 nm,
         // a power the drive knows from its characterisation, not from the model.
         let start_mw = to_mw((zone.nominal_clearance - 5e-9) / scene.heater.efficiency_m_per_w);
@@ -106,41 +152,88 @@ fn main() -> Res<()> {
         // is still there.
         let mut slow = opts;
         slow.staircase.settle_time = 5e-4;
-        let run = |m: &SliderModel,
-                   label: &str,
-                   det: &mut dyn TouchdownDetector,
-                   opts: &CalibrationOptions|
+        let mut run = |m: &SliderModel,
+                       label: &str,
+                       detector: &'static str,
+                       det: &mut dyn TouchdownDetector,
+                       opts: &CalibrationOptions|
          -> Res<()> {
             let c = Instant::now();
-            match calibrate(m, det, opts) {
-                Ok(cal) => print_row(&cal, label, c.elapsed().as_secs_f64()),
-                Err(e) => println!("{:<46} {:>9}  no result: {e}", det.name(), label),
-            }
+            let calibration = match calibrate(m, det, opts) {
+                Ok(cal) => {
+                    print_row(&cal, label, c.elapsed().as_secs_f64());
+                    Some(cal)
+                }
+                Err(e) => {
+                    println!("{:<46} {:>9}  no result: {e}", det.name(), label);
+                    None
+                }
+            };
+            rows.push(Row {
+                zone: zone.name.clone(),
+                detector,
+                dither: label.starts_with("on"),
+                calibration,
+            });
             Ok(())
         };
         let window = scene.detector.window_s;
         let ae = || ContactForceRms::new(1e-5, 5e3, 5e-5);
-        run(
-            &model,
-            "off",
-            &mut MeanContactForce::new(th, window)?,
-            &opts,
-        )?;
-        run(&model, "off", &mut ae()?, &opts)?;
-        run(&model, "off, slow", &mut ae()?, &slow)?;
-        run(&model, "off", &mut vibration()?, &opts)?;
-        run(
-            &dithered,
-            "on",
-            &mut MeanContactForce::new(th, window)?,
-            &opts,
-        )?;
-        run(&dithered, "on", &mut ae()?, &opts)?;
-        run(&dithered, "on, slow", &mut ae()?, &slow)?;
-        run(&dithered, "on", &mut vibration()?, &opts)?;
+        for (m, dither) in [(&model, "off"), (&dithered, "on")] {
+            run(
+                m,
+                dither,
+                "mean",
+                &mut MeanContactForce::new(th, window)?,
+                &opts,
+            )?;
+            run(m, dither, "ae", &mut ae()?, &opts)?;
+            run(m, &format!("{dither}, slow"), "ae_slow", &mut ae()?, &slow)?;
+            run(m, dither, "vibration", &mut vibration()?, &opts)?;
+        }
     }
     println!("\ntotal wall time {:.2} s", clock.elapsed().as_secs_f64());
-    Ok(())
+    Ok((statics, rows))
+}
+
+// Used by this example's test and by examples/docs_numbers.rs, which includes this file.
+#[allow(dead_code)]
+/// The numbers of this run that docs/clearance.md quotes, keyed
+/// `clearance.<zone>.<detector>.<on|off>.<td_mw|to_mw|dp_mw|clearance_nm>` and
+/// `clearance.<zone>.static.<td_mw|to_mw|clearance_nm|td_peak_mw>` (zones `id`, `md`, `od`).
+pub fn doc_numbers(statics: &[ZoneStatics], rows: &[Row]) -> Vec<doc_numbers::Quoted> {
+    use doc_numbers::Quoted;
+    let mut q = Vec::new();
+    for s in statics {
+        let at = format!("clearance.{}.static", s.zone.to_lowercase());
+        q.extend([
+            Quoted::new(&format!("{at}.td_mw"), s.touchdown * 1e3),
+            Quoted::new(&format!("{at}.to_mw"), s.takeoff * 1e3),
+            Quoted::new(&format!("{at}.clearance_nm"), s.clearance * 1e9),
+            Quoted::new(&format!("{at}.td_peak_mw"), s.touchdown_peak * 1e3),
+        ]);
+    }
+    for r in rows {
+        let Some(c) = &r.calibration else { continue };
+        let at = format!(
+            "clearance.{}.{}.{}",
+            r.zone.to_lowercase(),
+            r.detector,
+            if r.dither { "on" } else { "off" }
+        );
+        q.push(Quoted::new(&format!("{at}.td_mw"), c.touchdown_power * 1e3));
+        q.push(Quoted::new(
+            &format!("{at}.clearance_nm"),
+            c.clearance * 1e9,
+        ));
+        if let Some(to) = c.takeoff_power {
+            q.push(Quoted::new(&format!("{at}.to_mw"), to * 1e3));
+        }
+        if let Some(h) = c.hysteresis() {
+            q.push(Quoted::new(&format!("{at}.dp_mw"), h * 1e3));
+        }
+    }
+    q
 }
 
 /// High-pass displacement RMS above 0.02 nm and above 3 times its level at the start power
@@ -171,6 +264,10 @@ mod tests {
     /// `cargo test` runs the example, so CI runs every example.
     #[test]
     fn example_runs() {
-        super::main().expect("the example runs to completion");
+        let (statics, rows) = super::run().expect("the example runs to completion");
+        // The numbers docs/clearance.md quotes from this run are the run's.
+        let root = super::doc_numbers::repository_root();
+        let numbers = super::doc_numbers(&statics, &rows);
+        assert!(super::doc_numbers::assert_quoted(&root, &numbers) > 0);
     }
 }

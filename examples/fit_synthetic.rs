@@ -17,6 +17,10 @@ use hdi_tribology::fit::{fit, model_curves, DataSet, FitOptions, FitResult, Free
 use hdi_tribology::scene::Scene;
 use hdi_tribology::surface::Xoshiro256;
 
+#[path = "common/doc_numbers.rs"]
+#[allow(dead_code)]
+pub mod doc_numbers;
+
 /// Seeded Gaussian noise of standard deviation `sd` (Box–Muller).
 fn gauss(rng: &mut Xoshiro256, sd: f64) -> f64 {
     let (u, v) = (rng.next_open01(), rng.next_open01());
@@ -137,7 +141,8 @@ fn report(title: &str, r: &FitResult, truth: &[f64], secs: f64, one_eval: f64) {
 }
 
 /// Times one model evaluation of `baseline` and the fit from `start` (with `opts`), then
-/// reports both, wall and CPU time.
+/// reports both, wall and CPU time; returns the fit and, when made in two stages, the first
+/// stage's evaluations.
 ///
 /// With `static_first`, the fit is made in two stages, both timed: the first `static_first` data
 /// sets alone (static curves: cheap), then every set from that fit's result.
@@ -151,7 +156,7 @@ fn timed_fit(
     truth: &[f64],
     opts: &FitOptions,
     static_first: Option<usize>,
-) -> Result<(), hdi_tribology::Error> {
+) -> Result<(FitResult, Option<usize>), hdi_tribology::Error> {
     let (one, one_wall, one_cpu) = timed(|| model_curves(baseline, data));
     one?;
     let (r, wall, cpu) = timed(|| match static_first {
@@ -161,51 +166,207 @@ fn timed_fit(
                 "  (stage 1, the static curve alone: {} evaluations, trusted {})",
                 first.evaluations, first.trusted
             );
-            fit(&first.scene, data, free, opts)
+            fit(&first.scene, data, free, opts).map(|r| (r, Some(first.evaluations)))
         }
-        None => fit(start, data, free, opts),
+        None => fit(start, data, free, opts).map(|r| (r, None)),
     });
     let r = r?;
-    report(title, &r, truth, wall, one_wall);
+    report(title, &r.0, truth, wall, one_wall);
     println!(
         "  CPU time (all threads) {cpu:.2} s; one model evaluation {one_cpu:.3} s; ratio {:.1}",
         cpu / one_cpu
     );
-    Ok(())
+    Ok(r)
+}
+
+/// The synthetic experiment: the true scene, the starting scene (every free parameter off by
+/// 10–30 %), the free parameters, their true values and the DC voltages of the static curve.
+pub struct Setup {
+    truth: Scene,
+    start: Scene,
+    free: Vec<FreeParameter>,
+    true_values: [f64; 4],
+    dc: Vec<f64>,
+}
+
+impl Default for Setup {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Setup {
+    /// The experiment of this example.
+    pub fn new() -> Self {
+        // The truth: the paper scene with a contact potential of 0.2 V.
+        let mut truth = Scene::paper();
+        if let Some(e) = truth.electrostatic.as_mut() {
+            e.contact_potential_v = 0.2;
+        }
+        // The starting scene: every free parameter off by 10–30 %.
+        let mut start = truth.clone();
+        start.surface.height_sigma_m = 0.6e-9;
+        if let hdi_tribology::surface::PeakModel::RiceMaxima { sigma_m, .. } =
+            &mut start.surface.peaks
+        {
+            *sigma_m = 0.6e-9;
+        }
+        if let Some(m) = start.intermolecular.as_mut() {
+            m.hamaker_attractive_j = 1.3e-19;
+        }
+        if let Some(e) = start.electrostatic.as_mut() {
+            e.contact_potential_v = 0.0;
+        }
+        start.heater.efficiency_m_per_w = 1.1e-7;
+        let free = vec![
+            FreeParameter::new("height_sigma_nm").bounded(0.3, 1.5),
+            FreeParameter::new("hamaker_attractive_j").bounded(2e-20, 5e-19),
+            FreeParameter::new("contact_potential_v").bounded(-1.0, 1.0),
+            FreeParameter::new("efficiency_nm_per_mw").bounded(0.05, 0.2),
+        ];
+        Setup {
+            truth,
+            start,
+            free,
+            true_values: [0.7, 1e-19, 0.2, 0.1],
+            dc: (0..10).map(|i| -0.4 + 1.2 * i as f64 / 9.0).collect(),
+        }
+    }
+
+    /// The static curve plus a six-amplitude AC curve, σ, A and η free, from the paper scene as
+    /// it is (φ = 0): `dynamic` fits in two stages (the static curve first), `dynamic-direct`
+    /// both curves at once, `dynamic-from-truth` from the truth, `dynamic-starts` with three
+    /// seeded starts per stage, `dynamic-tight` at rtol 1e-8. Returns the fit, the first
+    /// stage's evaluations and the true values.
+    #[allow(clippy::type_complexity)]
+    pub fn dynamic(
+        &self,
+        which: &str,
+        opts: &FitOptions,
+    ) -> Result<(FitResult, Option<usize>, [f64; 3]), hdi_tribology::Error> {
+        let mut truth = self.truth.clone();
+        if let Some(e) = truth.electrostatic.as_mut() {
+            e.contact_potential_v = 0.0;
+        }
+        let mut start = self.start.clone();
+        if let Some(e) = start.electrostatic.as_mut() {
+            e.contact_potential_v = 0.0;
+        }
+        // `dynamic-from-truth`: the same fit started at the truth (is a misfit the optimiser's
+        // or the model's?).
+        if which == "dynamic-from-truth" {
+            start = truth.clone();
+        }
+        // `dynamic-tight`: cycles at rtol 1e-8 (the scene's is 1e-6).
+        if which == "dynamic-tight" {
+            for s in [&mut truth, &mut start] {
+                s.solver.rtol = 1e-8;
+                s.solver.atol_m = 1e-16;
+            }
+        }
+        let free = [
+            self.free[0].clone(),
+            self.free[1].clone(),
+            self.free[3].clone(),
+        ];
+        let true_values = [0.7, 1e-19, 0.1];
+        let ac = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0];
+        let ac_grid = grid("ac_amplitude_v", &ac);
+        let ac_data = measure(&truth, &ac_grid, "cycle_vs_vac.csv", 0.05, 11);
+        let dc_grid = grid("dc_voltage_v", &self.dc);
+        let static_data = measure(&truth, &dc_grid, "static_vs_vdc.csv", 0.05, 7);
+        let data = [static_data, ac_data];
+        // The static curve first, then both from there (`dynamic-direct`: both at once from the
+        // start, which ends in a false minimum the goodness-of-fit tests reject).
+        let staged = (which != "dynamic-direct").then_some(1);
+        // `dynamic-starts`: three seeded starts in each stage (other minima as good as the best
+        // mark the parameters that differ between them as not determined).
+        let opts = if which == "dynamic-starts" {
+            FitOptions { starts: 3, ..*opts }
+        } else {
+            *opts
+        };
+        let (r, stage1) = timed_fit(
+            "static curve plus a 6-amplitude AC hysteresis curve (32 points), σ, A, η",
+            // At the start the cycle detects no take-off at zero amplitude (clipped, fitted
+            // against the programme's end): the baseline evaluation is timed at the truth.
+            &truth,
+            &start,
+            &data,
+            &free,
+            &true_values,
+            &opts,
+            staged,
+        )?;
+        Ok((r, stage1, true_values))
+    }
+}
+
+// Used by examples/docs_numbers.rs, which includes this file.
+#[allow(dead_code)]
+/// The numbers of the dynamic fits that docs/fit.md quotes, keyed `fit.<run>.…` (`run`:
+/// `dynamic`, `direct`, `from_truth`): χ² and its p value against the stated uncertainties, the
+/// smallest and largest distance of a fitted value from the truth in error bars, the largest
+/// deviation from the truth in per cent, the first stage's evaluations, and each parameter's
+/// linearity figure.
+pub fn doc_numbers(
+    run: &str,
+    r: &FitResult,
+    stage1: Option<usize>,
+    truth: &[f64],
+) -> Vec<doc_numbers::Quoted> {
+    use doc_numbers::Quoted;
+    let at = |what: &str| format!("fit.{run}.{what}");
+    let mut q = vec![Quoted::new(&at("chi2"), r.chi2)];
+    if let Some(g) = &r.goodness.chi2 {
+        q.push(Quoted::count(&at("dof"), g.dof as usize));
+        q.push(Quoted::power_of_ten(&at("p"), g.p_value).within(0.5 * g.p_value));
+        q.push(Quoted::new(&at("p_decimal"), g.p_value));
+    }
+    if let Some(n) = stage1 {
+        q.push(Quoted::count(&at("stage1_evaluations"), n));
+    }
+    let distances: Vec<f64> = r
+        .parameters
+        .iter()
+        .zip(truth)
+        .filter_map(|(p, t)| p.standard_error.map(|se| (p.value - t).abs() / se))
+        .collect();
+    if !distances.is_empty() {
+        let lo = distances.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = distances.iter().copied().fold(0.0, f64::max);
+        q.push(Quoted::new(&at("se_distance_min"), lo));
+        q.push(Quoted::new(&at("se_distance_max"), hi));
+    }
+    // The largest deviation of a fitted value from the truth, relative to the truth (%).
+    let rel = r
+        .parameters
+        .iter()
+        .zip(truth)
+        .map(|(p, t)| 100.0 * ((p.value - t) / t).abs())
+        .fold(0.0, f64::max);
+    q.push(Quoted::new(&at("max_rel_dev_pct"), rel));
+    for p in &r.parameters {
+        if let Some(l) = p.linearity {
+            q.push(Quoted::new(&at(&format!("linearity.{}", p.name)), l));
+        }
+    }
+    q
 }
 
 fn main() -> Result<(), hdi_tribology::Error> {
     let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());
-    // The truth: the paper scene with a contact potential of 0.2 V.
-    let mut truth = Scene::paper();
-    if let Some(e) = truth.electrostatic.as_mut() {
-        e.contact_potential_v = 0.2;
-    }
-    // The starting scene: every free parameter off by 10–30 %.
-    let mut start = truth.clone();
-    start.surface.height_sigma_m = 0.6e-9;
-    if let hdi_tribology::surface::PeakModel::RiceMaxima { sigma_m, .. } = &mut start.surface.peaks
-    {
-        *sigma_m = 0.6e-9;
-    }
-    if let Some(m) = start.intermolecular.as_mut() {
-        m.hamaker_attractive_j = 1.3e-19;
-    }
-    if let Some(e) = start.electrostatic.as_mut() {
-        e.contact_potential_v = 0.0;
-    }
-    start.heater.efficiency_m_per_w = 1.1e-7;
-    let free = vec![
-        FreeParameter::new("height_sigma_nm").bounded(0.3, 1.5),
-        FreeParameter::new("hamaker_attractive_j").bounded(2e-20, 5e-19),
-        FreeParameter::new("contact_potential_v").bounded(-1.0, 1.0),
-        FreeParameter::new("efficiency_nm_per_mw").bounded(0.05, 0.2),
-    ];
-    let true_values = [0.7, 1e-19, 0.2, 0.1];
-    let dc: Vec<f64> = (0..10).map(|i| -0.4 + 1.2 * i as f64 / 9.0).collect();
+    let setup = Setup::new();
+    let Setup {
+        truth,
+        start,
+        free,
+        true_values,
+        dc,
+    } = &setup;
     let static_data = measure(
-        &truth,
-        &grid("dc_voltage_v", &dc),
+        truth,
+        &grid("dc_voltage_v", dc),
         "static_vs_vdc.csv",
         0.05,
         7,
@@ -215,11 +376,11 @@ fn main() -> Result<(), hdi_tribology::Error> {
     if which == "static" || which == "both" || which == "static-fd" {
         timed_fit(
             "static: touchdown and take-off at 10 DC voltages (20 points), 4 parameters",
-            &start,
-            &start,
+            start,
+            start,
             std::slice::from_ref(&static_data),
-            &free,
-            &true_values,
+            free,
+            true_values,
             &opts,
             None,
         )?;
@@ -229,11 +390,11 @@ fn main() -> Result<(), hdi_tribology::Error> {
         // transitions' sensitivities, in the same run.
         timed_fit(
             "the same, Jacobian by finite differences of the whole model",
-            &start,
-            &start,
+            start,
+            start,
             std::slice::from_ref(&static_data),
-            &free,
-            &true_values,
+            free,
+            true_values,
             &FitOptions {
                 finite_difference_jacobian: true,
                 ..opts
@@ -293,57 +454,7 @@ fn main() -> Result<(), hdi_tribology::Error> {
         )?;
     }
     if which.starts_with("dynamic") || which == "both" {
-        // The paper scene as it is (φ = 0), with σ, A and η free.
-        let mut truth = truth.clone();
-        if let Some(e) = truth.electrostatic.as_mut() {
-            e.contact_potential_v = 0.0;
-        }
-        let mut start = start.clone();
-        if let Some(e) = start.electrostatic.as_mut() {
-            e.contact_potential_v = 0.0;
-        }
-        // `dynamic-from-truth`: the same fit started at the truth (is a misfit the optimiser's
-        // or the model's?).
-        if which == "dynamic-from-truth" {
-            start = truth.clone();
-        }
-        // `dynamic-tight`: cycles at rtol 1e-8 (the scene's is 1e-6).
-        if which == "dynamic-tight" {
-            for s in [&mut truth, &mut start] {
-                s.solver.rtol = 1e-8;
-                s.solver.atol_m = 1e-16;
-            }
-        }
-        let free = [free[0].clone(), free[1].clone(), free[3].clone()];
-        let true_values = [0.7, 1e-19, 0.1];
-        let ac = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0];
-        let ac_grid = grid("ac_amplitude_v", &ac);
-        let ac_data = measure(&truth, &ac_grid, "cycle_vs_vac.csv", 0.05, 11);
-        let dc_grid = grid("dc_voltage_v", &dc);
-        let static_data = measure(&truth, &dc_grid, "static_vs_vdc.csv", 0.05, 7);
-        let data = [static_data, ac_data];
-        // The static curve first, then both from there (`dynamic-direct`: both at once from the
-        // start, which ends in a false minimum the goodness-of-fit tests reject).
-        let staged = (which != "dynamic-direct").then_some(1);
-        // `dynamic-starts`: three seeded starts in each stage (other minima as good as the best
-        // mark the parameters that differ between them as not determined).
-        let opts = if which == "dynamic-starts" {
-            FitOptions { starts: 3, ..opts }
-        } else {
-            opts
-        };
-        timed_fit(
-            "static curve plus a 6-amplitude AC hysteresis curve (32 points), σ, A, η",
-            // At the start the cycle detects no take-off at zero amplitude (clipped, fitted
-            // against the programme's end): the baseline evaluation is timed at the truth.
-            &truth,
-            &start,
-            &data,
-            &free,
-            &true_values,
-            &opts,
-            staged,
-        )?;
+        setup.dynamic(&which, &opts)?;
     }
     Ok(())
 }

@@ -111,7 +111,7 @@ const MAPS: [MapSpec; 4] = [
         range: (6.5, 9.5),
         // 10 MHz – 1.3 GHz: k = 2E*a = 4e5 … 2e6 N/m, m = ρL³ with L = 2 … 30 µm.
         plausible: (7.0, 9.11),
-        label: "f_b (Hz)",
+        label: "f_{b} (Hz)",
     },
     MapSpec {
         name: "zeta",
@@ -120,7 +120,7 @@ const MAPS: [MapSpec; 4] = [
         range: (-4.0, 0.0),
         // radiation into the body, ζ ≈ 0.43/√B for B = m/(ρa³) = 1 … 1000, plus material loss.
         plausible: (-1.9, -0.37),
-        label: "ζ_b",
+        label: "ζ_{b}",
     },
     MapSpec {
         name: "lag_rigid",
@@ -568,20 +568,38 @@ const QUANTITIES: [Quantity; 3] = [
     ("ΔP (mW)", |p| {
         p.dp().filter(|&d| d >= 0.0).map(|d| d * 1e3)
     }),
-    ("P_TD (mW)", |p| p.td.map(|x| x * 1e3)),
-    ("P_TO (mW)", |p| p.to.map(|x| x * 1e3)),
+    ("P_{TD} (mW)", |p| p.td.map(|x| x * 1e3)),
+    ("P_{TO} (mW)", |p| p.to.map(|x| x * 1e3)),
 ];
 
+/// Size of a map figure (px), set for the two-column width of a journal (7 in).
+const MAP_SIZE: (u32, u32) = (1500, 600);
+
+/// A font of `pt` points at the printed width of [`MAP_SIZE`] (plotters sets glyphs at 1/1.24 of
+/// the size asked).
+fn map_font(pt: f64) -> f64 {
+    pt * 1.24 * MAP_SIZE.0 as f64 / (7.0 * 72.0)
+}
+
 fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> {
-    let root = SVGBackend::new(path, (1500, 520)).into_drawing_area();
+    let mut svg = String::new();
+    draw_map_svg(&mut svg, spec, points, n)?;
+    hdi_tribology::report::write_file(path, &hdi_tribology::report::typeset_svg(&svg))?;
+    Ok(())
+}
+
+/// The three panels (ΔP, P_TD, P_TO) of a map with their colour bars and the legend below, for
+/// print: no title (the caption is the document's), text at 8–9 pt at 7 in.
+fn draw_map_svg(out: &mut String, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> {
+    let (tick, axis) = (map_font(8.5), map_font(9.0));
+    let root = SVGBackend::with_string(out, MAP_SIZE).into_drawing_area();
     root.fill(&WHITE)?;
-    let (top, bottom) = root.split_vertically(470);
-    let top = top.titled(spec.title, ("sans-serif", 22))?;
+    let (top, bottom) = root.split_vertically(MAP_SIZE.1 - (4.4 * tick) as u32);
     let panels = top.split_evenly((1, 3));
     let dv = 1.0 / (n.max(2) - 1) as f64;
     let dy = (spec.range.1 - spec.range.0) / (n.max(2) - 1) as f64;
     for (panel, (name, value)) in panels.iter().zip(QUANTITIES) {
-        let (plot, bar) = panel.split_horizontally(400);
+        let (plot, bar) = panel.split_horizontally(panel.dim_in_pixel().0 - (3.6 * tick) as u32);
         let shown: Vec<f64> = points
             .iter()
             .filter(|p| p.status == Status::Fine)
@@ -597,10 +615,10 @@ fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> 
             (0.0, 1.0)
         };
         let mut chart = ChartBuilder::on(&plot)
-            .caption(name, ("sans-serif", 18))
+            .caption(name, ("sans-serif", axis))
             .margin(8)
-            .x_label_area_size(40)
-            .y_label_area_size(55)
+            .x_label_area_size((2.4 * tick) as u32)
+            .y_label_area_size((3.6 * tick) as u32)
             .build_cartesian_2d(
                 -dv / 2.0..1.0 + dv / 2.0,
                 spec.range.0 - dy / 2.0..spec.range.1 + dy / 2.0,
@@ -608,11 +626,13 @@ fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> 
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc("V_ac (V)")
+            .x_desc("V_{ac} (V)")
             .y_desc(spec.label)
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 15))
-            .y_label_formatter(&|y| format!("1e{y:.0}"))
+            .x_labels(3)
+            .x_label_formatter(&|v| hdi_tribology::report::snapped_tick_label(*v, 1.0))
+            .label_style(("sans-serif", tick))
+            .axis_desc_style(("sans-serif", axis))
+            .y_label_formatter(&|y| format!("10^{{{y:.0}}}"))
             .y_labels((spec.range.1 - spec.range.0).ceil() as usize + 1)
             .draw()?;
         chart.draw_series(points.iter().map(|p| {
@@ -648,19 +668,19 @@ fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> 
                 c.stroke_width(w),
             )))?;
         }
-        // Colour bar.
+        // Colour bar, level with the plot, its labels on the right.
         let mut cb = ChartBuilder::on(&bar)
-            .margin_top(38)
-            .margin_bottom(48)
-            .margin_right(5)
-            .y_label_area_size(55)
+            .margin_top((axis * 1.1) as u32 + 8)
+            .margin_bottom((2.4 * tick) as u32 + 8)
+            .margin_left(6)
+            .right_y_label_area_size((2.2 * tick) as u32)
             .build_cartesian_2d(0.0..1.0, lo..hi)?;
         cb.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .y_labels(6)
-            .label_style(("sans-serif", 13))
-            .y_label_formatter(&|v| format!("{v:.2}"))
+            .y_labels(5)
+            .label_style(("sans-serif", tick))
+            .y_label_formatter(&|v| format!("{v:.1}"))
             .draw()?;
         let steps = 100;
         cb.draw_series((0..steps).map(|i| {
@@ -672,38 +692,99 @@ fn draw_map(path: &Path, spec: &MapSpec, points: &[Point], n: usize) -> Res<()> 
             )
         }))?;
     }
+    // The legend in two rows under the panels: swatches of the statuses, then the outline and
+    // the dot.
     let legend = [
-        (
-            UNCONVERGED,
-            "not converged (moves > 0.05 mW at 10× rtol or by method)",
-        ),
-        (UNDETECTED, "no touchdown or no take-off"),
-        (
-            BLACK,
-            "runaway: hits the disk, bounces below the tables, or too many steps",
-        ),
+        (UNCONVERGED, "not converged"),
+        (UNDETECTED, "no touchdown or take-off"),
+        (BLACK, "runaway"),
         (NEGATIVE, "ΔP < 0 (ΔP panel)"),
     ];
-    let style = ("sans-serif", 15).into_font();
+    let style = ("sans-serif", tick).into_font();
+    let h = (tick / 1.24) as i32;
+    let (row1, row2) = ((0.6 * tick) as i32, (2.2 * tick) as i32);
     let mut x = 20;
     for (c, text) in legend {
-        bottom.draw(&Rectangle::new([(x, 15), (x + 18, 33)], c.filled()))?;
+        bottom.draw(&Rectangle::new([(x, row1), (x + h, row1 + h)], c.filled()))?;
         bottom.draw(&Rectangle::new(
-            [(x, 15), (x + 18, 33)],
+            [(x, row1), (x + h, row1 + h)],
             BLACK.stroke_width(1),
         ))?;
-        bottom.draw(&Text::new(text, (x + 24, 17), style.clone()))?;
-        x += 24 + 7 * text.chars().count() as i32 + 20;
+        bottom.draw(&Text::new(text, (x + h + 8, row1), style.clone()))?;
+        x += h + 8 + (text.chars().count() as f64 * 0.46 * tick) as i32 + 40;
     }
-    // The second line: the outline and the bounce mark.
     let outlined = "outlined: physically plausible band";
-    bottom.draw(&Text::new(outlined, (20, 38), style.clone()))?;
-    let x = 20 + 7 * outlined.chars().count() as i32 + 40;
-    bottom.draw(&Circle::new((x + 9, 45), 5, WHITE.filled()))?;
-    bottom.draw(&Circle::new((x + 9, 45), 5, BLACK.stroke_width(1)))?;
-    bottom.draw(&Text::new("bounces in the hold", (x + 20, 38), style))?;
+    bottom.draw(&Text::new(outlined, (20, row2), style.clone()))?;
+    let x = 20 + (outlined.chars().count() as f64 * 0.46 * tick) as i32 + 40;
+    bottom.draw(&Circle::new(
+        (x + h / 2, row2 + h / 2),
+        h / 3,
+        WHITE.filled(),
+    ))?;
+    bottom.draw(&Circle::new(
+        (x + h / 2, row2 + h / 2),
+        h / 3,
+        BLACK.stroke_width(1),
+    ))?;
+    bottom.draw(&Text::new("bounces in the hold", (x + h + 8, row2), style))?;
     root.present()?;
     Ok(())
+}
+
+/// The points of a map as [`write_points`] wrote them, to draw again without computing
+/// (`--replot DIR`).
+fn read_points(path: &Path) -> Res<Vec<Point>> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut out = Vec::new();
+    for line in text.lines().skip(1) {
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|c| c.parse::<f64>())
+            .collect::<Result<_, _>>()?;
+        // Maps written before the `model` column have 11 fields: every point the full model's.
+        let (v, model) = match v.len() {
+            11 => (&v[..], 0.0),
+            _ => (&v[..v.len().saturating_sub(1)], v[v.len() - 1]),
+        };
+        let [v_ac, param, td, to, _, status, bounce, cpu, steps, runs, cause] = v[..] else {
+            return Err(format!("{}: a row of {} fields", path.display(), v.len()).into());
+        };
+        let model = [Model::Full, Model::QuasiStatic, Model::Shared]
+            .into_iter()
+            .find(|m| m.code() == model)
+            .ok_or("unknown model")?;
+        let status = [
+            Status::Fine,
+            Status::Unconverged,
+            Status::Undetected,
+            Status::Runaway,
+        ]
+        .into_iter()
+        .find(|s| s.code() == status)
+        .ok_or("unknown status")?;
+        let cause = [
+            Cause::HitTheDisk,
+            Cause::LeftTheTables,
+            Cause::StepPace,
+            Cause::Other,
+        ]
+        .into_iter()
+        .find(|c| c.code() == cause);
+        out.push(Point {
+            v_ac,
+            param,
+            td: td.is_finite().then_some(td),
+            to: to.is_finite().then_some(to),
+            status,
+            cause,
+            bounce: bounce != 0.0,
+            cpu,
+            steps: steps as usize,
+            runs: runs as usize,
+            model,
+        });
+    }
+    Ok(out)
 }
 
 fn write_points(path: &Path, points: &[Point]) -> Res<()> {
@@ -1017,9 +1098,26 @@ fn main() -> Res<()> {
     let out = value("--out").unwrap_or_else(|| "out/maps".into());
     let out = Path::new(&out);
     std::fs::create_dir_all(out)?;
+    let names = value("--maps").unwrap_or_else(|| "freq,zeta,lag_rigid,lag_bulge".into());
+    // `--replot DIR`: draw the maps again from the CSV files of an earlier run, computing
+    // nothing.
+    if let Some(dir) = value("--replot") {
+        for spec in MAPS
+            .iter()
+            .filter(|s| names.split(',').any(|x| x == s.name))
+        {
+            let points = read_points(&Path::new(&dir).join(format!("{}.csv", spec.name)))?;
+            let n = (points.len() as f64).sqrt().round() as usize;
+            if n * n != points.len() {
+                return Err(format!("{}: not a square map", spec.name).into());
+            }
+            draw_map(&out.join(format!("{}.svg", spec.name)), spec, &points, n)?;
+            println!("{}: {} ({n} × {n}), drawn again", spec.name, spec.title);
+        }
+        return Ok(());
+    }
     let scene =
         Scene::from_path(value("--scene").unwrap_or_else(|| "scenes/paper_bulge.toml".into()))?;
-    let names = value("--maps").unwrap_or_else(|| "freq,zeta,lag_rigid,lag_bulge".into());
     let setup = Setup::from_scene(&scene)?;
     let checks = Checks {
         full: args.iter().any(|a| a == "--full-check"),

@@ -35,7 +35,11 @@ use hdi_tribology::scene::Scene;
 use std::path::Path;
 use std::time::Instant;
 
+#[path = "common/doc_numbers.rs"]
+#[allow(dead_code)]
+pub mod doc_numbers;
 #[path = "common/figures.rs"]
+#[allow(dead_code)]
 mod figures;
 #[path = "common/output.rs"]
 mod output;
@@ -44,7 +48,7 @@ type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
 /// What the command line asks for besides the output directory.
 #[derive(Clone, Debug, Default)]
-struct Options {
+pub struct Options {
     /// An ODE method other than the scene's.
     method: Option<Method>,
     /// Fig. 1 against the absolute heater power, the indicator in µN.
@@ -71,7 +75,7 @@ fn main() -> Res<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let options = Options::parse(&args)?;
     let out = output::out_dir("paper", &args)?;
-    run(&options, &out)
+    run(&options, &out).map(|_| ())
 }
 
 /// The fixed programme's colour and marker in every figure.
@@ -79,8 +83,20 @@ const FIXED: (Colour, Marker) = (palette::BLUE, Marker::Circle);
 /// The touchdown-triggered programme's colour and marker in every figure.
 const TRIGGERED: (Colour, Marker) = (palette::VERMILION, Marker::Triangle);
 
+/// What the example computed, for the numbers the docs quote ([`doc_numbers`]).
+pub struct Summary {
+    /// The rigid slider's static loop.
+    pub stat: StaticHysteresis,
+    /// The rigid slider's sweeps and single results.
+    pub rigid: Rigid,
+    /// The bulge's static loop and sweep.
+    pub bulge: Bulge,
+    /// The refinement every sweep used.
+    pub refine: Refinement,
+}
+
 /// Computes everything and writes the files into `out`.
-fn run(options: &Options, out: &Path) -> Res<()> {
+pub fn run(options: &Options, out: &Path) -> Res<Summary> {
     let clock = Instant::now();
     let scene = Scene::paper();
     let model = SliderModel::from_scene(&scene)?;
@@ -108,22 +124,22 @@ fn run(options: &Options, out: &Path) -> Res<()> {
             .map_err(|_| "the bulge sweep stopped unexpectedly")?;
         Ok((rigid?, bulge?))
     })?;
-    let (fixed_refined, trig_refined) = rigid;
+    let (fixed_refined, trig_refined) = (&rigid.fixed, &rigid.triggered);
 
     // The rigid and bulge panels of Fig. 3(d) and Fig. 4, on the same axes.
-    bulge.print(&fixed_refined, &stat);
+    bulge.print(fixed_refined, &stat);
     sweep_table(&bulge.fixed, options.wall_seconds)
         .write(&out.join("fig3d_hysteresis_vs_ac_bulge_fixed.csv"))?;
     let rigid_sweeps = [
         Sweep {
             name: "fixed programme",
             style: FIXED,
-            results: &fixed_refined,
+            results: fixed_refined,
         },
         Sweep {
             name: "touchdown-triggered programme",
             style: TRIGGERED,
-            results: &trig_refined,
+            results: trig_refined,
         },
     ];
     let bulge_sweeps = [Sweep {
@@ -144,8 +160,9 @@ fn run(options: &Options, out: &Path) -> Res<()> {
         fig4_chart(RIGID_TITLES[1], &rigid_sweeps, &refine),
         fig4_chart(BULGE_TITLES[1], &bulge_sweeps, &refine),
     ];
-    share_ranges(&mut fig3d);
-    share_ranges(&mut fig4);
+    share_ranges(&mut fig3d, true);
+    // Fig. 4's panels differ by a factor of ten in temperature: each fits its data.
+    share_ranges(&mut fig4, false);
     let files = [
         [
             "fig3d_hysteresis_vs_ac.svg",
@@ -166,7 +183,24 @@ fn run(options: &Options, out: &Path) -> Res<()> {
         out.display(),
         clock.elapsed().as_secs_f64()
     );
-    Ok(())
+    Ok(Summary {
+        stat,
+        rigid,
+        bulge,
+        refine,
+    })
+}
+
+/// The rigid slider's refined sweeps and the single numbers its figures rest on.
+pub struct Rigid {
+    /// The refined sweep under the fixed programme.
+    pub fixed: Vec<RefinedCycle>,
+    /// The refined sweep under the touchdown-triggered programme.
+    pub triggered: Vec<RefinedCycle>,
+    /// The x² coefficient of the parabola through ΔFH(V_dc) (m/V²).
+    pub parabola: f64,
+    /// The dither amplitude at 2f at 60 mW and 0.6 V: predicted, simulated (m).
+    pub dither: (f64, f64),
 }
 
 /// The rigid slider of the paper scene: prints its static analyses, writes every figure but
@@ -180,7 +214,7 @@ fn rigid_slider(
     stat: &StaticHysteresis,
     refine: &Refinement,
     amplitudes: &[f64],
-) -> Res<(Vec<RefinedCycle>, Vec<RefinedCycle>)> {
+) -> Res<Rigid> {
     let static_opts = StaticOptions::from_scene(scene);
     let mut opts = CycleOptions::from_scene(scene)?;
     if let Some(m) = options.method {
@@ -272,13 +306,16 @@ fn rigid_slider(
     let (s0, s6) = (series(&c0)?, series(&c6)?);
     s0.write_csv(&out.join("fig3a_forces_0V.csv"))?;
     s6.write_csv(&out.join("fig3c_forces_0.6V.csv"))?;
-    let (fig3a, fig3c) = fig3ac_charts(s0, s6);
+    let period = 0.5 / scene.voltage.ac_frequency_hz;
+    let (fig3a, fig3c) = fig3ac_charts(s0, s6, period);
     fig3a.to_svg(&out.join("fig3a_forces_0V.svg"), 1000, 550)?;
     fig3c.to_svg(&out.join("fig3c_forces_0.6V.svg"), 1000, 550)?;
+    let zoom = (2.0e-3, 2.2e-3);
+    fig3b_table(s6, zoom).write(&out.join("fig3b_zoom_0.6V.csv"))?;
     figures::zoom_chart(
         "Fig. 3(b) zoom, V_ac = 0.6 V: forces (left) and spacing (right)",
         s6,
-        (2.0e-3, 2.2e-3),
+        zoom,
     )
     .to_svg(&out.join("fig3b_zoom_0.6V.svg"), 1000, 550)?;
 
@@ -381,7 +418,74 @@ fn rigid_slider(
         nm(lr.dither_amplitude),
         nm(sim)
     );
-    Ok((fixed_refined, trig_refined))
+    Ok(Rigid {
+        fixed: fixed_refined,
+        triggered: trig_refined,
+        parabola: a,
+        dither: (lr.dither_amplitude, sim),
+    })
+}
+
+// Used by this example's test and by examples/docs_numbers.rs, which includes this file.
+#[allow(dead_code)]
+/// The numbers of this run that the docs quote (docs/analyses.md), keyed `paper.…`: the static
+/// loops, every refined sweep point (`paper.fixed.v0_6.dp_mw`: the fixed programme's hysteresis
+/// at 0.6 V in mW; `td_mw`, `to_mw`, `dt_k`, `rtol`; `triggered`, `bulge`), the parabola of
+/// Fig. 2(b) and the dither at 0.6 V.
+pub fn doc_numbers(s: &Summary) -> Vec<doc_numbers::Quoted> {
+    use doc_numbers::Quoted;
+    let mut q = vec![
+        Quoted::new("paper.refine_tol_mw", mw(s.refine.power_tol)),
+        Quoted::new("paper.parabola_nm_per_v2", nm(s.rigid.parabola)),
+        Quoted::new("paper.dither_predicted_nm", nm(s.rigid.dither.0)),
+        Quoted::new("paper.dither_simulated_nm", nm(s.rigid.dither.1)),
+    ];
+    for (name, stat) in [("rigid", &s.stat), ("bulge", &s.bulge.stat)] {
+        q.extend([
+            Quoted::new(
+                &format!("paper.{name}.static.td_mw"),
+                mw(stat.touchdown.power),
+            ),
+            Quoted::new(
+                &format!("paper.{name}.static.to_mw"),
+                mw(stat.takeoff.power),
+            ),
+            Quoted::new(&format!("paper.{name}.static.dp_mw"), mw(stat.hysteresis)),
+        ]);
+    }
+    let sweeps = [
+        ("fixed", &s.rigid.fixed),
+        ("triggered", &s.rigid.triggered),
+        ("bulge", &s.bulge.fixed),
+    ];
+    for (name, sweep) in sweeps {
+        for r in sweep.iter() {
+            let c = &r.cycle;
+            // `v0_6`: the amplitude to 0.1 V, as the docs name it.
+            let at = format!(
+                "paper.{name}.v{}",
+                format!("{:.1}", c.v_ac).replace('.', "_")
+            );
+            q.push(Quoted::new(&format!("{at}.dt_k"), c.mean_temperature_rise));
+            q.push(Quoted::power_of_ten(&format!("{at}.rtol"), r.rtol));
+            let detected = [
+                ("td_mw", c.touchdown.map(|d| d.power)),
+                ("to_mw", c.takeoff.map(|d| d.power)),
+                ("dp_mw", c.hysteresis),
+                // A take-off above the touchdown: a negative hysteresis, quoted as its size.
+                (
+                    "to_above_td_mw",
+                    c.hysteresis.filter(|h| *h < 0.0).map(|h| -h),
+                ),
+            ];
+            for (what, v) in detected {
+                if let Some(v) = v {
+                    q.push(Quoted::new(&format!("{at}.{what}"), mw(v)));
+                }
+            }
+        }
+    }
+    q
 }
 
 /// Size of each figure panel (px); the rigid and bulge panels of a figure are shown side by side.
@@ -399,7 +503,7 @@ const BULGE_TITLES: [&str; 2] = [
 
 /// The deformable slider of `scenes/paper_bulge.toml`: its static loop and its refined sweep
 /// under the fixed programme.
-struct Bulge {
+pub struct Bulge {
     stat: StaticHysteresis,
     fixed: Vec<RefinedCycle>,
     refine: Refinement,
@@ -512,10 +616,10 @@ fn summary_cells(r: &RefinedCycle) -> String {
 /// Width of the legend panel of Fig. 3(d) and Fig. 4 (px), the same on both panels.
 const LEGEND_WIDTH: u32 = 300;
 
-/// Gives the panels of one figure (all on the same kind of axes) the same x and y ranges, those
-/// that show every point of every panel, and the same legend width, so that the rigid and bulge
-/// panels compare at a glance.
-fn share_ranges(charts: &mut [Chart<'_>]) {
+/// Gives the panels of one figure (all on the same kind of axes) the same legend width and,
+/// with `ranges`, the same x and y ranges, those that show every point of every panel, so that
+/// the rigid and bulge panels compare at a glance; without, each panel's axes fit its data.
+fn share_ranges(charts: &mut [Chart<'_>], ranges: bool) {
     let log = charts.first().map_or((false, false), |c| c.log);
     let points = || {
         charts
@@ -541,8 +645,10 @@ fn share_ranges(charts: &mut [Chart<'_>]) {
     let x = span(&mut points().map(|p| p.0), log.0);
     let y = span(&mut points().map(|p| p.1), log.1);
     for c in charts.iter_mut() {
-        c.x_range = x;
-        c.y_range = y;
+        if ranges {
+            c.x_range = x;
+            c.y_range = y;
+        }
         c.legend_width = Some(LEGEND_WIDTH);
         // Each panel is set for the full two-column width (7 in): at one column its legend and
         // notes would leave no room for the plot.
@@ -631,31 +737,44 @@ fn status_series<'a>(
     sweep: &Sweep<'a>,
     labels: [&'a str; 3],
     point: impl Fn(&CycleResult, f64) -> (f64, f64),
+    label_vac: bool,
 ) -> Vec<Series<'a>> {
     let (colour, marker) = sweep.style;
-    let pick = |keep: &dyn Fn(&RefinedCycle, f64) -> bool| -> Vec<(f64, f64)> {
-        sweep
+    let pick = |keep: &dyn Fn(&RefinedCycle, f64) -> bool| {
+        let kept: Vec<(&RefinedCycle, f64)> = sweep
             .results
             .iter()
             .filter_map(|r| r.cycle.hysteresis.map(|h| (r, h)))
             .filter(|&(r, h)| keep(r, h))
-            .map(|(r, h)| point(&r.cycle, h))
-            .collect()
+            .collect();
+        let texts = kept
+            .iter()
+            .map(|(r, _)| match label_vac {
+                true => format!("{:.1}", r.cycle.v_ac),
+                false => String::new(),
+            })
+            .collect();
+        (
+            kept.iter().map(|&(r, h)| point(&r.cycle, h)).collect(),
+            texts,
+        )
     };
-    let good = pick(&|r, h| r.converged && h >= 0.0);
-    let moving = pick(&|r, h| !r.converged && h >= 0.0);
-    let negative = pick(&|_, h| h < 0.0);
+    let (good, good_texts) = pick(&|r, h| r.converged && h >= 0.0);
+    let (moving, moving_texts) = pick(&|r, h| !r.converged && h >= 0.0);
+    let (negative, negative_texts) = pick(&|_, h| h < 0.0);
     let mut out = vec![Series::markers(labels[0], good)
         .colour(colour)
         .marker(marker)
-        .width(5)];
+        .width(5)
+        .point_labels(good_texts)];
     if !moving.is_empty() {
         out.push(
             Series::markers(labels[1], moving)
                 .colour(colour)
                 .marker(marker)
                 .width(5)
-                .hollow(),
+                .hollow()
+                .point_labels(moving_texts),
         );
     }
     if !negative.is_empty() {
@@ -663,7 +782,8 @@ fn status_series<'a>(
             Series::markers(labels[2], negative)
                 .colour(colour)
                 .marker(Marker::Cross)
-                .width(5),
+                .width(5)
+                .point_labels(negative_texts),
         );
     }
     out
@@ -674,6 +794,7 @@ fn sweep_series<'a>(
     sweeps: &[Sweep<'a>],
     names: [&'a str; 2],
     point: impl Fn(&CycleResult, f64) -> (f64, f64) + Copy,
+    label_vac: bool,
 ) -> Vec<Series<'a>> {
     let labels = [
         [names[0], "fixed, not converged", "fixed, negative"],
@@ -682,7 +803,7 @@ fn sweep_series<'a>(
     sweeps
         .iter()
         .zip(labels)
-        .flat_map(|(sweep, labels)| status_series(sweep, labels, point))
+        .flat_map(|(sweep, labels)| status_series(sweep, labels, point, label_vac))
         .collect()
 }
 
@@ -697,18 +818,27 @@ fn marker_name(m: Marker) -> &'static str {
     }
 }
 
-/// Notes on what the hollow and crossed markers mean, and which amplitudes have no hysteresis
-/// to draw.
+/// Notes on what the hollow and crossed markers mean (where a panel shows them), and which
+/// amplitudes have no hysteresis to draw.
 fn status_notes(sweeps: &[Sweep<'_>], refine: &Refinement) -> Vec<String> {
-    let mut notes = vec![
-        format!(
+    let shown = |f: &dyn Fn(&RefinedCycle, f64) -> bool| {
+        sweeps
+            .iter()
+            .flat_map(|s| s.results.iter())
+            .any(|r| r.cycle.hysteresis.is_some_and(|h| f(r, h)))
+    };
+    let mut notes = Vec::new();
+    if shown(&|r, h| !r.converged && h >= 0.0) {
+        notes.push(format!(
             "Hollow: touchdown or take-off moved by more than {:.3} mW between two of the last {} \
              tolerances (intermittent contact): not converged.",
             mw(refine.power_tol),
             refine.agreeing_runs
-        ),
-        "Cross: negative hysteresis, not physical.".to_string(),
-    ];
+        ));
+    }
+    if shown(&|_, h| h < 0.0) {
+        notes.push("Cross: negative hysteresis, not physical.".to_string());
+    }
     for sweep in sweeps {
         let missing: Vec<String> = sweep
             .results
@@ -757,11 +887,26 @@ fn fig3d_chart<'a>(
         sweeps,
         ["fixed programme", "touchdown-triggered"],
         |c, h| (c.v_ac, mw(h)),
+        false,
     ));
+    // With both programmes, their markers are set a little either side of the amplitude, so
+    // that equal values do not hide one another.
+    let dodge = 0.012;
+    if sweeps.len() > 1 {
+        for s in series.iter_mut().filter(|s| s.markers) {
+            let dx = if s.colour == Some(TRIGGERED.0) {
+                dodge
+            } else {
+                -dodge
+            };
+            s.points.iter_mut().for_each(|p| p.0 += dx);
+        }
+    }
     let mut notes = vec![if sweeps.len() > 1 {
         format!(
             "The letter's Fig. 3(d) uses the fixed programme ({}); the experiment's protocol \
-             is the touchdown-triggered programme ({}).",
+             is the touchdown-triggered programme ({}). Their markers sit {dodge} V either side \
+             of the amplitude.",
             marker_name(FIXED.1),
             marker_name(TRIGGERED.1)
         )
@@ -786,6 +931,7 @@ fn fig4_chart<'a>(title: &'a str, sweeps: &'a [Sweep<'a>], refine: &Refinement) 
         sweeps,
         ["fixed programme", "touchdown-triggered (letter)"],
         |c, h| (mw(h), c.mean_temperature_rise),
+        true,
     );
     let mut notes = vec![match sweeps {
         [fixed, triggered, ..] => format!(
@@ -797,13 +943,24 @@ fn fig4_chart<'a>(title: &'a str, sweeps: &'a [Sweep<'a>], refine: &Refinement) 
         ),
         _ => FIXED_ONLY.to_string(),
     }];
+    notes.push("Beside each point: its V_{ac} (V).".to_string());
     notes.extend(status_notes(sweeps, refine));
+    // Room on the right of the points for their labels.
+    let (lo, hi) = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+    let pad = if hi > lo { hi - lo } else { 1.0 };
     Chart {
         title,
         x_label: "P_{TD} − P_{TO} (mW)",
         y_label: "mean ΔT (K)",
         series,
         notes,
+        x_range: (lo <= hi).then_some((lo - 0.05 * pad, hi + 0.25 * pad)),
         ..Chart::default()
     }
 }
@@ -836,11 +993,49 @@ fn fig2b_chart<'a>(volts: &[f64], dfh: &[f64], (a, b, c): (f64, f64, f64)) -> Ch
     }
 }
 
-/// Fig. 3(a) and (c): the forces over the whole cycle at 0 V and 0.6 V, on one y range.
-fn fig3ac_charts<'a>(s0: &TimeSeries, s6: &TimeSeries) -> (Chart<'a>, Chart<'a>) {
+/// The data of Fig. 3(b): every sample of the zoom's window, as the time series' CSV names
+/// its columns.
+fn fig3b_table(s: &TimeSeries, span: (f64, f64)) -> CsvTable {
+    let col = |f: fn(&TimeSeries, usize) -> f64| {
+        figures::window(s, span, f)
+            .into_iter()
+            .map(|p| p.1)
+            .collect::<Vec<f64>>()
+    };
+    CsvTable::new()
+        .real("t_s", col(|s, i| s.t[i]))
+        .real("total_n", col(|s, i| s.total[i]))
+        .real("electrostatic_n", col(|s, i| s.electrostatic[i]))
+        .real("air_bearing_n", col(|s, i| s.air_bearing[i]))
+        .real("d_m", col(|s, i| s.d[i]))
+}
+
+/// Fig. 3(a) and (c): the forces over the whole cycle at 0 V and 0.6 V, on one y range, each
+/// as its mean over one period of `V²` (`period`, s) with its range over the period shaded.
+fn fig3ac_charts<'a>(s0: &TimeSeries, s6: &TimeSeries, period: f64) -> (Chart<'a>, Chart<'a>) {
     let all = (f64::NEG_INFINITY, f64::INFINITY);
-    let mut a = figures::forces_chart("Fig. 3(a) forces, V_ac = 0 V", s0, all, None);
-    let mut c = figures::forces_chart("Fig. 3(c) forces, V_ac = 0.6 V", s6, all, None);
+    let note = format!(
+        "Lines: each force's mean over one period of V² ({:.1} µs); shaded: its range over \
+         that period.",
+        period * 1e6
+    );
+    let chart = |title, s| {
+        let (series, zero) = figures::force_envelopes(s, all, period);
+        let mut notes = vec![note.clone()];
+        if !zero.is_empty() {
+            notes.push(format!("Zero throughout, not drawn: {}.", zero.join(", ")));
+        }
+        Chart {
+            title,
+            x_label: "t (ms)",
+            y_label: "force (mN)",
+            series,
+            notes,
+            ..Chart::default()
+        }
+    };
+    let mut a = chart("Fig. 3(a) forces, V_ac = 0 V", s0);
+    let mut c = chart("Fig. 3(c) forces, V_ac = 0.6 V", s6);
     let range = match (a.data_y_range(), c.data_y_range()) {
         (Some(p), Some(q)) => Some((p.0.min(q.0), p.1.max(q.1))),
         (p, q) => p.or(q),
@@ -848,6 +1043,39 @@ fn fig3ac_charts<'a>(s0: &TimeSeries, s6: &TimeSeries) -> (Chart<'a>, Chart<'a>)
     a.y_range = range;
     c.y_range = range;
     (a, c)
+}
+
+/// Where Fig. 1 marks the direction of a cycle's loop `curve` (points in the order run): on
+/// the flying branch on the way up (the `k`-th cycle a little further along, so that the
+/// cycles' marks there do not cover each other), halfway up the jump into contact, halfway
+/// back along the contact branch, and on the drop at take-off.
+fn loop_arrows(curve: &[(f64, f64)], k: usize) -> Vec<usize> {
+    let top = curve.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+    if curve.len() < 4 || !top.is_finite() || top <= 0.0 {
+        return Vec::new();
+    }
+    // Up at half the top; down a quarter of the way up, below where the contact branch
+    // itself may sink before the head leaves.
+    let (Some(up), Some(down)) = (
+        curve.iter().position(|p| p.1 >= 0.5 * top),
+        curve.iter().rposition(|p| p.1 >= 0.25 * top),
+    ) else {
+        return Vec::new();
+    };
+    // The turn: the highest power, between the jump up and the drop.
+    let turn = (up..=down).max_by(|&a, &b| curve[a].0.total_cmp(&curve[b].0));
+    let nearest = |range: std::ops::Range<usize>, x: f64| {
+        range.min_by(|&a, &b| (curve[a].0 - x).abs().total_cmp(&(curve[b].0 - x).abs()))
+    };
+    let f = 0.45 + 0.2 * (k % 2) as f64;
+    let mut at = Vec::new();
+    at.extend(nearest(0..up, curve[0].0 + f * (curve[up].0 - curve[0].0)));
+    at.push(up);
+    if let Some(t) = turn {
+        at.extend(nearest(t..down, 0.5 * (curve[t].0 + curve[down].0)));
+    }
+    at.push(down);
+    at
 }
 
 /// Fig. 1: the contact indicator over touchdown-triggered cycles, with their touchdown and
@@ -876,11 +1104,12 @@ fn fig1_chart<'a>(
             move |p: f64| mw(p - origin),
             move |f: f64| if absolute { f * 1e6 } else { f / threshold },
         );
-        let curve = (0..s.t.len())
+        let curve: Vec<(f64, f64)> = (0..s.t.len())
             .filter(|&i| s.indicator[i].is_finite())
             .map(|i| (x(s.power[i]), y(s.indicator[i])))
             .collect();
-        lines.push(Series::line(label, curve).colour(colour));
+        let arrows = loop_arrows(&curve, k);
+        lines.push(Series::line(label, curve).colour(colour).arrows(arrows));
         let events: Vec<(f64, f64)> = [r.touchdown, r.takeoff]
             .iter()
             .flatten()
@@ -915,7 +1144,8 @@ fn fig1_chart<'a>(
     }
     notes.insert(
         0,
-        "Hollow diamonds: detected touchdown and take-off, where the running mean crosses F_{th}."
+        "Hollow diamonds: detected touchdown and take-off, where the running mean crosses F_{th}. \
+         Arrowheads: the way each cycle runs (power up, contact, power down, take-off)."
             .into(),
     );
     let (title, x_label, y_label) = if absolute {
@@ -947,7 +1177,12 @@ mod tests {
     #[test]
     fn example_runs() {
         let dir = tempfile::tempdir().unwrap();
-        super::run(&super::Options::default(), dir.path()).expect("the example runs to completion");
+        let summary = super::run(&super::Options::default(), dir.path())
+            .expect("the example runs to completion");
+        // The numbers docs/analyses.md quotes from this run are the run's.
+        let root = super::doc_numbers::repository_root();
+        let agreed = super::doc_numbers::assert_quoted(&root, &super::doc_numbers(&summary));
+        assert!(agreed > 0, "the docs quote numbers of the paper example");
         let table = std::fs::read_to_string(dir.path().join("fig4_triggered_sweep.csv")).unwrap();
         let header = table.lines().next().unwrap();
         assert!(header.starts_with("v_ac_v,") && !header.contains("wall_seconds"));

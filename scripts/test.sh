@@ -9,6 +9,9 @@ root=$PWD
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
 
 cargo test --all-features
+# The numbers the docs quote against the code (docs/architecture.md, "Numbers in the docs"):
+# about 9 s of CPU, mostly the paper example's sweeps; `-- --check --slow` adds the fits.
+cargo run --all-features --profile test --example docs_numbers -- --check >/dev/null
 # The `hdi` program that run built (the integration tests run it): the Python tests compare
 # against that same binary, so nothing is built again for them.
 if [ -z "${HDI_BIN:-}" ]; then

@@ -330,6 +330,15 @@ pub struct Series<'a> {
     pub dashed: bool,
     /// Plot against the chart's second y axis (on the right, [`Chart::y2_label`]).
     pub secondary: bool,
+    /// A shaded band instead of a line: the upper edge at each point, `points` giving the
+    /// lower edge ([`Series::band`]). Drawn under every line and marker.
+    pub upper: Vec<f64>,
+    /// Text beside each point (empty: none), placed where it overlaps no marker and no other
+    /// label; points closer than a label's height share one label ([`Series::point_labels`]).
+    pub labels: Vec<String>,
+    /// Arrowheads along a line at these point indices, pointing the way the points run (the
+    /// direction a loop is travelled).
+    pub arrows: Vec<usize>,
 }
 
 /// Builder methods that switch one `bool` field of [`Series`] on.
@@ -358,6 +367,30 @@ impl<'a> Series<'a> {
             markers: true,
             ..Self::line(label, points)
         }
+    }
+    /// A shaded band between `lower` (points `(x, y_lo)`) and `upper` (`y_hi` at the same x),
+    /// in the series colour, lightened; a band without a label stays out of the legend.
+    ///
+    /// ```
+    /// use hdi_tribology::report::Series;
+    /// let b = Series::band("range", vec![(0.0, -1.0), (1.0, -2.0)], vec![1.0, 2.0]);
+    /// assert_eq!(b.upper.len(), b.points.len());
+    /// ```
+    pub fn band(label: &'a str, lower: Vec<(f64, f64)>, upper: Vec<f64>) -> Self {
+        Series {
+            upper,
+            ..Self::line(label, lower)
+        }
+    }
+    /// With a text beside each point (`labels[i]` beside `points[i]`; empty for none).
+    pub fn point_labels(mut self, labels: Vec<String>) -> Self {
+        self.labels = labels;
+        self
+    }
+    /// With arrowheads at these point indices, pointing along the line.
+    pub fn arrows(mut self, at: Vec<usize>) -> Self {
+        self.arrows = at;
+        self
     }
     /// With this colour.
     pub fn colour(mut self, c: Colour) -> Self {
@@ -458,8 +491,8 @@ fn padded_span(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64
 }
 
 impl Chart<'_> {
-    /// The y range (with margin) that shows every drawable point of the primary-axis series,
-    /// to share between panels through [`Chart::y_range`].
+    /// The y range (with margin) that shows every drawable point of the primary-axis series
+    /// (and both edges of a band), to share between panels through [`Chart::y_range`].
     ///
     /// ```
     /// use hdi_tribology::report::{Chart, Series};
@@ -476,7 +509,11 @@ impl Chart<'_> {
         self.series
             .iter()
             .filter(move |s| s.secondary == secondary)
-            .flat_map(|s| s.points.iter().copied())
+            .flat_map(|s| {
+                // A band's upper edge counts as its points do.
+                let upper = s.points.iter().zip(&s.upper).map(|(p, &y)| (p.0, y));
+                s.points.iter().copied().chain(upper)
+            })
             .filter(move |&p| drawable(p, log))
     }
 }
@@ -496,6 +533,42 @@ const SUPERSAMPLE: u32 = 4;
 /// labels, legend, notes. No text is below 8 pt in print.
 #[cfg(feature = "plot")]
 const FONT_PT: (f64, f64, f64, f64) = (8.5, 9.0, 8.5, 8.0);
+
+/// Opacity of a band ([`Series::band`]).
+#[cfg(feature = "plot")]
+const BAND_ALPHA: f64 = 0.3;
+
+/// The triangle of an arrowhead of half-size `s` (pixels) centred on point `i` of a line
+/// (`px`: its points in pixels, `None` where not drawn), pointing from the line's points before
+/// it to those after it (the nearest ones at least `s` away); `None` where the line has no
+/// direction there.
+#[cfg(feature = "plot")]
+fn arrowhead(px: &[Option<(i32, i32)>], i: usize, s: i32) -> Option<Vec<(i32, i32)>> {
+    let p = (*px.get(i)?)?;
+    let far = |q: &(i32, i32)| (q.0 - p.0).abs().max((q.1 - p.1).abs()) >= s;
+    let after = px[i + 1..].iter().flatten().find(|q| far(q)).copied();
+    let before = px[..i].iter().rev().flatten().find(|q| far(q)).copied();
+    let (a, b) = match (before, after) {
+        (Some(a), Some(b)) => (a, b),
+        (None, Some(b)) => (p, b),
+        (Some(a), None) => (a, p),
+        (None, None) => return None,
+    };
+    let (dx, dy) = ((b.0 - a.0) as f64, (b.1 - a.1) as f64);
+    let n = dx.hypot(dy);
+    if n == 0.0 {
+        return None;
+    }
+    let (ux, uy) = (dx / n, dy / n);
+    let s = s as f64;
+    let at = |along: f64, across: f64| {
+        (
+            p.0 + (ux * along - uy * across).round() as i32,
+            p.1 + (uy * along + ux * across).round() as i32,
+        )
+    };
+    Some(vec![at(1.2 * s, 0.0), at(-s, 0.8 * s), at(-s, -0.8 * s)])
+}
 
 /// Text set for print: a hyphen-minus before a digit (or a decimal point) becomes a minus sign
 /// (U+2212), `_{…}` a subscript and `^{…}` a superscript (SVG `tspan`s). `text` is the escaped
@@ -550,9 +623,24 @@ pub fn typeset(text: &str) -> String {
 fn finish_svg(svg: &str, width: u32, height: u32) -> String {
     let k = SUPERSAMPLE;
     let big = format!(r#"width="{}" height="{}""#, width * k, height * k);
-    let svg = svg.replacen(&big, &format!(r#"width="{width}" height="{height}""#), 1);
+    typeset_svg(&svg.replacen(&big, &format!(r#"width="{width}" height="{height}""#), 1))
+}
+
+/// An SVG document with the content of every `text` element [`typeset`]: minus signs,
+/// subscripts (`V_{ac}`) and superscripts (`10^{-3}`) for print, for figures drawn outside
+/// [`Chart`].
+///
+/// ```
+/// use hdi_tribology::report::typeset_svg;
+/// let svg = r#"<svg><text x="1">V_{ac} = -1</text></svg>"#;
+/// assert_eq!(
+///     typeset_svg(svg),
+///     "<svg><text x=\"1\">V<tspan baseline-shift=\"sub\" font-size=\"75%\">ac</tspan> = \u{2212}1</text></svg>"
+/// );
+/// ```
+pub fn typeset_svg(svg: &str) -> String {
     let mut out = String::with_capacity(svg.len());
-    let mut rest = svg.as_str();
+    let mut rest = svg;
     while let Some(open) = rest.find("<text") {
         let Some(gt) = rest[open..].find('>') else {
             break;
@@ -801,7 +889,23 @@ impl Chart<'_> {
                     .copied()
                     .filter(|&p| drawable(p, log))
                     .collect();
-                if s.markers {
+                if !s.upper.is_empty() {
+                    let upper: Vec<(f64, f64)> = s
+                        .points
+                        .iter()
+                        .zip(&s.upper)
+                        .map(|(&(x, _), &y)| (x, y))
+                        .filter(|&p| drawable(p, log))
+                        .rev()
+                        .collect();
+                    let outline: Vec<(f64, f64)> = pts.iter().copied().chain(upper).collect();
+                    $chart
+                        .$method(std::iter::once(Polygon::new(
+                            outline,
+                            c.mix(BAND_ALPHA).filled(),
+                        )))
+                        .map_err(|e| err(&e))?;
+                } else if s.markers {
                     let size = if s.width == 0 { 4 } else { s.width as i32 };
                     $chart
                         .$method(
@@ -828,17 +932,104 @@ impl Chart<'_> {
                 }
             }};
         }
-        // The series on one axis: lines first, then markers on top.
+        // The series on one axis: bands first, then lines, then markers on top.
         macro_rules! draw_all {
             ($chart:ident . $method:ident, $secondary:expr) => {
-                for pass in [false, true] {
+                for pass in 0..3 {
                     for (s, c) in self.series.iter().zip(&colours) {
-                        if s.secondary == $secondary && s.markers == pass {
+                        let kind = if !s.upper.is_empty() {
+                            0
+                        } else if s.markers {
+                            2
+                        } else {
+                            1
+                        };
+                        if s.secondary == $secondary && kind == pass {
                             series_into!($chart.$method, s, *c);
                         }
                     }
                 }
             };
+        }
+        // Arrowheads and point labels of the primary-axis series, in the canvas's pixels.
+        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+        macro_rules! annotate {
+            ($chart:ident) => {{
+                let ki = k as i32;
+                let label_font = ("sans-serif", legend_px).into_font().color(&BLACK);
+                // Every marker is an obstacle to the labels.
+                for s in self.series.iter().filter(|s| s.markers && !s.secondary) {
+                    let r = ki * if s.width == 0 { 4 } else { s.width as i32 } + ki;
+                    for &p in s.points.iter().filter(|&&p| drawable(p, log)) {
+                        let (x, y) = $chart.backend_coord(&p);
+                        placed.push((x - r, y - r, x + r, y + r));
+                    }
+                }
+                for (s, c) in self.series.iter().zip(&colours) {
+                    if s.secondary {
+                        continue;
+                    }
+                    let px: Vec<Option<(i32, i32)>> = s
+                        .points
+                        .iter()
+                        .map(|&p| drawable(p, log).then(|| $chart.backend_coord(&p)))
+                        .collect();
+                    for &i in &s.arrows {
+                        if let Some(head) = arrowhead(&px, i, 5 * ki) {
+                            root.draw(&Polygon::new(head, c.filled()))
+                                .map_err(|e| err(&e))?;
+                        }
+                    }
+                    let h = (legend_px / 1.24) as i32;
+                    let width = |t: &str| (t.chars().count() as f64 * CHAR_EM * legend_px) as i32;
+                    let mut i = 0;
+                    while i < s.labels.len().min(px.len()) {
+                        // Points closer than a label's height share one label.
+                        let mut j = i + 1;
+                        let mut text = s.labels[i].clone();
+                        while let (Some(Some(a)), Some(Some(b))) = (px.get(i), px.get(j)) {
+                            if (a.0 - b.0).abs().max((a.1 - b.1).abs()) > h || j >= s.labels.len() {
+                                break;
+                            }
+                            if !s.labels[j].is_empty() {
+                                text = format!("{text}, {}", s.labels[j]);
+                            }
+                            j += 1;
+                        }
+                        if let (Some(p), false) = (px[i], text.is_empty()) {
+                            let (w, gap) = (width(&text), 4 * ki + h / 2);
+                            // Right of the point, above, below, left: a label to the left
+                            // reads as the right-hand label of the point before.
+                            let spots = [
+                                (p.0 + gap, p.1 - h / 2),
+                                (p.0 - w / 2, p.1 - gap - h),
+                                (p.0 - w / 2, p.1 + gap),
+                                (p.0 - gap - w, p.1 - h / 2),
+                            ];
+                            // Inside the plot, clear of the markers and the labels placed so far.
+                            let (xr, yr) = $chart.plotting_area().get_pixel_range();
+                            let inside = |&(x, y): &(i32, i32)| {
+                                x >= xr.start && x + w <= xr.end && y >= yr.start && y + h <= yr.end
+                            };
+                            let clear = |&(x, y): &(i32, i32)| {
+                                placed
+                                    .iter()
+                                    .all(|&(a, b, c, d)| x + w < a || x > c || y + h < b || y > d)
+                            };
+                            let (x, y) = spots
+                                .iter()
+                                .copied()
+                                .find(|s| inside(s) && clear(s))
+                                .or_else(|| spots.iter().copied().find(|s| inside(s)))
+                                .unwrap_or(spots[0]);
+                            placed.push((x, y, x + w, y + h));
+                            root.draw(&Text::new(text, (x, y), label_font.clone()))
+                                .map_err(|e| err(&e))?;
+                        }
+                        i = j;
+                    }
+                }
+            }};
         }
         macro_rules! primary {
             ($chart:ident) => {{
@@ -859,6 +1050,7 @@ impl Chart<'_> {
                     .draw()
                     .map_err(|e| err(&e))?;
                 draw_all!($chart.draw_series, false);
+                annotate!($chart);
             }};
         }
         macro_rules! build {
@@ -910,7 +1102,15 @@ impl Chart<'_> {
         for &i in &labelled {
             let (s, c) = (&self.series[i], colours[i]);
             let sym = (legend_px * 1.8) as i32;
-            if s.markers {
+            if !s.upper.is_empty() {
+                let half = (legend_px * 0.35) as i32;
+                legend_area
+                    .draw(&Rectangle::new(
+                        [(4 * ki, y - half), (4 * ki + sym, y + half)],
+                        c.mix(BAND_ALPHA).filled(),
+                    ))
+                    .map_err(|e| err(&e))?;
+            } else if s.markers {
                 let size = if s.width == 0 { 4 } else { s.width as i32 };
                 legend_area
                     .draw(&marker_element(
