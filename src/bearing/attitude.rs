@@ -11,7 +11,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::geometry::Bearing;
 use super::grid::nudged;
-use super::reynolds::{Attitude, Factored, Reynolds, REFERENCE_SPACING};
+use super::reynolds::{Attitude, Factored, Interrupt, Reynolds, REFERENCE_SPACING};
 use crate::error::AnalysisError;
 use crate::{Error, Result};
 
@@ -56,6 +56,9 @@ pub struct AttitudeOptions {
     pub max_iterations: usize,
     /// Solve on coarser grids first.
     pub coarse_to_fine: bool,
+    /// Asked between the linear solves whether to stop; kept by the [`Equilibrium`]'s
+    /// equation, so that its damping and curves stop too.
+    pub interrupt: Option<Interrupt>,
 }
 
 impl Default for AttitudeOptions {
@@ -69,6 +72,7 @@ impl Default for AttitudeOptions {
             tolerance: 1e-9,
             max_iterations: 40,
             coarse_to_fine: true,
+            interrupt: None,
         }
     }
 }
@@ -328,7 +332,8 @@ pub fn solve_attitude(bearing: &Bearing, opts: &AttitudeOptions) -> Result<Equil
     let mut levels = Vec::new();
     let last = sizes.len() - 1;
     for (k, &(a, c)) in sizes.iter().enumerate() {
-        let r = Reynolds::new(bearing, a, c);
+        let mut r = Reynolds::new(bearing, a, c);
+        r.interrupt = opts.interrupt.clone();
         let mut p = match &prev {
             Some((rc, pc, _)) => r.interpolate_from(rc, pc),
             None => r.ambient(),

@@ -138,6 +138,61 @@ pub struct Reynolds {
     pub tolerance: f64,
     /// Newton steps allowed.
     pub max_newton: usize,
+    /// Asked between the linear solves whether to stop (see [`Interrupt`]).
+    pub interrupt: Option<Interrupt>,
+}
+
+/// A check the solver asks between its linear solves (each Newton step of the pressure, each
+/// sensitivity and damping solve): when it says so, the solve stops with an error
+/// ([`Error::NoConvergence`], stopped on request). How a caller that watches for Ctrl-C, or a
+/// deadline, stops a long solve; a solve on the finest grids asks it every few tenths of a
+/// second.
+///
+/// ```
+/// use std::sync::atomic::{AtomicBool, Ordering};
+/// use std::sync::Arc;
+/// use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec, Interrupt};
+/// let b = BearingSpec::from_path(concat!(
+///     env!("CARGO_MANIFEST_DIR"),
+///     "/scenes/bearing/two_rail_taper_flat.toml"
+/// ))?
+/// .build()?;
+/// let stop = Arc::new(AtomicBool::new(true));
+/// let flag = stop.clone();
+/// let opts = AttitudeOptions {
+///     interrupt: Some(Interrupt::new(move || flag.load(Ordering::Relaxed))),
+///     ..AttitudeOptions::default()
+/// };
+/// let e = solve_attitude(&b, &opts).unwrap_err().to_string();
+/// assert!(e.contains("stopped on request"), "{e}");
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone)]
+pub struct Interrupt(std::sync::Arc<dyn Fn() -> bool + Send + Sync>);
+
+impl Interrupt {
+    /// A check that stops the solve when `stop` returns `true`.
+    pub fn new(stop: impl Fn() -> bool + Send + Sync + 'static) -> Self {
+        Interrupt(std::sync::Arc::new(stop))
+    }
+
+    /// Whether the check asks to stop.
+    pub fn requested(&self) -> bool {
+        (self.0)()
+    }
+}
+
+impl std::fmt::Debug for Interrupt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Interrupt")
+    }
+}
+
+impl PartialEq for Interrupt {
+    /// The same check (clones of one).
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 /// Patankar's power-law weight `A(|Pe|) = max(0, (1 − 0.1 |Pe|)⁵)` and its derivative.
@@ -263,6 +318,15 @@ impl Reynolds {
             yc,
             tolerance: 1e-10,
             max_newton: 60,
+            interrupt: None,
+        }
+    }
+
+    /// An error if the [`Interrupt`] asks to stop `what`.
+    fn check_interrupt(&self, what: &str) -> Result<()> {
+        match &self.interrupt {
+            Some(i) if i.requested() => Err(Error::no_convergence(what, "stopped on request")),
+            _ => Ok(()),
         }
     }
 
@@ -545,6 +609,7 @@ impl Reynolds {
                     ),
                 ));
             }
+            self.check_interrupt("air-bearing pressure")?;
             let ilu = refreshed(&mut mg, &a);
             let eta = forcing.next(rnorm);
             dp.iter_mut().for_each(|x| *x = 0.0);
@@ -718,6 +783,7 @@ impl Reynolds {
         let l = self.bearing.length;
         let pa = self.bearing.ambient_pressure;
         for q in 0..3 {
+            self.check_interrupt("air-bearing sensitivity")?;
             let dmax = dh[q].iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let eps = 1e-6 * hmax / dmax;
             for c in 0..n {
@@ -774,6 +840,7 @@ impl Reynolds {
         let n = p.len();
         let mut c = [[0.0; 3]; 3];
         for q in 0..3 {
+            self.check_interrupt("air-bearing damping")?;
             let mut rhs = vec![0.0; n];
             for j in 0..ny {
                 for i in 0..nx {
