@@ -24,7 +24,9 @@ fn bearing() -> ([[f64; 2]; 2], [[f64; 2]; 2], f64) {
     spec.grid.nx = 65;
     spec.grid.ny = 65;
     let eq = solve_attitude(&spec.build().unwrap(), &AttitudeOptions::default()).unwrap();
-    ReynoldsBearing::from_equilibrium(&eq).unwrap().heave_pitch()
+    ReynoldsBearing::from_equilibrium(&eq)
+        .unwrap()
+        .heave_pitch()
 }
 
 /// Coefficients `a₄ … a₀` of `det(λ² diag(m, I) + λ C + K)`, expanded by hand.
@@ -43,10 +45,19 @@ fn the_pitch_structure_takes_the_bearings_matrices() {
     let (k, c, lever) = bearing();
     // What makes them a film's coefficients, not a structure's: this could fail if the
     // bearing's matrices were symmetric or its pitch damping positive.
-    assert!((k[0][1] - k[1][0]).abs() > 0.1 * k[0][1].abs().max(k[1][0].abs()), "{k:?}");
-    assert!((c[0][1] - c[1][0]).abs() > 0.1 * c[0][1].abs().max(c[1][0].abs()), "{c:?}");
+    assert!(
+        (k[0][1] - k[1][0]).abs() > 0.1 * k[0][1].abs().max(k[1][0].abs()),
+        "{k:?}"
+    );
+    assert!(
+        (c[0][1] - c[1][0]).abs() > 0.1 * c[0][1].abs().max(c[1][0].abs()),
+        "{c:?}"
+    );
     assert!(c[1][1] < 0.0, "{c:?}");
-    assert!((lever - 1.0e-3).abs() < 1e-15, "the pivot is at the centre: {lever}");
+    assert!(
+        (lever - 1.0e-3).abs() < 1e-15,
+        "the pivot is at the centre: {lever}"
+    );
 
     // A structure built from symmetric springs still refuses them.
     let sym = Structure::general(
@@ -96,7 +107,10 @@ fn the_modes_are_the_roots_of_the_2x2_quadratic_eigenproblem() {
         .collect();
     let f = s.natural_frequencies(k[0][0]);
     for (got, want) in f.iter().zip(&exact) {
-        assert!((got - want).abs() <= 1e-10 * want, "{f:?} against {exact:?}");
+        assert!(
+            (got - want).abs() <= 1e-10 * want,
+            "{f:?} against {exact:?}"
+        );
     }
 
     // Damped: the four eigenvalues against det(λ²M + λC + K) = a₄λ⁴ + … + a₀.
@@ -131,11 +145,15 @@ fn the_modes_are_the_roots_of_the_2x2_quadratic_eigenproblem() {
     }
     // Each one a root: |det| small against the size of its terms.
     for x in &l {
-        let det = (x * x * MASS + x * c[0][0] + k[0][0]) * (x * x * INERTIA + x * c[1][1] + k[1][1])
+        let det = (x * x * MASS + x * c[0][0] + k[0][0])
+            * (x * x * INERTIA + x * c[1][1] + k[1][1])
             - (x * c[0][1] + k[0][1]) * (x * c[1][0] + k[1][0]);
         let size = (x.norm().powi(2) * MASS + x.norm() * c[0][0].abs() + k[0][0].abs())
             * (x.norm().powi(2) * INERTIA + x.norm() * c[1][1].abs() + k[1][1].abs());
-        assert!(det.norm() <= 1e-9 * size, "λ = {x}: det {det} against {size}");
+        assert!(
+            det.norm() <= 1e-9 * size,
+            "λ = {x}: det {det} against {size}"
+        );
     }
     // Real eigenvalues and complex pairs: the spectrum is closed under conjugation.
     for x in &l {
@@ -144,5 +162,5 @@ fn the_modes_are_the_roots_of_the_2x2_quadratic_eigenproblem() {
             "{x} without its conjugate in {l:?}"
         );
     }
-    println!("modes of the pitching slider on its bearing (1/s): {l:?}");
+    println!("heave-pitch K {k:?}, C {c:?}; modes (1/s): {l:?}");
 }

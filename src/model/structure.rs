@@ -148,11 +148,12 @@ impl Structure {
     ///
     /// ```
     /// use hdi_tribology::model::Structure;
-    /// let k = [[2.4e5, 4.8e1], [-9.6e1, 2.5e-2]];
-    /// let c = [[9.9, 3.4e-3], [-1.3e-2, -1.3e-6]];
-    /// let s = Structure::pitch_on_bearing(1.6e-6, 1.1e-12, k, c, 1e-3)?;
-    /// assert_eq!(s.stiffness_matrix()[(1, 0)], -9.6e1);
-    /// assert_eq!(s.damping_matrix()[(1, 1)], -1.3e-6);
+    /// // The example slider's bearing at 65² (tests/bearing_pitch_structure.rs).
+    /// let k = [[2.4e5, 1.23e2], [3.89e1, 0.106]];
+    /// let c = [[9.9, -4.5e-3], [3.4e-3, -6.6e-7]];
+    /// let s = Structure::pitch_on_bearing(4.1e-6, 1.4e-12, k, c, 1e-3)?;
+    /// assert_eq!(s.stiffness_matrix()[(1, 0)], 3.89e1);
+    /// assert_eq!(s.damping_matrix()[(1, 1)], -6.6e-7);
     /// assert_eq!(s.stiffness_matrix()[(0, 0)], 0.0); // the heave law's
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
@@ -718,10 +719,10 @@ enum Kind {
     /// Finite only: the coefficients of a gas film, a flow that the disk drives through the
     /// gap. Such a film is not a conservative spring: its stiffness is not the Hessian of an
     /// energy and need not be symmetric (the cross-coupled coefficients of fluid-film bearings,
-    /// Lund 1987), and the pressure lags the motion by the time the disk takes to carry the
-    /// gas along the slider, which makes the low-frequency pitch damping of an air-bearing
-    /// slider negative about a central pivot (docs/air_bearing.md, "Stiffness and damping"; the
-    /// non-symmetric stiffness and damping matrices of air-bearing sliders: Zeng & Bogy 1999).
+    /// Lund 1987; those of the gas-lubricated slider bearing, Ono 1975), and the pressure lags
+    /// the motion by the time the disk takes to carry the gas along the slider, which makes
+    /// the low-frequency pitch damping of an air-bearing slider negative about a central pivot
+    /// (docs/air_bearing.md, "Stiffness and damping", with its closed form).
     Film,
 }
 
