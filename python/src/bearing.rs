@@ -4,12 +4,13 @@
 
 use std::path::PathBuf;
 
-use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec};
+use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec, Interrupt};
+use hdi_tribology::ode::Cancel;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{invalid, to_py_err, OrPy};
+use super::{invalid, on_own_thread, to_py_err, OrPy};
 
 /// The equilibrium of a slider on its air bearing (see `bearing`).
 #[pyclass(module = "hdi_tribology", frozen)]
@@ -171,14 +172,21 @@ fn bearing(
         }
         other => to_py_err(other),
     })?;
-    let opts = AttitudeOptions::default();
-    let (eq, damping) = py
-        .detach(|| {
+    // On a thread of its own, watching a flag that Ctrl-C raises: the solve asks it between
+    // its linear solves and stops.
+    let opts = AttitudeOptions {
+        interrupt: Some(Interrupt::new(Cancel::requested)),
+        ..AttitudeOptions::default()
+    };
+    let (eq, damping) = on_own_thread(
+        py,
+        || {
             let eq = solve_attitude(&b, &opts)?;
             let c = eq.damping()?;
             Ok::<_, hdi_tribology::Error>((eq, c))
-        })
-        .py()?;
+        },
+        to_py_err,
+    )?;
     let a = eq.attitude;
     Ok(AirBearing {
         fly_height_nm: a.fly_height * 1e9,

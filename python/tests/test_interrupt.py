@@ -9,6 +9,8 @@ import time
 
 import pytest
 
+from conftest import REPO
+
 SCRIPT = r"""
 import sys, time
 import hdi_tribology as hdi
@@ -29,6 +31,9 @@ CALLS = {
     "sweep": "ac_sweep(model, [0.0005 * i for i in range(2000)], rtol=1e-12, threads=1)",
     "replay": "replay(model, [0.0, 30.0], [60.0, 60.0], [0.0, 0.0])",
     "forces": "forces(model, [1e6 + i for i in range(10**6)])",
+    # the air bearing on 1025 x 1025 control volumes: some 15 s of work on one core
+    "bearing": "bearing({!r}, cells=1025)".format(
+        str(REPO / "scenes" / "bearing" / "two_rail_taper_flat.toml")),
 }
 
 

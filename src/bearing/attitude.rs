@@ -12,7 +12,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::error::BearingError;
 use super::geometry::Bearing;
 use super::grid::nudged;
-use super::reynolds::{Attitude, Factored, Reynolds, REFERENCE_SPACING};
+use super::reynolds::{Attitude, Factored, Interrupt, Reynolds, REFERENCE_SPACING};
 use crate::{Error, Result};
 
 /// The smallest spacing the attitude solve lets the slider reach, m: a bearing that does not
@@ -56,6 +56,9 @@ pub struct AttitudeOptions {
     pub max_iterations: usize,
     /// Solve on coarser grids first.
     pub coarse_to_fine: bool,
+    /// Asked between the linear solves whether to stop; kept by the [`Equilibrium`]'s
+    /// equation, so that its damping and curves stop too.
+    pub interrupt: Option<Interrupt>,
 }
 
 impl Default for AttitudeOptions {
@@ -69,6 +72,7 @@ impl Default for AttitudeOptions {
             tolerance: 1e-9,
             max_iterations: 40,
             coarse_to_fine: true,
+            interrupt: None,
         }
     }
 }
@@ -127,9 +131,17 @@ struct LevelResult {
     spacing: Vec<f64>,
 }
 
-/// One Newton solve of the attitude on one grid; `p` is the start and the result. `jacobian`
-/// is the load Jacobian of a coarser grid, if any: it steers the steps until they stop
-/// converging fast, when the sensitivities on this grid replace it.
+/// What a coarser grid hands to the next: its load Jacobian, and its pressure derivatives
+/// interpolated onto the next grid.
+struct Coarser {
+    jacobian: [[f64; 3]; 3],
+    dps: [Vec<f64>; 3],
+}
+
+/// One Newton solve of the attitude on one grid; `p` is the start and the result. The load
+/// Jacobian of a coarser grid, if any, steers the steps until they stop converging fast, when
+/// the sensitivities on this grid replace it; their linear solves start from the coarser grid's
+/// pressure derivatives.
 fn solve_level(
     r: &Reynolds,
     start: Attitude,
@@ -137,7 +149,7 @@ fn solve_level(
     tol: f64,
     max_iterations: usize,
     final_level: bool,
-    jacobian: Option<[[f64; 3]; 3]>,
+    coarser: Option<Coarser>,
 ) -> Result<LevelResult> {
     let b = &r.bearing;
     let mut att = start;
@@ -148,8 +160,17 @@ fn solve_level(
         krylov_iterations: 0,
         imbalance: f64::INFINITY,
     };
-    let mut jac = jacobian;
+    let (mut jac, guess) = match coarser {
+        Some(c) => (Some(c.jacobian), Some(c.dps)),
+        None => (None, None),
+    };
     let mut dps: Option<[Vec<f64>; 3]> = None;
+    // Where the linear solves of the sensitivities start: the last ones on this grid, or the
+    // coarser grid's interpolated.
+    let n = p.len();
+    let mut guess = guess
+        .filter(|g| g.iter().all(|d| d.len() == n))
+        .unwrap_or_else(|| [vec![0.0; n], vec![0.0; n], vec![0.0; n]]);
     let mut last = f64::INFINITY;
     loop {
         let h = r.spacing(&att);
@@ -178,7 +199,8 @@ fn solve_level(
             } else {
                 STEP_SENSITIVITY_RTOL
             };
-            let (k, d, its) = r.sensitivities(p, &h, &fac, rtol)?;
+            let start = dps.unwrap_or(guess);
+            let (k, d, its) = r.sensitivities_from(p, &h, &fac, rtol, start)?;
             report.krylov_iterations += its;
             return Ok(LevelResult {
                 attitude: att,
@@ -199,7 +221,11 @@ fn solve_level(
             .into());
         }
         if jac.is_none() || report.imbalance > FAST_CONVERGENCE * last {
-            let (k, d, its) = r.sensitivities(p, &h, &fac, STEP_SENSITIVITY_RTOL)?;
+            let start = match dps.take() {
+                Some(d) => d,
+                None => std::mem::take(&mut guess),
+            };
+            let (k, d, its) = r.sensitivities_from(p, &h, &fac, STEP_SENSITIVITY_RTOL, start)?;
             report.krylov_iterations += its;
             jac = Some(k);
             dps = Some(d);
@@ -304,25 +330,30 @@ pub fn solve_attitude(bearing: &Bearing, opts: &AttitudeOptions) -> Result<Equil
     let mut levels = Vec::new();
     let last = sizes.len() - 1;
     for (k, &(a, c)) in sizes.iter().enumerate() {
-        let r = Reynolds::new(bearing, a, c);
+        let mut r = Reynolds::new(bearing, a, c);
+        r.interrupt = opts.interrupt.clone();
         let mut p = match &prev {
             Some((rc, pc, _)) => r.interpolate_from(rc, pc),
             None => r.ambient(),
         };
+        // The coarser grid's pressure derivatives on this grid: where the sensitivities' linear
+        // solves start, and the first-order move of the pressure below.
+        let coarse_dps: Option<[Vec<f64>; 3]> = prev
+            .as_ref()
+            .map(|(rc, _, d)| std::array::from_fn(|i| r.interpolate_from(rc, &d[i])));
         // From the third grid on, start from the attitude extrapolated from the two coarser
         // grids (second-order convergence: the error falls fourfold per halving), and move the
         // interpolated pressure there to first order.
         let mut start = att;
-        if let (Some(b0), Some((rc, _, dps))) = (before, &prev) {
+        if let (Some(b0), Some(dps)) = (before, &coarse_dps) {
             let q = att.to_array();
             let q0 = b0.to_array();
             let ext: [f64; 3] = std::array::from_fn(|i| q[i] + (q[i] - q0[i]) / EXTRAPOLATION);
             let moved = Attitude::from_array(ext);
             if r.min_spacing(&moved) > 0.5 * r.min_spacing(&att) {
-                for (i, d) in dps.iter().enumerate() {
-                    let di = r.interpolate_from(rc, d);
+                for (i, di) in dps.iter().enumerate() {
                     let dq = ext[i] - q[i];
-                    for (pc, dc) in p.iter_mut().zip(&di) {
+                    for (pc, dc) in p.iter_mut().zip(di) {
                         *pc += dc * dq;
                     }
                 }
@@ -337,7 +368,16 @@ pub fn solve_attitude(bearing: &Bearing, opts: &AttitudeOptions) -> Result<Equil
         } else {
             COARSE_TOLERANCE.max(opts.tolerance)
         };
-        let res = solve_level(&r, start, &mut p, tol, opts.max_iterations, k == last, jac)?;
+        let res = solve_level(
+            &r,
+            start,
+            &mut p,
+            tol,
+            opts.max_iterations,
+            k == last,
+            jac.zip(coarse_dps)
+                .map(|(jacobian, dps)| Coarser { jacobian, dps }),
+        )?;
         before = Some(att);
         att = res.attitude;
         jac = Some(res.jacobian);

@@ -10,10 +10,23 @@ impl Stage {
 /// Which linear solve of the air bearing fell short of its tolerance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Solve {
+    /// The pressure (Newton's method on the Reynolds equation).
+    Pressure,
     /// The pressure's sensitivities to the attitude (the stiffness).
     Sensitivity,
     /// The small-amplitude squeeze solve (the damping).
     Damping,
+}
+
+impl Solve {
+    /// The solve's name as the messages write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Solve::Pressure => "pressure",
+            Solve::Sensitivity => "sensitivity",
+            Solve::Damping => "damping",
+        }
+    }
 }
 
 /// Why the air bearing could not be solved. Numbers are in engineering units, as the field names
@@ -74,7 +87,7 @@ pub enum BearingError {
     /// A linear (GMRES) solve for the stiffness or damping fell short of its tolerance.
     #[error(
         "the {}: GMRES reached {relative_residual:.3e} in {iterations} iterations",
-        match .solve { Solve::Sensitivity => "sensitivity", Solve::Damping => "damping" }
+        .solve.name()
     )]
     Krylov {
         /// Which solve.
@@ -102,9 +115,15 @@ pub enum BearingError {
     /// The bearing's stiffness matrix is singular.
     #[error("the bearing's stiffness matrix is singular")]
     SingularStiffness,
+    /// The caller's [`Interrupt`](super::reynolds::Interrupt) asked the solve to stop.
+    #[error("stopped on request during the {} solve", .during.name())]
+    Interrupted {
+        /// The solve under way.
+        during: Solve,
+    },
 }
 
-failure_kind!(BearingError, convergence = |e| !matches!(e, BearingError::DoesNotFly { .. }), {
+failure_kind!(BearingError, convergence = |e| !matches!(e, BearingError::DoesNotFly { .. } | BearingError::Interrupted { .. }), {
         DoesNotFly => Stage::AIR_BEARING,
         Touches => Stage::AIR_BEARING,
         PressureNewton => Stage::AIR_BEARING,
@@ -112,4 +131,5 @@ failure_kind!(BearingError, convergence = |e| !matches!(e, BearingError::DoesNot
         Krylov => Stage::AIR_BEARING,
         AttitudeNewton => Stage::AIR_BEARING,
         SingularStiffness => Stage::AIR_BEARING,
+    Interrupted => Stage::AIR_BEARING,
 });

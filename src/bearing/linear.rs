@@ -158,77 +158,127 @@ impl FivePoint {
 #[derive(Clone, Debug)]
 pub struct Ilu0 {
     nx: usize,
-    /// Reciprocals of the pivots of `U` (the backward sweep multiplies: a division would
-    /// lengthen its chain of dependent operations).
-    inv_pivot: Vec<f64>,
-    /// Multipliers of `L` (west, south).
-    lw: Vec<f64>,
-    ls: Vec<f64>,
-    /// Off-diagonals of `U` (east, north), those of `A`.
-    ue: Vec<f64>,
-    un: Vec<f64>,
+    /// Multipliers of `L` (west, south), what the forward sweep reads, side by side.
+    lower: Vec<[f64; 2]>,
+    /// Off-diagonals of `U` (east, north; those of `A`) and the reciprocal of its pivot (the
+    /// backward sweep multiplies: a division would lengthen its chain of dependent operations),
+    /// what the backward sweep reads, side by side.
+    upper: Vec<[f64; 3]>,
 }
 
 impl Ilu0 {
     /// Factorises `a`; a vanishing pivot is replaced by a small one of the row's scale.
-    pub fn new(a: &FivePoint) -> Ilu0 {
+    pub fn new(a: &FivePoint) -> Self {
+        let mut f = Ilu0 {
+            nx: a.nx,
+            lower: Vec::new(),
+            upper: Vec::new(),
+        };
+        f.refactor(a);
+        f
+    }
+
+    /// Factorises `a` in place of the factors held (their storage is reused).
+    pub fn refactor(&mut self, a: &FivePoint) {
         let nx = a.nx;
         let n = a.diag.len();
-        let mut pivot = vec![0.0; n];
-        let mut lw = vec![0.0; n];
-        let mut ls = vec![0.0; n];
+        self.nx = nx;
+        self.lower.clear();
+        self.lower.resize(n, [0.0; 2]);
+        self.upper.clear();
+        self.upper.resize(n, [0.0; 3]);
+        // The pivots of the row below (by column) and of the west neighbour.
+        let mut pivot_prev_row = vec![0.0; nx.min(n)];
+        let mut west_pivot = 0.0;
         for c in 0..n {
+            let i = c % nx;
             let mut d = a.diag[c];
             if c >= 1 && a.west[c] != 0.0 {
-                lw[c] = a.west[c] / pivot[c - 1];
-                d -= lw[c] * a.east[c - 1];
+                let lw = a.west[c] / west_pivot;
+                d -= lw * a.east[c - 1];
+                self.lower[c][0] = lw;
             }
             if c >= nx && a.south[c] != 0.0 {
-                ls[c] = a.south[c] / pivot[c - nx];
-                d -= ls[c] * a.north[c - nx];
+                let ls = a.south[c] / pivot_prev_row[i];
+                d -= ls * a.north[c - nx];
+                self.lower[c][1] = ls;
             }
             if d.abs() < 1e-14 * a.diag[c].abs().max(f64::MIN_POSITIVE) {
                 d = 1e-14 * a.diag[c].abs().max(1.0);
             }
-            pivot[c] = d;
-        }
-        let inv_pivot = pivot.iter().map(|d| 1.0 / d).collect();
-        Ilu0 {
-            nx,
-            inv_pivot,
-            lw,
-            ls,
-            ue: a.east.clone(),
-            un: a.north.clone(),
+            pivot_prev_row[i] = d;
+            west_pivot = d;
+            self.upper[c] = [a.east[c], a.north[c], 1.0 / d];
         }
     }
 
     /// `x = (L U)⁻¹ x`, in place.
+    ///
+    /// Each sweep is a chain of dependent operations along a row (a cell needs its west or
+    /// east neighbour's result) and across rows (its south or north neighbour's). Rows are
+    /// swept four at a time, each a cell behind the one before it, so that the
+    /// processor works on that many independent chains at once; every cell still sees its
+    /// neighbours' final values, so the result is the row-by-row sweep's to the bit.
     pub fn solve(&self, x: &mut [f64]) {
         let nx = self.nx;
         let n = x.len();
+        if nx == 0 || n == 0 {
+            return;
+        }
+        let ny = n / nx;
+        let (lo, up) = (&self.lower[..n], &self.upper[..n]);
         // Forward: the first row has west neighbours only, the rest south ones too.
         for c in 1..nx.min(n) {
-            x[c] -= self.lw[c] * x[c - 1];
+            x[c] -= lo[c][0] * x[c - 1];
         }
-        for c in nx..n {
-            x[c] -= self.lw[c] * x[c - 1] + self.ls[c] * x[c - nx];
+        let mut j0 = 1;
+        while j0 < ny {
+            let rows = WAVEFRONT.min(ny - j0);
+            for t in 0..nx + rows - 1 {
+                for r in 0..rows {
+                    if t < r || t - r >= nx {
+                        continue;
+                    }
+                    let i = t - r;
+                    let c = (j0 + r) * nx + i;
+                    let [w, s] = lo[c];
+                    let west = if i > 0 { w * x[c - 1] } else { 0.0 };
+                    x[c] -= west + s * x[c - nx];
+                }
+            }
+            j0 += rows;
         }
         // Backward: the last row has east neighbours only.
         let top = n.saturating_sub(nx);
         for c in (top..n).rev() {
-            let east = if c + 1 < n {
-                self.ue[c] * x[c + 1]
-            } else {
-                0.0
-            };
-            x[c] = (x[c] - east) * self.inv_pivot[c];
+            let [e, _, inv] = up[c];
+            let east = if c + 1 < n { e * x[c + 1] } else { 0.0 };
+            x[c] = (x[c] - east) * inv;
         }
-        for c in (0..top).rev() {
-            x[c] = (x[c] - self.un[c] * x[c + nx] - self.ue[c] * x[c + 1]) * self.inv_pivot[c];
+        // Rows ny − 2 down to 0, in blocks whose top row is `j1`.
+        let mut done = 1;
+        while done < ny {
+            let rows = WAVEFRONT.min(ny - done);
+            let j1 = ny - 1 - done;
+            for t in 0..nx + rows - 1 {
+                for r in 0..rows {
+                    if t < r || t - r >= nx {
+                        continue;
+                    }
+                    let i = nx - 1 - (t - r);
+                    let c = (j1 - r) * nx + i;
+                    let [e, no, inv] = up[c];
+                    let east = if i + 1 < nx { e * x[c + 1] } else { 0.0 };
+                    x[c] = (x[c] - no * x[c + nx] - east) * inv;
+                }
+            }
+            done += rows;
         }
     }
 }
+
+/// Rows an [`Ilu0`] sweep works on at once (eight were no faster on the example slider).
+const WAVEFRONT: usize = 4;
 
 impl Preconditioner for Ilu0 {
     fn apply(&self, x: &mut [f64]) {
@@ -299,9 +349,17 @@ fn agg(i: usize, nc: usize) -> usize {
 }
 
 fn coarsen(a: &FivePoint) -> FivePoint {
+    let mut c = FivePoint::zeros(a.nx / 2, a.ny / 2);
+    coarsen_into(a, &mut c);
+    c
+}
+
+/// The coarse matrix of `a` into `c` (of `a`'s sides halved).
+fn coarsen_into(a: &FivePoint, c: &mut FivePoint) {
     let (nx, ny) = (a.nx, a.ny);
     let (mx, my) = (nx / 2, ny / 2);
-    let mut c = FivePoint::zeros(mx, my);
+    debug_assert_eq!((c.nx, c.ny), (mx, my));
+    c.clear();
     for j in 0..ny {
         let jc = agg(j, my);
         for i in 0..nx {
@@ -339,7 +397,6 @@ fn coarsen(a: &FivePoint) -> FivePoint {
             }
         }
     }
-    c
 }
 
 impl Multigrid {
@@ -374,34 +431,91 @@ impl Multigrid {
                 e2: vec![0.0; m],
             });
         }
-        let coarsest = if levels.len() > 1 {
-            let a = &levels[levels.len() - 1].a;
-            let n = a.nx * a.ny;
-            let mut m = DMatrix::<f64>::zeros(n, n);
-            for k in 0..n {
-                m[(k, k)] = a.diag[k];
-                if k >= 1 {
-                    m[(k, k - 1)] = a.west[k];
-                }
-                if k + 1 < n {
-                    m[(k, k + 1)] = a.east[k];
-                }
-                if k >= a.nx {
-                    m[(k, k - a.nx)] = a.south[k];
-                }
-                if k + a.nx < n {
-                    m[(k, k + a.nx)] = a.north[k];
-                }
-            }
-            Some(m.lu())
-        } else {
-            None
-        };
+        let coarsest = Self::coarsest_lu(&levels);
         Multigrid {
             rhs: RefCell::new(Vec::with_capacity(a.diag.len())),
             levels,
             coarsest,
         }
+    }
+
+    /// The multigrid of `a`, a matrix of the same size as the one it was built for, in place:
+    /// the levels' matrices and smoothers are recomputed in their storage (a Newton iteration
+    /// builds one per step). A matrix of another size builds a new hierarchy.
+    ///
+    /// ```
+    /// use hdi_tribology::bearing::linear::{gmres, FivePoint, Multigrid};
+    /// let (nx, ny) = (32, 32);
+    /// let laplace = |d: f64| {
+    ///     let mut a = FivePoint::zeros(nx, ny);
+    ///     for c in 0..nx * ny {
+    ///         a.diag[c] = d;
+    ///         if c % nx > 0 { a.west[c] = -1.0; }
+    ///         if c % nx + 1 < nx { a.east[c] = -1.0; }
+    ///         if c >= nx { a.south[c] = -1.0; }
+    ///         if c + nx < nx * ny { a.north[c] = -1.0; }
+    ///     }
+    ///     a
+    /// };
+    /// let mut mg = Multigrid::new(&laplace(4.0));
+    /// let a = laplace(4.5);
+    /// mg.refresh(&a);
+    /// let mut x = vec![0.0; nx * ny];
+    /// let stats = gmres(&a, &mg, &vec![1.0; nx * ny], &mut x, 1e-10, 30, 200);
+    /// assert!(stats.relative_residual <= 1e-10);
+    /// ```
+    pub fn refresh(&mut self, a: &FivePoint) {
+        let l0 = &self.levels[0].a;
+        if (l0.nx, l0.ny) != (a.nx, a.ny) {
+            *self = Multigrid::new(a);
+            return;
+        }
+        for k in 0..self.levels.len() {
+            let (done, rest) = self.levels.split_at_mut(k);
+            let level = &mut rest[0];
+            match done.last() {
+                None => {
+                    for (dst, src) in [
+                        (&mut level.a.diag, &a.diag),
+                        (&mut level.a.west, &a.west),
+                        (&mut level.a.east, &a.east),
+                        (&mut level.a.south, &a.south),
+                        (&mut level.a.north, &a.north),
+                    ] {
+                        dst.copy_from_slice(src);
+                    }
+                }
+                Some(finer) => coarsen_into(&finer.a, &mut level.a),
+            }
+            level.ilu.refactor(&level.a);
+        }
+        self.coarsest = Self::coarsest_lu(&self.levels);
+    }
+
+    /// Dense LU of the coarsest level (none with a single level).
+    fn coarsest_lu(levels: &[Level]) -> Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> {
+        if levels.len() < 2 {
+            return None;
+        }
+        let a = &levels[levels.len() - 1].a;
+        let n = a.nx * a.ny;
+        let mut m = DMatrix::<f64>::zeros(n, n);
+        for k in 0..n {
+            m[(k, k)] = a.diag[k];
+            if k >= 1 {
+                m[(k, k - 1)] = a.west[k];
+            }
+            if k + 1 < n {
+                m[(k, k + 1)] = a.east[k];
+            }
+            if k >= a.nx {
+                m[(k, k - a.nx)] = a.south[k];
+            }
+            if k + a.nx < n {
+                m[(k, k + a.nx)] = a.north[k];
+            }
+        }
+        Some(m.lu())
     }
 
     fn cycle(&self, l: usize, b: &[f64], x: &mut [f64]) {
@@ -495,8 +609,25 @@ pub struct KrylovStats {
     pub relative_residual: f64,
 }
 
+/// `aᵀb`, summed in four interleaved partial sums: one running sum is a chain of dependent
+/// additions, four keep the processor's adders busy.
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut s = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for k in 0..4 {
+            s[k] += x[k] * y[k];
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 fn norm(a: &[f64]) -> f64 {
@@ -536,20 +667,30 @@ pub fn gmres(
     let bnorm = norm(b).max(f64::MIN_POSITIVE);
     let ilu = m;
     let m = restart.max(1);
-    let mut v: Vec<Vec<f64>> = vec![vec![0.0; n]; m + 1];
-    // Flexible GMRES: the preconditioned vectors are kept, so the preconditioner may vary.
-    let mut zs: Vec<Vec<f64>> = vec![vec![0.0; n]; m];
-    let mut w = vec![0.0; n];
+    // The Krylov basis and its preconditioned vectors are this thread's, kept from one call to
+    // the next: allocating 2 × restart vectors per call cost more than the orthogonalisation
+    // (fresh pages each time).
+    let mut guard = KRYLOV_WORK.with(|w| w.take());
+    let KrylovWork { v, zs, w } = &mut guard;
+    v.resize_with(m + 1, Vec::new);
+    zs.resize_with(m, Vec::new);
+    for x in v
+        .iter_mut()
+        .chain(zs.iter_mut())
+        .chain(std::iter::once(&mut *w))
+    {
+        x.resize(n, 0.0);
+    }
     let mut h = vec![vec![0.0; m]; m + 1];
     let (mut cs, mut sn, mut g) = (vec![0.0; m], vec![0.0; m], vec![0.0; m + 1]);
     let mut iters = 0;
     let mut rel;
     loop {
-        a.apply(x, &mut w);
+        a.apply(x, w);
         for k in 0..n {
             w[k] = b[k] - w[k];
         }
-        let beta = norm(&w);
+        let beta = norm(w);
         rel = beta / bnorm;
         if rel <= rtol || iters >= max_iter {
             break;
@@ -563,17 +704,17 @@ pub fn gmres(
         for j in 0..m {
             zs[j].copy_from_slice(&v[j]);
             ilu.apply(&mut zs[j]);
-            a.apply(&zs[j], &mut w);
+            a.apply(&zs[j], w);
             iters += 1;
             // Modified Gram–Schmidt.
             for i in 0..=j {
-                let hij = dot(&w, &v[i]);
+                let hij = dot(w, &v[i]);
                 h[i][j] = hij;
                 for (wk, vk) in w.iter_mut().zip(&v[i]) {
                     *wk -= hij * vk;
                 }
             }
-            let hn = norm(&w);
+            let hn = norm(w);
             h[j + 1][j] = hn;
             if hn > 0.0 {
                 for k in 0..n {
@@ -617,8 +758,22 @@ pub fn gmres(
             }
         }
     }
+    KRYLOV_WORK.with(|w| w.replace(guard));
     KrylovStats {
         iterations: iters,
         relative_residual: rel,
     }
+}
+
+/// The work vectors of [`gmres`]: the Krylov basis `v`, its preconditioned vectors `zs`, and
+/// one vector for the products.
+#[derive(Default)]
+struct KrylovWork {
+    v: Vec<Vec<f64>>,
+    zs: Vec<Vec<f64>>,
+    w: Vec<f64>,
+}
+
+thread_local! {
+    static KRYLOV_WORK: RefCell<KrylovWork> = RefCell::default();
 }

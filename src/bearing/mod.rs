@@ -29,4 +29,4 @@ pub use geometry::{
     Bearing, BearingSpec, GridSpec, OperatingConditions, Polygon, Region, SliderGeometry, Taper,
 };
 pub use grid::Grid;
-pub use reynolds::{Attitude, NewtonStats, Reynolds, Sides};
+pub use reynolds::{Attitude, Interrupt, NewtonStats, Reynolds, Sides};

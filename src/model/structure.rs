@@ -135,6 +135,56 @@ impl Structure {
         Ok(s)
     }
 
+    /// Body heave (mass `body_mass`, kg) and pitch (inertia `inertia`, kg m²) on an air bearing
+    /// whose heave–pitch stiffness `k` and damping `c` (2 × 2, rows heave force and pitch
+    /// moment, columns heave and pitch; N/m, N/rad, N m/m, N m/rad and the same times s) come
+    /// from its Reynolds equation, with the bulge at `trailing_edge` (m) from the pivot:
+    /// [`ReynoldsBearing::heave_pitch`](crate::force::ReynoldsBearing::heave_pitch) gives the
+    /// three. The heave entries `k[0][0]`, `c[0][0]` are the bearing's heave law on coordinate
+    /// 0, not part of the structure's matrices; the others are.
+    ///
+    /// Unlike [`Structure::pitch`], the matrices need not be symmetric and the pitch damping
+    /// may be negative: they are the coefficients of a gas film that the disk drives, not
+    /// springs and dampers (see `docs/air_bearing.md`).
+    ///
+    /// ```
+    /// use hdi_tribology::model::Structure;
+    /// // The example slider's bearing at 65² (tests/bearing_pitch_structure.rs).
+    /// let k = [[2.4e5, 1.23e2], [3.89e1, 0.106]];
+    /// let c = [[9.9, -4.5e-3], [3.4e-3, -6.6e-7]];
+    /// let s = Structure::pitch_on_bearing(4.1e-6, 1.4e-12, k, c, 1e-3)?;
+    /// assert_eq!(s.stiffness_matrix()[(1, 0)], 3.89e1);
+    /// assert_eq!(s.damping_matrix()[(1, 1)], -6.6e-7);
+    /// assert_eq!(s.stiffness_matrix()[(0, 0)], 0.0); // the heave law's
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn pitch_on_bearing(
+        body_mass: f64,
+        inertia: f64,
+        k: [[f64; 2]; 2],
+        c: [[f64; 2]; 2],
+        trailing_edge: f64,
+    ) -> Result<Self> {
+        check_positive("slider.mass_kg", body_mass)?;
+        check_positive("structure.inertia_kg_m2", inertia)?;
+        check_finite("structure.trailing_edge_m", trailing_edge)?;
+        let off = |m: [[f64; 2]; 2]| [[0.0, m[0][1]], [m[1][0], m[1][1]]];
+        let mut s = Self::build_as(
+            2,
+            &[[body_mass, 0.0], [0.0, inertia]],
+            &off(c),
+            &off(k),
+            &[1.0, trailing_edge],
+            "air_bearing",
+            Kind::Film,
+        )?;
+        if trailing_edge != 0.0 {
+            s.length_scale[1] = trailing_edge.abs();
+        }
+        s.base[0] = 1.0;
+        Ok(s)
+    }
+
     /// Any structure of 1 to [`MAX_DOF`] coordinates: `M`, `C`, `K` (rows) and the bulge
     /// influence vector `b`. `M` must be symmetric positive definite, `C` and `K`
     /// symmetric (the air bearing's heave law is added on coordinate 0).
@@ -221,6 +271,19 @@ impl Structure {
         bulge: &[f64],
         prefix: &str,
     ) -> Result<Self> {
+        Self::build_as(n, mass, damping, stiffness, bulge, prefix, Kind::Symmetric)
+    }
+
+    /// [`Structure::build`] with the damping and stiffness checked as `coefficients`.
+    fn build_as<const R: usize>(
+        n: usize,
+        mass: &[[f64; R]],
+        damping: &[[f64; R]],
+        stiffness: &[[f64; R]],
+        bulge: &[f64],
+        prefix: &str,
+        coefficients: Kind,
+    ) -> Result<Self> {
         let fill = |rows: &[[f64; R]]| {
             let mut m = DofMatrix::zeros();
             for i in 0..n {
@@ -235,12 +298,12 @@ impl Structure {
         for i in 0..n {
             b[i] = bulge[i];
         }
-        for (name, a, definite) in [
-            ("mass", &m, true),
-            ("damping", &c, false),
-            ("stiffness", &k, false),
+        for (name, a, kind) in [
+            ("mass", &m, Kind::Mass),
+            ("damping", &c, coefficients),
+            ("stiffness", &k, coefficients),
         ] {
-            check_matrix(&format!("{prefix}.{name}"), a, n, definite)?;
+            check_matrix(&format!("{prefix}.{name}"), a, n, kind)?;
         }
         let mut padded = m;
         for i in n..MAX_DOF {
@@ -571,6 +634,18 @@ impl Structure {
     pub fn natural_frequencies(&self, k_heave: f64) -> Vec<f64> {
         let k = self.tangent(k_heave, 0.0, 0.0);
         let n = self.n;
+        if !self.is_symmetric(&k) {
+            // A film's stiffness (Structure::pitch_on_bearing): the eigenvalues of M⁻¹K, whose
+            // real parts give the frequencies (complex pairs would be a flutter).
+            let mk = (self.mass_inverse * k).view((0, 0), (n, n)).into_owned();
+            let mut w: Vec<f64> = mk
+                .complex_eigenvalues()
+                .iter()
+                .map(|l| l.re.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+                .collect();
+            w.sort_by(f64::total_cmp);
+            return w;
+        }
         // Symmetric form L⁻¹ K L⁻ᵀ with M = L Lᵀ.
         let m = self.mass_matrix();
         let Some(chol) = m.cholesky() else {
@@ -593,15 +668,89 @@ impl Structure {
     }
 }
 
-/// Finite and symmetric on the used block, and positive definite if `definite` (the mass). The
-/// stiffness and damping are not required to be semi-definite on their own: the air bearing's
-/// heave law completes them (a pitch coupling makes the structural part alone indefinite).
-fn check_matrix(field: &str, a: &DofMatrix, n: usize, definite: bool) -> Result<()> {
+impl Structure {
+    /// Whether `a` is symmetric on the used block (to the check's 10⁻¹² relative).
+    fn is_symmetric(&self, a: &DofMatrix) -> bool {
+        (0..self.n).all(|i| {
+            (0..i).all(|j| {
+                let (x, y) = (a[(i, j)], a[(j, i)]);
+                (x - y).abs() <= 1e-12 * x.abs().max(y.abs())
+            })
+        })
+    }
+
+    /// The eigenvalues `λ` (1/s) of the free structure on an air bearing of heave stiffness
+    /// `k_heave` (N/m) and damping `c_heave` (N s/m) on coordinate 0: the roots of
+    /// `det(λ²M + λ(C + e₀e₀ᵀ c_heave) + K + e₀e₀ᵀ k_heave) = 0`, from the first-order form
+    /// `[[0, I], [−M⁻¹K, −M⁻¹C]]`, by ascending imaginary part then real part. A mode with a
+    /// positive real part grows.
+    ///
+    /// ```
+    /// use hdi_tribology::model::Structure;
+    /// // One mass on the bearing: λ = (−c ± √(c² − 4mk)) / 2m.
+    /// let (m, k, c) = (1e-6, 3e5, 0.1);
+    /// let l = Structure::rigid(m)?.modes(k, c);
+    /// let (re, im) = (-c / (2.0 * m), (4.0 * m * k - c * c).sqrt() / (2.0 * m));
+    /// assert!((l[1].re - re).abs() < 1e-9 * im && (l[1].im - im).abs() < 1e-9 * im);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn modes(&self, k_heave: f64, c_heave: f64) -> Vec<num_complex::Complex64> {
+        let n = self.n;
+        // Balanced for the eigensolver: each coordinate in length (the rotations times their
+        // lever) and the velocities over a frequency of the stiffness, which keeps the entries
+        // within a few orders of one another (a similarity: the eigenvalues are the same).
+        let s = |i: usize| self.length_scale[i];
+        let k = self.mass_inverse * self.tangent(k_heave, 0.0, 0.0);
+        let c = self.mass_inverse * self.damping_with(c_heave);
+        let ks = DMatrix::from_fn(n, n, |i, j| k[(i, j)] * s(i) / s(j));
+        let cs = DMatrix::from_fn(n, n, |i, j| c[(i, j)] * s(i) / s(j));
+        let w = ks.amax().sqrt().max(f64::MIN_POSITIVE);
+        let a = DMatrix::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+            (true, true) => 0.0,
+            (true, false) => {
+                if j - n == i {
+                    w
+                } else {
+                    0.0
+                }
+            }
+            (false, true) => -ks[(i - n, j)] / w,
+            (false, false) => -cs[(i - n, j - n)],
+        });
+        let mut l: Vec<_> = a.complex_eigenvalues().iter().copied().collect();
+        l.sort_by(|p, q| p.im.total_cmp(&q.im).then(p.re.total_cmp(&q.re)));
+        l
+    }
+}
+
+/// What a matrix of a structure must be.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// Symmetric positive definite.
+    Mass,
+    /// Symmetric: the springs and dampers of a structure, which store and dissipate energy
+    /// (Maxwell–Betti reciprocity).
+    Symmetric,
+    /// Finite only: the coefficients of a gas film, a flow that the disk drives through the
+    /// gap. Such a film is not a conservative spring: its stiffness is not the Hessian of an
+    /// energy and need not be symmetric (the cross-coupled coefficients of fluid-film bearings,
+    /// Lund 1987; those of the gas-lubricated slider bearing, Ono 1975), and the pressure lags
+    /// the motion by the time the disk takes to carry the gas along the slider, which makes
+    /// the low-frequency pitch damping of an air-bearing slider negative about a central pivot
+    /// (docs/air_bearing.md, "Stiffness and damping", with its closed form).
+    Film,
+}
+
+/// Finite on the used block; symmetric unless the coefficients of a film ([`Kind::Film`]);
+/// positive definite for the mass. The stiffness and damping are not required to be
+/// semi-definite on their own: the air bearing's heave law completes them (a pitch coupling
+/// makes the structural part alone indefinite).
+fn check_matrix(field: &str, a: &DofMatrix, n: usize, kind: Kind) -> Result<()> {
     for i in 0..n {
         for j in 0..n {
             check_finite(&format!("{field}[{i}][{j}]"), a[(i, j)])?;
             let (x, y) = (a[(i, j)], a[(j, i)]);
-            if (x - y).abs() > 1e-12 * x.abs().max(y.abs()) {
+            if kind != Kind::Film && (x - y).abs() > 1e-12 * x.abs().max(y.abs()) {
                 return Err(Error::invalid(
                     format!("{field}[{i}][{j}]"),
                     format!("the matrix must be symmetric, got {x:e} and [{j}][{i}] = {y:e}"),
@@ -609,7 +758,7 @@ fn check_matrix(field: &str, a: &DofMatrix, n: usize, definite: bool) -> Result<
             }
         }
     }
-    if !definite {
+    if kind != Kind::Mass {
         return Ok(());
     }
     let block = a.view((0, 0), (n, n)).into_owned();
