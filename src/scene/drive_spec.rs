@@ -28,7 +28,7 @@ pub const MAX_HEADS: u32 = 32;
 /// assert!(e.contains("drive.initial_heater_power_mw") && e.contains("-5 mW"), "{e}");
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveSpec {
     /// Heads, one per disk surface (1 to [`MAX_HEADS`]; default 1).
@@ -116,6 +116,27 @@ pub struct DriveSensorsSpec {
     /// Read-back wavelength (m, > 0; default 100 nm).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub readback_wavelength_m: Option<f64>,
+}
+
+impl Default for DriveSpec {
+    /// One head; every other setting the library's default.
+    ///
+    /// ```
+    /// use hdi_tribology::scene::DriveSpec;
+    /// assert_eq!(DriveSpec::default().heads, 1);
+    /// ```
+    fn default() -> Self {
+        DriveSpec {
+            heads: one_head(),
+            radius_m: None,
+            rpm: None,
+            initial_heater_power_w: None,
+            heater_time_constant_s: None,
+            disk: DriveDiskSpec::default(),
+            ambient: DriveAmbientSpec::default(),
+            sensors: DriveSensorsSpec::default(),
+        }
+    }
 }
 
 fn one_head() -> u32 {
