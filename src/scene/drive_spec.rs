@@ -16,7 +16,7 @@ pub const MAX_HEADS: u32 = 32;
 /// use hdi_tribology::scene::Scene;
 /// let text = format!("{}\n[drive]\nheads = 2\nrpm = 7200\ninitial_heater_power_mw = 65\n\
 ///     [drive.ambient]\nrate_k_per_s = 20\n[drive.sensors]\nreadback_wavelength_nm = 80\n",
-///     Scene::paper().to_toml()?);
+///     Scene::paper().to_toml_string()?);
 /// let scene = Scene::from_toml_str(&text)?;
 /// let d = scene.drive.unwrap();
 /// assert_eq!((d.heads, d.rpm), (2, Some(7200.0)));
