@@ -50,7 +50,7 @@ pub use disk::{DiskSpec, Harmonic};
 pub use error::DriveError;
 pub use heads::{head_seed, MultiDrive, MultiPlant};
 pub use plant::{
-    scene_zone, spec_zone, Ambient, Command, Drive, DriveOptions, Plant, DEFAULT_RADIUS,
+    scene_zone, spec_zone, zone_at, Ambient, Command, Drive, DriveOptions, Plant, DEFAULT_RADIUS,
 };
 pub use replay::{
     check_commands, read_commands, replay, replay_each, replay_heads, replay_heads_each,

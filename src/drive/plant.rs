@@ -355,8 +355,28 @@ impl DriveOptions {
 /// An invalid scene or spec (named field).
 pub fn spec_zone(scene: &Scene, spec: &DriveSpec) -> Result<Zone> {
     spec.validate()?;
-    let mut zone = scene_zone(scene, spec.radius_m.unwrap_or(DEFAULT_RADIUS))?;
-    if let Some(rpm) = spec.rpm {
+    zone_at(scene, spec.radius_m.unwrap_or(DEFAULT_RADIUS), spec.rpm)
+}
+
+/// The zone of a scene at `radius` (m) and, with `rpm`, the disk speed there
+/// (`2π r · rpm / 60`); otherwise the scene's own disk speed ([`scene_zone`]).
+///
+/// ```
+/// use hdi_tribology::{drive::{scene_zone, zone_at}, scene::Scene};
+/// let s = Scene::paper();
+/// assert_eq!(zone_at(&s, 0.03, None)?, scene_zone(&s, 0.03)?);
+/// let z = zone_at(&s, 0.03, Some(5400.0))?;
+/// assert!((z.disk_speed - 2.0 * std::f64::consts::PI * 0.03 * 90.0).abs() < 1e-12);
+/// assert!(zone_at(&s, 0.03, Some(-1.0)).is_err());
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+///
+/// # Errors
+/// An invalid scene, radius or rpm (named field).
+pub fn zone_at(scene: &Scene, radius: f64, rpm: Option<f64>) -> Result<Zone> {
+    let mut zone = scene_zone(scene, radius)?;
+    if let Some(rpm) = rpm {
+        crate::error::check_positive("rpm", rpm)?;
         zone.disk_speed = 2.0 * PI * zone.radius * rpm / 60.0;
     }
     Ok(zone)
