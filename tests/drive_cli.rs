@@ -221,3 +221,57 @@ fn hdi_drive_bad_settings_name_the_flag_in_its_unit() {
         "{err}"
     );
 }
+
+/// `--heads 3` (or the scene's `drive.heads`) replays the commands on every head: a leading
+/// `head` column, one row per period and head; head 0's rows are the one-head file's, byte for
+/// byte, and the other heads' surfaces are their own.
+#[test]
+fn hdi_drive_heads_replays_every_head() {
+    let cmds = tmp("heads_commands.csv");
+    std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,62,0\n0.001,66,0\n").unwrap();
+    let c = cmds.to_str().unwrap();
+    let run = |extra: &[&str], name: &str| {
+        let out = tmp(name);
+        let mut args = vec!["drive", "--commands", c, "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = hdi(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (std::fs::read_to_string(out).unwrap(), summary)
+    };
+    let (one, s1) = run(&["--paper"], "one_head.csv");
+    assert!(s1.get("heads").is_none(), "{s1}");
+    let (three, s3) = run(&["--paper", "--heads", "3"], "three_heads.csv");
+    assert_eq!(
+        (s3["heads"].as_u64(), s3["periods"].as_u64()),
+        (Some(3), Some(20))
+    );
+    let scene = hdi_tribology::scene::Scene::paper()
+        .to_toml_string()
+        .unwrap();
+    let in_scene = tmp("heads_scene.toml");
+    std::fs::write(&in_scene, format!("{scene}\n[drive]\nheads = 3\n")).unwrap();
+    let (from_scene, _) = run(&[in_scene.to_str().unwrap()], "three_heads_scene.csv");
+    assert_eq!(three, from_scene);
+
+    let mut lines = three.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        format!("head,{}", hdi_tribology::drive::SENSOR_COLUMNS.join(","))
+    );
+    let rows: Vec<(&str, &str)> = lines.map(|l| l.split_once(',').unwrap()).collect();
+    assert_eq!(rows.len(), 60);
+    let head = |h: &str| -> Vec<&str> {
+        rows.iter()
+            .filter(|(k, _)| *k == h)
+            .map(|(_, r)| *r)
+            .collect()
+    };
+    assert_eq!(rows[0].0, "0");
+    assert_eq!(rows[1].0, "1");
+    assert_eq!(rows[2].0, "2");
+    let head0: Vec<&str> = one.lines().skip(1).collect();
+    assert_eq!(head("0"), head0);
+    assert_ne!(head("1"), head0);
+    assert_ne!(head("1"), head("2"));
+}

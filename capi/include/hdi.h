@@ -35,7 +35,7 @@
 
 // The version of the ABI this header describes: a program built against one version must be
 // run with a library of the same version (check [`hdi_abi_version`] at start-up).
-#define HDI_ABI_VERSION 1
+#define HDI_ABI_VERSION 2
 
 // What a call did. `HDI_STATUS_OK` is 0; every other value is a failure, with its message
 // from [`hdi_last_error`].
@@ -77,7 +77,8 @@ typedef enum HdiCause {
 } HdiCause;
 
 // A simulated drive: the slider of a scene in its zone over a disk, with a heater, a voltage
-// and the sensors firmware reads, stepped one controller period at a time.
+// and the sensors firmware reads, stepped one controller period at a time; one head or
+// several on one spindle and one clock (`HdiDriveConfig.heads`).
 typedef struct HdiDrive HdiDrive;
 
 // A slider model of a scene, with the scene's analysis protocol (detector threshold, heater
@@ -183,11 +184,15 @@ typedef struct HdiHarmonic {
   double phase_rad;
 } HdiHarmonic;
 
-// The disk surface: fixed harmonics (run-out, known waviness) plus seeded random waviness
-// with a `1/n` amplitude spectrum.
+// The disk surface (each head's surface its own, drawn from its seed): a once-around run-out,
+// fixed harmonics (known waviness) and seeded random waviness with a `1/n` amplitude
+// spectrum.
 typedef struct HdiDisk {
-  // The fixed harmonics (`harmonic_count` of them; read during `hdi_drive_new` only; may be
-  // `NULL` when the count is 0).
+  // Once-around axial run-out amplitude (nm, ≥ 0; phase 0; 0 for none): the harmonic of
+  // order 1 the scene's `drive.disk.runout_nm` sets.
+  double runout_nm;
+  // More fixed harmonics (`harmonic_count` of them; read during `hdi_drive_new` only; may
+  // be `NULL` when the count is 0).
   const struct HdiHarmonic *harmonics;
   // Number of fixed harmonics (at most 4096).
   size_t harmonic_count;
@@ -199,8 +204,10 @@ typedef struct HdiDisk {
   uint32_t random_order_max;
 } HdiDisk;
 
-// Ambient temperature drift `ΔT(t) = rate · t + amplitude · sin(2π t / period)`; the nominal
-// clearance moves by `clearance_per_kelvin_nm · ΔT` and the contact sensor reads `ΔT`.
+// Ambient temperature drift
+// `ΔT(t) = rate · t + amplitude · sin(2π t / period) + step · H(t − step_time)`; the nominal
+// clearance moves by `clearance_per_kelvin_nm · ΔT` and the contact sensor reads `ΔT`. One
+// drive has one ambient: every head sees it.
 typedef struct HdiAmbient {
   // Linear drift (K/s).
   double rate_k_per_s;
@@ -210,6 +217,11 @@ typedef struct HdiAmbient {
   double period_s;
   // Clearance change per kelvin (nm/K).
   double clearance_per_kelvin_nm;
+  // A step of the ambient temperature (K; 0 for none): a disturbance to test a clearance
+  // loop against.
+  double step_k;
+  // When the step comes (s, ≥ 0).
+  double step_time_s;
 } HdiAmbient;
 
 // The embedded contact sensor (a thermal resistor at the air-bearing surface).
@@ -269,11 +281,17 @@ typedef struct HdiSensorOptions {
   struct HdiReadbackOptions readback;
 } HdiSensorOptions;
 
-// How a drive is built: fill it with [`hdi_drive_config_default`], change what you need, pass
-// it to [`hdi_drive_new`].
+// How a drive is built: fill it with [`hdi_drive_config_default`] (the library's defaults) or
+// [`hdi_drive_config_from_scene`] (a scene's `[drive]` section), change what you need, pass it
+// to [`hdi_drive_new`].
 typedef struct HdiDriveConfig {
-  // Radius of the zone (mm, > 0): with the scene's disk speed, the spindle's rpm.
+  // Heads, one per disk surface (1 to 32): one spindle and one clock, each head its own
+  // surface and sensor noise, stepped together by [`hdi_drive_step_heads`].
+  uint32_t heads;
+  // Radius of the zone (mm, > 0): every head sits there (one actuator).
   double radius_mm;
+  // Spindle speed (rpm, > 0), or 0 for the scene's disk speed at the radius.
+  double rpm;
   // Heater power at the start (mW, ≥ 0): the slider starts at rest in its flying
   // equilibrium there.
   double initial_heater_power_mw;
@@ -468,18 +486,28 @@ enum HdiStatus hdi_cycle_options_default(const struct HdiModel *model, struct Hd
 // `options` is `NULL` or valid for reads; `out` is `NULL` or valid for writes.
 enum HdiStatus hdi_model_cycle(const struct HdiModel *model, const struct HdiCycleOptions *options, struct HdiCycle *out);
 
-// Fills `out` with the default drive: a 25 mm zone, 60 mW at the start, a 100 µs heater lag,
-// 1 µm once-around run-out and 0.3 nm of random waviness (orders 20–400), no ambient drift,
-// the default sensors and solver. `out->disk.harmonics` points at static storage of the
-// library.
+// Fills `out` with the default drive: one head, a 25 mm zone at the scene's disk speed, 60 mW
+// at the start, a 100 µs heater lag, 1 µm once-around run-out and 0.3 nm of random waviness
+// (orders 20–400), no ambient drift, the default sensors and solver.
 //
 // # Safety
 // `out` is `NULL` or valid for writes.
 enum HdiStatus hdi_drive_config_default(struct HdiDriveConfig *out);
 
-// A drive of `scene` in the zone at `config->radius_mm`, its disk and sensor noise seeded by
-// `seed`; `config`: `NULL` for [`hdi_drive_config_default`]. The drive starts at time 0, at
-// rest in the flying equilibrium at the initial heater power, with no voltage.
+// Fills `out` with the drive of `scene`'s `[drive]` section (docs/scene_format.md: heads,
+// radius, rpm, start power, heater lag, run-out, waviness, ambient drift and step, sensor
+// options), the library's defaults where it has none (all of them without the section).
+//
+// # Safety
+// `out` is `NULL` or valid for writes.
+enum HdiStatus hdi_drive_config_from_scene(const struct HdiScene *scene, struct HdiDriveConfig *out);
+
+// A drive of `scene` as `config` sets it: `config->heads` heads in the zone at
+// `config->radius_mm`, head `k`'s surface and sensor noise seeded `head_seed(seed, k)` (head 0
+// by `seed` itself: a one-head drive is head 0 of a drive of several); `config`: `NULL` for
+// [`hdi_drive_config_from_scene`] (the scene's `[drive]` section, or the defaults). Every head
+// starts at time 0, at rest in its flying equilibrium at the initial heater power, with no
+// voltage.
 //
 // # Safety
 // `config` is `NULL` or valid for reads (and its `disk.harmonics` for `disk.harmonic_count`
@@ -493,13 +521,31 @@ enum HdiStatus hdi_drive_new(const struct HdiScene *scene, const struct HdiDrive
 enum HdiStatus hdi_drive_free(struct HdiDrive *drive);
 
 // Holds `command` for `period_s` seconds (0 < period ≤ 1 s), advances the drive and fills
-// `sensors` with the sensors and the truth at the period's end.
+// `sensors` with the sensors and the truth at the period's end. A drive of several heads is
+// stepped by [`hdi_drive_step_heads`].
 //
 // # Safety
 // `command` is `NULL` or valid for reads; `sensors` is `NULL` or valid for writes.
 enum HdiStatus hdi_drive_step(struct HdiDrive *drive, const struct HdiCommand *command, double period_s, struct HdiSensors *sensors);
 
-// The drive's time (s): the end of its last period.
+// Holds `commands[k]` on head `k` for `period_s` seconds (0 < period ≤ 1 s), advances every
+// head (one clock) and fills `sensors[k]` with head `k`'s sensors and truth at the period's
+// end. `count` is the number of heads ([`hdi_drive_heads`]), of commands and of sensors. Every
+// command is checked before any head moves; a head whose integration fails leaves the drive
+// refusing further steps (the heads before it had moved on): free it and start again.
+//
+// # Safety
+// `commands` is `NULL` or valid for `count` reads; `sensors` is `NULL` or valid for `count`
+// writes.
+enum HdiStatus hdi_drive_step_heads(struct HdiDrive *drive, const struct HdiCommand *commands, size_t count, double period_s, struct HdiSensors *sensors);
+
+// The number of heads of the drive.
+//
+// # Safety
+// `heads` is `NULL` or valid for writes.
+enum HdiStatus hdi_drive_heads(struct HdiDrive *drive, uint32_t *heads);
+
+// The drive's time (s): the end of its last period (one clock for every head).
 //
 // # Safety
 // `time_s` is `NULL` or valid for writes.
@@ -507,11 +553,17 @@ enum HdiStatus hdi_drive_time(struct HdiDrive *drive, double *time_s);
 
 // The slider model of the drive's zone (with the heater lag the drive uses) as a new model
 // handle, with the scene's analysis protocol: its static touchdown is the one the drive's
-// heater meets.
+// heater meets. Head 0's, for a drive of several heads (see [`hdi_drive_head_model`]).
 //
 // # Safety
 // `out` is `NULL` or valid for writes.
 enum HdiStatus hdi_drive_model(struct HdiDrive *drive, struct HdiModel **out);
+
+// [`hdi_drive_model`] of head `head` (0 to heads − 1).
+//
+// # Safety
+// `out` is `NULL` or valid for writes.
+enum HdiStatus hdi_drive_head_model(struct HdiDrive *drive, uint32_t head, struct HdiModel **out);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -40,19 +40,19 @@ use hdi_tribology::analysis::{
     Transition,
 };
 use hdi_tribology::drive::{
-    scene_zone, Ambient, Command, DiskSpec, Drive, DriveOptions, Harmonic, Plant, SensorSpec,
-    Sensors,
+    zone_at, Ambient, Command, DiskSpec, DriveOptions, Harmonic, MultiDrive, MultiPlant,
+    SensorSpec, Sensors, DEFAULT_RADIUS,
 };
+use hdi_tribology::scene::DriveSpec;
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::scene::Scene;
 use hdi_tribology::units;
 use std::cell::UnsafeCell;
 use std::ffi::{c_char, CStr};
-use std::sync::OnceLock;
 
 /// The version of the ABI this header describes: a program built against one version must be
 /// run with a library of the same version (check [`hdi_abi_version`] at start-up).
-pub const HDI_ABI_VERSION: u32 = 1;
+pub const HDI_ABI_VERSION: u32 = 2;
 
 /// What a call did. `HDI_STATUS_OK` is 0; every other value is a failure, with its message
 /// from [`hdi_last_error`].
@@ -105,11 +105,14 @@ pub struct HdiModel {
 }
 
 /// A simulated drive: the slider of a scene in its zone over a disk, with a heater, a voltage
-/// and the sensors firmware reads, stepped one controller period at a time.
+/// and the sensors firmware reads, stepped one controller period at a time; one head or
+/// several on one spindle and one clock (`HdiDriveConfig.heads`).
 pub struct HdiDrive {
     header: Header,
     /// Reached only under the handle's exclusive access.
-    drive: UnsafeCell<Drive>,
+    drive: UnsafeCell<MultiDrive>,
+    /// The library's sensors of the heads' last step (no allocation per step).
+    scratch: UnsafeCell<Vec<Sensors>>,
     protocol: Protocol,
 }
 
@@ -225,13 +228,17 @@ pub struct HdiHarmonic {
     pub phase_rad: f64,
 }
 
-/// The disk surface: fixed harmonics (run-out, known waviness) plus seeded random waviness
-/// with a `1/n` amplitude spectrum.
+/// The disk surface (each head's surface its own, drawn from its seed): a once-around run-out,
+/// fixed harmonics (known waviness) and seeded random waviness with a `1/n` amplitude
+/// spectrum.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HdiDisk {
-    /// The fixed harmonics (`harmonic_count` of them; read during `hdi_drive_new` only; may be
-    /// `NULL` when the count is 0).
+    /// Once-around axial run-out amplitude (nm, ≥ 0; phase 0; 0 for none): the harmonic of
+    /// order 1 the scene's `drive.disk.runout_nm` sets.
+    pub runout_nm: f64,
+    /// More fixed harmonics (`harmonic_count` of them; read during `hdi_drive_new` only; may
+    /// be `NULL` when the count is 0).
     pub harmonics: *const HdiHarmonic,
     /// Number of fixed harmonics (at most 4096).
     pub harmonic_count: usize,
@@ -243,8 +250,10 @@ pub struct HdiDisk {
     pub random_order_max: u32,
 }
 
-/// Ambient temperature drift `ΔT(t) = rate · t + amplitude · sin(2π t / period)`; the nominal
-/// clearance moves by `clearance_per_kelvin_nm · ΔT` and the contact sensor reads `ΔT`.
+/// Ambient temperature drift
+/// `ΔT(t) = rate · t + amplitude · sin(2π t / period) + step · H(t − step_time)`; the nominal
+/// clearance moves by `clearance_per_kelvin_nm · ΔT` and the contact sensor reads `ΔT`. One
+/// drive has one ambient: every head sees it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct HdiAmbient {
@@ -256,6 +265,11 @@ pub struct HdiAmbient {
     pub period_s: f64,
     /// Clearance change per kelvin (nm/K).
     pub clearance_per_kelvin_nm: f64,
+    /// A step of the ambient temperature (K; 0 for none): a disturbance to test a clearance
+    /// loop against.
+    pub step_k: f64,
+    /// When the step comes (s, ≥ 0).
+    pub step_time_s: f64,
 }
 
 /// The embedded contact sensor (a thermal resistor at the air-bearing surface).
@@ -323,13 +337,19 @@ pub struct HdiSensorOptions {
     pub readback: HdiReadbackOptions,
 }
 
-/// How a drive is built: fill it with [`hdi_drive_config_default`], change what you need, pass
-/// it to [`hdi_drive_new`].
+/// How a drive is built: fill it with [`hdi_drive_config_default`] (the library's defaults) or
+/// [`hdi_drive_config_from_scene`] (a scene's `[drive]` section), change what you need, pass it
+/// to [`hdi_drive_new`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HdiDriveConfig {
-    /// Radius of the zone (mm, > 0): with the scene's disk speed, the spindle's rpm.
+    /// Heads, one per disk surface (1 to 32): one spindle and one clock, each head its own
+    /// surface and sensor noise, stepped together by [`hdi_drive_step_heads`].
+    pub heads: u32,
+    /// Radius of the zone (mm, > 0): every head sits there (one actuator).
     pub radius_mm: f64,
+    /// Spindle speed (rpm, > 0), or 0 for the scene's disk speed at the radius.
+    pub rpm: f64,
     /// Heater power at the start (mW, ≥ 0): the slider starts at rest in its flying
     /// equilibrium there.
     pub initial_heater_power_mw: f64,
@@ -999,33 +1019,37 @@ pub unsafe extern "C" fn hdi_model_cycle(
 // ---------------------------------------------------------------------------------------------
 // Drives
 
-/// The default disk's fixed harmonics, in the units of [`HdiHarmonic`] (static storage, so a
-/// default config may point at them).
-fn default_harmonics() -> &'static [HdiHarmonic] {
-    static H: OnceLock<Vec<HdiHarmonic>> = OnceLock::new();
-    H.get_or_init(|| {
-        DiskSpec::default()
-            .harmonics
-            .iter()
-            .map(|h| HdiHarmonic {
-                order: h.order,
-                amplitude_nm: units::to_nm(h.amplitude),
-                phase_rad: h.phase,
-            })
-            .collect()
-    })
+/// The scene's drive: its `[drive]` section (the library's defaults without one), the options
+/// it sets and its zone's radius (m) and spindle speed (rpm; `None`: the scene's disk speed).
+fn scene_drive(scene: &Scene) -> (DriveSpec, DriveOptions, f64, Option<f64>) {
+    let spec = scene.drive.clone().unwrap_or_default();
+    let opts = DriveOptions::from_spec(&spec);
+    let radius = spec.radius_m.unwrap_or(DEFAULT_RADIUS);
+    let rpm = spec.rpm;
+    (spec, opts, radius, rpm)
 }
 
-/// The library's drive options in the units of [`HdiDriveConfig`].
-fn config_of(o: &DriveOptions, harmonics: &[HdiHarmonic]) -> HdiDriveConfig {
+/// The library's drive options in the units of [`HdiDriveConfig`]: the run-out is the first
+/// harmonic of order 1 and phase 0 (as the scene and the defaults set it), and there are no
+/// other fixed harmonics (`harmonics` is `NULL`).
+fn config_of(o: &DriveOptions, heads: u32, radius: f64, rpm: Option<f64>) -> HdiDriveConfig {
     let (c, a, r) = (&o.sensors.contact, &o.sensors.acoustic, &o.sensors.readback);
+    let runout = o
+        .disk
+        .harmonics
+        .iter()
+        .find(|h| h.order == 1 && h.phase == 0.0)
+        .map_or(0.0, |h| h.amplitude);
     HdiDriveConfig {
-        radius_mm: DEFAULT_RADIUS_MM,
+        heads,
+        radius_mm: radius * 1e3,
+        rpm: rpm.unwrap_or(0.0),
         initial_heater_power_mw: units::to_mw(o.initial_power),
         heater_time_constant_us: to_micro(o.heater_time_constant),
         disk: HdiDisk {
-            harmonics: harmonics.as_ptr(),
-            harmonic_count: harmonics.len(),
+            runout_nm: units::to_nm(runout),
+            harmonics: std::ptr::null(),
+            harmonic_count: 0,
             random_rms_nm: units::to_nm(o.disk.random_rms),
             random_order_min: o.disk.random_orders.0,
             random_order_max: o.disk.random_orders.1,
@@ -1035,6 +1059,8 @@ fn config_of(o: &DriveOptions, harmonics: &[HdiHarmonic]) -> HdiDriveConfig {
             amplitude_k: o.ambient.amplitude,
             period_s: o.ambient.period,
             clearance_per_kelvin_nm: units::to_nm(o.ambient.clearance_per_kelvin),
+            step_k: o.ambient.step,
+            step_time_s: o.ambient.step_time,
         },
         sensors: HdiSensorOptions {
             contact: HdiContactSensorOptions {
@@ -1069,30 +1095,53 @@ fn config_of(o: &DriveOptions, harmonics: &[HdiHarmonic]) -> HdiDriveConfig {
     }
 }
 
-/// Default radius of the zone (mm): 25 mm, a 3.5-inch disk's middle diameter.
-const DEFAULT_RADIUS_MM: f64 = 25.0;
-
 /// Most fixed harmonics a disk may list.
 const MAX_HARMONICS: usize = 4096;
 
-/// The library's drive options of a config, checked field by field in the config's names and
-/// units. A value equal to the default's (as [`hdi_drive_config_default`] gives it) stands for
-/// the library's default exactly, so the default config builds the very drive
-/// `DriveOptions::default()` does.
+/// A drive built from a config: the heads, the zone's radius (m) and spindle speed (rpm), and
+/// the options of every head.
+struct Built {
+    heads: usize,
+    radius: f64,
+    rpm: Option<f64>,
+    opts: DriveOptions,
+}
+
+/// The library's drive of a config on `scene`, checked field by field in the config's names
+/// and units. A value equal to the scene's (as [`hdi_drive_config_from_scene`] gives it; the
+/// library's default where the scene's `[drive]` section has none) stands for the scene's value
+/// exactly, so the scene's config builds the very drive `hdi drive` builds on the scene, and
+/// the default config on a scene without a `[drive]` section the drive of
+/// `DriveOptions::default()`.
 ///
 /// # Safety
 /// `c.disk.harmonics` is `NULL` or valid for `c.disk.harmonic_count` reads.
-unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failure> {
-    let lib = DriveOptions::default();
-    let d = config_of(&lib, default_harmonics());
-    // The library's value when `v` is the default's, else `v` converted by `si`.
+unsafe fn drive_options(scene: &Scene, c: &HdiDriveConfig) -> Result<Built, Failure> {
+    let (spec, lib, lib_radius, lib_rpm) = scene_drive(scene);
+    let d = config_of(&lib, spec.heads, lib_radius, lib_rpm);
+    // The scene's value when `v` is the scene config's, else `v` converted by `si`.
     let pick = |v: f64, dv: f64, lib: f64, si: fn(f64) -> f64| if v == dv { lib } else { si(v) };
+    let heads = c.heads;
+    if !(1..=hdi_tribology::scene::MAX_HEADS).contains(&heads) {
+        return Err(Failure::invalid(
+            "config.heads",
+            format!(
+                "must be from 1 to {} heads, got {heads}",
+                hdi_tribology::scene::MAX_HEADS
+            ),
+        ));
+    }
     let radius = pick(
         positive("config.radius_mm", c.radius_mm, "mm")?,
         d.radius_mm,
-        DEFAULT_RADIUS_MM * 1e-3,
+        lib_radius,
         |x| x * 1e-3,
     );
+    let rpm = match non_negative("config.rpm", c.rpm, "rpm")? {
+        v if v == d.rpm => lib_rpm,
+        0.0 => None,
+        v => Some(v),
+    };
     let harmonics: &[HdiHarmonic] = match c.disk.harmonic_count {
         0 => &[],
         n if n > MAX_HARMONICS => {
@@ -1107,14 +1156,23 @@ unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failu
                 .map(|h| std::slice::from_raw_parts(h, n))
         }?,
     };
-    let disk = if harmonics == default_harmonics()
+    let runout = non_negative("config.disk.runout_nm", c.disk.runout_nm, "nm")?;
+    let disk = if harmonics.is_empty()
+        && runout == d.disk.runout_nm
         && c.disk.random_rms_nm == d.disk.random_rms_nm
         && (c.disk.random_order_min, c.disk.random_order_max)
             == (d.disk.random_order_min, d.disk.random_order_max)
     {
         lib.disk.clone()
     } else {
-        let mut h = Vec::with_capacity(harmonics.len());
+        let mut h = Vec::with_capacity(harmonics.len() + 1);
+        if runout != 0.0 {
+            h.push(Harmonic {
+                order: 1,
+                amplitude: units::nm(runout),
+                phase: 0.0,
+            });
+        }
         for (i, x) in harmonics.iter().enumerate() {
             if x.order == 0 {
                 return Err(Failure::invalid(
@@ -1161,11 +1219,12 @@ unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failu
             la.clearance_per_kelvin,
             units::nm,
         ),
-        ..*la
+        step: finite("config.ambient.step_k", ca.step_k, "K")?,
+        step_time: non_negative("config.ambient.step_time_s", ca.step_time_s, "s")?,
     };
     let (ls, ds, cs) = (&lib.sensors, &d.sensors, &c.sensors);
     let kilo = |x: f64| x * 1e3;
-    let mut sensors = SensorSpec::default();
+    let mut sensors: SensorSpec = lib.sensors;
     {
         let (l, d, c, s) = (&ls.contact, &ds.contact, &cs.contact, &mut sensors.contact);
         let f = "config.sensors.contact.";
@@ -1325,7 +1384,12 @@ unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failu
         max_step,
         ..lib
     };
-    Ok((radius, opts))
+    Ok(Built {
+        heads: heads as usize,
+        radius,
+        rpm,
+        opts,
+    })
 }
 
 /// The library's name of a drive option to the config's (`None`: not a drive option, such as a
@@ -1333,6 +1397,8 @@ unsafe fn drive_options(c: &HdiDriveConfig) -> Result<(f64, DriveOptions), Failu
 fn config_field(field: &str) -> Option<String> {
     let f = match field {
         "radius" => "config.radius_mm",
+        "zone rpm" | "rpm" => "config.rpm",
+        "heads" => "config.heads",
         "initial_power" => "config.initial_heater_power_mw",
         "heater_time_constant" => "config.heater_time_constant_us",
         "rtol" => "config.rtol",
@@ -1354,10 +1420,9 @@ fn config_field(field: &str) -> Option<String> {
     Some(f.into())
 }
 
-/// Fills `out` with the default drive: a 25 mm zone, 60 mW at the start, a 100 µs heater lag,
-/// 1 µm once-around run-out and 0.3 nm of random waviness (orders 20–400), no ambient drift,
-/// the default sensors and solver. `out->disk.harmonics` points at static storage of the
-/// library.
+/// Fills `out` with the default drive: one head, a 25 mm zone at the scene's disk speed, 60 mW
+/// at the start, a 100 µs heater lag, 1 µm once-around run-out and 0.3 nm of random waviness
+/// (orders 20–400), no ambient drift, the default sensors and solver.
 ///
 /// # Safety
 /// `out` is `NULL` or valid for writes.
@@ -1366,14 +1431,38 @@ pub unsafe extern "C" fn hdi_drive_config_default(out: *mut HdiDriveConfig) -> H
     call(|| {
         // SAFETY: the caller's contract.
         let out = unsafe { out_ref(out, "out") }?;
-        *out = config_of(&DriveOptions::default(), default_harmonics());
+        *out = config_of(&DriveOptions::default(), 1, DEFAULT_RADIUS, None);
         Ok(())
     })
 }
 
-/// A drive of `scene` in the zone at `config->radius_mm`, its disk and sensor noise seeded by
-/// `seed`; `config`: `NULL` for [`hdi_drive_config_default`]. The drive starts at time 0, at
-/// rest in the flying equilibrium at the initial heater power, with no voltage.
+/// Fills `out` with the drive of `scene`'s `[drive]` section (docs/scene_format.md: heads,
+/// radius, rpm, start power, heater lag, run-out, waviness, ambient drift and step, sensor
+/// options), the library's defaults where it has none (all of them without the section).
+///
+/// # Safety
+/// `out` is `NULL` or valid for writes.
+#[no_mangle]
+pub unsafe extern "C" fn hdi_drive_config_from_scene(
+    scene: *const HdiScene,
+    out: *mut HdiDriveConfig,
+) -> HdiStatus {
+    call(|| {
+        let s = acquire(scene, "scene", Access::Shared)?;
+        // SAFETY: the caller's contract.
+        let out = unsafe { out_ref(out, "out") }?;
+        let (spec, opts, radius, rpm) = scene_drive(&s.get().scene);
+        *out = config_of(&opts, spec.heads, radius, rpm);
+        Ok(())
+    })
+}
+
+/// A drive of `scene` as `config` sets it: `config->heads` heads in the zone at
+/// `config->radius_mm`, head `k`'s surface and sensor noise seeded `head_seed(seed, k)` (head 0
+/// by `seed` itself: a one-head drive is head 0 of a drive of several); `config`: `NULL` for
+/// [`hdi_drive_config_from_scene`] (the scene's `[drive]` section, or the defaults). Every head
+/// starts at time 0, at rest in its flying equilibrium at the initial heater power, with no
+/// voltage.
 ///
 /// # Safety
 /// `config` is `NULL` or valid for reads (and its `disk.harmonics` for `disk.harmonic_count`
@@ -1390,16 +1479,25 @@ pub unsafe extern "C" fn hdi_drive_new(
         make(out, || {
             let s = acquire(scene, "scene", Access::Shared)?;
             let scene = &s.get().scene;
-            let (radius, opts) = match config.as_ref() {
-                Some(c) => drive_options(c)?,
-                None => (DEFAULT_RADIUS_MM * 1e-3, DriveOptions::default()),
+            let b = match config.as_ref() {
+                Some(c) => drive_options(scene, c)?,
+                None => {
+                    let (spec, opts, radius, rpm) = scene_drive(scene);
+                    Built {
+                        heads: spec.heads as usize,
+                        radius,
+                        rpm,
+                        opts,
+                    }
+                }
             };
-            let zone = scene_zone(scene, radius).map_err(|e| renamed(e, config_field))?;
-            let plant =
-                Plant::new(scene, &zone, seed, opts).map_err(|e| renamed(e, config_field))?;
+            let zone = zone_at(scene, b.radius, b.rpm).map_err(|e| renamed(e, config_field))?;
+            let plant = MultiPlant::uniform(scene, &zone, b.heads, seed, b.opts)
+                .map_err(|e| renamed(e, config_field))?;
             Ok(HdiDrive {
                 header: Header::default(),
-                drive: UnsafeCell::new(plant.into_drive()?),
+                drive: UnsafeCell::new(plant.drive()?),
+                scratch: UnsafeCell::new(vec![Sensors::default(); b.heads]),
                 protocol: Protocol::from_scene(scene)?,
             })
         })
@@ -1413,12 +1511,6 @@ pub unsafe extern "C" fn hdi_drive_new(
 #[no_mangle]
 pub unsafe extern "C" fn hdi_drive_free(drive: *mut HdiDrive) -> HdiStatus {
     call(|| free(drive, "drive"))
-}
-
-/// The library's name of a step argument to the C call's (the command's fields have the same
-/// names in both).
-fn command_field(field: &str) -> Option<String> {
-    (field == "dt").then(|| "period_s".to_string())
 }
 
 /// The library's sensors, field by field: the same units and names.
@@ -1449,8 +1541,23 @@ fn sensors_of(s: &Sensors) -> HdiSensors {
     }
 }
 
+/// One C command, checked in the C call's names (`name` is `command` or `commands[k]`).
+fn command_of(c: &HdiCommand, name: &str) -> Result<Command, Failure> {
+    non_negative(&format!("{name}.heater_power_mw"), c.heater_power_mw, "mW")?;
+    finite(&format!("{name}.dc_voltage_v"), c.dc_voltage_v, "V")?;
+    finite(&format!("{name}.ac_amplitude_v"), c.ac_amplitude_v, "V")?;
+    non_negative(&format!("{name}.ac_frequency_khz"), c.ac_frequency_khz, "kHz")?;
+    Ok(Command {
+        heater_power_mw: c.heater_power_mw,
+        dc_voltage_v: c.dc_voltage_v,
+        ac_amplitude_v: c.ac_amplitude_v,
+        ac_frequency_khz: c.ac_frequency_khz,
+    })
+}
+
 /// Holds `command` for `period_s` seconds (0 < period ≤ 1 s), advances the drive and fills
-/// `sensors` with the sensors and the truth at the period's end.
+/// `sensors` with the sensors and the truth at the period's end. A drive of several heads is
+/// stepped by [`hdi_drive_step_heads`].
 ///
 /// # Safety
 /// `command` is `NULL` or valid for reads; `sensors` is `NULL` or valid for writes.
@@ -1465,28 +1572,106 @@ pub unsafe extern "C" fn hdi_drive_step(
         let d = acquire(drive.cast_const(), "drive", Access::Exclusive)?;
         // SAFETY: the caller's contract.
         let (c, out) = unsafe { (in_ref(command, "command")?, out_ref(sensors, "sensors")?) };
-        non_negative("command.heater_power_mw", c.heater_power_mw, "mW")?;
-        finite("command.dc_voltage_v", c.dc_voltage_v, "V")?;
-        finite("command.ac_amplitude_v", c.ac_amplitude_v, "V")?;
-        non_negative("command.ac_frequency_khz", c.ac_frequency_khz, "kHz")?;
+        let cmd = command_of(c, "command")?;
         positive("period_s", period_s, "s")?;
-        let cmd = Command {
-            heater_power_mw: c.heater_power_mw,
-            dc_voltage_v: c.dc_voltage_v,
-            ac_amplitude_v: c.ac_amplitude_v,
-            ac_frequency_khz: c.ac_frequency_khz,
-        };
         // SAFETY: the guard holds the handle exclusively: no other reference to the drive.
-        let drive = unsafe { &mut *d.get().drive.get() };
-        let s = drive
-            .step(&cmd, period_s)
-            .map_err(|e| renamed(e, command_field))?;
-        *out = sensors_of(&s);
+        let (drive, scratch) = unsafe { (&mut *d.get().drive.get(), &mut *d.get().scratch.get()) };
+        if drive.heads() != 1 {
+            return Err(Failure::invalid(
+                "drive",
+                format!(
+                    "has {} heads: step them together with hdi_drive_step_heads",
+                    drive.heads()
+                ),
+            ));
+        }
+        drive
+            .step_into(std::slice::from_ref(&cmd), period_s, scratch)
+            .map_err(|e| renamed(e, |f| step_field(f, "command")))?;
+        *out = sensors_of(&scratch[0]);
         Ok(())
     })
 }
 
-/// The drive's time (s): the end of its last period.
+/// The library's name of a step argument to the C call's: `dt` is `period_s`, head 0's
+/// command `one` (`command` for [`hdi_drive_step`]).
+fn step_field(field: &str, one: &str) -> Option<String> {
+    if field == "dt" {
+        return Some("period_s".into());
+    }
+    field
+        .strip_prefix("commands[0].")
+        .filter(|_| one == "command")
+        .map(|rest| format!("{one}.{rest}"))
+}
+
+/// Holds `commands[k]` on head `k` for `period_s` seconds (0 < period ≤ 1 s), advances every
+/// head (one clock) and fills `sensors[k]` with head `k`'s sensors and truth at the period's
+/// end. `count` is the number of heads ([`hdi_drive_heads`]), of commands and of sensors. Every
+/// command is checked before any head moves; a head whose integration fails leaves the drive
+/// refusing further steps (the heads before it had moved on): free it and start again.
+///
+/// # Safety
+/// `commands` is `NULL` or valid for `count` reads; `sensors` is `NULL` or valid for `count`
+/// writes.
+#[no_mangle]
+pub unsafe extern "C" fn hdi_drive_step_heads(
+    drive: *mut HdiDrive,
+    commands: *const HdiCommand,
+    count: usize,
+    period_s: f64,
+    sensors: *mut HdiSensors,
+) -> HdiStatus {
+    call(|| {
+        let d = acquire(drive.cast_const(), "drive", Access::Exclusive)?;
+        // SAFETY: the guard holds the handle exclusively: no other reference to the drive.
+        let (drive, scratch) = unsafe { (&mut *d.get().drive.get(), &mut *d.get().scratch.get()) };
+        let n = drive.heads();
+        if count != n {
+            return Err(Failure::invalid(
+                "count",
+                format!("one command and one sensors struct per head: the drive has {n} heads, got {count}"),
+            ));
+        }
+        // SAFETY: the caller's contract (both checked for `NULL`, `count` elements each).
+        let (cs, out) = unsafe {
+            (
+                std::slice::from_raw_parts(in_ref(commands, "commands")?, n),
+                std::slice::from_raw_parts_mut(out_ref(sensors, "sensors")?, n),
+            )
+        };
+        let mut cmds = [Command::default(); hdi_tribology::scene::MAX_HEADS as usize];
+        for (k, c) in cs.iter().enumerate() {
+            cmds[k] = command_of(c, &format!("commands[{k}]"))?;
+        }
+        positive("period_s", period_s, "s")?;
+        drive
+            .step_into(&cmds[..n], period_s, scratch)
+            .map_err(|e| renamed(e, |f| step_field(f, "commands")))?;
+        for (o, s) in out.iter_mut().zip(scratch.iter()) {
+            *o = sensors_of(s);
+        }
+        Ok(())
+    })
+}
+
+/// The number of heads of the drive.
+///
+/// # Safety
+/// `heads` is `NULL` or valid for writes.
+#[no_mangle]
+pub unsafe extern "C" fn hdi_drive_heads(drive: *mut HdiDrive, heads: *mut u32) -> HdiStatus {
+    call(|| {
+        let d = acquire(drive.cast_const(), "drive", Access::Exclusive)?;
+        // SAFETY: the caller's contract.
+        let out = unsafe { out_ref(heads, "heads") }?;
+        // SAFETY: held exclusively.
+        *out = unsafe { &*d.get().drive.get() }.heads() as u32;
+        Ok(())
+    })
+}
+
+/// The drive's time (s): the end of its last period (one clock for every head).
 ///
 /// # Safety
 /// `time_s` is `NULL` or valid for writes.
@@ -1504,7 +1689,7 @@ pub unsafe extern "C" fn hdi_drive_time(drive: *mut HdiDrive, time_s: *mut f64) 
 
 /// The slider model of the drive's zone (with the heater lag the drive uses) as a new model
 /// handle, with the scene's analysis protocol: its static touchdown is the one the drive's
-/// heater meets.
+/// heater meets. Head 0's, for a drive of several heads (see [`hdi_drive_head_model`]).
 ///
 /// # Safety
 /// `out` is `NULL` or valid for writes.
@@ -1514,14 +1699,37 @@ pub unsafe extern "C" fn hdi_drive_model(
     out: *mut *mut HdiModel,
 ) -> HdiStatus {
     // SAFETY: the caller's contract.
+    unsafe { hdi_drive_head_model(drive, 0, out) }
+}
+
+/// [`hdi_drive_model`] of head `head` (0 to heads − 1).
+///
+/// # Safety
+/// `out` is `NULL` or valid for writes.
+#[no_mangle]
+pub unsafe extern "C" fn hdi_drive_head_model(
+    drive: *mut HdiDrive,
+    head: u32,
+    out: *mut *mut HdiModel,
+) -> HdiStatus {
+    // SAFETY: the caller's contract.
     unsafe {
         make(out, || {
             let d = acquire(drive.cast_const(), "drive", Access::Exclusive)?;
             // SAFETY: held exclusively.
             let drive = &*d.get().drive.get();
+            let Some(h) = drive.head(head as usize) else {
+                return Err(Failure::invalid(
+                    "head",
+                    format!(
+                        "the drive has heads 0 to {}, got {head}",
+                        drive.heads() - 1
+                    ),
+                ));
+            };
             Ok(HdiModel {
                 header: Header::default(),
-                model: drive.model().clone(),
+                model: h.model().clone(),
                 protocol: d.get().protocol.clone(),
             })
         })
@@ -1541,9 +1749,10 @@ mod tests {
             HdiStatus::Ok
         );
         let c = unsafe { c.assume_init() };
-        let (radius, o) = unsafe { drive_options(&c) }.unwrap();
-        assert_eq!(radius.to_bits(), 0.025f64.to_bits());
-        assert_eq!(o, DriveOptions::default());
+        let b = unsafe { drive_options(&Scene::paper(), &c) }.unwrap();
+        assert_eq!(b.radius.to_bits(), 0.025f64.to_bits());
+        assert_eq!((b.heads, b.rpm), (1, None));
+        assert_eq!(b.opts, DriveOptions::default());
     }
 
     fn message() -> String {

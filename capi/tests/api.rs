@@ -4,7 +4,8 @@
 use hdi::*;
 use hdi_tribology::analysis::{self, Protocol};
 use hdi_tribology::drive::{
-    scene_zone, Ambient, Command, DiskSpec, DriveOptions, Harmonic, Plant, Sensors,
+    head_seed, spec_zone, zone_at, Ambient, Command, DiskSpec, DriveOptions, Harmonic,
+    MultiPlant, Plant, Sensors,
 };
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
@@ -143,8 +144,8 @@ fn versions() {
     }
 }
 
-/// A drive with a changed disk, ambient drift and sensors, under a ramp with a dither and
-/// a DC voltage, steps as the Rust drive with the same options, to the bit.
+/// A drive with a changed zone, disk, ambient drift and step and sensors, under a ramp with a
+/// dither and a DC voltage, steps as the Rust drive with the same options, to the bit.
 #[test]
 fn configured_drive_steps_as_the_rust_drive() {
     let harmonics = [
@@ -163,8 +164,11 @@ fn configured_drive_steps_as_the_rust_drive() {
     ok(unsafe { hdi_drive_config_default(config.as_mut_ptr()) });
     let mut config: HdiDriveConfig = unsafe { config.assume_init() };
     config.radius_mm = 30.0;
+    config.rpm = 7200.0;
     config.initial_heater_power_mw = 62.0;
     config.heater_time_constant_us = 50.0;
+    // The run-out of phase 0.25 among the harmonics, not the phase-0 one.
+    config.disk.runout_nm = 0.0;
     config.disk.harmonics = harmonics.as_ptr();
     config.disk.harmonic_count = harmonics.len();
     config.disk.random_rms_nm = 0.1;
@@ -175,6 +179,8 @@ fn configured_drive_steps_as_the_rust_drive() {
         amplitude_k: 0.5,
         period_s: 0.004,
         clearance_per_kelvin_nm: 0.05,
+        step_k: 2.0,
+        step_time_s: 0.01,
     };
     config.sensors.contact.noise_ohm = 0.01;
     config.sensors.contact.bandwidth_khz = 20.0;
@@ -215,13 +221,15 @@ fn configured_drive_steps_as_the_rust_drive() {
             amplitude: 0.5,
             period: 0.004,
             clearance_per_kelvin: units::nm(0.05),
-            ..Ambient::default()
+            step: 2.0,
+            step_time: 0.01,
         },
         sensors,
         atol_displacement_flight: 1.0 * 1e-12,
         ..DriveOptions::default()
     };
-    let plant = Plant::new(&s, &scene_zone(&s, 30.0 * 1e-3).unwrap(), 42, opts).unwrap();
+    let zone = zone_at(&s, 30.0 * 1e-3, Some(7200.0)).unwrap();
+    let plant = Plant::new(&s, &zone, 42, opts).unwrap();
     let mut rust = plant.into_drive().unwrap();
     let mut c = HdiSensors::default();
     for k in 0..300 {
@@ -244,9 +252,10 @@ fn configured_drive_steps_as_the_rust_drive() {
             .unwrap();
         same_sensors(k, &c, &r);
     }
-    // The drift is in: ΔT = rate·t + amplitude·sin(2πt/period) at the last period's start.
+    // The drift and the step are in: ΔT = rate·t + amplitude·sin(2πt/period) + step at the
+    // last period's start (past the step's time).
     let t0 = 299.0 * 50e-6;
-    let want = 200.0 * t0 + 0.5 * (2.0 * std::f64::consts::PI * t0 / 0.004).sin();
+    let want = 200.0 * t0 + 0.5 * (2.0 * std::f64::consts::PI * t0 / 0.004).sin() + 2.0;
     assert!(
         (c.truth.ambient_k - want).abs() < 1e-9,
         "{} K, expected {want} K",
@@ -429,4 +438,143 @@ fn a_handle_in_use_is_not_freed() {
         break;
     }
     assert!(seen_busy, "no free was refused in 20 tries");
+}
+
+fn scene_toml(extra: &str) -> *mut HdiScene {
+    let text = format!("{}\n{extra}", Scene::paper().to_toml_string().unwrap());
+    let c = std::ffi::CString::new(text).unwrap();
+    let mut s = null_mut();
+    ok(unsafe { hdi_scene_from_toml(c.as_ptr(), &mut s) });
+    s
+}
+
+const DRIVE_SECTION: &str = "[drive]\nheads = 3\nrpm = 7200\ninitial_heater_power_mw = 62\n\
+    [drive.disk]\nrunout_nm = 500\nwaviness_rms_nm = 0.2\n\
+    [drive.ambient]\nrate_k_per_s = 50\nstep_k = 1.5\nstep_time_s = 0.002\n\
+    [drive.sensors]\nreadback_wavelength_nm = 80\ncontact_noise_ohm = 0.01\n";
+
+/// A scene's `[drive]` section builds, through the C ABI (with a `NULL` config or the config
+/// `hdi_drive_config_from_scene` gives), the drive `hdi drive` builds on the scene: three heads
+/// stepped together, each equal to the Rust drive's head to the bit.
+#[test]
+fn the_scene_drive_section_builds_the_rust_drive_of_several_heads() {
+    let scene = scene_toml(DRIVE_SECTION);
+    let mut config = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_drive_config_from_scene(scene, config.as_mut_ptr()) });
+    let config: HdiDriveConfig = unsafe { config.assume_init() };
+    assert_eq!((config.heads, config.rpm), (3, 7200.0));
+    assert_eq!(config.initial_heater_power_mw, 62.0);
+    assert_eq!((config.ambient.step_k, config.ambient.step_time_s), (1.5, 0.002));
+    assert!((config.disk.runout_nm - 500.0).abs() < 1e-9);
+    let (mut a, mut b) = (null_mut(), null_mut());
+    ok(unsafe { hdi_drive_new(scene, null(), 9, &mut a) });
+    ok(unsafe { hdi_drive_new(scene, &config, 9, &mut b) });
+    let mut heads = 0;
+    ok(unsafe { hdi_drive_heads(a, &mut heads) });
+    assert_eq!(heads, 3);
+
+    let s = Scene::from_toml_str(&format!(
+        "{}\n{DRIVE_SECTION}",
+        Scene::paper().to_toml_string().unwrap()
+    ))
+    .unwrap();
+    let spec = s.drive.clone().unwrap();
+    let zone = spec_zone(&s, &spec).unwrap();
+    let plant = MultiPlant::uniform(&s, &zone, 3, 9, DriveOptions::from_spec(&spec)).unwrap();
+    let mut rust = plant.drive().unwrap();
+    let mut ca = [HdiSensors::default(); 3];
+    let mut cb = [HdiSensors::default(); 3];
+    for n in 0..120 {
+        let cmds: Vec<HdiCommand> = (0..3)
+            .map(|k| HdiCommand {
+                heater_power_mw: 62.0 + 0.1 * (n * (k + 1)) as f64,
+                ..HdiCommand::default()
+            })
+            .collect();
+        ok(unsafe { hdi_drive_step_heads(a, cmds.as_ptr(), 3, 50e-6, ca.as_mut_ptr()) });
+        ok(unsafe { hdi_drive_step_heads(b, cmds.as_ptr(), 3, 50e-6, cb.as_mut_ptr()) });
+        let rc: Vec<Command> = cmds
+            .iter()
+            .map(|c| Command::heater_mw(c.heater_power_mw))
+            .collect();
+        let r = rust.step(&rc, 50e-6).unwrap();
+        for k in 0..3 {
+            same_sensors(n, &ca[k], &r[k]);
+            same_sensors(n, &cb[k], &r[k]);
+        }
+    }
+    // Head 2 alone is the one-head drive of its seed.
+    let one = Plant::new(&s, &zone, head_seed(9, 2), DriveOptions::from_spec(&spec)).unwrap();
+    assert_eq!(rust.head(2).unwrap().plant().seed(), one.seed());
+    // The ambient step is in.
+    assert!(ca[0].truth.ambient_k > 1.5);
+    ok(unsafe { hdi_drive_free(a) });
+    ok(unsafe { hdi_drive_free(b) });
+    ok(unsafe { hdi_scene_free(scene) });
+}
+
+/// The misuses of a drive of several heads get a status and a message naming the argument.
+#[test]
+fn several_heads_are_stepped_together() {
+    let scene = paper();
+    let mut config = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_drive_config_default(config.as_mut_ptr()) });
+    let mut config: HdiDriveConfig = unsafe { config.assume_init() };
+    assert_eq!(config.heads, 1);
+    let mut drive = null_mut();
+    config.heads = 0;
+    let st = unsafe { hdi_drive_new(scene, &config, 1, &mut drive) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("config.heads"), "{}", last_error());
+    assert!(drive.is_null());
+    config.heads = 2;
+    ok(unsafe { hdi_drive_new(scene, &config, 1, &mut drive) });
+    let cmd = HdiCommand {
+        heater_power_mw: 60.0,
+        ..HdiCommand::default()
+    };
+    let mut s = [HdiSensors::default(); 2];
+    let st = unsafe { hdi_drive_step(drive, &cmd, 50e-6, s.as_mut_ptr()) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("hdi_drive_step_heads"), "{}", last_error());
+    let st = unsafe { hdi_drive_step_heads(drive, &cmd, 1, 50e-6, s.as_mut_ptr()) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("count"), "{}", last_error());
+    let bad = [cmd, HdiCommand { heater_power_mw: -1.0, ..cmd }];
+    let st = unsafe { hdi_drive_step_heads(drive, bad.as_ptr(), 2, 50e-6, s.as_mut_ptr()) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("commands[1].heater_power_mw"), "{}", last_error());
+    let big = [HdiCommand { heater_power_mw: 2000.0, ..cmd }, cmd];
+    let st = unsafe { hdi_drive_step_heads(drive, big.as_ptr(), 2, 50e-6, s.as_mut_ptr()) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("commands[0].heater_power_mw"), "{}", last_error());
+    let st = unsafe { hdi_drive_step_heads(drive, [cmd, cmd].as_ptr(), 2, 0.0, s.as_mut_ptr()) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("period_s"), "{}", last_error());
+    let st = unsafe { hdi_drive_step_heads(drive, null(), 2, 50e-6, s.as_mut_ptr()) };
+    assert_eq!(st, HdiStatus::NullPointer);
+    let mut t = -1.0;
+    ok(unsafe { hdi_drive_time(drive, &mut t) });
+    assert_eq!(t, 0.0, "nothing moved");
+    ok(unsafe { hdi_drive_step_heads(drive, [cmd, cmd].as_ptr(), 2, 50e-6, s.as_mut_ptr()) });
+    assert_eq!(s[0].time_s, s[1].time_s);
+    assert_ne!(s[0].truth.disk_height_nm, s[1].truth.disk_height_nm);
+    let mut model = null_mut();
+    assert_eq!(
+        unsafe { hdi_drive_head_model(drive, 2, &mut model) },
+        HdiStatus::InvalidInput
+    );
+    assert!(last_error().contains("head"), "{}", last_error());
+    ok(unsafe { hdi_drive_head_model(drive, 1, &mut model) });
+    ok(unsafe { hdi_model_free(model) });
+    ok(unsafe { hdi_drive_free(drive) });
+    // A one-head step names its command as `command`.
+    let mut one = null_mut();
+    ok(unsafe { hdi_drive_new(scene, null(), 1, &mut one) });
+    let big = HdiCommand { heater_power_mw: 2000.0, ..cmd };
+    let st = unsafe { hdi_drive_step(one, &big, 50e-6, s.as_mut_ptr()) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("command.heater_power_mw"), "{}", last_error());
+    ok(unsafe { hdi_drive_free(one) });
+    ok(unsafe { hdi_scene_free(scene) });
 }

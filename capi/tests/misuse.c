@@ -79,6 +79,37 @@ int main(int argc, char **argv) {
            "config.disk");
     require("drive NULL after failure", drive == NULL);
 
+    /* A drive of two heads: stepped with both commands at once, one clock. */
+    hdi_drive_config_default(&config);
+    config.heads = 33;
+    expect("too many heads", hdi_drive_new(scene, &config, 1, &drive), HDI_STATUS_INVALID_INPUT,
+           "config.heads");
+    config.heads = 2;
+    expect("two heads", hdi_drive_new(scene, &config, 1, &drive), HDI_STATUS_OK, NULL);
+    HdiCommand two[2] = {{60.0, 0.0, 0.0, 0.0}, {60.0, 0.0, 0.0, 0.0}};
+    HdiSensors s2[2];
+    uint32_t heads = 0;
+    expect("heads", hdi_drive_heads(drive, &heads), HDI_STATUS_OK, NULL);
+    require("two heads counted", heads == 2);
+    expect("one step on two heads", hdi_drive_step(drive, &two[0], 50e-6, &s2[0]),
+           HDI_STATUS_INVALID_INPUT, "hdi_drive_step_heads");
+    expect("wrong count", hdi_drive_step_heads(drive, two, 3, 50e-6, s2), HDI_STATUS_INVALID_INPUT,
+           "count");
+    two[1].heater_power_mw = NAN;
+    expect("NaN on head 1", hdi_drive_step_heads(drive, two, 2, 50e-6, s2),
+           HDI_STATUS_INVALID_INPUT, "commands[1].heater_power_mw");
+    two[1].heater_power_mw = 61.0;
+    expect("NULL sensors of heads", hdi_drive_step_heads(drive, two, 2, 50e-6, NULL),
+           HDI_STATUS_NULL_POINTER, "sensors");
+    expect("step heads", hdi_drive_step_heads(drive, two, 2, 50e-6, s2), HDI_STATUS_OK, NULL);
+    require("one clock", s2[0].time_s == 50e-6 && s2[1].time_s == 50e-6);
+    HdiModel *head_model = NULL;
+    expect("head past the last", hdi_drive_head_model(drive, 2, &head_model),
+           HDI_STATUS_INVALID_INPUT, "head");
+    require("head model NULL after failure", head_model == NULL);
+    expect("two heads free", hdi_drive_free(drive), HDI_STATUS_OK, NULL);
+    drive = NULL;
+
     /* A drive, a model; commands the library refuses, named as the command's fields. */
     HdiModel *model = NULL;
     expect("drive", hdi_drive_new(scene, NULL, 1, &drive), HDI_STATUS_OK, NULL);

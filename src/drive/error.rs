@@ -37,9 +37,20 @@ pub enum DriveError {
         /// End of the period (s).
         t1_s: f64,
     },
+    /// A head of a [`MultiDrive`](super::MultiDrive) failed in an earlier step, after the
+    /// heads before it had moved on: the heads no longer share one clock.
+    #[error(
+        "head {head} failed in an earlier step and the heads before it had moved on: they no \
+         longer share one clock (start the drive again)"
+    )]
+    HeadsOutOfStep {
+        /// The head that failed.
+        head: usize,
+    },
 }
 
 failure_kind!(DriveError, convergence = |e| matches!(e, DriveError::PeriodSteps { .. }), {
         NotFinished => Stage::DRIVE_CONTROLLER,
         PeriodSteps => Stage::DRIVE,
+        HeadsOutOfStep => Stage::DRIVE,
 });

@@ -8,7 +8,8 @@
 //! [`Drive::step`] advances it by one controller period and
 //! returns the [`Sensors`] firmware reads: the embedded contact sensor, acoustic emission and
 //! the read-back amplitudes, each with its bandwidth and seeded noise, plus the [`Truth`] for
-//! test oracles.
+//! test oracles. [`MultiPlant`] and [`MultiDrive`] are a drive of several heads on one disk
+//! stack: one spindle and one clock, each head its own slider, heater, sensors and surface.
 //!
 //! ```
 //! use hdi_tribology::drive::{scene_zone, Command, DriveOptions, Plant};
@@ -32,6 +33,7 @@
 mod controller;
 mod disk;
 mod error;
+mod heads;
 mod plant;
 mod replay;
 mod rng;
@@ -46,12 +48,13 @@ pub use controller::{
 };
 pub use disk::{DiskSpec, Harmonic};
 pub use error::DriveError;
+pub use heads::{head_seed, MultiDrive, MultiPlant};
 pub use plant::{
-    scene_zone, spec_zone, Ambient, Command, Drive, DriveOptions, Plant, DEFAULT_RADIUS,
+    scene_zone, spec_zone, zone_at, Ambient, Command, Drive, DriveOptions, Plant, DEFAULT_RADIUS,
 };
 pub use replay::{
-    check_commands, read_commands, replay, replay_each, sensor_row, whole_periods, CommandRow,
-    ReplaySummary, MAX_REPLAY_PERIODS, SENSOR_COLUMNS,
+    check_commands, read_commands, replay, replay_each, replay_heads, replay_heads_each,
+    sensor_row, whole_periods, CommandRow, ReplaySummary, MAX_REPLAY_PERIODS, SENSOR_COLUMNS,
 };
 pub use roc::{touchdown_roc, RocPoint};
 pub use sensors::{

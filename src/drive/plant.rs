@@ -57,7 +57,7 @@ impl Command {
         crate::units::mw(self.heater_power_mw)
     }
 
-    fn validate(&self) -> Result<()> {
+    pub(crate) fn validate(&self) -> Result<()> {
         check_non_negative("command.heater_power_mw", self.heater_power_mw)?;
         if self.heater_power() > MAX_HEATER_POWER {
             return Err(Error::invalid(
@@ -74,6 +74,18 @@ impl Command {
         check_non_negative("command.ac_frequency_khz", self.ac_frequency_khz)?;
         Ok(())
     }
+}
+
+/// Checks a controller period `dt` (s): positive, at most 1 s.
+pub(crate) fn check_period(dt: f64) -> Result<()> {
+    crate::error::check_positive("dt", dt)?;
+    if dt > 1.0 {
+        return Err(Error::invalid(
+            "dt",
+            format!("a controller period must not exceed 1 s, got {dt} s"),
+        ));
+    }
+    Ok(())
 }
 
 /// Largest heater power a command may ask for (W): far above any thermal fly-height heater.
@@ -343,8 +355,28 @@ impl DriveOptions {
 /// An invalid scene or spec (named field).
 pub fn spec_zone(scene: &Scene, spec: &DriveSpec) -> Result<Zone> {
     spec.validate()?;
-    let mut zone = scene_zone(scene, spec.radius_m.unwrap_or(DEFAULT_RADIUS))?;
-    if let Some(rpm) = spec.rpm {
+    zone_at(scene, spec.radius_m.unwrap_or(DEFAULT_RADIUS), spec.rpm)
+}
+
+/// The zone of a scene at `radius` (m) and, with `rpm`, the disk speed there
+/// (`2π r · rpm / 60`); otherwise the scene's own disk speed ([`scene_zone`]).
+///
+/// ```
+/// use hdi_tribology::{drive::{scene_zone, zone_at}, scene::Scene};
+/// let s = Scene::paper();
+/// assert_eq!(zone_at(&s, 0.03, None)?, scene_zone(&s, 0.03)?);
+/// let z = zone_at(&s, 0.03, Some(5400.0))?;
+/// assert!((z.disk_speed - 2.0 * std::f64::consts::PI * 0.03 * 90.0).abs() < 1e-12);
+/// assert!(zone_at(&s, 0.03, Some(-1.0)).is_err());
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+///
+/// # Errors
+/// An invalid scene, radius or rpm (named field).
+pub fn zone_at(scene: &Scene, radius: f64, rpm: Option<f64>) -> Result<Zone> {
+    let mut zone = scene_zone(scene, radius)?;
+    if let Some(rpm) = rpm {
+        crate::error::check_positive("rpm", rpm)?;
         zone.disk_speed = 2.0 * PI * zone.radius * rpm / 60.0;
     }
     Ok(zone)
@@ -657,6 +689,16 @@ impl Plant {
     pub fn sensor_spec(&self) -> &SensorSpec {
         &self.sensors
     }
+
+    /// The spindle speed (rpm): the zone's disk speed at its radius.
+    pub fn rpm(&self) -> f64 {
+        self.rpm
+    }
+
+    /// The ambient drift.
+    pub fn ambient(&self) -> &Ambient {
+        &self.ambient
+    }
 }
 
 /// A simulated drive: the slider of a [`Plant`] flying over its wavy disk, with a heater, a
@@ -759,13 +801,12 @@ impl Drive {
     /// An invalid command or period (named field); an integration failure.
     pub fn step(&mut self, command: &Command, dt: f64) -> Result<Sensors> {
         command.validate()?;
-        crate::error::check_positive("dt", dt)?;
-        if dt > 1.0 {
-            return Err(Error::invalid(
-                "dt",
-                format!("a controller period must not exceed 1 s, got {dt} s"),
-            ));
-        }
+        check_period(dt)?;
+        self.step_checked(command, dt)
+    }
+
+    /// [`Drive::step`] of a command and period already checked.
+    pub(crate) fn step_checked(&mut self, command: &Command, dt: f64) -> Result<Sensors> {
         let plant = &*self.plant;
         let (t0, t1) = (self.t, self.t + dt);
         let ambient = plant.ambient.temperature(t0);

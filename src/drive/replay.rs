@@ -1,5 +1,6 @@
 //! Replaying a command file through a drive: the way in for tools that are not Rust.
 
+use super::heads::MultiPlant;
 use super::plant::{Command, Plant};
 use super::sensors::{clearance_change, Sensors};
 use crate::error::{Error, Result};
@@ -315,6 +316,13 @@ pub struct ReplaySummary {
     /// Drive time simulated (s).
     #[serde(rename = "simulated_time_s")]
     pub simulated_time: f64,
+    /// Heads run (each period gives one row per head); written only when more than one.
+    #[serde(skip_serializing_if = "is_one")]
+    pub heads: usize,
+}
+
+fn is_one(n: &usize) -> bool {
+    *n == 1
 }
 
 /// Replays `rows` (see [`read_commands`]) through a drive started on `plant`, stepping at period
@@ -349,20 +357,61 @@ pub fn replay<W: Write>(
     dt: f64,
     out: W,
 ) -> Result<ReplaySummary> {
+    replay_heads(&MultiPlant::new(vec![plant.clone()])?, rows, dt, out)
+}
+
+/// [`replay`] on every head of a drive of several heads, each head holding the same commands:
+/// one CSV row per period and head, in head order, led by a `head` column (0 for the first)
+/// when there is more than one head; with one head, the file of [`replay`].
+///
+/// ```
+/// use hdi_tribology::drive::{read_commands, replay_heads, scene_zone, DriveOptions, MultiPlant};
+/// use hdi_tribology::scene::Scene;
+/// let scene = Scene::paper();
+/// let zone = scene_zone(&scene, 0.025)?;
+/// let plant = MultiPlant::uniform(&scene, &zone, 2, 1, DriveOptions::default())?;
+/// let rows = read_commands("time_s,heater_mw,voltage_dc_v\n0,60,0\n0.0005,60,0\n".as_bytes(), "c.csv")?;
+/// let mut out = Vec::new();
+/// let summary = replay_heads(&plant, &rows, 50e-6, &mut out)?;
+/// assert_eq!((summary.periods, summary.heads), (10, 2));
+/// let text = String::from_utf8(out).unwrap();
+/// assert!(text.starts_with("head,time_s,heater_mw"));
+/// assert_eq!(text.lines().count(), 21);
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+///
+/// # Errors
+/// As [`replay`].
+pub fn replay_heads<W: Write>(
+    plant: &MultiPlant,
+    rows: &[CommandRow],
+    dt: f64,
+    out: W,
+) -> Result<ReplaySummary> {
     let io = |e: csv::Error| Error::invalid("output", e.to_string());
     let mut w = csv::Writer::from_writer(out);
+    let several = plant.heads() > 1;
+    let write_header = |w: &mut csv::Writer<W>| {
+        if several {
+            w.write_field("head").map_err(io)?;
+        }
+        w.write_record(SENSOR_COLUMNS).map_err(io)
+    };
     // The header goes out with the first row, so that nothing is written when the checks of
-    // `replay_each` fail.
+    // `replay_heads_each` fail.
     let mut header = false;
-    let summary = replay_each(plant, rows, dt, |row| {
+    let summary = replay_heads_each(plant, rows, dt, |head, row| {
         if !header {
-            w.write_record(SENSOR_COLUMNS).map_err(io)?;
+            write_header(&mut w)?;
             header = true;
+        }
+        if several {
+            w.write_field(head.to_string()).map_err(io)?;
         }
         w.serialize(row).map_err(io)
     })?;
     if !header {
-        w.write_record(SENSOR_COLUMNS).map_err(io)?;
+        write_header(&mut w)?;
     }
     w.flush()
         .map_err(|e| Error::invalid("output", e.to_string()))?;
@@ -393,6 +442,21 @@ pub fn replay_each(
     dt: f64,
     mut each: impl FnMut(&[f64; 12]) -> Result<()>,
 ) -> Result<ReplaySummary> {
+    let one = MultiPlant::new(vec![plant.clone()])?;
+    replay_heads_each(&one, rows, dt, |_, row| each(row))
+}
+
+/// [`replay_heads`] without the file: `each` receives the head and its row of sensors, for
+/// every period and head, in that order.
+///
+/// # Errors
+/// As [`replay`]; an error `each` returns stops the replay and is passed on.
+pub fn replay_heads_each(
+    plant: &MultiPlant,
+    rows: &[CommandRow],
+    dt: f64,
+    mut each: impl FnMut(usize, &[f64; 12]) -> Result<()>,
+) -> Result<ReplaySummary> {
     crate::error::check_positive("dt", dt)?;
     let end = rows.last().map_or(0.0, |r| r.time_s);
     let periods = (end / dt * (1.0 + 1e-12)).floor();
@@ -406,29 +470,38 @@ pub fn replay_each(
         ));
     }
     let periods = periods as usize;
-    let wavelength = plant.sensor_spec().readback.wavelength;
+    let heads = plant.heads();
+    let wavelengths: Vec<f64> = (0..heads)
+        .filter_map(|k| plant.head(k))
+        .map(|p| p.sensor_spec().readback.wavelength)
+        .collect();
     let mut drive = plant.drive()?;
+    let mut commands = vec![Command::default(); heads];
+    let mut sensors = vec![Sensors::default(); heads];
+    let mut reference = vec![None; heads];
     let mut k = 0usize;
-    let mut reference = None;
     for n in 0..periods {
         let t0 = n as f64 * dt;
         while k + 1 < rows.len() && rows[k + 1].time_s <= t0 * (1.0 + 1e-12) {
             k += 1;
         }
         let r = rows[k];
-        let cmd = Command {
+        commands.fill(Command {
             heater_power_mw: r.heater_mw,
             dc_voltage_v: r.voltage_dc_v,
             ac_amplitude_v: r.voltage_ac_v,
             ac_frequency_khz: r.ac_frequency_khz,
-        };
-        let s = drive.step(&cmd, dt)?;
-        let lr0 = *reference.get_or_insert(s.readback.log_ratio());
-        each(&sensor_row(&s, lr0, wavelength))?;
+        });
+        drive.step_into(&commands, dt, &mut sensors)?;
+        for (h, s) in sensors.iter().enumerate() {
+            let lr0 = *reference[h].get_or_insert(s.readback.log_ratio());
+            each(h, &sensor_row(s, lr0, wavelengths[h]))?;
+        }
     }
     Ok(ReplaySummary {
         periods,
         simulated_time: drive.time(),
+        heads,
     })
 }
 

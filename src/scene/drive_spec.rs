@@ -139,6 +139,27 @@ pub struct DriveSensorsSpec {
     pub readback_wavelength_m: Option<f64>,
 }
 
+impl Default for DriveSpec {
+    /// One head; every other setting the library's default.
+    ///
+    /// ```
+    /// use hdi_tribology::scene::DriveSpec;
+    /// assert_eq!(DriveSpec::default().heads, 1);
+    /// ```
+    fn default() -> Self {
+        DriveSpec {
+            heads: one_head(),
+            radius_m: None,
+            rpm: None,
+            initial_heater_power_w: None,
+            heater_time_constant_s: None,
+            disk: DriveDiskSpec::default(),
+            ambient: DriveAmbientSpec::default(),
+            sensors: DriveSensorsSpec::default(),
+        }
+    }
+}
+
 fn one_head() -> u32 {
     1
 }

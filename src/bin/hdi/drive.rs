@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use hdi_tribology::drive::{
-    read_commands, replay, spec_zone, whole_periods, DiskSpec, DriveOptions, Plant,
+    read_commands, replay_heads, spec_zone, whole_periods, DiskSpec, DriveOptions, MultiPlant,
 };
 
 use hdi_tribology::scene::DriveSpec;
@@ -39,7 +39,9 @@ pub struct Args {
     /// clearance, stiffness and disk speed.
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     radius_mm: Option<f64>,
-    /// Heads on the disk (scene `drive.heads`; the replay runs one).
+    /// Heads on the disk, one per surface (scene `drive.heads`) [default: 1]: every head holds
+    /// the same commands over its own surface (head k seeded `drive::head_seed(seed, k)`), and
+    /// the CSV gains a leading `head` column, one row per period and head.
     #[arg(long, value_name = "N", allow_hyphen_values = true)]
     heads: Option<f64>,
     /// Spindle speed (rpm) [default: the scene's disk speed at the radius].
@@ -138,13 +140,6 @@ fn drive_spec(a: &Args, scene: &hdi_tribology::scene::Scene) -> Result<DriveSpec
                 .map_err(|e| CliError::Usage(e.to_string()))?;
         }
     }
-    if spec.heads != 1 {
-        return Err(CliError::Usage(format!(
-            "--heads: a replay runs one head, got {} (run one replay per head, each with its \
-             own --seed)",
-            spec.heads
-        )));
-    }
     Ok(spec)
 }
 
@@ -175,9 +170,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .as_deref()
         .map(|p| Output::prepare(p, "--out"))
         .transpose()?;
-    let plant = Plant::new(&scene, &spec_zone(&scene, &spec)?, a.seed, opts)?;
-    // One line per period, and the header.
-    let progress = common::Progress::bar("drive", periods as u64 + 1, "lines");
+    let zone = spec_zone(&scene, &spec)?;
+    let heads = spec.heads as usize;
+    let plant = MultiPlant::uniform(&scene, &zone, heads, a.seed, opts)?;
+    // One line per period and head, and the header.
+    let progress = common::Progress::bar("drive", (periods * heads) as u64 + 1, "lines");
     match out {
         Some(out) => {
             let mut summary = None;
@@ -186,7 +183,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                     inner: w,
                     progress: &progress,
                 };
-                summary = Some(replay(&plant, &rows, dt, w)?);
+                summary = Some(replay_heads(&plant, &rows, dt, w)?);
                 Ok(())
             })?;
             drop(progress);
@@ -199,7 +196,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 inner: &mut buf,
                 progress: &progress,
             };
-            replay(&plant, &rows, dt, w)?;
+            replay_heads(&plant, &rows, dt, w)?;
             drop(progress);
             common::write_stdout(&buf)
         }
