@@ -57,27 +57,6 @@ pub struct DriveSpec {
     pub sensors: DriveSensorsSpec,
 }
 
-/// One head, and every other setting the drive's own default (as an empty `[drive]` section).
-///
-/// ```
-/// use hdi_tribology::scene::DriveSpec;
-/// assert_eq!(DriveSpec::default().heads, 1);
-/// ```
-impl Default for DriveSpec {
-    fn default() -> Self {
-        DriveSpec {
-            heads: one_head(),
-            radius_m: None,
-            rpm: None,
-            initial_heater_power_w: None,
-            heater_time_constant_s: None,
-            disk: DriveDiskSpec::default(),
-            ambient: DriveAmbientSpec::default(),
-            sensors: DriveSensorsSpec::default(),
-        }
-    }
-}
-
 /// `[drive.disk]`: each surface's run-out and waviness (each surface draws its own random
 /// waviness from its seed).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
