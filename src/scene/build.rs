@@ -5,7 +5,7 @@ use std::sync::Arc;
 use super::{Scene, WettingSpec};
 use crate::force::{
     lj_zero, AirBearing, Electrostatic, GreenwoodWilliamson, InterfaceForces, InterfaceTerm,
-    Intermolecular, Meniscus, MeniscusParams, Wetting,
+    Intermolecular, Meniscus, MeniscusParams, Pickup, Wetting,
 };
 use crate::quadrature::TableOptions;
 use crate::surface::{Discrete, GaussianHeights, PeakDistribution, PeakModel};
@@ -160,6 +160,10 @@ impl Scene {
             rupture_distance: l.rupture_distance_m,
             healing_time: l.healing_time_s,
             formation_time: l.formation_time_s,
+            pickup: match (l.pickup_rate_m_per_s, l.pickup_loss_time_s) {
+                (Some(rate), Some(loss_time)) => Some(Pickup { rate, loss_time }),
+                _ => None,
+            },
         };
         let opts = TableOptions {
             rel_tol: self.table.rel_tol,
