@@ -3,7 +3,10 @@
 //! the few-peak deformable-slider scene `scenes/paper_bulge.toml`:
 //! - `freq`: V_ac × the bulge's natural frequency on a fixed body (`bulge`);
 //! - `zeta`: V_ac × the bulge's damping ratio (`bulge`);
-//! - `lag_rigid`, `lag_bulge`: V_ac × the interface lag τ, on `rigid` and on `bulge`.
+//! - `lag_rigid`, `lag_bulge`: V_ac × the interface lag τ, on `rigid` and on `bulge`;
+//! - `lag_paper` (only when named in `--maps`): V_ac × the interface lag τ = 1 – 320 ns on the
+//!   paper scene itself, `scenes/paper.toml` (Greenwood–Williamson contact, rigid slider), whose
+//!   c/K_contact (≈ 27 ns) lies inside the plausible lags.
 //!
 //! Every point runs the scene's fixed programme at the scene's tolerance, and where that run
 //! gives touchdown and take-off, once more at a tolerance ten times tighter as a check: a point
@@ -101,9 +104,11 @@ struct MapSpec {
     /// log10 of the physically plausible band.
     plausible: (f64, f64),
     label: &'static str,
+    /// The scene the map runs on, where it is not the one given by `--scene`.
+    scene: Option<&'static str>,
 }
 
-const MAPS: [MapSpec; 4] = [
+const MAPS: [MapSpec; 5] = [
     MapSpec {
         name: "freq",
         title: "bulge: V_ac × bulge natural frequency",
@@ -112,6 +117,7 @@ const MAPS: [MapSpec; 4] = [
         // 10 MHz – 1.3 GHz: k = 2E*a = 4e5 … 2e6 N/m, m = ρL³ with L = 2 … 30 µm.
         plausible: (7.0, 9.11),
         label: "f_{b} (Hz)",
+        scene: None,
     },
     MapSpec {
         name: "zeta",
@@ -121,6 +127,7 @@ const MAPS: [MapSpec; 4] = [
         // radiation into the body, ζ ≈ 0.43/√B for B = m/(ρa³) = 1 … 1000, plus material loss.
         plausible: (-1.9, -0.37),
         label: "ζ_{b}",
+        scene: None,
     },
     MapSpec {
         name: "lag_rigid",
@@ -130,6 +137,7 @@ const MAPS: [MapSpec; 4] = [
         // a wave crossing 10 µm … 1.2 mm at 8.7 km/s: 1 ns … 140 ns.
         plausible: (-9.0, -6.854),
         label: "τ (s)",
+        scene: None,
     },
     MapSpec {
         name: "lag_bulge",
@@ -138,6 +146,16 @@ const MAPS: [MapSpec; 4] = [
         range: (-10.0, -5.0),
         plausible: (-9.0, -6.854),
         label: "τ (s)",
+        scene: None,
+    },
+    MapSpec {
+        name: "lag_paper",
+        title: "paper scene (GW, rigid): V_ac × interface lag",
+        axis: Axis::Lag { bulge: false },
+        range: (-9.0, -6.5),
+        plausible: (-9.0, -6.854),
+        label: "τ (s)",
+        scene: Some("scenes/paper.toml"),
     },
 ];
 
@@ -251,7 +269,8 @@ struct Setup {
     base: SliderModel,
     programme: HeaterProgramme,
     opts: CycleOptions,
-    bulge: Bulge,
+    /// The scene's bulge; `None` on a rigid scene (lag maps on `rigid` only).
+    bulge: Option<Bulge>,
     body_mass: f64,
     /// Start and end of the hold at the highest power (s).
     hold: (f64, f64),
@@ -261,13 +280,17 @@ struct Setup {
 
 impl Setup {
     fn from_scene(scene: &Scene) -> Res<Self> {
-        let StructureSpec::Bulge {
-            mass_kg,
-            stiffness_n_per_m,
-            damping_ratio,
-        } = scene.structure
-        else {
-            return Err("the maps need a scene with a bulge structure".into());
+        let bulge = match scene.structure {
+            StructureSpec::Bulge {
+                mass_kg,
+                stiffness_n_per_m,
+                damping_ratio,
+            } => Some(Bulge {
+                mass: mass_kg,
+                stiffness: stiffness_n_per_m,
+                zeta: damping_ratio,
+            }),
+            _ => None,
         };
         let knots = &scene.heater.programme;
         let top = knots.iter().map(|k| k[1]).fold(f64::MIN, f64::max);
@@ -286,11 +309,7 @@ impl Setup {
             base,
             programme: HeaterProgramme::Fixed(SliderModel::programme_from_knots(knots)?),
             opts,
-            bulge: Bulge {
-                mass: mass_kg,
-                stiffness: stiffness_n_per_m,
-                zeta: damping_ratio,
-            },
+            bulge,
             body_mass: scene.slider.mass_kg,
             hold: (at_top[0], at_top[at_top.len() - 1]),
         })
@@ -298,17 +317,27 @@ impl Setup {
 
     /// The model of one map point.
     fn model(&self, axis: Axis, param: f64, v_ac: f64) -> Res<SliderModel> {
-        let b = self.bulge;
         let mut m = self.base.clone();
+        let bulge = || {
+            self.bulge
+                .ok_or("this map needs a scene with a bulge structure")
+        };
         let structure = match axis {
-            Axis::Frequency => Structure::bulge(
-                self.body_mass,
-                b.mass,
-                b.mass * (2.0 * PI * param).powi(2),
-                b.zeta,
-            )?,
-            Axis::Damping => Structure::bulge(self.body_mass, b.mass, b.stiffness, param)?,
+            Axis::Frequency => {
+                let b = bulge()?;
+                Structure::bulge(
+                    self.body_mass,
+                    b.mass,
+                    b.mass * (2.0 * PI * param).powi(2),
+                    b.zeta,
+                )?
+            }
+            Axis::Damping => {
+                let b = bulge()?;
+                Structure::bulge(self.body_mass, b.mass, b.stiffness, param)?
+            }
             Axis::Lag { bulge: true } => {
+                let b = bulge()?;
                 m = m.with_interface_lag(param);
                 Structure::bulge(self.body_mass, b.mass, b.stiffness, b.zeta)?
             }
@@ -1124,23 +1153,39 @@ fn main() -> Res<()> {
         method: !args.iter().any(|a| a == "--no-method-check"),
         quasi_static: args.iter().any(|a| a == "--quasi-static"),
     };
-    println!(
-        "# {} ({} × {} grid, {} threads); scene bulge {:.3e} kg, {:.3e} N/m ({:.1} MHz), ζ = {}",
+    let head = format!(
+        "# {} ({} × {} grid, {} threads)",
         scene.name,
         n,
         n,
-        rayon::current_num_threads(),
-        setup.bulge.mass,
-        setup.bulge.stiffness,
-        setup.bulge.frequency() * 1e-6,
-        setup.bulge.zeta
+        rayon::current_num_threads()
     );
+    match setup.bulge {
+        Some(b) => println!(
+            "{head}; scene bulge {:.3e} kg, {:.3e} N/m ({:.1} MHz), ζ = {}",
+            b.mass,
+            b.stiffness,
+            b.frequency() * 1e-6,
+            b.zeta
+        ),
+        None => println!("{head}; rigid scene"),
+    }
     for spec in MAPS
         .iter()
         .filter(|s| names.split(',').any(|x| x == s.name))
     {
+        // A map on a scene of its own (`lag_paper`) loads it; the others share `--scene`'s.
+        let own = match spec.scene {
+            Some(path) => {
+                let scene = Scene::from_path(path)?;
+                println!("{:<10} scene {} ({path})", spec.name, scene.name);
+                Some(Setup::from_scene(&scene)?)
+            }
+            None => None,
+        };
+        let setup = own.as_ref().unwrap_or(&setup);
         let clock = Instant::now();
-        let points = run_map(&setup, spec, n, checks)?;
+        let points = run_map(setup, spec, n, checks)?;
         let wall = clock.elapsed().as_secs_f64();
         cost(spec, &points, wall);
         models(spec, &points);
@@ -1153,10 +1198,10 @@ fn main() -> Res<()> {
         );
         summarise(spec, &points);
         if args.iter().any(|a| a == "--check") {
-            check(&setup, spec, &points)?;
+            check(setup, spec, &points)?;
         }
         if args.iter().any(|a| a == "--probe") {
-            probe(&setup, spec, &points)?;
+            probe(setup, spec, &points)?;
         }
     }
     Ok(())

@@ -4,7 +4,9 @@
 //! - `thickness`: the mobile lubricant thickness t_m (log scale), at the healing time τ_h below;
 //! - `healing`: the healing time τ_h (log scale), at the mobile thickness below;
 //! - `rupture`: the rupture distance s_r given outright (log scale) in place of Lian's law,
-//!   at both of the others below (`--maps rupture`; not in the default set).
+//!   at both of the others below (`--maps rupture`; not in the default set);
+//! - `formation`: the formation time τ_f (log scale, 10 ns – 1 ms), at the others below
+//!   (`--maps formation`; not in the default set).
 //!
 //! Every point runs the scene's fixed programme at the scene's tolerance and once more at a
 //! tolerance ten times tighter: a point counts as converged when touchdown and take-off move by
@@ -55,6 +57,7 @@ enum Axis {
     Thickness,
     Healing,
     Rupture,
+    Formation,
 }
 
 impl Axis {
@@ -63,6 +66,7 @@ impl Axis {
             Axis::Thickness => "thickness",
             Axis::Healing => "healing",
             Axis::Rupture => "rupture",
+            Axis::Formation => "formation",
         }
     }
     fn label(self) -> &'static str {
@@ -70,6 +74,7 @@ impl Axis {
             Axis::Thickness => "mobile thickness t_m (nm)",
             Axis::Healing => "healing time τ_h (µs)",
             Axis::Rupture => "rupture distance s_r (nm)",
+            Axis::Formation => "formation time τ_f (µs)",
         }
     }
     /// Range (SI) and the factor to the unit of the label.
@@ -78,13 +83,15 @@ impl Axis {
             Axis::Thickness => ((0.05e-9, 1.5e-9), 1e9),
             Axis::Healing => ((1e-7, 1e-2), 1e6),
             Axis::Rupture => ((0.02e-9, 3e-9), 1e9),
+            Axis::Formation => ((1e-8, 1e-3), 1e6),
         }
     }
     fn params(self, value: f64) -> MeniscusParams {
-        let (t_m, tau_h, s_r) = match self {
-            Axis::Thickness => (value, HEALING_S, None),
-            Axis::Healing => (MOBILE_M, value, None),
-            Axis::Rupture => (MOBILE_M, HEALING_S, Some(value)),
+        let (t_m, tau_h, s_r, tau_f) = match self {
+            Axis::Thickness => (value, HEALING_S, None, FORMATION_S),
+            Axis::Healing => (MOBILE_M, value, None, FORMATION_S),
+            Axis::Rupture => (MOBILE_M, HEALING_S, Some(value), FORMATION_S),
+            Axis::Formation => (MOBILE_M, HEALING_S, None, value),
         };
         MeniscusParams {
             surface_tension: GAMMA,
@@ -93,7 +100,8 @@ impl Axis {
             mobile_thickness: t_m,
             rupture_distance: s_r,
             healing_time: tau_h,
-            formation_time: FORMATION_S,
+            formation_time: tau_f,
+            pickup: None,
         }
     }
 }
@@ -229,6 +237,7 @@ fn write_csv(path: &Path, axis: Axis, points: &[Point]) -> Res<()> {
             Axis::Thickness => "mobile_thickness_nm",
             Axis::Healing => "healing_time_us",
             Axis::Rupture => "rupture_distance_nm",
+            Axis::Formation => "formation_time_us",
         }
     );
     for p in points {
@@ -493,6 +502,7 @@ fn main() -> Res<()> {
                         "thickness" => Ok(Axis::Thickness),
                         "healing" => Ok(Axis::Healing),
                         "rupture" => Ok(Axis::Rupture),
+                        "formation" => Ok(Axis::Formation),
                         other => Err(format!("unknown map {other:?}")),
                     })
                     .collect::<Result<_, _>>()?

@@ -7,11 +7,11 @@ use std::sync::Arc;
 
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
 use hdi_tribology::force::{
-    lian_rupture_distance, Footprint, Gaps, Meniscus, MeniscusParams, StatefulTerm, Wetting,
+    lian_rupture_distance, Footprint, Gaps, Meniscus, MeniscusParams, Pickup, StatefulTerm, Wetting,
 };
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::{LubricantSpec, Scene, WettingSpec};
-use hdi_tribology::surface::{Discrete, RiceMaxima};
+use hdi_tribology::surface::{Discrete, Gaussian, PeakDistribution, RiceMaxima};
 use hdi_tribology::Error;
 
 const GAMMA: f64 = 0.024; // N/m, PFPE (Zdol) at room temperature
@@ -26,6 +26,7 @@ fn params(t_m: f64, theta: f64, wetting: Wetting, rupture: Option<f64>) -> Menis
         rupture_distance: rupture,
         healing_time: 1e-5,
         formation_time: 1e-7,
+        pickup: None,
     }
 }
 
@@ -190,6 +191,8 @@ fn lubricant(total: f64, bonded: f64, tau_h: f64) -> LubricantSpec {
         healing_time_s: tau_h,
         formation_time_s: 1e-7,
         rupture_distance_m: None,
+        pickup_rate_m_per_s: None,
+        pickup_loss_time_s: None,
     }
 }
 
@@ -276,4 +279,183 @@ fn bad_lubricant_parameters_are_named_with_their_unit() {
     assert!((l.healing_time_s - 1e-5).abs() < 1e-20);
     let model = SliderModel::from_scene(&s).unwrap();
     assert_eq!(model.term_states(), 1);
+    // the head's pick-up: both fields or neither, each > 0; with both, a second state
+    let lub = "total_thickness_nm = 1.5\nbonded_thickness_nm = 0.5\n";
+    for (extra, want) in [
+        (
+            "pickup_rate_m_per_s = 1e-5\n",
+            "lubricant.pickup_loss_time_s: is required with lubricant.pickup_rate_m_per_s",
+        ),
+        (
+            "pickup_loss_time_us = 50\n",
+            "lubricant.pickup_rate_m_per_s: is required with lubricant.pickup_loss_time_s",
+        ),
+        (
+            "pickup_rate_m_per_s = -1e-5\npickup_loss_time_us = 50\n",
+            "lubricant.pickup_rate_m_per_s: must be finite and > 0, got -1e-5",
+        ),
+        (
+            "pickup_rate_m_per_s = 1e-5\npickup_loss_time_us = 0\n",
+            "lubricant.pickup_loss_time_us: must be finite and > 0, got 0 µs",
+        ),
+    ] {
+        let err = Scene::from_toml_str(&with(&format!("{lub}{ok}{extra}"))).unwrap_err();
+        assert!(matches!(err, Error::InvalidInput { .. }), "{err:?}");
+        let msg = err.to_string();
+        assert!(msg.contains(want), "{msg}\n wanted: {want}");
+    }
+    let s = Scene::from_toml_str(&with(&format!(
+        "{lub}{ok}pickup_rate_m_per_s = 1e-5\npickup_loss_time_us = 50\n"
+    )))
+    .unwrap();
+    assert_eq!(SliderModel::from_scene(&s).unwrap().term_states(), 2);
+}
+
+/// A term with the head's pick-up on Gaussian peaks (σ = 0.7 nm) under a flat footprint:
+/// `t_m` = 1 nm, `r_p` = 20 µm/s, `τ_p` = 50 µs (saturation 1 nm).
+fn with_pickup() -> Meniscus {
+    let mut p = params(1e-9, 0.3, Wetting::Disk, None);
+    p.pickup = Some(Pickup {
+        rate: 2e-5,
+        loss_time: 5e-5,
+    });
+    let peaks = Arc::new(Gaussian::new(0.0, 0.7e-9).unwrap());
+    Meniscus::new(p, R, 1.5e14, peaks, Footprint::Flat { area_m2: 1e-9 })
+        .unwrap()
+        .tabulated((-4e-9, 3e-8), &Default::default())
+        .unwrap()
+}
+
+/// The head's film, integrated from the term's rates with the crate's stiff solver: held at a
+/// gap in contact it grows as `t_h = r_p τ_p S (1 − e^{−t/τ_p})`, with `S` the Gaussian survival
+/// `erfc(z/σ√2)/2` of the peak heights at `z = d − t_m`; moved far from the disk it decays as
+/// `t_h(t₁) e^{−(t−t₁)/τ_p}`, while `d*` heals towards the gap with τ_h.
+#[test]
+fn the_head_pickup_grows_and_decays_in_closed_form() {
+    use hdi_tribology::ode::{solve, FnSystem, Method, Options};
+    use nalgebra::Vector2;
+    let m = with_pickup();
+    assert_eq!(m.states(), 2);
+    let (rate, tau) = (2e-5, 5e-5);
+    let run = |d: f64, y0: Vector2<f64>, t_end: f64| {
+        let m = &m;
+        let sys = FnSystem::new(move |_t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>| {
+            let mut r = [0.0; 2];
+            m.rates(Gaps::same(d), y.as_slice(), &mut r);
+            dy.copy_from_slice(&r);
+        });
+        let opts = Options::default().rtol(1e-10).atol(1e-22);
+        solve(&sys, 0.0, y0, t_end, Method::Radau5, &opts, &mut []).unwrap()
+    };
+    // in contact: the gap 0.2 nm above t_m; S from the Gaussian's own closed form
+    let d1 = 1.2e-9;
+    let s = Gaussian::new(0.0, 0.7e-9)
+        .unwrap()
+        .partial_moment(d1 - 1e-9, 0.0);
+    let erfc_half = 0.5 * erfc_series(0.2 / (0.7 * 2f64.sqrt()));
+    assert!((s - erfc_half).abs() < 1e-12, "{s} vs {erfc_half}");
+    let grow = run(d1, Vector2::new(d1, 0.0), 3.1e-4);
+    let mut worst: f64 = 0.0;
+    for k in 1..=30 {
+        let t = 1e-5 * k as f64;
+        let y = grow.sample(t).unwrap();
+        let exact = rate * tau * s * (1.0 - (-t / tau).exp());
+        worst = worst.max((y[1] - exact).abs() / (rate * tau * s));
+        assert_eq!(y[0], d1, "d* rests at the gap held");
+    }
+    assert!(worst < 1e-6, "growth: worst relative error {worst}");
+    // the term's own rest value is the end of the growth
+    let at_rest = m.pickup_at_rest(d1).0;
+    assert!(
+        (at_rest - rate * tau * s).abs() < 1e-8 * at_rest,
+        "{at_rest}"
+    );
+    let t1 = *grow.y_final();
+    // far from the disk (S < 1e-300 at 40 σ): pure decay of t_h, d* heals towards 30 nm
+    let far = 3e-8;
+    let decay = run(far, t1, 3.1e-4);
+    worst = 0.0;
+    for k in 1..=30 {
+        let t = 1e-5 * k as f64;
+        let y = decay.sample(t).unwrap();
+        let exact = t1[1] * (-t / tau).exp();
+        worst = worst.max((y[1] - exact).abs() / t1[1]);
+        let healed = far + (t1[0] - far) * (-t / 1e-5).exp();
+        assert!(
+            (y[0] - healed).abs() < 1e-6 * far,
+            "d* at {t}: {} vs {healed}",
+            y[0]
+        );
+    }
+    assert!(worst < 1e-6, "decay: worst relative error {worst}");
+}
+
+/// `erfc(x) = 1 − erf(x)`, erf from its Taylor series (for small x; independent of the crate's).
+fn erfc_series(x: f64) -> f64 {
+    let mut sum = 0.0;
+    let mut term = x;
+    let mut n = 0;
+    while term.abs() > 1e-18 {
+        sum += term / (2 * n + 1) as f64;
+        n += 1;
+        term *= -x * x / n as f64;
+    }
+    1.0 - 2.0 / PI.sqrt() * sum
+}
+
+/// With a pick-up, the static force is the term's force at `d* = d` and `t_h` at rest, its slope
+/// that of this force along the rest path (central difference), and a picked-up film only adds
+/// attraction: at every gap the force with the head's film at rest is at least as attractive
+/// as without a pick-up.
+#[test]
+fn the_pickup_enters_the_statics_at_rest() {
+    let with = SliderModel::from_scene(&paper_lubricated(true)).unwrap();
+    let without = SliderModel::from_scene(&paper_lubricated(false)).unwrap();
+    let plain = SliderModel::from_scene(&Scene::paper()).unwrap();
+    let m = paper_lubricated(true).meniscus().unwrap().unwrap();
+    let mut compared = 0;
+    for d in [0.3e-9, 0.8e-9, 1.2e-9, 1.6e-9, 2.5e-9] {
+        let g = Gaps::same(d);
+        let base = plain.interface_force(g, 0.0);
+        let f = with.interface_force(g, 0.0);
+        let mut x = [0.0; 2];
+        m.equilibrium(g, &mut x);
+        assert_eq!(x[0], d);
+        let own = m.force(g, &x).force.value;
+        assert!(
+            (f.value - base.value - own).abs() <= 1e-12 * base.value.abs().max(own.abs()),
+            "{d}: {} vs {own}",
+            f.value - base.value
+        );
+        let h = 1e-13;
+        let at = |d: f64| {
+            let g = Gaps::same(d);
+            let mut x = [0.0; 2];
+            m.equilibrium(g, &mut x);
+            m.force(g, &x).force.value
+        };
+        let fd = (at(d + h) - at(d - h)) / (2.0 * h);
+        let slope = f.d_bulge - base.d_bulge;
+        assert!(
+            (slope - fd).abs() <= 1e-4 * fd.abs().max(1.0),
+            "{d}: slope {slope} vs {fd}"
+        );
+        let f0 = without.interface_force(g, 0.0).value;
+        assert!(f.value <= f0, "{d}: {} > {f0}", f.value);
+        compared += (f.value < f0) as usize;
+    }
+    assert!(compared >= 3, "the pick-up adds attraction in contact");
+}
+
+/// The paper scene with 0.3 nm of mobile lubricant, with or without the head's pick-up
+/// (`r_p` = 10 µm/s, `τ_p` = 50 µs: saturation 0.5 nm).
+fn paper_lubricated(pickup: bool) -> Scene {
+    let mut scene = Scene::paper();
+    let mut l = lubricant(1.3e-9, 1.0e-9, 2e-5);
+    if pickup {
+        l.pickup_rate_m_per_s = Some(1e-5);
+        l.pickup_loss_time_s = Some(5e-5);
+    }
+    scene.lubricant = Some(l);
+    scene
 }

@@ -1,6 +1,7 @@
 //! Lubricant menisci with memory: capillary bridges between the head and the asperity peaks of a
 //! lubricated disk, formed when the local gap falls below the mobile lubricant thickness and
-//! broken only past a larger rupture distance, with the bridge population carried in a state.
+//! broken only past a larger rupture distance, with the bridge population carried in a state,
+//! and optionally the lubricant the head picks up in contact as a second state.
 //!
 //! See `docs/analyses.md` (section "Lubricant menisci") for the equations, the parameter ranges
 //! and their sources.
@@ -76,6 +77,39 @@ pub struct MeniscusParams {
     pub healing_time: f64,
     /// Formation time τ_f (s, > 0): the closest approach follows a closing gap with it.
     pub formation_time: f64,
+    /// The head's pick-up of lubricant (a second state); `None`: no pick-up, one state.
+    pub pickup: Option<Pickup>,
+}
+
+/// The lubricant film the head picks up in contact and loses over time, `t_h`:
+///
+/// `ṫ_h = r_p S(d − t_m) − t_h/τ_p`,
+///
+/// with `S(d − t_m)` the fraction of the peaks whose top lies within the disk's mobile film of
+/// the head at the bulge gap `d` (the survival of the peak heights): the head gains lubricant
+/// at the rate `r_p` with every peak wetting it, and loses it with the time `τ_p` (spreading,
+/// evaporation, transfer back). A bridge then forms where the local gap falls below
+/// `t_m + t_h` (the disk's mobile film plus the head's), and breaks past `t_m + t_h + s_r`.
+/// At rest `t_h = r_p τ_p S(d − t_m)`: the saturation `r_p τ_p` when every peak wets the head.
+///
+/// ```
+/// use hdi_tribology::force::Pickup;
+/// let p = Pickup { rate: 1e-6, loss_time: 1e-3 };
+/// assert!((p.saturation() - 1e-9).abs() < 1e-24);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pickup {
+    /// Gain rate `r_p` with every peak wetting the head (m/s, > 0).
+    pub rate: f64,
+    /// Loss time `τ_p` (s, > 0).
+    pub loss_time: f64,
+}
+
+impl Pickup {
+    /// The film at rest with every peak wetting the head, `r_p τ_p` (m).
+    pub fn saturation(&self) -> f64 {
+        self.rate * self.loss_time
+    }
 }
 
 /// Lubricant menisci on the asperity peaks, with the closest approach `d*` as their state.
@@ -99,7 +133,7 @@ pub struct MeniscusParams {
 /// let p = MeniscusParams {
 ///     surface_tension: 0.025, contact_angle: 0.0, wetting: Wetting::Disk,
 ///     mobile_thickness: 1e-9, rupture_distance: Some(3e-9),
-///     healing_time: 1e-5, formation_time: 1e-7,
+///     healing_time: 1e-5, formation_time: 1e-7, pickup: None,
 /// };
 /// let peaks = Arc::new(Gaussian::new(0.0, 0.7e-9)?);
 /// let m = Meniscus::new(p, 1e-7, 1.5e14, peaks, Footprint::Flat { area_m2: 1e-8 })?;
@@ -120,6 +154,8 @@ pub struct Meniscus {
     footprint: Footprint,
     /// The force and its slope in `e`, where tabulated.
     table: Option<Arc<Table>>,
+    /// With a pick-up: the fraction of the peaks above `z` and its slope, where tabulated.
+    survival: Option<Arc<Table>>,
 }
 
 impl Meniscus {
@@ -150,6 +186,10 @@ impl Meniscus {
         }
         check_positive("healing_time_s", params.healing_time)?;
         check_positive("formation_time_s", params.formation_time)?;
+        if let Some(p) = params.pickup {
+            check_positive("pickup_rate_m_per_s", p.rate)?;
+            check_positive("pickup_loss_time_s", p.loss_time)?;
+        }
         check_positive("asperity_radius_m", asperity_radius)?;
         check_positive("asperity_density_per_m2", asperity_density)?;
         footprint.validate("footprint")?;
@@ -171,6 +211,7 @@ impl Meniscus {
             peaks,
             footprint,
             table: None,
+            survival: None,
         })
     }
 
@@ -182,8 +223,14 @@ impl Meniscus {
             return Ok(self);
         }
         let (t_m, s_r) = (self.params.mobile_thickness, self.rupture);
-        let table = Table::build(|e| self.direct(e), lo - t_m - s_r, hi - t_m, opts)?;
+        // The head's film shifts `e` down by up to its saturation.
+        let t_h = self.params.pickup.map_or(0.0, |p| p.saturation());
+        let table = Table::build(|e| self.direct(e), lo - t_m - t_h - s_r, hi - t_m, opts)?;
         self.table = Some(Arc::new(table));
+        if self.params.pickup.is_some() {
+            let survival = Table::build(|z| Ok(self.survival_direct(z)), lo - t_m, hi - t_m, opts)?;
+            self.survival = Some(Arc::new(survival));
+        }
         Ok(self)
     }
 
@@ -248,6 +295,31 @@ impl Meniscus {
         }
     }
 
+    /// The fraction of the peaks above `z` and its slope `−p(z)`.
+    fn survival_direct(&self, z: f64) -> (f64, f64) {
+        (self.peaks.partial_moment(z, 0.0), -self.peaks.pdf(z))
+    }
+
+    /// The fraction of the peaks above `z` and its slope, from the table where there is one.
+    fn survival(&self, z: f64) -> (f64, f64) {
+        self.survival
+            .as_ref()
+            .and_then(|t| t.eval(z))
+            .unwrap_or_else(|| self.survival_direct(z))
+    }
+
+    /// The head's film at rest at the bulge gap `d` (m), and its slope in `d`: `r_p τ_p S(d − t_m)`
+    /// (0 without a pick-up).
+    pub fn pickup_at_rest(&self, d: f64) -> (f64, f64) {
+        match self.params.pickup {
+            Some(p) => {
+                let (s, ds) = self.survival(d - self.params.mobile_thickness);
+                (p.saturation() * s, p.saturation() * ds)
+            }
+            None => (0.0, 0.0),
+        }
+    }
+
     /// The force and its slope in `e` (0 where the evaluation fails: far outside the peaks).
     fn at(&self, e: f64) -> (f64, f64) {
         if let Some((f, df)) = self.table.as_ref().and_then(|t| t.eval(e)) {
@@ -259,13 +331,20 @@ impl Meniscus {
     /// The force at the bulge gap `d` with the closest approach `d_star` (m), and its partial
     /// derivatives along `d` and `d_star`.
     pub fn force_at(&self, d: f64, d_star: f64) -> (f64, f64, f64) {
-        let t_m = self.params.mobile_thickness;
+        let (f, d_bulge, d_star, _) = self.force_with_pickup(d, d_star, 0.0);
+        (f, d_bulge, d_star)
+    }
+
+    /// The force with the head's film `t_h` (m) on top of the disk's mobile film, and its partial
+    /// derivatives along `d`, `d_star` and `t_h`. With `t_h = 0` it is [`Meniscus::force_at`].
+    pub fn force_with_pickup(&self, d: f64, d_star: f64, t_h: f64) -> (f64, f64, f64, f64) {
+        let t = self.params.mobile_thickness + t_h;
         if d - d_star < self.rupture {
-            let (f, df) = self.at(d_star - t_m);
-            (f, 0.0, df)
+            let (f, df) = self.at(d_star - t);
+            (f, 0.0, df, -df)
         } else {
-            let (f, df) = self.at(d - t_m - self.rupture);
-            (f, df, 0.0)
+            let (f, df) = self.at(d - t - self.rupture);
+            (f, df, 0.0, -df)
         }
     }
 
@@ -282,26 +361,47 @@ impl StatefulTerm for Meniscus {
     fn name(&self) -> &str {
         "meniscus"
     }
+    /// One (`d*`), or two with a pick-up (`d*`, `t_h`).
     fn states(&self) -> usize {
-        1
+        1 + self.params.pickup.is_some() as usize
     }
     fn equilibrium(&self, g: Gaps, x: &mut [f64]) {
         x[0] = g.bulge;
+        if self.params.pickup.is_some() {
+            x[1] = self.pickup_at_rest(g.bulge).0;
+        }
     }
     fn rates(&self, g: Gaps, x: &[f64], dx: &mut [f64]) {
         dx[0] = (g.bulge - x[0]) / self.tau(g.bulge, x[0]);
+        if let Some(p) = self.params.pickup {
+            let (s, _) = self.survival(g.bulge - self.params.mobile_thickness);
+            dx[1] = p.rate * s - x[1] / p.loss_time;
+        }
     }
     fn rate_partials(&self, g: Gaps, x: &[f64]) -> RatePartials {
         let rate = 1.0 / self.tau(g.bulge, x[0]);
         let mut p = RatePartials::default();
         p.d_bulge[0] = rate;
         p.d_state[0][0] = -rate;
+        if let Some(k) = self.params.pickup {
+            let (_, ds) = self.survival(g.bulge - self.params.mobile_thickness);
+            p.d_bulge[1] = k.rate * ds;
+            p.d_state[1][1] = -1.0 / k.loss_time;
+        }
         p
     }
     fn force(&self, g: Gaps, x: &[f64]) -> StateForce {
-        let (f, d_bulge, d_star) = self.force_at(g.bulge, x[0]);
         let mut d_state = [0.0; MAX_TERM_STATES];
+        let t_h = if self.params.pickup.is_some() {
+            x[1]
+        } else {
+            0.0
+        };
+        let (f, d_bulge, d_star, d_th) = self.force_with_pickup(g.bulge, x[0], t_h);
         d_state[0] = d_star;
+        if self.params.pickup.is_some() {
+            d_state[1] = d_th;
+        }
         StateForce {
             force: ForceEval {
                 value: f,
@@ -311,11 +411,15 @@ impl StatefulTerm for Meniscus {
             d_state,
         }
     }
-    /// `d*` is a gap: the displacement tolerance.
+    /// `d*` is a gap and `t_h` a thickness: the displacement tolerance.
     fn tolerances(&self, displacement: f64, atol: &mut [f64]) {
         atol[0] = displacement;
+        if self.params.pickup.is_some() {
+            atol[1] = displacement;
+        }
     }
-    /// At rest `d* = d`, and the force sees `d` and `d*` alone.
+    /// At rest `d* = d` and `t_h = r_p τ_p S(d − t_m)`, and the force sees `d`, `d*` and `t_h`
+    /// alone.
     fn rests_on_bulge_gap(&self) -> bool {
         true
     }
@@ -336,6 +440,7 @@ mod tests {
             rupture_distance: None,
             healing_time: 1e-5,
             formation_time: 1e-7,
+            pickup: None,
         };
         let peaks = Arc::new(Gaussian::new(0.0, 0.7e-9).unwrap());
         for footprint in Footprint::samples() {

@@ -9,7 +9,7 @@ use crate::cache::codec::{malformed, Reader, Writer};
 use crate::cache::{CacheReport, TableCache};
 use crate::force::{
     lj_zero, AirBearing, Electrostatic, Footprint, GapReference, GreenwoodWilliamson,
-    InterfaceForces, InterfaceTerm, Intermolecular, Meniscus, MeniscusParams, Wetting,
+    InterfaceForces, InterfaceTerm, Intermolecular, Meniscus, MeniscusParams, Pickup, Wetting,
 };
 use crate::quadrature::{Table, TableOptions};
 use crate::surface::{Discrete, GaussianHeights, PeakDistribution, PeakModel};
@@ -189,6 +189,10 @@ impl Scene {
             rupture_distance: l.rupture_distance_m,
             healing_time: l.healing_time_s,
             formation_time: l.formation_time_s,
+            pickup: match (l.pickup_rate_m_per_s, l.pickup_loss_time_s) {
+                (Some(rate), Some(loss_time)) => Some(Pickup { rate, loss_time }),
+                _ => None,
+            },
         };
         let m = Meniscus::new(
             params,
@@ -370,6 +374,8 @@ mod tests {
             healing_time_s: 1e-5,
             formation_time_s: 1e-7,
             rupture_distance_m: None,
+            pickup_rate_m_per_s: None,
+            pickup_loss_time_s: None,
         });
         s
     }

@@ -154,6 +154,13 @@ pub struct LubricantSpec {
     /// volume `V = π R t_m²`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rupture_distance_m: Option<f64>,
+    /// The head's pick-up: gain rate `r_p` with every peak wetting the head (m/s, > 0); with
+    /// `pickup_loss_time_s`, a second state `t_h` (none by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pickup_rate_m_per_s: Option<f64>,
+    /// The head's pick-up: loss time `τ_p` (s, > 0); given together with `pickup_rate_m_per_s`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pickup_loss_time_s: Option<f64>,
 }
 
 fn default_formation_time() -> f64 {

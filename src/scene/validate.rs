@@ -262,6 +262,25 @@ impl Scene {
         if let Some(s) = l.rupture_distance_m {
             check_non_negative("lubricant.rupture_distance_m", s)?;
         }
+        match (l.pickup_rate_m_per_s, l.pickup_loss_time_s) {
+            (Some(r), Some(t)) => {
+                check_positive("lubricant.pickup_rate_m_per_s", r)?;
+                check_positive("lubricant.pickup_loss_time_s", t)?;
+            }
+            (Some(_), None) => {
+                return Err(Error::invalid(
+                    "lubricant.pickup_loss_time_s",
+                    "is required with lubricant.pickup_rate_m_per_s",
+                ))
+            }
+            (None, Some(_)) => {
+                return Err(Error::invalid(
+                    "lubricant.pickup_rate_m_per_s",
+                    "is required with lubricant.pickup_loss_time_s",
+                ))
+            }
+            (None, None) => {}
+        }
         if self.contact.is_none() && l.mobile_thickness_m() > 0.0 {
             return Err(Error::invalid(
                 "lubricant",
