@@ -138,9 +138,9 @@ SENSOR_COLUMNS: List[str]
 def replay(scene: Union[Scene, Model], time_s: Sequence[float], heater_mw: Sequence[float],
            voltage_dc_v: Sequence[float], voltage_ac_v: Optional[Sequence[float]] = None,
            ac_frequency_khz: Optional[Sequence[float]] = None, *, rate_khz: float = 20.0,
-           seed: int = 1, radius_mm: float = 25.0, flat_disk: bool = False,
+           seed: int = 1, flat_disk: bool = False,
            atol_pm: Optional[float] = None,
-           atol_flight_pm: Optional[float] = None) -> Dict[str, F64Array]:
+           atol_flight_pm: Optional[float] = None, **settings: float) -> Dict[str, F64Array]:
     """Replays commands (each holds from its ``time_s`` until the next; the last time ends the
     run) through a new drive, as ``hdi drive SCENE --commands FILE`` does: the sensor columns
     of ``SENSOR_COLUMNS`` as float64 arrays, one value per period, bit for bit the CLI's.
