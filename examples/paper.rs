@@ -391,12 +391,31 @@ fn rigid_slider(
         series(&r)?.write_csv(&out.join(format!("fig1_triggered_{v:.1}V.csv")))?;
         fig1.push(r);
     }
-    fig1_chart(
-        &[("V_{ac} = 0 V", &fig1[0]), ("V_{ac} = 0.6 V", &fig1[1])],
-        scene.detector.contact_threshold_n,
-        options.fig1_absolute,
-    )?
-    .to_svg(&out.join("fig1_indicator_vs_power.svg"), 1000, 550)?;
+    let fig1_cycles = [("V_{ac} = 0 V", &fig1[0]), ("V_{ac} = 0.6 V", &fig1[1])];
+    let threshold = scene.detector.contact_threshold_n;
+    fig1_chart(&fig1_cycles, threshold, options.fig1_absolute)?.to_svg(
+        &out.join("fig1_indicator_vs_power.svg"),
+        1000,
+        550,
+    )?;
+    // The same cycles against the absolute power, to set beside the letter's frame: there a
+    // lower touchdown moves every point of its cycle to the right, take-off included.
+    fig1_chart(&fig1_cycles, threshold, true)?.to_svg(
+        &out.join("fig1_indicator_vs_absolute_power.svg"),
+        1000,
+        550,
+    )?;
+    for (label, r) in fig1_cycles {
+        let (td, to) = (r.touchdown.map(|d| d.power), r.takeoff.map(|d| d.power));
+        println!(
+            "Fig. 1 {}: touchdown {} mW, take-off {} mW; take-off from touchdown {} mW",
+            label.replace("_{ac}", "_ac"),
+            opt_mw(td),
+            opt_mw(to),
+            td.zip(to)
+                .map_or("—".into(), |(a, b)| format!("{:.3}", mw(b - a)))
+        );
+    }
 
     // Linear response: predicted against simulated dither at 0.6 V.
     let m6 = at(0.6);
@@ -1188,6 +1207,7 @@ mod tests {
         assert!(header.starts_with("v_ac_v,") && !header.contains("wall_seconds"));
         for name in [
             "fig1_indicator_vs_power.svg",
+            "fig1_indicator_vs_absolute_power.svg",
             "fig2b_clearance_vs_dc.svg",
             "fig3a_forces_0V.svg",
             "fig3b_zoom_0.6V.svg",
