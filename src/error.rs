@@ -1,11 +1,10 @@
 //! The crate's error type: every variant says what went wrong and where.
 //!
-//! There is one error type, [`Error`]. Bad input, a bad scene file, an output that cannot be
-//! written, a file error and a failed ODE step each have a variant of their own. A failure of an
-//! analysis or a numerical procedure is a [`Failure`]: its kind is a typed enum owned by the
-//! module that raises it (touchdown's in [`analysis::touchdown`](crate::analysis::touchdown),
-//! the cycle's in [`analysis::cycle`](crate::analysis::cycle), …), so this file knows no
-//! analysis. Match on a kind with [`Failure::downcast_ref`]; bindings that cannot match use
+//! There is one error type, [`Error`](enum@Error). Bad input, a bad scene or data file, an
+//! output that cannot be written, a file error and a failed ODE step each have a variant of their
+//! own. A failure of an analysis or a numerical procedure is a [`Failure`]: its kind is a typed
+//! enum owned by the module that raises it (touchdown's `TransitionError`, the cycle's
+//! `CycleError`, …), so this file knows no analysis. Match on a kind with [`Failure::downcast_ref`]; bindings that cannot match use
 //! [`Failure::stage`] and [`Failure::kind`].
 
 use std::any::Any;
@@ -275,7 +274,7 @@ impl fmt::Display for Stage {
 
 /// The typed kind of a [`Failure`]: an enum owned by the module that raises it, whose `Display`
 /// is the reason (without the stage's name), with numbers in engineering units as its field names
-/// say. Any `Clone` type implementing it converts into [`Error`] with `?` or `.into()`.
+/// say. Any `Clone` type implementing it converts into [`Error`](enum@Error) with `?` or `.into()`.
 ///
 /// ```
 /// use hdi_tribology::error::{Error, FailureKind, Stage};

@@ -7,7 +7,7 @@ impl Stage {
     pub const ROOT_SEARCH: Stage = Stage::named("root search");
 }
 
-/// Why a bracketed root search failed (always [`Error::NoConvergence`]).
+/// Why a bracketed root search failed (always [`Error::NoConvergence`](crate::Error::NoConvergence)).
 ///
 /// ```
 /// use hdi_tribology::analysis::roots::{brent, RootError};

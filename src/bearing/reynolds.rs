@@ -145,8 +145,8 @@ pub struct Reynolds {
 
 /// A check the solver asks between its linear solves (each Newton step of the pressure, each
 /// sensitivity and damping solve): when it says so, the solve stops with an error
-/// ([`Error::NoConvergence`], stopped on request). How a caller that watches for Ctrl-C, or a
-/// deadline, stops a long solve; a solve on the finest grids asks it every few tenths of a
+/// ([`BearingError::Interrupted`]). How a caller that watches for Ctrl-C, or a deadline, stops
+/// a long solve; a solve on the finest grids asks it every few tenths of a
 /// second.
 ///
 /// ```

@@ -94,7 +94,7 @@ impl Default for AcousticSpec {
 /// lubricant), low-passed over the read-back `bandwidth`. Each amplitude carries a relative
 /// Gaussian noise `noise` and a common gain `g(t)` (preamplifier drift) that the harmonic
 /// ratio cancels: `ln(A_1/A_3) = const + 4π d_m/λ`, so the clearance change is
-/// `Δd = λ/(4π) Δln(A_1/A_3)` ([`Readback::clearance_change`]).
+/// `Δd = λ/(4π) Δln(A_1/A_3)` ([`Readback::clearance_change_nm`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ReadbackSpec {
     /// Wavelength of the fundamental `λ` (m).
