@@ -27,8 +27,12 @@ def _stub_params(fn: ast.FunctionDef, method: bool):
     defaults = [None] * (len(positional) - len(a.defaults)) + list(a.defaults)
     for (p, kind), d in zip(positional, defaults):
         params.append((p.arg, KINDS[kind], d))
+    if a.vararg is not None:
+        params.append((a.vararg.arg, inspect.Parameter.VAR_POSITIONAL, None))
     for p, d in zip(a.kwonlyargs, a.kw_defaults):
         params.append((p.arg, KINDS["kwonly"], d))
+    if a.kwarg is not None:
+        params.append((a.kwarg.arg, inspect.Parameter.VAR_KEYWORD, None))
     if method and params and params[0][0] in ("self", "cls"):
         params = params[1:]
     return params
