@@ -43,8 +43,8 @@ use hdi_tribology::drive::{
     zone_at, Ambient, Command, DiskSpec, DriveOptions, Harmonic, MultiDrive, MultiPlant,
     SensorSpec, Sensors, DEFAULT_RADIUS,
 };
-use hdi_tribology::scene::DriveSpec;
 use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::scene::DriveSpec;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::units;
 use std::cell::UnsafeCell;
@@ -1546,7 +1546,11 @@ fn command_of(c: &HdiCommand, name: &str) -> Result<Command, Failure> {
     non_negative(&format!("{name}.heater_power_mw"), c.heater_power_mw, "mW")?;
     finite(&format!("{name}.dc_voltage_v"), c.dc_voltage_v, "V")?;
     finite(&format!("{name}.ac_amplitude_v"), c.ac_amplitude_v, "V")?;
-    non_negative(&format!("{name}.ac_frequency_khz"), c.ac_frequency_khz, "kHz")?;
+    non_negative(
+        &format!("{name}.ac_frequency_khz"),
+        c.ac_frequency_khz,
+        "kHz",
+    )?;
     Ok(Command {
         heater_power_mw: c.heater_power_mw,
         dc_voltage_v: c.dc_voltage_v,
@@ -1721,10 +1725,7 @@ pub unsafe extern "C" fn hdi_drive_head_model(
             let Some(h) = drive.head(head as usize) else {
                 return Err(Failure::invalid(
                     "head",
-                    format!(
-                        "the drive has heads 0 to {}, got {head}",
-                        drive.heads() - 1
-                    ),
+                    format!("the drive has heads 0 to {}, got {head}", drive.heads() - 1),
                 ));
             };
             Ok(HdiModel {

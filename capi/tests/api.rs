@@ -4,8 +4,8 @@
 use hdi::*;
 use hdi_tribology::analysis::{self, Protocol};
 use hdi_tribology::drive::{
-    head_seed, spec_zone, zone_at, Ambient, Command, DiskSpec, DriveOptions, Harmonic,
-    MultiPlant, Plant, Sensors,
+    head_seed, spec_zone, zone_at, Ambient, Command, DiskSpec, DriveOptions, Harmonic, MultiPlant,
+    Plant, Sensors,
 };
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
@@ -464,7 +464,10 @@ fn the_scene_drive_section_builds_the_rust_drive_of_several_heads() {
     let config: HdiDriveConfig = unsafe { config.assume_init() };
     assert_eq!((config.heads, config.rpm), (3, 7200.0));
     assert_eq!(config.initial_heater_power_mw, 62.0);
-    assert_eq!((config.ambient.step_k, config.ambient.step_time_s), (1.5, 0.002));
+    assert_eq!(
+        (config.ambient.step_k, config.ambient.step_time_s),
+        (1.5, 0.002)
+    );
     assert!((config.disk.runout_nm - 500.0).abs() < 1e-9);
     let (mut a, mut b) = (null_mut(), null_mut());
     ok(unsafe { hdi_drive_new(scene, null(), 9, &mut a) });
@@ -536,18 +539,42 @@ fn several_heads_are_stepped_together() {
     let mut s = [HdiSensors::default(); 2];
     let st = unsafe { hdi_drive_step(drive, &cmd, 50e-6, s.as_mut_ptr()) };
     assert_eq!(st, HdiStatus::InvalidInput);
-    assert!(last_error().contains("hdi_drive_step_heads"), "{}", last_error());
+    assert!(
+        last_error().contains("hdi_drive_step_heads"),
+        "{}",
+        last_error()
+    );
     let st = unsafe { hdi_drive_step_heads(drive, &cmd, 1, 50e-6, s.as_mut_ptr()) };
     assert_eq!(st, HdiStatus::InvalidInput);
     assert!(last_error().contains("count"), "{}", last_error());
-    let bad = [cmd, HdiCommand { heater_power_mw: -1.0, ..cmd }];
+    let bad = [
+        cmd,
+        HdiCommand {
+            heater_power_mw: -1.0,
+            ..cmd
+        },
+    ];
     let st = unsafe { hdi_drive_step_heads(drive, bad.as_ptr(), 2, 50e-6, s.as_mut_ptr()) };
     assert_eq!(st, HdiStatus::InvalidInput);
-    assert!(last_error().contains("commands[1].heater_power_mw"), "{}", last_error());
-    let big = [HdiCommand { heater_power_mw: 2000.0, ..cmd }, cmd];
+    assert!(
+        last_error().contains("commands[1].heater_power_mw"),
+        "{}",
+        last_error()
+    );
+    let big = [
+        HdiCommand {
+            heater_power_mw: 2000.0,
+            ..cmd
+        },
+        cmd,
+    ];
     let st = unsafe { hdi_drive_step_heads(drive, big.as_ptr(), 2, 50e-6, s.as_mut_ptr()) };
     assert_eq!(st, HdiStatus::InvalidInput);
-    assert!(last_error().contains("commands[0].heater_power_mw"), "{}", last_error());
+    assert!(
+        last_error().contains("commands[0].heater_power_mw"),
+        "{}",
+        last_error()
+    );
     let st = unsafe { hdi_drive_step_heads(drive, [cmd, cmd].as_ptr(), 2, 0.0, s.as_mut_ptr()) };
     assert_eq!(st, HdiStatus::InvalidInput);
     assert!(last_error().contains("period_s"), "{}", last_error());
@@ -571,10 +598,17 @@ fn several_heads_are_stepped_together() {
     // A one-head step names its command as `command`.
     let mut one = null_mut();
     ok(unsafe { hdi_drive_new(scene, null(), 1, &mut one) });
-    let big = HdiCommand { heater_power_mw: 2000.0, ..cmd };
+    let big = HdiCommand {
+        heater_power_mw: 2000.0,
+        ..cmd
+    };
     let st = unsafe { hdi_drive_step(one, &big, 50e-6, s.as_mut_ptr()) };
     assert_eq!(st, HdiStatus::InvalidInput);
-    assert!(last_error().contains("command.heater_power_mw"), "{}", last_error());
+    assert!(
+        last_error().contains("command.heater_power_mw"),
+        "{}",
+        last_error()
+    );
     ok(unsafe { hdi_drive_free(one) });
     ok(unsafe { hdi_scene_free(scene) });
 }

@@ -24,8 +24,8 @@ use hdi_tribology::calibration::{
     VibrationRms,
 };
 use hdi_tribology::drive::{
-    check_commands, replay_heads_each, sensor_row, spec_zone, Command, CommandRow, DiskSpec,
-    Drive, DriveOptions, MultiDrive, MultiPlant, Plant, Sensors, DEFAULT_RADIUS, SENSOR_COLUMNS,
+    check_commands, replay_heads_each, sensor_row, spec_zone, Command, CommandRow, DiskSpec, Drive,
+    DriveOptions, MultiDrive, MultiPlant, Plant, Sensors, DEFAULT_RADIUS, SENSOR_COLUMNS,
 };
 use hdi_tribology::fit::{DataSet, FitOptions, FreeParameter};
 use hdi_tribology::force::{Gaps, RelaxingState};
@@ -1517,7 +1517,11 @@ fn plant_of(
             if heads_given && spec.heads as usize != s.len() {
                 return Err(invalid(
                     "heads",
-                    format!("{} heads for a list of {} scenes, one per head", spec.heads, s.len()),
+                    format!(
+                        "{} heads for a list of {} scenes, one per head",
+                        spec.heads,
+                        s.len()
+                    ),
                 ));
             }
             spec.heads = s.len() as u32;
@@ -1742,13 +1746,19 @@ fn per_head(v: &Bound<'_, PyAny>, name: &str, heads: usize) -> PyResult<Vec<f64>
     if let Ok(x) = v.extract::<f64>() {
         return Ok(vec![x; heads]);
     }
-    let xs: Vec<f64> = v
-        .extract()
-        .map_err(|_| invalid(name, "must be a number or a sequence of numbers, one per head"))?;
+    let xs: Vec<f64> = v.extract().map_err(|_| {
+        invalid(
+            name,
+            "must be a number or a sequence of numbers, one per head",
+        )
+    })?;
     if xs.len() != heads {
         return Err(invalid(
             name,
-            format!("one value per head: the drive has {heads} heads, got {}", xs.len()),
+            format!(
+                "one value per head: the drive has {heads} heads, got {}",
+                xs.len()
+            ),
         ));
     }
     Ok(xs)
@@ -1783,7 +1793,11 @@ impl PyMultiDrive {
         let tol = [atol_pm, atol_flight_pm];
         let plant = plant_of(py, scene, seed, flat_disk, settings, tol, false)?;
         let n = plant.heads();
-        let head = |k: usize| plant.head(k).ok_or_else(|| invalid("heads", "no such head"));
+        let head = |k: usize| {
+            plant
+                .head(k)
+                .ok_or_else(|| invalid("heads", "no such head"))
+        };
         let mut wavelengths = Vec::with_capacity(n);
         let mut seeds = Vec::with_capacity(n);
         for k in 0..n {
