@@ -85,7 +85,10 @@ fn main() {
         "check" => {
             let (a, b) = (checksum(true), checksum(false));
             assert_eq!(a.1, b.1, "the two modes differ");
-            println!("same sensors to the bit: {heads} heads, {periods} periods, {} nm", a.0);
+            println!(
+                "same sensors to the bit: {heads} heads, {periods} periods, {} nm",
+                a.0
+            );
         }
         other => panic!("MODE is together, apart or check, got {other}"),
     }
