@@ -1541,16 +1541,25 @@ fn sensors_of(s: &Sensors) -> HdiSensors {
     }
 }
 
-/// One C command, checked in the C call's names (`name` is `command` or `commands[k]`).
-fn command_of(c: &HdiCommand, name: &str) -> Result<Command, Failure> {
-    non_negative(&format!("{name}.heater_power_mw"), c.heater_power_mw, "mW")?;
-    finite(&format!("{name}.dc_voltage_v"), c.dc_voltage_v, "V")?;
-    finite(&format!("{name}.ac_amplitude_v"), c.ac_amplitude_v, "V")?;
-    non_negative(
-        &format!("{name}.ac_frequency_khz"),
-        c.ac_frequency_khz,
-        "kHz",
-    )?;
+/// One C command, checked in the C call's names (`name()` is `command` or `commands[k]`,
+/// made only for an error: a step that succeeds formats nothing).
+fn command_of(c: &HdiCommand, name: impl Fn() -> String) -> Result<Command, Failure> {
+    let valid = |v: f64, at_least_zero: bool| v.is_finite() && (!at_least_zero || v >= 0.0);
+    if !(valid(c.heater_power_mw, true)
+        && valid(c.dc_voltage_v, false)
+        && valid(c.ac_amplitude_v, false)
+        && valid(c.ac_frequency_khz, true))
+    {
+        let name = name();
+        non_negative(&format!("{name}.heater_power_mw"), c.heater_power_mw, "mW")?;
+        finite(&format!("{name}.dc_voltage_v"), c.dc_voltage_v, "V")?;
+        finite(&format!("{name}.ac_amplitude_v"), c.ac_amplitude_v, "V")?;
+        non_negative(
+            &format!("{name}.ac_frequency_khz"),
+            c.ac_frequency_khz,
+            "kHz",
+        )?;
+    }
     Ok(Command {
         heater_power_mw: c.heater_power_mw,
         dc_voltage_v: c.dc_voltage_v,
@@ -1576,7 +1585,7 @@ pub unsafe extern "C" fn hdi_drive_step(
         let d = acquire(drive.cast_const(), "drive", Access::Exclusive)?;
         // SAFETY: the caller's contract.
         let (c, out) = unsafe { (in_ref(command, "command")?, out_ref(sensors, "sensors")?) };
-        let cmd = command_of(c, "command")?;
+        let cmd = command_of(c, || "command".into())?;
         positive("period_s", period_s, "s")?;
         // SAFETY: the guard holds the handle exclusively: no other reference to the drive.
         let (drive, scratch) = unsafe { (&mut *d.get().drive.get(), &mut *d.get().scratch.get()) };
@@ -1646,7 +1655,7 @@ pub unsafe extern "C" fn hdi_drive_step_heads(
         };
         let mut cmds = [Command::default(); hdi_tribology::scene::MAX_HEADS as usize];
         for (k, c) in cs.iter().enumerate() {
-            cmds[k] = command_of(c, &format!("commands[{k}]"))?;
+            cmds[k] = command_of(c, || format!("commands[{k}]"))?;
         }
         positive("period_s", period_s, "s")?;
         drive

@@ -37,7 +37,7 @@ from ._core import (
     simulated_dither,
     static_hysteresis,
 )
-from ._drive import Drive
+from ._drive import Drive, MultiDrive
 from ._results import (
     Calibration,
     Cycle,
@@ -76,6 +76,7 @@ __all__ = [
     "LinearResponse",
     "Mode",
     "Model",
+    "MultiDrive",
     "NoConvergenceError",
     "PullIn",
     "Result",

@@ -135,16 +135,42 @@ class LinearResponse:
 SENSOR_COLUMNS: List[str]
 """The columns of a sensor stream (``replay``, ``hdi drive``), units in their names."""
 
-def replay(scene: Union[Scene, Model], time_s: Sequence[float], heater_mw: Sequence[float],
-           voltage_dc_v: Sequence[float], voltage_ac_v: Optional[Sequence[float]] = None,
+def replay(scene: Union[Scene, Model, Sequence[Scene]], time_s: Sequence[float],
+           heater_mw: Sequence[float], voltage_dc_v: Sequence[float],
+           voltage_ac_v: Optional[Sequence[float]] = None,
            ac_frequency_khz: Optional[Sequence[float]] = None, *, rate_khz: float = 20.0,
-           seed: int = 1, flat_disk: bool = False,
-           atol_pm: Optional[float] = None,
-           atol_flight_pm: Optional[float] = None, **settings: float) -> Dict[str, F64Array]:
+           seed: int = 1, flat_disk: bool = False, atol_pm: Optional[float] = None,
+           atol_flight_pm: Optional[float] = None,
+           **settings: Any) -> Dict[str, npt.NDArray[Any]]:
     """Replays commands (each holds from its ``time_s`` until the next; the last time ends the
     run) through a new drive, as ``hdi drive SCENE --commands FILE`` does: the sensor columns
     of ``SENSOR_COLUMNS`` as float64 arrays, one value per period, bit for bit the CLI's.
-    The GIL is released while the drive runs."""
+    ``settings`` are the drive settings of ``Drive`` (``radius_mm``, ``rpm``, ``heads``, …);
+    with more than one head every head holds the commands, the rows run period by period and
+    head by head, and an int64 ``head`` column leads. The GIL is released while the drive
+    runs."""
+
+class MultiDrive:
+    """The native half of ``hdi_tribology.MultiDrive`` (see there)."""
+
+    def __init__(self, scene: Union[Scene, Model, Sequence[Scene]], *, seed: int = 1,
+                 flat_disk: bool = False, atol_pm: Optional[float] = None,
+                 atol_flight_pm: Optional[float] = None, **settings: Any) -> None: ...
+    def step(self, heater_power_mw: Union[float, Sequence[float]], *,
+             dc_voltage_v: Union[float, Sequence[float], None] = None,
+             ac_amplitude_v: Union[float, Sequence[float], None] = None,
+             ac_frequency_khz: Union[float, Sequence[float], None] = None,
+             period_s: float = 50e-6) -> List[Sensors]:
+        """Every head's command held for one period; the heads' sensors in head order."""
+    @property
+    def heads(self) -> int:
+        """The number of heads."""
+    @property
+    def time_s(self) -> float:
+        """Simulated time so far (s)."""
+    @property
+    def seeds(self) -> List[int]:
+        """Each head's seed."""
 
 class Forces(TypedDict):
     d_m: F64Array

@@ -25,8 +25,8 @@ use hdi_tribology::calibration::{
     VibrationRms,
 };
 use hdi_tribology::drive::{
-    check_commands, replay_each, sensor_row, spec_zone, Command, CommandRow, DiskSpec, Drive,
-    DriveOptions, Plant, Sensors, DEFAULT_RADIUS, SENSOR_COLUMNS,
+    check_commands, replay_heads_each, sensor_row, spec_zone, Command, CommandRow, DiskSpec, Drive,
+    DriveOptions, MultiDrive, MultiPlant, Plant, Sensors, DEFAULT_RADIUS, SENSOR_COLUMNS,
 };
 use hdi_tribology::fit::{DataSet, FitOptions, FreeParameter};
 use hdi_tribology::force::{Gaps, RelaxingState};
@@ -1437,9 +1437,45 @@ fn calibrate<'py>(
 // ---------------------------------------------------------------------------------------------
 // Drive
 
-/// The plant of a `Drive` or a replay: the scene in its zone with its `[drive]` section, the
-/// keyword `settings` (the names of `DriveSpec::settings`, in their engineering units) over
-/// it, the seed, and the tolerances.
+/// What a drive is made of: one `Scene` or `Model` for every head, or a list of scenes (one per
+/// head).
+enum Heads {
+    Model(Arc<SliderModel>),
+    Scenes(Vec<hdi_tribology::scene::Scene>),
+}
+
+fn heads_of(scene: &Bound<'_, PyAny>) -> PyResult<Heads> {
+    const WANT: &str = "scene: expected a Scene, a Model or a list of Scenes (one per head)";
+    if let Ok(m) = scene.cast::<Model>() {
+        return Ok(Heads::Model(m.get().model.clone()));
+    }
+    if let Ok(s) = scene.cast::<Scene>() {
+        return Ok(Heads::Scenes(vec![s.get().get()]));
+    }
+    if scene.is_instance_of::<pyo3::types::PyString>() {
+        return Err(PyTypeError::new_err(WANT));
+    }
+    let Ok(items) = scene.try_iter() else {
+        return Err(PyTypeError::new_err(WANT));
+    };
+    let mut scenes = Vec::new();
+    for item in items {
+        let item = item?;
+        let s = item
+            .cast::<Scene>()
+            .map_err(|_| PyTypeError::new_err(WANT))?;
+        scenes.push(s.get().get());
+    }
+    if scenes.is_empty() {
+        return Err(invalid("scene", "an empty list: one scene per head"));
+    }
+    Ok(Heads::Scenes(scenes))
+}
+
+/// The drive of a `Drive`, a `MultiDrive` or a replay: the (first) scene in its zone with its
+/// `[drive]` section, the keyword `settings` (the names of `DriveSpec::settings`, in their
+/// engineering units) over it, the seed, and the tolerances; a list of scenes gives one head
+/// each (all in the first scene's zone). `one_head` refuses more than one head (a `Drive`).
 fn plant_of(
     py: Python<'_>,
     scene: &Bound<'_, PyAny>,
@@ -1447,22 +1483,14 @@ fn plant_of(
     flat_disk: bool,
     settings: Option<&Bound<'_, PyDict>>,
     atol_pm: [Option<f64>; 2],
-) -> PyResult<Plant> {
-    let model = scene.cast::<Model>().ok().map(|m| m.get().model.clone());
-    let scene = match model {
-        Some(_) => None,
-        None => Some(
-            scene
-                .cast::<Scene>()
-                .map_err(|_| PyTypeError::new_err("scene: expected a Scene or a Model"))?
-                .get()
-                .get(),
-        ),
+    one_head: bool,
+) -> PyResult<MultiPlant> {
+    let heads = heads_of(scene)?;
+    let mut spec = match &heads {
+        Heads::Scenes(s) => s[0].drive.clone().unwrap_or_default(),
+        Heads::Model(_) => DriveSpec::default(),
     };
-    let mut spec = scene
-        .as_ref()
-        .and_then(|s| s.drive.clone())
-        .unwrap_or_default();
+    let mut heads_given = false;
     if let Some(kw) = settings {
         for (k, v) in kw.iter() {
             let key: String = k.extract()?;
@@ -1482,12 +1510,31 @@ fn plant_of(
             }
             let x: f64 = v.extract().map_err(|_| invalid(&key, "must be a number"))?;
             spec.set(&key, x, &key).py()?;
+            heads_given |= key == "heads";
         }
     }
-    if spec.heads != 1 {
+    if let Heads::Scenes(s) = &heads {
+        if s.len() > 1 {
+            if heads_given && spec.heads as usize != s.len() {
+                return Err(invalid(
+                    "heads",
+                    format!(
+                        "{} heads for a list of {} scenes, one per head",
+                        spec.heads,
+                        s.len()
+                    ),
+                ));
+            }
+            spec.heads = s.len() as u32;
+        }
+    }
+    if one_head && spec.heads != 1 {
         return Err(invalid(
             "heads",
-            "a Drive is one head: make one Drive per head (each with its own seed)",
+            format!(
+                "a Drive is one head, got {}: MultiDrive steps several on one disk",
+                spec.heads
+            ),
         ));
     }
     let mut opts = DriveOptions::from_spec(&spec);
@@ -1498,19 +1545,47 @@ fn plant_of(
         .with_tolerances_pm(atol_pm[0], atol_pm[1], ["atol_pm", "atol_flight_pm"])
         .py()?;
     let radius = spec.radius_m.unwrap_or(DEFAULT_RADIUS);
+    let n = spec.heads as usize;
     // A `Model` drives as it is (its terms with memory included), a `Scene` at its own zone.
-    match (model, scene) {
-        (Some(model), _) => interruptible(py, || Plant::from_model(&model, radius, seed, opts)),
-        (None, Some(scene)) => interruptible(py, || {
-            Plant::new(&scene, &spec_zone(&scene, &spec)?, seed, opts)
+    match heads {
+        Heads::Model(model) => interruptible(py, || {
+            MultiPlant::of_plant(Plant::from_model(&model, radius, seed, opts)?, n)
         }),
-        (None, None) => Err(PyTypeError::new_err("scene: expected a Scene or a Model")),
+        Heads::Scenes(scenes) if scenes.len() == 1 => interruptible(py, || {
+            let zone = spec_zone(&scenes[0], &spec)?;
+            MultiPlant::uniform(&scenes[0], &zone, n, seed, opts)
+        }),
+        Heads::Scenes(scenes) => interruptible(py, || {
+            let zone = spec_zone(&scenes[0], &spec)?;
+            let plants = scenes
+                .iter()
+                .enumerate()
+                .map(|(k, s)| {
+                    // Each head its own slider at the drive's radius and spindle speed.
+                    let mut z = hdi_tribology::drive::scene_zone(s, zone.radius)?;
+                    z.disk_speed = zone.disk_speed;
+                    Plant::new(
+                        s,
+                        &z,
+                        hdi_tribology::drive::head_seed(seed, k),
+                        opts.clone(),
+                    )
+                    .map_err(|e| match e {
+                        hdi_tribology::Error::InvalidInput { field, reason } => {
+                            hdi_tribology::Error::invalid(format!("scene[{k}].{field}"), reason)
+                        }
+                        other => other,
+                    })
+                })
+                .collect::<hdi_tribology::Result<Vec<_>>>()?;
+            MultiPlant::new(plants)
+        }),
     }
 }
 
-/// One period of a drive, the command and period checked as a command file's row (in the
-/// argument names of `Drive.step`).
-fn step_checked(drive: &mut Drive, c: &Command, period_s: f64) -> PyResult<Sensors> {
+/// A command checked as a command file's row, in the argument names of `Drive.step`
+/// (`name(arg)` gives the name an error shows).
+fn check_command(c: &Command, name: impl Fn(&str) -> String) -> PyResult<()> {
     let row = CommandRow {
         time_s: 0.0,
         heater_mw: c.heater_power_mw,
@@ -1518,25 +1593,35 @@ fn step_checked(drive: &mut Drive, c: &Command, period_s: f64) -> PyResult<Senso
         voltage_ac_v: c.ac_amplitude_v,
         ac_frequency_khz: c.ac_frequency_khz,
     };
-    let arg = |name: &str| {
-        match name {
+    let arg = |column: &str| {
+        name(match column {
             "heater_mw" => "heater_power_mw",
             "voltage_dc_v" => "dc_voltage_v",
             "voltage_ac_v" => "ac_amplitude_v",
             other => other,
-        }
-        .to_string()
+        })
     };
     check_commands(&[row, CommandRow { time_s: 1.0, ..row }], "step", |_, n| {
         arg(n)
     })
-    .py()?;
+    .py()
+}
+
+fn check_period(period_s: f64) -> PyResult<()> {
     if !(period_s.is_finite() && period_s > 0.0 && period_s <= 1.0) {
         return Err(invalid(
             "period_s",
             format!("must be a period in (0, 1] s, got {period_s} s"),
         ));
     }
+    Ok(())
+}
+
+/// One period of a drive, the command and period checked as a command file's row (in the
+/// argument names of `Drive.step`).
+fn step_checked(drive: &mut Drive, c: &Command, period_s: f64) -> PyResult<Sensors> {
+    check_command(c, str::to_string)?;
+    check_period(period_s)?;
     drive.step(c, period_s).py()
 }
 
@@ -1584,10 +1669,13 @@ impl PyDrive {
     ) -> PyResult<Self> {
         let seed = seed_of("seed", seed)?;
         let tol = [atol_pm, atol_flight_pm];
-        let plant = plant_of(py, scene, seed, flat_disk, settings, tol)?;
+        let plant = plant_of(py, scene, seed, flat_disk, settings, tol, true)?;
+        let Some(plant) = plant.head(0) else {
+            return Err(invalid("heads", "a Drive has one head"));
+        };
         let wavelength = plant.sensor_spec().readback.wavelength;
         Ok(PyDrive {
-            inner: plant.into_drive().py()?,
+            inner: plant.drive().py()?,
             wavelength,
             reference: None,
         })
@@ -1654,6 +1742,149 @@ impl PyDrive {
     }
 }
 
+/// One command argument of `MultiDrive.step`: a number for every head, or one per head.
+fn per_head(v: &Bound<'_, PyAny>, name: &str, heads: usize) -> PyResult<Vec<f64>> {
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(vec![x; heads]);
+    }
+    let xs: Vec<f64> = v.extract().map_err(|_| {
+        invalid(
+            name,
+            "must be a number or a sequence of numbers, one per head",
+        )
+    })?;
+    if xs.len() != heads {
+        return Err(invalid(
+            name,
+            format!(
+                "one value per head: the drive has {heads} heads, got {}",
+                xs.len()
+            ),
+        ));
+    }
+    Ok(xs)
+}
+
+/// A drive of several heads on one disk for firmware prototyping (the native half of
+/// `hdi_tribology.MultiDrive`). See `hdi_tribology.MultiDrive`.
+#[pyclass(module = "hdi_tribology._core", name = "MultiDrive", unsendable)]
+struct PyMultiDrive {
+    inner: MultiDrive,
+    wavelengths: Vec<f64>,
+    seeds: Vec<u64>,
+    /// Each head's first read-back log ratio: the reference of its harmonic-ratio change.
+    reference: Vec<Option<f64>>,
+    out: Vec<Sensors>,
+}
+
+#[pymethods]
+impl PyMultiDrive {
+    #[new]
+    #[pyo3(signature = (scene, *, seed = 1, flat_disk = false, atol_pm = None, atol_flight_pm = None, **settings))]
+    fn new(
+        py: Python<'_>,
+        scene: &Bound<'_, PyAny>,
+        seed: i128,
+        flat_disk: bool,
+        atol_pm: Option<f64>,
+        atol_flight_pm: Option<f64>,
+        settings: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let seed = seed_of("seed", seed)?;
+        let tol = [atol_pm, atol_flight_pm];
+        let plant = plant_of(py, scene, seed, flat_disk, settings, tol, false)?;
+        let n = plant.heads();
+        let head = |k: usize| {
+            plant
+                .head(k)
+                .ok_or_else(|| invalid("heads", "no such head"))
+        };
+        let mut wavelengths = Vec::with_capacity(n);
+        let mut seeds = Vec::with_capacity(n);
+        for k in 0..n {
+            wavelengths.push(head(k)?.sensor_spec().readback.wavelength);
+            seeds.push(head(k)?.seed());
+        }
+        Ok(PyMultiDrive {
+            inner: plant.drive().py()?,
+            wavelengths,
+            seeds,
+            reference: vec![None; n],
+            out: vec![Sensors::default(); n],
+        })
+    }
+
+    /// Holds head `k`'s command for one controller period of `period_s` (s) on every head
+    /// and returns the list of their `Sensors`, in head order. Each of `heater_power_mw` (mW),
+    /// `dc_voltage_v` (V), `ac_amplitude_v` (V) and `ac_frequency_khz` (kHz) is a number for
+    /// every head or a sequence of one per head.
+    #[pyo3(signature = (heater_power_mw, *, dc_voltage_v = None, ac_amplitude_v = None, ac_frequency_khz = None, period_s = 50e-6))]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        heater_power_mw: &Bound<'py, PyAny>,
+        dc_voltage_v: Option<&Bound<'py, PyAny>>,
+        ac_amplitude_v: Option<&Bound<'py, PyAny>>,
+        ac_frequency_khz: Option<&Bound<'py, PyAny>>,
+        period_s: f64,
+    ) -> PyResult<Bound<'py, PyList>> {
+        let n = self.inner.heads();
+        let arg = |v: Option<&Bound<'py, PyAny>>, name: &str| match v {
+            Some(v) => per_head(v, name, n),
+            None => Ok(vec![0.0; n]),
+        };
+        let p = per_head(heater_power_mw, "heater_power_mw", n)?;
+        let (dc, ac, f) = (
+            arg(dc_voltage_v, "dc_voltage_v")?,
+            arg(ac_amplitude_v, "ac_amplitude_v")?,
+            arg(ac_frequency_khz, "ac_frequency_khz")?,
+        );
+        let commands: Vec<Command> = (0..n)
+            .map(|k| Command {
+                heater_power_mw: p[k],
+                dc_voltage_v: dc[k],
+                ac_amplitude_v: ac[k],
+                ac_frequency_khz: f[k],
+            })
+            .collect();
+        for (k, c) in commands.iter().enumerate() {
+            check_command(c, |name| format!("{name}[{k}]"))?;
+        }
+        check_period(period_s)?;
+        self.inner
+            .step_into(&commands, period_s, &mut self.out)
+            .py()?;
+        let list = PyList::empty(py);
+        for (k, s) in self.out.iter().enumerate() {
+            let lr0 = *self.reference[k].get_or_insert(s.readback.log_ratio());
+            list.append(record(
+                py,
+                "Sensors",
+                &sensors_value(s, lr0, self.wavelengths[k])?,
+            )?)?;
+        }
+        Ok(list)
+    }
+
+    /// The number of heads.
+    #[getter]
+    fn heads(&self) -> usize {
+        self.inner.heads()
+    }
+
+    /// Simulated time so far (s): one clock for every head.
+    #[getter]
+    fn time_s(&self) -> f64 {
+        self.inner.time()
+    }
+
+    /// Each head's seed (its surface and sensor noise): `head_seed(seed, k)`.
+    #[getter]
+    fn seeds(&self) -> Vec<u64> {
+        self.seeds.clone()
+    }
+}
+
 /// Replays commands through a new drive, as `hdi drive SCENE --commands FILE` does, and returns
 /// the sensor columns as float64 arrays (the CSV's columns, `SENSOR_COLUMNS`; units in their
 /// names), bit for bit the CLI's. Each command holds from its `time_s` until the next; the last
@@ -1717,19 +1948,25 @@ fn replay<'py>(
         flat_disk,
         settings,
         [atol_pm, atol_flight_pm],
+        false,
     )?;
     let dt = 1e-3 / rate_khz;
-    let columns = interruptible(py, || {
+    let (heads, columns) = interruptible(py, || {
+        let mut heads: Vec<i64> = Vec::new();
         let mut cols: Vec<Vec<f64>> = vec![Vec::new(); SENSOR_COLUMNS.len()];
-        replay_each(&plant, &rows, dt, |row| {
+        replay_heads_each(&plant, &rows, dt, |head, row| {
+            heads.push(head as i64);
             for (c, v) in cols.iter_mut().zip(row) {
                 c.push(*v);
             }
             Ok(())
         })?;
-        Ok(cols)
+        Ok((heads, cols))
     })?;
     let out = PyDict::new(py);
+    if plant.heads() > 1 {
+        out.set_item("head", PyArray1::from_vec(py, heads))?;
+    }
     for (name, col) in SENSOR_COLUMNS.iter().zip(columns) {
         out.set_item(name, array(py, col))?;
     }
@@ -1846,6 +2083,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
     m.add_class::<LinearResponse>()?;
     m.add_class::<PyDrive>()?;
+    m.add_class::<PyMultiDrive>()?;
     m.add_function(wrap_pyfunction!(forces, m)?)?;
     m.add_function(wrap_pyfunction!(static_hysteresis, m)?)?;
     m.add_function(wrap_pyfunction!(pull_in_voltage, m)?)?;

@@ -174,3 +174,84 @@ def test_tolerances_match_the_cli_and_name_the_argument(tmp_path, paper_scene, h
         with pytest.raises(hdi.InvalidInputError) as e:
             hdi.replay(paper_scene, times, heater, dc, **kwargs)
         assert e.value.field == field
+
+
+def _fields(s):
+    """Every number of a period's sensors (the truth's too), in a fixed order."""
+    d = s.to_dict()
+    truth = d.pop("truth")
+    return [d[k] for k in sorted(d)] + [truth[k] for k in sorted(truth)]
+
+
+def test_multi_drive_heads_are_one_head_drives_to_the_bit(paper_scene):
+    """Three heads of one scene, each its own heater programme: head k equals a one-head
+    ``Drive`` seeded ``seeds[k]`` (head 0 by the drive's seed) to the bit; one clock; each
+    surface its own."""
+    multi = hdi.MultiDrive(paper_scene, heads=3, seed=4)
+    assert multi.heads == 3 and multi.seeds[0] == 4 and len(set(multi.seeds)) == 3
+    singles = [hdi.Drive(paper_scene, seed=s) for s in multi.seeds]
+    for n in range(40):
+        powers = [60.0 + 0.1 * n, 62.0, 65.0 + 0.05 * n]
+        got = multi.step(powers, dc_voltage_v=[0.0, 0.2, 0.0])
+        assert len(got) == 3 and {s.time_s for s in got} == {multi.time_s}
+        for k, d in enumerate(singles):
+            want = d.step(powers[k], dc_voltage_v=[0.0, 0.2, 0.0][k])
+            assert _fields(got[k]) == _fields(want), (n, k)
+    heights = {s.truth.disk_height_nm for s in got}
+    assert len(heights) == 3
+    assert "MultiDrive(heads=3" in repr(multi)
+
+
+def test_multi_drive_of_several_scenes(paper_scene):
+    """A list of scenes is one head each; a head of another slider equals its one-head drive."""
+    d = paper_scene.to_dict()
+    d["nominal_clearance_m"] *= 1.05
+    high = hdi.Scene.from_dict(d)
+    multi = hdi.MultiDrive([paper_scene, high], seed=2)
+    alone = hdi.Drive(high, seed=multi.seeds[1])
+    for _ in range(10):
+        got = multi.step(66.0)
+        assert _fields(got[1]) == _fields(alone.step(66.0))
+    assert got[1].truth.gap_nm > got[0].truth.gap_nm
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.MultiDrive([paper_scene, high], heads=3)
+    assert e.value.field == "heads"
+
+
+def test_multi_drive_errors_name_the_argument_and_head(paper_scene):
+    multi = hdi.MultiDrive(paper_scene, heads=2)
+    for args, kwargs, field in [
+        (([60.0, -1.0],), {}, "heater_power_mw[1]"),
+        (([60.0],), {}, "heater_power_mw"),
+        ((60.0,), dict(ac_frequency_khz=[0.0, float("nan")]), "ac_frequency_khz[1]"),
+        ((60.0,), dict(period_s=2.0), "period_s"),
+    ]:
+        with pytest.raises(hdi.InvalidInputError) as e:
+            multi.step(*args, **kwargs)
+        assert e.value.field == field
+    assert multi.time_s == 0.0  # nothing was stepped
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.Drive(paper_scene, heads=2)
+    assert e.value.field == "heads" and "MultiDrive" in str(e.value)
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.MultiDrive(paper_scene, heads=0)
+    assert e.value.field == "heads"
+
+
+def test_replay_of_several_heads_matches_the_cli(tmp_path, paper_scene, hdi_cli):
+    commands = tmp_path / "commands.csv"
+    commands.write_text("time_s,heater_mw,voltage_dc_v\n0,60,0\n0.0005,66,0\n0.001,66,0\n")
+    csv = tmp_path / "sensors.csv"
+    summary = hdi_cli("drive", "--paper", "--commands", str(commands), "--out", str(csv),
+                      "--heads", "2", "--seed", "3")
+    assert summary["heads"] == 2
+    table = np.genfromtxt(csv, delimiter=",", names=True)
+    py = hdi.replay(paper_scene, [0.0, 0.0005, 0.001], [60.0, 66.0, 66.0], [0.0] * 3,
+                    heads=2, seed=3)
+    assert list(py) == ["head"] + list(hdi.SENSOR_COLUMNS)
+    assert py["head"].dtype == np.int64 and py["head"][:4].tolist() == [0, 1, 0, 1]
+    for name in ["head"] + list(hdi.SENSOR_COLUMNS):
+        assert table[name].tolist() == py[name].tolist(), name
+    one = hdi.replay(paper_scene, [0.0, 0.0005, 0.001], [60.0, 66.0, 66.0], [0.0] * 3, seed=3)
+    for name in hdi.SENSOR_COLUMNS:
+        assert py[name][py["head"] == 0].tolist() == one[name].tolist(), name

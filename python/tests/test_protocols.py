@@ -110,21 +110,22 @@ def test_python_arguments_are_named_as_written(paper_model):
     assert e.value.field == "power_tol_mw" and "mW" in e.value.reason
 
 
-def test_drive_step_and_replay_name_the_measured_channels_alike(paper_scene):
-    # A step returns the firmware-facing names (as the C ABI's HdiSensors, the truth apart in
-    # `truth`); a replay returns the CSV's columns. The measured channels share their names.
+def test_drive_step_and_replay_give_the_same_columns(paper_scene):
+    """A step's `Sensors` carry the fields of the C `HdiSensors` (the truth in `truth`, as its
+    `HdiTruth`) and the harmonic-ratio change; every replay column is one of them, equal."""
     d = hdi.Drive(paper_scene, flat_disk=True)
     s = d.step(60.0)
-    r = hdi.replay(paper_scene, [0.0, 1e-4], [60.0, 60.0], [0.0, 0.0], flat_disk=True)
+    assert sorted(s.keys()) == sorted([
+        "time_s", "heater_power_mw", "contact_resistance_ohm", "acoustic_v",
+        "readback_fundamental_v", "readback_third_v", "hr_clearance_change_nm", "truth"])
+    assert all(not math.isnan(s[k]) for k in s if k != "truth")
+    assert all(not math.isnan(s.truth[k]) for k in s.truth)
+    r = hdi.replay(paper_scene, [0.0, 5e-5], [60.0, 60.0], [0.0, 0.0], flat_disk=True)
     assert list(r) == list(hdi.SENSOR_COLUMNS)
-    measured = [
-        "time_s",
-        "contact_resistance_ohm",
-        "acoustic_v",
-        "readback_fundamental_v",
-        "readback_third_v",
-        "hr_clearance_change_nm",
-    ]
-    assert [k for k in s.keys() if k in r] == measured
-    assert "heater_power_mw" in s.keys() and "heater_mw" in r
-    assert all(not math.isnan(s[k]) for k in measured)
+    of_step = {"heater_mw": s.heater_power_mw, "true_gap_nm": s.truth.gap_nm,
+               "true_contact_force_un": s.truth.mean_contact_force_un,
+               "true_sensor_temperature_k": s.truth.sensor_temperature_k,
+               "true_disk_height_nm": s.truth.disk_height_nm,
+               "true_ambient_k": s.truth.ambient_k}
+    for name in hdi.SENSOR_COLUMNS:
+        assert r[name].tolist() == [of_step[name] if name in of_step else s[name]], name
