@@ -180,11 +180,12 @@ fn pitch_follows_the_linear_transmissibility() {
     let (inertia, kp) = (m * l * l / 3.0, k_ab * l * l / 3.0);
     let spec = StructureSpec::Pitch {
         inertia_kg_m2: inertia,
-        stiffness_n_m_per_rad: kp,
-        coupling_stiffness_n_per_rad: 12.0,
-        damping_n_m_s_per_rad: 2.0 * 0.05 * (kp * inertia).sqrt(),
-        coupling_damping_n_s_per_rad: 0.0,
-        trailing_edge_m: l,
+        stiffness_n_m_per_rad: Some(kp),
+        coupling_stiffness_n_per_rad: Some(12.0),
+        damping_n_m_s_per_rad: Some(2.0 * 0.05 * (kp * inertia).sqrt()),
+        coupling_damping_n_s_per_rad: Some(0.0),
+        trailing_edge_m: Some(l),
+        from_bearing: false,
     };
     check(spec, 500, 0.2e-9, "pitch");
 }

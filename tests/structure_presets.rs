@@ -88,11 +88,12 @@ fn pitch_modes_match_the_heave_pitch_closed_form() {
     let (inertia, kp, kc) = (M * l * l / 3.0, K_AB * l * l / 3.0, 12.0);
     let scene = undamped_free(StructureSpec::Pitch {
         inertia_kg_m2: inertia,
-        stiffness_n_m_per_rad: kp,
-        coupling_stiffness_n_per_rad: kc,
-        damping_n_m_s_per_rad: 0.0,
-        coupling_damping_n_s_per_rad: 0.0,
-        trailing_edge_m: l,
+        stiffness_n_m_per_rad: Some(kp),
+        coupling_stiffness_n_per_rad: Some(kc),
+        damping_n_m_s_per_rad: Some(0.0),
+        coupling_damping_n_s_per_rad: Some(0.0),
+        trailing_edge_m: Some(l),
+        from_bearing: false,
     });
     let model = SliderModel::from_scene(&scene).unwrap();
     // det(K − ω² M) = 0 with K = [[k_ab, k_c], [k_c, k_θθ]], M = diag(m, I).

@@ -203,6 +203,21 @@ pub enum AirBearingModel {
 }
 
 impl AirBearingModel {
+    /// The model's name as a scene file writes it (`model = "…"`).
+    ///
+    /// ```
+    /// use hdi_tribology::scene::Scene;
+    /// assert_eq!(Scene::paper().air_bearing.name(), "linear");
+    /// ```
+    pub fn name(&self) -> &'static str {
+        match self {
+            AirBearingModel::Linear { .. } => "linear",
+            AirBearingModel::Cubic { .. } => "cubic",
+            AirBearingModel::Reynolds { .. } => "reynolds",
+            AirBearingModel::PowerLaw { .. } => "power_law",
+        }
+    }
+
     /// Validates and builds the model.
     pub fn build(&self) -> Result<Box<dyn AirBearing>> {
         Ok(match *self {
@@ -334,6 +349,7 @@ pub struct ReynoldsBearing {
     stiffness: [[f64; 3]; 3],
     damping: [[f64; 3]; 3],
     pivot_to_trailing_edge: f64,
+    pivot_to_bulge: f64,
 }
 
 /// Bearings already solved in this process, by their description.
@@ -376,6 +392,7 @@ impl ReynoldsBearing {
             stiffness: eq.stiffness(),
             damping: eq.damping()?,
             pivot_to_trailing_edge: b.length - b.pivot[0],
+            pivot_to_bulge: b.bulge[0] - b.pivot[0],
         })
     }
 
@@ -406,6 +423,28 @@ impl ReynoldsBearing {
             ]
         };
         (map(self.stiffness), map(self.damping), a)
+    }
+
+    /// The distance along the slider from the pivot to the bulge (m, positive towards the
+    /// trailing edge): the lever `L` of the bulge in the coordinates of
+    /// [`ReynoldsBearing::heave_pitch`], whose displacement is `y + L θ`. The geometry's
+    /// `bulge_um` and `operating.pivot_um` give it; with the defaults (the bulge at the trailing
+    /// edge) it is the pivot's distance to the trailing edge.
+    ///
+    /// ```
+    /// use hdi_tribology::bearing::BearingSpec;
+    /// use hdi_tribology::force::ReynoldsBearing;
+    /// let mut spec = BearingSpec::from_path(concat!(
+    ///     env!("CARGO_MANIFEST_DIR"), "/scenes/bearing/two_rail_taper_flat.toml"))?;
+    /// spec.grid.nx = 33;
+    /// spec.grid.ny = 33;
+    /// let ab = ReynoldsBearing::of_spec(&spec)?;
+    /// // The example's bulge sits on the trailing edge, its pivot at the centre.
+    /// assert_eq!(ab.bulge_lever(), ab.heave_pitch().2);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn bulge_lever(&self) -> f64 {
+        self.pivot_to_bulge
     }
 
     /// `F(y)` and `dF/dy`.

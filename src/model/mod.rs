@@ -283,7 +283,7 @@ impl SliderModel {
         SliderModel {
             forces: Arc::new(forces),
             bearing,
-            structure: Structure::from_spec(&scene.structure, scene.slider.mass_kg)?,
+            structure: Structure::from_scene(scene)?,
             nominal_clearance: scene.nominal_clearance_m,
             efficiency: scene.heater.efficiency_m_per_w,
             thermal_lag: scene.heater.thermal_lag_s,

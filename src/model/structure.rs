@@ -10,7 +10,7 @@ use nalgebra::{DMatrix, SMatrix, SVector};
 
 use super::condensed::QuasiStaticBulge;
 use crate::error::{check_finite, check_non_negative, check_positive};
-use crate::scene::{StructureSpec, MAX_DOF};
+use crate::scene::{Scene, StructureSpec, MAX_DOF};
 use crate::{Error, Result};
 
 /// Generalised coordinates `q` (m for translations, rad for rotations); entries beyond
@@ -235,7 +235,9 @@ impl Structure {
         Ok(s)
     }
 
-    /// The structure a scene describes, with the body mass of `slider.mass_kg`.
+    /// The structure a `[structure]` section describes, with the body mass `body_mass` (kg).
+    /// A `pitch` preset that takes its matrices from the air bearing (`from_bearing = true`)
+    /// needs the scene's bearing: build it with [`Structure::from_scene`].
     pub fn from_spec(spec: &StructureSpec, body_mass: f64) -> Result<Self> {
         spec.validate()?;
         match spec {
@@ -250,8 +252,9 @@ impl Structure {
                     Self::pitch(body_mass, inertia, stiffness, damping, trailing_edge)
                 }
                 None => Err(Error::invalid(
-                    "structure.preset",
-                    "pitch without its values",
+                    "structure.from_bearing",
+                    "the matrices come from the scene's air bearing: build the structure with \
+                     Structure::from_scene",
                 )),
             },
             StructureSpec::General {
@@ -260,6 +263,31 @@ impl Structure {
                 stiffness,
                 bulge_influence,
             } => Self::general(mass, damping, stiffness, bulge_influence),
+        }
+    }
+
+    /// The structure of a scene: its `[structure]` section with the body mass `slider.mass_kg`,
+    /// and for a `pitch` preset with `from_bearing = true` the [`Structure::pitch_on_bearing`]
+    /// of the scene's `reynolds` air bearing: its
+    /// [`heave_pitch`](crate::force::ReynoldsBearing::heave_pitch) stiffness and damping and the
+    /// lever of its bulge ([`bulge_lever`](crate::force::ReynoldsBearing::bulge_lever)). The
+    /// bearing is the one the scene's validation solved (solved once per process).
+    ///
+    /// ```
+    /// use hdi_tribology::model::Structure;
+    /// use hdi_tribology::scene::Scene;
+    /// assert_eq!(Structure::from_scene(&Scene::paper())?, Structure::rigid(1e-6)?);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn from_scene(scene: &Scene) -> Result<Self> {
+        let body_mass = scene.slider.mass_kg;
+        scene.structure.validate()?;
+        match (&scene.structure, scene.structure_bearing()?) {
+            (&StructureSpec::Pitch { inertia_kg_m2, .. }, Some(bearing)) => {
+                let (k, c, _) = bearing.heave_pitch();
+                Self::pitch_on_bearing(body_mass, inertia_kg_m2, k, c, bearing.bulge_lever())
+            }
+            (spec, _) => Self::from_spec(spec, body_mass),
         }
     }
 

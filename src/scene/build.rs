@@ -9,7 +9,8 @@ use crate::cache::codec::{malformed, Reader, Writer};
 use crate::cache::{CacheReport, TableCache};
 use crate::force::{
     lj_zero, AirBearing, Electrostatic, Footprint, GapReference, GreenwoodWilliamson,
-    InterfaceForces, InterfaceTerm, Intermolecular, Meniscus, MeniscusParams, Pickup, Wetting,
+    InterfaceForces, InterfaceTerm, Intermolecular, Meniscus, MeniscusParams, Pickup,
+    ReynoldsBearing, Wetting,
 };
 use crate::quadrature::{Table, TableOptions};
 use crate::surface::{Discrete, GaussianHeights, PeakDistribution, PeakModel};
@@ -349,6 +350,43 @@ impl Scene {
     /// The air bearing.
     pub fn build_air_bearing(&self) -> Result<Box<dyn AirBearing>> {
         self.air_bearing.build()
+    }
+
+    /// The bearing the structure takes its matrices from: the `reynolds` air bearing when
+    /// `structure.from_bearing = true`, else `None`. The bearing is solved once per process
+    /// ([`ReynoldsBearing::of_spec`]): after the scene's validation this solves nothing.
+    ///
+    /// # Errors
+    /// `structure.from_bearing` with an air bearing that is not `reynolds`; the air bearing's
+    /// own errors.
+    ///
+    /// ```
+    /// use hdi_tribology::scene::Scene;
+    /// assert!(Scene::paper().structure_bearing()?.is_none());
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn structure_bearing(&self) -> Result<Option<ReynoldsBearing>> {
+        if !self.structure.from_bearing() {
+            return Ok(None);
+        }
+        match self.air_bearing.bearing_spec()? {
+            Some(spec) => Ok(Some(ReynoldsBearing::of_spec(&spec)?)),
+            None => Err(self.no_bearing_for_structure()),
+        }
+    }
+
+    /// The error of `structure.from_bearing` on an air bearing that is not solved from the
+    /// slider's geometry.
+    pub(crate) fn no_bearing_for_structure(&self) -> Error {
+        let model = self.air_bearing.name();
+        Error::invalid(
+            "structure.from_bearing",
+            format!(
+                "takes the pitch stiffness and damping from the air bearing solved from the \
+                 slider's geometry, which needs air_bearing.model = \"reynolds\", not \
+                 \"{model}\"; or give the four matrix entries and trailing_edge_m"
+            ),
+        )
     }
 }
 

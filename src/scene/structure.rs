@@ -48,19 +48,44 @@ pub enum StructureSpec {
     /// Body heave `y` plus pitch `θ` (positive lifts the trailing edge), with the air bearing's
     /// pitch stiffness and damping and their coupling to heave; the bulge sits rigidly at the
     /// trailing edge, `z = y + L θ`.
+    ///
+    /// The four matrix entries and `L` are given, or, with `from_bearing = true` and
+    /// `air_bearing.model = "reynolds"`, taken from the bearing solved from the slider's
+    /// geometry: its heave–pitch stiffness and damping at the equilibrium
+    /// ([`ReynoldsBearing::heave_pitch`](crate::force::ReynoldsBearing::heave_pitch)) and `L`
+    /// the distance from its pivot to its bulge along the slider. Then none of the five may be
+    /// given: each has one source.
+    ///
+    /// ```
+    /// use hdi_tribology::scene::StructureSpec;
+    /// let s: StructureSpec = toml::from_str(
+    ///     "preset = \"pitch\"\ninertia_kg_m2 = 1.4e-12\nfrom_bearing = true").unwrap();
+    /// assert!(s.from_bearing() && s.pitch_values().is_none());
+    /// assert!(s.validate().is_ok()); // the bearing is the scene's: `Scene::validate` asks for it
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     Pitch {
         /// Pitch inertia about the pivot `I` (kg m²).
         inertia_kg_m2: f64,
-        /// Pitch stiffness `k_θθ` (N m/rad).
-        stiffness_n_m_per_rad: f64,
-        /// Heave–pitch coupling stiffness `k_yθ = k_θy` (N/rad).
-        coupling_stiffness_n_per_rad: f64,
-        /// Pitch damping `c_θθ` (N m s/rad).
-        damping_n_m_s_per_rad: f64,
-        /// Heave–pitch coupling damping `c_yθ = c_θy` (N s/rad).
-        coupling_damping_n_s_per_rad: f64,
-        /// Distance `L` from the pivot to the bulge at the trailing edge (m).
-        trailing_edge_m: f64,
+        /// Pitch stiffness `k_θθ` (N m/rad); required unless `from_bearing`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        stiffness_n_m_per_rad: Option<f64>,
+        /// Heave–pitch coupling stiffness `k_yθ = k_θy` (N/rad); required unless `from_bearing`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        coupling_stiffness_n_per_rad: Option<f64>,
+        /// Pitch damping `c_θθ` (N m s/rad); required unless `from_bearing`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        damping_n_m_s_per_rad: Option<f64>,
+        /// Heave–pitch coupling damping `c_yθ = c_θy` (N s/rad); required unless `from_bearing`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        coupling_damping_n_s_per_rad: Option<f64>,
+        /// Distance `L` from the pivot to the bulge at the trailing edge (m); required unless
+        /// `from_bearing`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        trailing_edge_m: Option<f64>,
+        /// Whether the matrices and `L` come from the `reynolds` air bearing (default false).
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        from_bearing: bool,
     },
     /// Any linear structure of 1 to [`MAX_DOF`] degrees of freedom:
     /// `M q̈ + C q̇ + K q = e₀ F_ab + b F_if`. Degree of freedom 0 is the body heave, where the
@@ -96,7 +121,8 @@ impl StructureSpec {
     }
 
     /// The pitch preset's values in the order [`Structure::pitch`](crate::model::Structure::pitch)
-    /// takes them: `(I, [k_θθ, k_yθ], [c_θθ, c_yθ], L)`; `None` for the other presets.
+    /// takes them: `(I, [k_θθ, k_yθ], [c_θθ, c_yθ], L)`; `None` for the other presets, and for a
+    /// pitch preset that takes them from the air bearing or lacks one of them.
     ///
     /// ```
     /// use hdi_tribology::scene::StructureSpec;
@@ -106,19 +132,31 @@ impl StructureSpec {
         match *self {
             StructureSpec::Pitch {
                 inertia_kg_m2,
-                stiffness_n_m_per_rad,
-                coupling_stiffness_n_per_rad,
-                damping_n_m_s_per_rad,
-                coupling_damping_n_s_per_rad,
-                trailing_edge_m,
-            } => Some((
-                inertia_kg_m2,
-                [stiffness_n_m_per_rad, coupling_stiffness_n_per_rad],
-                [damping_n_m_s_per_rad, coupling_damping_n_s_per_rad],
-                trailing_edge_m,
-            )),
+                stiffness_n_m_per_rad: Some(k),
+                coupling_stiffness_n_per_rad: Some(k_c),
+                damping_n_m_s_per_rad: Some(c),
+                coupling_damping_n_s_per_rad: Some(c_c),
+                trailing_edge_m: Some(l),
+                from_bearing: false,
+            } => Some((inertia_kg_m2, [k, k_c], [c, c_c], l)),
             _ => None,
         }
+    }
+
+    /// Whether the structure takes its matrices from the scene's `reynolds` air bearing (the
+    /// `pitch` preset with `from_bearing = true`).
+    ///
+    /// ```
+    /// assert!(!hdi_tribology::scene::StructureSpec::Rigid.from_bearing());
+    /// ```
+    pub fn from_bearing(&self) -> bool {
+        matches!(
+            self,
+            StructureSpec::Pitch {
+                from_bearing: true,
+                ..
+            }
+        )
     }
 
     /// Field-by-field checks; errors name `structure.<field>`. The matrix properties of the
@@ -135,9 +173,52 @@ impl StructureSpec {
                 check_positive("structure.stiffness_n_per_m", *stiffness_n_per_m)?;
                 check_non_negative("structure.damping_ratio", *damping_ratio)?;
             }
-            StructureSpec::Pitch { .. } => {
-                if let Some((inertia, [k, k_c], [c, c_c], l)) = self.pitch_values() {
-                    check_positive("structure.inertia_kg_m2", inertia)?;
+            &StructureSpec::Pitch {
+                inertia_kg_m2,
+                stiffness_n_m_per_rad,
+                coupling_stiffness_n_per_rad,
+                damping_n_m_s_per_rad,
+                coupling_damping_n_s_per_rad,
+                trailing_edge_m,
+                from_bearing,
+            } => {
+                check_positive("structure.inertia_kg_m2", inertia_kg_m2)?;
+                let given = [
+                    ("stiffness_n_m_per_rad", stiffness_n_m_per_rad),
+                    ("coupling_stiffness_n_per_rad", coupling_stiffness_n_per_rad),
+                    ("damping_n_m_s_per_rad", damping_n_m_s_per_rad),
+                    ("coupling_damping_n_s_per_rad", coupling_damping_n_s_per_rad),
+                    ("trailing_edge_m", trailing_edge_m),
+                ];
+                for (name, value) in given {
+                    let field = format!("structure.{name}");
+                    match (value, from_bearing) {
+                        (Some(_), true) => {
+                            let what = if name == "trailing_edge_m" {
+                                "the distance from the pivot to the bulge from the bearing's \
+                                 geometry (its operating.pivot_um and bulge_um)"
+                            } else {
+                                "the air bearing's heave-pitch stiffness and damping"
+                            };
+                            return Err(Error::invalid(
+                                field,
+                                format!(
+                                    "given together with structure.from_bearing = true, which \
+                                     takes {what}: give the one or the other"
+                                ),
+                            ));
+                        }
+                        (None, false) => {
+                            return Err(Error::invalid(
+                                field,
+                                "required by the pitch preset, unless structure.from_bearing = \
+                                 true takes the matrices from a reynolds air bearing",
+                            ));
+                        }
+                        _ => {}
+                    }
+                }
+                if let Some((_, [k, k_c], [c, c_c], l)) = self.pitch_values() {
                     check_positive("structure.stiffness_n_m_per_rad", k)?;
                     check_finite("structure.coupling_stiffness_n_per_rad", k_c)?;
                     check_non_negative("structure.damping_n_m_s_per_rad", c)?;

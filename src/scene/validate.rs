@@ -457,10 +457,19 @@ impl Scene {
 }
 
 impl Scene {
-    /// The structure's own fields, and that pad-gap terms (which act on the body) are only used
-    /// with the rigid structure, where body and bulge are one.
+    /// The structure's own fields, that a structure taking its matrices from the air bearing has
+    /// a `reynolds` one, and that pad-gap terms (which act on the body) are only used with the
+    /// rigid structure, where body and bulge are one.
     fn validate_structure(&self) -> Result<()> {
         self.structure.validate()?;
+        if self.structure.from_bearing()
+            && !matches!(
+                self.air_bearing,
+                crate::force::AirBearingModel::Reynolds { .. }
+            )
+        {
+            return Err(self.no_bearing_for_structure());
+        }
         if self.structure.is_rigid() {
             return Ok(());
         }

@@ -46,11 +46,12 @@ pub fn bench_structures() -> Vec<(&'static str, hdi_tribology::scene::StructureS
             "pitch",
             StructureSpec::Pitch {
                 inertia_kg_m2: paper.slider.mass_kg * l * l / 3.0,
-                stiffness_n_m_per_rad: k_ab * l * l / 3.0,
-                coupling_stiffness_n_per_rad: 10.0,
-                damping_n_m_s_per_rad: 1e-9,
-                coupling_damping_n_s_per_rad: 0.0,
-                trailing_edge_m: l,
+                stiffness_n_m_per_rad: Some(k_ab * l * l / 3.0),
+                coupling_stiffness_n_per_rad: Some(10.0),
+                damping_n_m_s_per_rad: Some(1e-9),
+                coupling_damping_n_s_per_rad: Some(0.0),
+                trailing_edge_m: Some(l),
+                from_bearing: false,
             },
         ),
     ]
