@@ -25,9 +25,12 @@ fn scene() -> Scene {
     Scene::from_path(scene_path()).unwrap()
 }
 
+/// `ReynoldsBearing::heave_pitch`: stiffness, damping, pivot to trailing edge.
+type HeavePitch = ([[f64; 2]; 2], [[f64; 2]; 2], f64);
+
 /// The shipped scene's bearing, solved here from the geometry file on the scene's grid, not
-/// through the scene: `(K, C, pivot to trailing edge)` of `heave_pitch`, and the bulge's lever.
-fn independent_bearing(cells: usize) -> (([[f64; 2]; 2], [[f64; 2]; 2], f64), f64) {
+/// through the scene: its `heave_pitch`, and the bulge's lever.
+fn independent_bearing(cells: usize) -> (HeavePitch, f64) {
     let mut spec = BearingSpec::from_path(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/bearing/two_rail_taper_flat.toml"),
     )
@@ -60,6 +63,7 @@ fn the_models_matrices_are_the_bearings_heave_pitch_to_the_bit() {
     let model = SliderModel::from_scene(&scene).unwrap();
     let ((k, c, to_trailing_edge), lever) = independent_bearing(cells(&scene));
     let s = model.structure();
+    println!("bearing_pitch heave-pitch K {k:?}, C {c:?}, lever {lever} m");
     // Heave on coordinate 0 is the bearing's heave law; the rest is the structure's.
     assert_eq!(model.bearing().stiffness(0.0), k[0][0]);
     assert_eq!(model.bearing().damping(0.0), c[0][0]);
@@ -127,7 +131,7 @@ fn the_modes_are_those_of_pitch_on_bearing() {
         .filter(|x| x.im > 0.0)
         .map(|x: &Complex64| x.norm() / (2.0 * std::f64::consts::PI))
         .collect();
-    println!("bearing_pitch modes (1/s): {got:?}; undamped |λ|/2π (Hz): {freq:?}");
+    println!("bearing_pitch modes (1/s): {got:?}; |λ|/2π (Hz): {freq:?}");
 }
 
 #[test]
@@ -291,7 +295,11 @@ fn hdi_static_cycle_and_drive_run_on_it() {
 
     let dir = tempfile::tempdir().unwrap();
     let cmds = dir.path().join("commands.csv");
-    std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.0005,65,0\n").unwrap();
+    std::fs::write(
+        &cmds,
+        "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.0005,65,0\n",
+    )
+    .unwrap();
     let d = json(&hdi(&[
         "drive",
         path,
