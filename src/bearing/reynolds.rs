@@ -697,6 +697,15 @@ impl Reynolds {
         ]
     }
 
+    /// The loads (N, N m, N m) of a non-dimensional pressure field `x` with the weights `w`
+    /// ([`Reynolds::weights`]): each weighted sum times the ambient pressure and the length
+    /// squared.
+    fn weighted_loads(&self, w: &[Vec<f64>; 3], x: &[f64]) -> [f64; 3] {
+        let (l, pa) = (self.bearing.length, self.bearing.ambient_pressure);
+        w.each_ref()
+            .map(|wi| x.iter().zip(wi).map(|(a, b)| a * b).sum::<f64>() * pa * l * l)
+    }
+
     /// Weights of the loads: area, area × lever arm ahead of the pivot (m), area × lever arm to
     /// its `+y` side.
     fn weights(&self) -> [Vec<f64>; 3] {
@@ -773,8 +782,6 @@ impl Reynolds {
         let mut k = [[0.0; 3]; 3];
         let mut iterations = 0;
         let w = self.weights();
-        let l = self.bearing.length;
-        let pa = self.bearing.ambient_pressure;
         for q in 0..3 {
             self.check_interrupt(Solve::Sensitivity)?;
             let dmax = dh[q].iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -788,26 +795,10 @@ impl Reynolds {
             }
             self.residual(p, &hs, &mut rm, None);
             let rhs: Vec<f64> = (0..n).map(|c| -(rp[c] - rm[c]) / (2.0 * eps)).collect();
-            let stats = gmres(
-                &f.jacobian,
-                &f.ilu,
-                &rhs,
-                &mut dps[q],
-                rtol,
-                RESTART,
-                MAX_KRYLOV,
-            );
-            iterations += stats.iterations;
-            if stats.relative_residual > 10.0 * rtol {
-                return Err(BearingError::Krylov {
-                    solve: Solve::Sensitivity,
-                    relative_residual: stats.relative_residual,
-                    iterations: stats.iterations,
-                }
-                .into());
-            }
+            iterations += f.solve(&rhs, &mut dps[q], rtol, Solve::Sensitivity)?;
+            let loads = self.weighted_loads(&w, &dps[q]);
             for i in 0..3 {
-                k[i][q] = dps[q].iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>() * pa * l * l;
+                k[i][q] = loads[i];
             }
         }
         Ok((k, dps, iterations))
@@ -842,28 +833,10 @@ impl Reynolds {
                 }
             }
             let mut x = vec![0.0; n];
-            let stats = gmres(
-                &f.jacobian,
-                &f.ilu,
-                &rhs,
-                &mut x,
-                DAMPING_RTOL,
-                RESTART,
-                MAX_KRYLOV,
-            );
-            if stats.relative_residual > 10.0 * DAMPING_RTOL {
-                return Err(BearingError::Krylov {
-                    solve: Solve::Damping,
-                    relative_residual: stats.relative_residual,
-                    iterations: stats.iterations,
-                }
-                .into());
-            }
+            f.solve(&rhs, &mut x, DAMPING_RTOL, Solve::Damping)?;
+            let loads = self.weighted_loads(&w, &x);
             for i in 0..3 {
-                c[i][q] = -x.iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>()
-                    * b.ambient_pressure
-                    * b.length
-                    * b.length;
+                c[i][q] = -loads[i];
             }
         }
         Ok(c)
@@ -928,6 +901,24 @@ pub struct Factored {
     pub jacobian: FivePoint,
     /// Its multigrid preconditioner.
     pub ilu: Multigrid,
+}
+
+impl Factored {
+    /// Solves `J x = rhs` by GMRES from the start in `x` to the relative tolerance `rtol`, and
+    /// returns the iterations; a residual left above ten times `rtol` is a
+    /// [`BearingError::Krylov`] of `solve`.
+    fn solve(&self, rhs: &[f64], x: &mut [f64], rtol: f64, solve: Solve) -> Result<usize> {
+        let stats = gmres(&self.jacobian, &self.ilu, rhs, x, rtol, RESTART, MAX_KRYLOV);
+        if stats.relative_residual > 10.0 * rtol {
+            return Err(BearingError::Krylov {
+                solve,
+                relative_residual: stats.relative_residual,
+                iterations: stats.iterations,
+            }
+            .into());
+        }
+        Ok(stats.iterations)
+    }
 }
 
 /// The multigrid preconditioner of `a`: the hierarchy of the last Newton step given the new

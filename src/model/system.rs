@@ -1,7 +1,7 @@
 //! The slider as an ODE: state layout, right-hand side and analytic Jacobian.
 
 use super::{Dofs, Inputs, QuasiStaticBulge, SliderModel};
-use crate::force::{Gaps, MAX_TERM_STATES};
+use crate::force::{Gaps, HotValues, MAX_TERM_STATES};
 use crate::ode::OdeSystem;
 use crate::scene::MAX_DOF;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
@@ -327,6 +327,46 @@ impl SliderSystem {
         Local { g, f, hot }
     }
 
+    /// The interface force that drives the slider at state `s`: the lagged force where the state
+    /// keeps one, else the force `hot` of the gaps now.
+    fn interface_drive<D: Dim>(&self, s: &OVector<f64, D>, hot: &HotValues) -> f64
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        match self.layout.lagged_force {
+            Some(i) => s[i],
+            None => hot.interface,
+        }
+    }
+
+    /// The rates of the states besides the mechanical ones and the stateful terms', at time `t`
+    /// and state `s` with the interface's values `hot`: the protrusion's and the lagged force's
+    /// first-order lags, and the integrands of the contact impulse and of the heat.
+    fn lag_and_integral_rates<D: Dim>(
+        &self,
+        t: f64,
+        s: &OVector<f64, D>,
+        hot: &HotValues,
+        ds: &mut OVector<f64, D>,
+    ) where
+        DefaultAllocator: Allocator<D>,
+    {
+        let m = &*self.model;
+        let lay = self.layout;
+        if let Some(i) = lay.delta {
+            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - s[i]) / m.thermal_lag;
+        }
+        if let Some(i) = lay.lagged_force {
+            ds[i] = (hot.interface - s[i]) / m.interface_lag;
+        }
+        if let Some(i) = lay.contact_impulse {
+            ds[i] = hot.contact;
+        }
+        if let Some(i) = lay.heat {
+            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
+        }
+    }
+
     /// The derivative of the flash temperature (the heat state's rate) along the bulge gap at
     /// the point of `l`: the derivative of the interpolants the right-hand side reads.
     fn heat_slope(&self, l: &Local) -> f64 {
@@ -614,10 +654,7 @@ where
         let delta = self.protrusion(t, s);
         let g = m.gaps_offset(&q, delta, self.inputs.clearance_offset);
         let hot = m.hot_values(g, self.inputs.voltage.squared(t));
-        let mut drive = match lay.lagged_force {
-            Some(i) => s[i],
-            None => hot.interface,
-        };
+        let mut drive = self.interface_drive(s, &hot);
         if lay.term_states.1 > 0 {
             drive += self.term_rates(g, s, ds);
         }
@@ -627,18 +664,7 @@ where
             ds[i] = v[i];
             ds[lay.velocity(i)] = a[i];
         }
-        if let Some(i) = lay.delta {
-            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - delta) / m.thermal_lag;
-        }
-        if let Some(i) = lay.lagged_force {
-            ds[i] = (hot.interface - s[i]) / m.interface_lag;
-        }
-        if let Some(i) = lay.contact_impulse {
-            ds[i] = hot.contact;
-        }
-        if let Some(i) = lay.heat {
-            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
-        }
+        self.lag_and_integral_rates(t, s, &hot, ds);
         if let Some(b) = &self.inputs.base_motion {
             let a = b.acceleration_value(t);
             for &(i, r) in &self.base[..self.n_base] {
@@ -859,24 +885,10 @@ impl SliderSystem {
         };
         let hot = m.hot_values(g, self.inputs.voltage.squared(t));
         let v = s[lay.velocity(0)];
-        let drive = match lay.lagged_force {
-            Some(i) => s[i],
-            None => hot.interface,
-        };
+        let drive = self.interface_drive(s, &hot);
         ds[0] = v;
         ds[lay.velocity(0)] = (m.bearing().force(s[0], v) + drive) / m.structure.body_mass();
-        if let Some(i) = lay.delta {
-            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - s[i]) / m.thermal_lag;
-        }
-        if let Some(i) = lay.lagged_force {
-            ds[i] = (hot.interface - s[i]) / m.interface_lag;
-        }
-        if let Some(i) = lay.contact_impulse {
-            ds[i] = hot.contact;
-        }
-        if let Some(i) = lay.heat {
-            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
-        }
+        self.lag_and_integral_rates(t, s, &hot, ds);
         if let Some(motion) = &self.inputs.base_motion {
             ds[lay.velocity(0)] -= motion.acceleration_value(t);
         }

@@ -1,6 +1,6 @@
 //! Globally adaptive 21-point Gauss–Kronrod integration (G10/K21).
 
-use super::mapping::{mapped_eval, Mapping};
+use super::mapping::{mapped_eval, ordered_limits, Mapping};
 use super::QuadratureError;
 use super::{Estimate, QuadOptions};
 use crate::error::Stage;
@@ -207,22 +207,8 @@ fn adapt<F: FnMut(f64) -> f64>(
     strict: bool,
 ) -> Result<Estimate> {
     opts.validate()?;
-    let (lo, hi, sign) = match a.partial_cmp(&b) {
-        None => {
-            return Err(Error::invalid(
-                "quad.limits",
-                format!("integration limits must not be NaN, got [{a}, {b}]"),
-            ))
-        }
-        Some(Ordering::Equal) => {
-            return Ok(Estimate {
-                value: 0.0,
-                error: 0.0,
-                evaluations: 0,
-            })
-        }
-        Some(Ordering::Less) => (a, b, 1.0),
-        Some(Ordering::Greater) => (b, a, -1.0),
+    let Some((lo, hi, sign)) = ordered_limits(a, b)? else {
+        return Ok(Estimate::EMPTY);
     };
     let (map, ta, tb) = Mapping::new(lo, hi)?;
     let mut cuts: Vec<f64> = breaks

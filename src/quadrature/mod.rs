@@ -81,3 +81,12 @@ pub struct Estimate {
     /// Number of integrand evaluations used.
     pub evaluations: usize,
 }
+
+impl Estimate {
+    /// The integral over an empty range: zero, exactly, from no evaluation.
+    pub(crate) const EMPTY: Estimate = Estimate {
+        value: 0.0,
+        error: 0.0,
+        evaluations: 0,
+    };
+}
