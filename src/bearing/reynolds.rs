@@ -364,21 +364,14 @@ impl Reynolds {
     /// How the non-dimensional spacing of each control volume changes with the attitude's
     /// fly height (per m), pitch and roll (per rad).
     pub fn spacing_derivatives(&self) -> [Vec<f64>; 3] {
-        let (nx, ny) = self.size();
         let (l, w) = (self.bearing.length, self.bearing.width);
-        let mut d = [
-            Vec::with_capacity(nx * ny),
-            Vec::with_capacity(nx * ny),
-            Vec::with_capacity(nx * ny),
-        ];
-        for j in 0..ny {
-            for i in 0..nx {
-                d[0].push(1.0 / REFERENCE_SPACING);
-                d[1].push((l - self.grid.xc[i]) / REFERENCE_SPACING);
-                d[2].push((self.grid.yc[j] - 0.5 * w) / REFERENCE_SPACING);
-            }
-        }
-        d
+        self.per_cell(|i, j| {
+            [
+                1.0 / REFERENCE_SPACING,
+                (l - self.grid.xc[i]) / REFERENCE_SPACING,
+                (self.grid.yc[j] - 0.5 * w) / REFERENCE_SPACING,
+            ]
+        })
     }
 
     /// Smallest spacing over the grid's nodes (surface depth included), m.
@@ -614,7 +607,35 @@ impl Reynolds {
             stats.krylov_iterations += ks.iterations;
             stats.iterations += 1;
             let full = dp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if full <= tol {
+            let (accepted, tnorm) = if full <= tol {
+                (false, rnorm)
+            } else {
+                // Keep the pressure positive, then backtrack on the residual's norm.
+                let mut t: f64 = 1.0;
+                for c in 0..n {
+                    if dp[c] < 0.0 {
+                        t = t.min((MIN_PRESSURE_FRACTION - 1.0) * p[c] / dp[c]);
+                    }
+                }
+                let mut accepted = false;
+                let mut tnorm = rnorm;
+                for _ in 0..12 {
+                    for c in 0..n {
+                        trial[c] = p[c] + t * dp[c];
+                    }
+                    self.residual(&trial, h, &mut trial_r, None);
+                    tnorm = norm(&trial_r);
+                    if tnorm.is_finite() && tnorm <= (1.0 - 1e-4 * t) * rnorm {
+                        accepted = true;
+                        break;
+                    }
+                    t *= 0.5;
+                }
+                (accepted, tnorm)
+            };
+            // Converged, or the residual is at its round-off floor (the backtracking found no
+            // descent): the full step is the answer.
+            if full <= tol || (!accepted && full <= ROUND_OFF_UPDATE) {
                 for c in 0..n {
                     p[c] += dp[c];
                 }
@@ -623,41 +644,8 @@ impl Reynolds {
                 rnorm = norm(&r);
                 break;
             }
-            // Keep the pressure positive, then backtrack on the residual's norm.
-            let mut t: f64 = 1.0;
-            for c in 0..n {
-                if dp[c] < 0.0 {
-                    t = t.min((MIN_PRESSURE_FRACTION - 1.0) * p[c] / dp[c]);
-                }
-            }
-            let mut accepted = false;
-            let mut tnorm = rnorm;
-            for _ in 0..12 {
-                for c in 0..n {
-                    trial[c] = p[c] + t * dp[c];
-                }
-                self.residual(&trial, h, &mut trial_r, None);
-                tnorm = norm(&trial_r);
-                if tnorm.is_finite() && tnorm <= (1.0 - 1e-4 * t) * rnorm {
-                    accepted = true;
-                    break;
-                }
-                t *= 0.5;
-            }
-            if !accepted {
-                if full <= ROUND_OFF_UPDATE {
-                    // The residual is at its round-off floor: the full step is the answer.
-                    for c in 0..n {
-                        p[c] += dp[c];
-                    }
-                    stats.last_update = full;
-                    self.residual(p, h, &mut r, Some(&mut a));
-                    rnorm = norm(&r);
-                    break;
-                }
-                if !tnorm.is_finite() {
-                    return Err(BearingError::NonFiniteResidual.into());
-                }
+            if !accepted && !tnorm.is_finite() {
+                return Err(BearingError::NonFiniteResidual.into());
             }
             let mut upd: f64 = 0.0;
             for c in 0..n {
@@ -709,22 +697,30 @@ impl Reynolds {
     /// Weights of the loads: area, area × lever arm ahead of the pivot (m), area × lever arm to
     /// its `+y` side.
     fn weights(&self) -> [Vec<f64>; 3] {
-        let (nx, ny) = self.size();
         let [px, py] = self.bearing.pivot;
-        let mut w = [
+        self.per_cell(|i, j| {
+            let a = self.dx[i] * self.dy[j];
+            [a, a * (px - self.grid.xc[i]), a * (self.grid.yc[j] - py)]
+        })
+    }
+
+    /// Three quantities of every control volume, row by row: `f(i, j)` of the volume in column
+    /// `i` and row `j`.
+    fn per_cell(&self, f: impl Fn(usize, usize) -> [f64; 3]) -> [Vec<f64>; 3] {
+        let (nx, ny) = self.size();
+        let mut out = [
             Vec::with_capacity(nx * ny),
             Vec::with_capacity(nx * ny),
             Vec::with_capacity(nx * ny),
         ];
         for j in 0..ny {
             for i in 0..nx {
-                let a = self.dx[i] * self.dy[j];
-                w[0].push(a);
-                w[1].push(a * (px - self.grid.xc[i]));
-                w[2].push(a * (self.grid.yc[j] - py));
+                for (v, o) in f(i, j).into_iter().zip(&mut out) {
+                    o.push(v);
+                }
             }
         }
-        w
+        out
     }
 
     /// ```

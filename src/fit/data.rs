@@ -117,7 +117,8 @@ enum Role {
     Err(Quantity),
 }
 
-/// Column stems, their role and their units.
+/// Column stems of the x and the measured columns, their role and their units. The uncertainty
+/// of a measured column is the column of its stem and [`ERR`], in its units.
 const COLUMNS: &[(&str, Role, &[Unit])] = &[
     ("dc_voltage", Role::X(CurveKind::StaticVsDc), VOLTS),
     ("ac_amplitude", Role::X(CurveKind::CycleVsAc), VOLTS),
@@ -125,26 +126,28 @@ const COLUMNS: &[(&str, Role, &[Unit])] = &[
     ("touchdown_power", Role::Y(Quantity::TouchdownPower), WATTS),
     ("takeoff_power", Role::Y(Quantity::TakeoffPower), WATTS),
     (
-        "touchdown_power_err",
-        Role::Err(Quantity::TouchdownPower),
-        WATTS,
-    ),
-    (
-        "takeoff_power_err",
-        Role::Err(Quantity::TakeoffPower),
-        WATTS,
-    ),
-    (
         "contact_indicator",
         Role::Y(Quantity::ContactIndicator),
         NEWTONS,
     ),
-    (
-        "contact_indicator_err",
-        Role::Err(Quantity::ContactIndicator),
-        NEWTONS,
-    ),
 ];
+
+/// What ends the stem of an uncertainty column (`touchdown_power_err_mw`).
+const ERR: &str = "_err";
+
+/// The role and units of a column stem, an uncertainty's among them; `None` for an unknown one.
+fn column(stem: &str) -> Option<(Role, &'static [Unit])> {
+    match stem.strip_suffix(ERR) {
+        Some(measured) => COLUMNS.iter().find_map(|&(s, role, units)| match role {
+            Role::Y(q) if s == measured => Some((Role::Err(q), units)),
+            _ => None,
+        }),
+        None => COLUMNS
+            .iter()
+            .find(|(s, _, _)| *s == stem)
+            .map(|&(_, role, units)| (role, units)),
+    }
+}
 
 /// One measured column of a curve, in SI, with its optional 1σ uncertainties.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -210,18 +213,23 @@ fn classify(name: &str) -> Result<(Role, Unit), String> {
     let known = || {
         COLUMNS
             .iter()
-            .map(|(stem, _, units)| format!("{stem}_{}", units[0].suffix))
+            .flat_map(|&(stem, role, units)| {
+                let own = format!("{stem}_{}", units[0].suffix);
+                let err =
+                    matches!(role, Role::Y(_)).then(|| format!("{stem}{ERR}_{}", units[0].suffix));
+                std::iter::once(own).chain(err)
+            })
             .collect::<Vec<_>>()
             .join(", ")
     };
     let Some((stem, unit)) = name.rsplit_once('_') else {
         return Err(format!("unknown column; known columns: {}", known()));
     };
-    let Some((_, role, units)) = COLUMNS.iter().find(|(s, _, _)| *s == stem) else {
+    let Some((role, units)) = column(stem) else {
         return Err(format!("unknown column; known columns: {}", known()));
     };
     match units.iter().find(|u| u.suffix == unit) {
-        Some(u) => Ok((*role, *u)),
+        Some(u) => Ok((role, *u)),
         None => Err(format!(
             "unknown unit `{unit}` for {stem}; known units: {}",
             units

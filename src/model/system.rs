@@ -39,6 +39,15 @@ pub struct StateLayout {
     len: usize,
 }
 
+/// The index of the next state of a vector `len` states long so far, when the state is `on`: the
+/// vector then grows by one.
+fn next_index(len: &mut usize, on: bool) -> Option<usize> {
+    on.then(|| {
+        *len += 1;
+        *len - 1
+    })
+}
+
 impl StateLayout {
     /// Positions and velocities of `dofs` coordinates first, then the optional states (no
     /// states of stateful terms; see [`StateLayout::of`]).
@@ -55,24 +64,12 @@ impl StateLayout {
         integrals: bool,
     ) -> Self {
         let mut len = 2 * dofs;
-        let mut next = |on: bool| {
-            on.then(|| {
-                len += 1;
-                len - 1
-            })
-        };
-        let delta = next(thermal_lag);
-        let lagged_force = next(interface_lag);
+        let delta = next_index(&mut len, thermal_lag);
+        let lagged_force = next_index(&mut len, interface_lag);
         let term_states = (len, terms);
         len += terms;
-        let mut next = |on: bool| {
-            on.then(|| {
-                len += 1;
-                len - 1
-            })
-        };
-        let contact_impulse = next(integrals);
-        let heat = next(integrals);
+        let contact_impulse = next_index(&mut len, integrals);
+        let heat = next_index(&mut len, integrals);
         StateLayout {
             dofs,
             delta,
@@ -367,6 +364,18 @@ impl SliderSystem {
         }
     }
 
+    /// The heater power's rate at time `t` (W/s) and the protrusion's rate it makes (m/s): the
+    /// protrusion moves with the programme only without a thermal lag (with one it is a state,
+    /// and its rate here is zero).
+    fn power_and_protrusion_rates(&self, t: f64) -> (f64, f64) {
+        let (_, p_rate) = self.inputs.heater.power_and_rate(t);
+        let delta_rate = match self.layout.delta {
+            Some(_) => 0.0,
+            None => self.model.protrusion(p_rate),
+        };
+        (p_rate, delta_rate)
+    }
+
     /// The derivative of the flash temperature (the heat state's rate) along the bulge gap at
     /// the point of `l`: the derivative of the interpolants the right-hand side reads.
     fn heat_slope(&self, l: &Local) -> f64 {
@@ -496,12 +505,7 @@ impl SliderSystem {
     {
         let m = &*self.model;
         dfdt.fill(0.0);
-        let (_, p_rate) = self.inputs.heater.power_and_rate(t);
-        // Protrusion moves with the programme only without a thermal lag.
-        let delta_rate = match self.layout.delta {
-            Some(_) => 0.0,
-            None => m.protrusion(p_rate),
-        };
+        let (p_rate, delta_rate) = self.power_and_protrusion_rates(t);
         let f_t =
             -l.f.d_bulge * delta_rate + self.inputs.voltage.squared_rate(t) * l.hot.per_volt2.value;
         match self.layout.lagged_force {
@@ -929,11 +933,7 @@ impl SliderSystem {
         j[(v, 0)] = -m.bearing().stiffness(y0) / mass;
         j[(v, v)] = -m.bearing().damping(y0) / mass;
         // The protrusion's and the voltage's explicit rates, and the gap's rate they make.
-        let (_, p_rate) = self.inputs.heater.power_and_rate(t);
-        let delta_rate = match lay.delta {
-            Some(_) => 0.0,
-            None => m.protrusion(p_rate),
-        };
+        let (p_rate, delta_rate) = self.power_and_protrusion_rates(t);
         let f_t = self.inputs.voltage.squared_rate(t) * l.hot.per_volt2.value;
         let d_t = match lay.lagged_force {
             Some(_) => -delta_rate,

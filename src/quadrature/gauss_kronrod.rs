@@ -182,30 +182,30 @@ pub fn integrate_with_breaks<F: FnMut(f64) -> f64>(
     breaks: &[f64],
     opts: &QuadOptions,
 ) -> Result<Estimate> {
-    adapt(f, a, b, breaks, opts, true)
+    integrate_adaptive(f, a, b, breaks, opts, Exhausted::Fail)
 }
 
-/// Like [`integrate_with_breaks`], but when the interval budget is exhausted (or
-/// an interval cannot be split) it returns the best estimate, whose `error`
-/// field then exceeds the target. Non-finite integrand values are still errors.
-pub(crate) fn integrate_best_effort<F: FnMut(f64) -> f64>(
-    f: F,
-    a: f64,
-    b: f64,
-    breaks: &[f64],
-    opts: &QuadOptions,
-) -> Result<Estimate> {
-    adapt(f, a, b, breaks, opts, false)
+/// What [`integrate_adaptive`] gives when its interval budget is spent (or an interval cannot be
+/// split) before the target is met.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Exhausted {
+    /// An error: [`QuadratureError::IntervalBudget`] or [`QuadratureError::CannotSplit`].
+    Fail,
+    /// The best estimate, whose `error` field then exceeds the target. Non-finite integrand
+    /// values are still errors.
+    BestEstimate,
 }
 
-fn adapt<F: FnMut(f64) -> f64>(
+/// [`integrate_with_breaks`], with what to do when the interval budget is spent.
+pub(crate) fn integrate_adaptive<F: FnMut(f64) -> f64>(
     mut f: F,
     a: f64,
     b: f64,
     breaks: &[f64],
     opts: &QuadOptions,
-    strict: bool,
+    exhausted: Exhausted,
 ) -> Result<Estimate> {
+    let strict = exhausted == Exhausted::Fail;
     opts.validate()?;
     let Some((lo, hi, sign)) = ordered_limits(a, b)? else {
         return Ok(Estimate::EMPTY);

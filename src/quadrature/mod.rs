@@ -17,8 +17,8 @@ mod table;
 mod tanh_sinh;
 
 pub use error::QuadratureError;
-pub(crate) use gauss_kronrod::integrate_best_effort;
 pub use gauss_kronrod::{integrate, integrate_with_breaks};
+pub(crate) use gauss_kronrod::{integrate_adaptive, Exhausted};
 pub(crate) use table::{hermite_bounds, Span};
 pub use table::{Table, TableOptions};
 pub use tanh_sinh::integrate_tanh_sinh;
