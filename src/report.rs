@@ -759,6 +759,124 @@ impl<C, DB: plotters_backend::DrawingBackend> plotters::element::Drawable<DB> fo
     }
 }
 
+/// Font sizes in the canvas's pixels: tick labels, axis labels, legend, notes.
+#[cfg(feature = "plot")]
+#[derive(Clone, Copy)]
+struct FontPx {
+    tick: f64,
+    axis: f64,
+    legend: f64,
+    note: f64,
+}
+
+/// The ranges a chart draws: x, y and the second y axis's.
+#[cfg(feature = "plot")]
+#[derive(Clone, Copy)]
+struct Ranges {
+    x: (f64, f64),
+    y: (f64, f64),
+    y2: (f64, f64),
+}
+
+/// A part of the SVG canvas.
+#[cfg(feature = "plot")]
+type Area<'b> =
+    plotters::drawing::DrawingArea<plotters::backend::SVGBackend<'b>, plotters::coord::Shift>;
+
+/// What each part of a chart draws with: the whole canvas (for what is placed in its pixels),
+/// the colour of each series, the font sizes.
+#[cfg(feature = "plot")]
+struct Canvas<'r, 'b> {
+    root: &'r Area<'b>,
+    colours: &'r [plotters::style::RGBColor],
+    fonts: FontPx,
+}
+
+/// A drawing error in words.
+#[cfg(feature = "plot")]
+fn draw_error(e: &dyn std::fmt::Display) -> String {
+    e.to_string()
+}
+
+/// A dashed line through `points` (dashes of 7 px, gaps of 5 px, in the figure's pixels).
+#[cfg(feature = "plot")]
+fn dashed<P: Clone>(
+    points: Vec<P>,
+    style: plotters::style::ShapeStyle,
+) -> plotters::element::DashedPathElement<std::vec::IntoIter<P>, u32> {
+    let k = SUPERSAMPLE;
+    plotters::element::DashedPathElement::new(points, 7 * k, 5 * k, style)
+}
+
+/// How a series is drawn, one for the plot and its legend entry alike.
+#[cfg(feature = "plot")]
+impl Series<'_> {
+    /// Which layer the series is drawn in: bands (0) under lines (1) under markers (2).
+    fn layer(&self) -> u8 {
+        if !self.upper.is_empty() {
+            0
+        } else if self.markers {
+            2
+        } else {
+            1
+        }
+    }
+
+    /// The points that can be drawn on axes with the log flags `log`.
+    fn drawable_points(&self, log: (bool, bool)) -> Vec<(f64, f64)> {
+        self.points
+            .iter()
+            .copied()
+            .filter(|&p| drawable(p, log))
+            .collect()
+    }
+
+    /// The outline of a band: its lower edge forwards, then its upper edge backwards.
+    fn band_outline(&self, log: (bool, bool)) -> Vec<(f64, f64)> {
+        let upper: Vec<(f64, f64)> = self
+            .points
+            .iter()
+            .zip(&self.upper)
+            .map(|(&(x, _), &y)| (x, y))
+            .filter(|&p| drawable(p, log))
+            .rev()
+            .collect();
+        self.drawable_points(log).into_iter().chain(upper).collect()
+    }
+
+    /// The marker's half-size in the figure's pixels (4 unless set).
+    fn marker_size(&self) -> i32 {
+        if self.width == 0 {
+            4
+        } else {
+            self.width as i32
+        }
+    }
+
+    /// The line's style in colour `c`, 2 figure pixels wide unless set.
+    fn line_style(&self, c: plotters::style::RGBColor) -> plotters::style::ShapeStyle {
+        use plotters::style::Color;
+        c.stroke_width(SUPERSAMPLE * if self.width == 0 { 2 } else { self.width })
+    }
+
+    /// The label of point `i` (at `px`, in pixels), shared with the points after it that lie
+    /// within `h` pixels: the text and the first point after them.
+    fn shared_label(&self, px: &[Option<(i32, i32)>], i: usize, h: i32) -> (String, usize) {
+        let mut j = i + 1;
+        let mut text = self.labels[i].clone();
+        while let (Some(Some(a)), Some(Some(b))) = (px.get(i), px.get(j)) {
+            if (a.0 - b.0).abs().max((a.1 - b.1).abs()) > h || j >= self.labels.len() {
+                break;
+            }
+            if !self.labels[j].is_empty() {
+                text = format!("{text}, {}", self.labels[j]);
+            }
+            j += 1;
+        }
+        (text, j)
+    }
+}
+
 #[cfg(feature = "plot")]
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
 impl Chart<'_> {
@@ -793,25 +911,53 @@ impl Chart<'_> {
     fn draw(&self, out: &mut String, width: u32, height: u32) -> std::result::Result<(), String> {
         use plotters::prelude::*;
         let k = SUPERSAMPLE;
-        // Font sizes in the canvas's pixels: points at the printed width.
+        let fonts = self.font_px(width);
+        let (width, height) = (width * k, height * k);
+        let has2 = self.points(true).next().is_some();
+        if has2 && self.log != (false, false) {
+            return Err("a second y axis needs linear axes".into());
+        }
+        let ranges = self.ranges()?;
+        let colours = self.colours();
+        let root = SVGBackend::with_string(out, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_error(&e))?;
+        let labelled: Vec<usize> = (0..self.series.len())
+            .filter(|&i| !self.series[i].label.is_empty())
+            .collect();
+        let legend_w = self.legend_panel_width(&labelled, fonts.legend, width);
+        let (plot_area, legend_area) = root.split_horizontally(width - legend_w);
+        let canvas = Canvas {
+            root: &root,
+            colours: &colours,
+            fonts,
+        };
+        self.draw_plot(&canvas, &plot_area, ranges, has2)?;
+        self.draw_legend(&canvas, &legend_area, &labelled, legend_w)?;
+        root.present().map_err(|e| draw_error(&e))?;
+        Ok(())
+    }
+
+    /// Font sizes in the canvas's pixels for a figure `width` pixels wide: points at the printed
+    /// width.
+    fn font_px(&self, width: u32) -> FontPx {
         let print_in = self
             .print_width_in
             .unwrap_or(if width < 950 { 3.5 } else { 7.0 });
         // plotters writes a font of size `f` as `font-size = f/1.24` in SVG: ask for 1.24 times
         // the size wanted.
-        let px_per_pt = 1.24 * (width * k) as f64 / (print_in * 72.0);
-        let tick_px = FONT_PT.0 * px_per_pt;
-        let axis_px = FONT_PT.1 * px_per_pt;
-        let legend_px = FONT_PT.2 * px_per_pt;
-        let note_px = FONT_PT.3 * px_per_pt;
-        let (width, height) = (width * k, height * k);
-        let err = |e: &dyn std::fmt::Display| e.to_string();
-        let log = self.log;
-        let has2 = self.points(true).next().is_some();
-        if has2 && log != (false, false) {
-            return Err("a second y axis needs linear axes".into());
+        let px_per_pt = 1.24 * (width * SUPERSAMPLE) as f64 / (print_in * 72.0);
+        FontPx {
+            tick: FONT_PT.0 * px_per_pt,
+            axis: FONT_PT.1 * px_per_pt,
+            legend: FONT_PT.2 * px_per_pt,
+            note: FONT_PT.3 * px_per_pt,
         }
-        let xr = self
+    }
+
+    /// The x, y and second y ranges drawn: those given, else the data's with a margin.
+    fn ranges(&self) -> std::result::Result<Ranges, String> {
+        let log = self.log;
+        let x = self
             .x_range
             .or_else(|| {
                 padded_span(
@@ -820,55 +966,77 @@ impl Chart<'_> {
                 )
             })
             .ok_or("no finite points to draw")?;
-        let yr = self
+        let y = self
             .y_range
             .or_else(|| self.data_y_range())
             .unwrap_or((0.0, 1.0));
-        let y2r = self
+        let y2 = self
             .y2_range
             .or_else(|| padded_span(self.points(true).map(|p| p.1), false))
             .unwrap_or((0.0, 1.0));
-        // Colours: explicit ones, else the palette in order.
+        Ok(Ranges { x, y, y2 })
+    }
+
+    /// The colour of each series: its own, else the palette's next.
+    fn colours(&self) -> Vec<plotters::style::RGBColor> {
         let mut next = 0;
-        let colours: Vec<RGBColor> = self
-            .series
+        self.series
             .iter()
             .map(|s| {
                 let c = s.colour.unwrap_or_else(|| {
                     next += 1;
                     palette::SERIES[(next - 1) % palette::SERIES.len()]
                 });
-                RGBColor(c.0, c.1, c.2)
+                plotters::style::RGBColor(c.0, c.1, c.2)
             })
-            .collect();
+            .collect()
+    }
 
-        let root = SVGBackend::with_string(out, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let labelled: Vec<usize> = (0..self.series.len())
-            .filter(|&i| !self.series[i].label.is_empty())
-            .collect();
+    /// The width of the legend panel (canvas pixels) on a canvas `width` wide: the one given,
+    /// else one that fits the longest of the `labelled` series' labels (none without labels or
+    /// notes).
+    fn legend_panel_width(&self, labelled: &[usize], legend_px: f64, width: u32) -> u32 {
+        let k = SUPERSAMPLE;
         let widest = labelled
             .iter()
             .map(|&i| self.series[i].label.chars().count() + 4)
             .max()
             .unwrap_or(0);
-        let legend_w = if let Some(w) = self.legend_width {
+        if let Some(w) = self.legend_width {
             (w * k).min(width / 2)
         } else if labelled.is_empty() && self.notes.is_empty() {
             0
         } else {
             ((widest as f64 * CHAR_EM * legend_px) as u32 + 6 * k)
                 .clamp(110 * k, (width as f64 * 0.4) as u32)
-        };
-        let (plot_area, legend_area) = root.split_horizontally(width - legend_w);
-        let mut builder = ChartBuilder::on(&plot_area);
+        }
+    }
+
+    /// The plot: its axes and grid, the series on their axes (bands first, then lines, then
+    /// markers on top), and the arrowheads and point labels of the primary-axis series.
+    fn draw_plot(
+        &self,
+        canvas: &Canvas<'_, '_>,
+        plot_area: &Area<'_>,
+        ranges: Ranges,
+        has2: bool,
+    ) -> std::result::Result<(), String> {
+        use plotters::prelude::*;
+        let k = SUPERSAMPLE;
+        let (fonts, log, err) = (canvas.fonts, self.log, draw_error);
+        let Ranges {
+            x: xr,
+            y: yr,
+            y2: y2r,
+        } = ranges;
+        let mut builder = ChartBuilder::on(plot_area);
         // The title is the caption's job, not the plot's.
         builder
             .margin(12 * k)
-            .x_label_area_size((tick_px + axis_px * 1.3) as u32)
-            .y_label_area_size((tick_px * CHAR_EM * 4.5 + axis_px * 1.5) as u32);
+            .x_label_area_size((fonts.tick + fonts.axis * 1.3) as u32)
+            .y_label_area_size((fonts.tick * CHAR_EM * 4.5 + fonts.axis * 1.5) as u32);
         if has2 {
-            builder.right_y_label_area_size((tick_px * CHAR_EM * 4.5 + axis_px * 1.5) as u32);
+            builder.right_y_label_area_size((fonts.tick * CHAR_EM * 4.5 + fonts.axis * 1.5) as u32);
         }
         let (xs, ys, y2s) = (xr.1 - xr.0, yr.1 - yr.0, y2r.1 - y2r.0);
         let grid = RGBAColor(0, 0, 0, 0.12);
@@ -879,157 +1047,34 @@ impl Chart<'_> {
                 snapped_tick_label(v, span)
             }
         };
-        macro_rules! series_into {
-            ($chart:ident . $method:ident, $s:expr, $c:expr) => {{
-                let s: &Series = $s;
-                let c: RGBColor = $c;
-                let pts: Vec<(f64, f64)> = s
-                    .points
-                    .iter()
-                    .copied()
-                    .filter(|&p| drawable(p, log))
-                    .collect();
-                if !s.upper.is_empty() {
-                    let upper: Vec<(f64, f64)> = s
-                        .points
-                        .iter()
-                        .zip(&s.upper)
-                        .map(|(&(x, _), &y)| (x, y))
-                        .filter(|&p| drawable(p, log))
-                        .rev()
-                        .collect();
-                    let outline: Vec<(f64, f64)> = pts.iter().copied().chain(upper).collect();
-                    $chart
-                        .$method(std::iter::once(Polygon::new(
-                            outline,
-                            c.mix(BAND_ALPHA).filled(),
-                        )))
-                        .map_err(|e| err(&e))?;
-                } else if s.markers {
-                    let size = if s.width == 0 { 4 } else { s.width as i32 };
-                    $chart
-                        .$method(
-                            pts.iter()
-                                .map(|&p| marker_element(s.marker, p, size, c, s.hollow)),
-                        )
-                        .map_err(|e| err(&e))?;
-                } else {
-                    let style = c.stroke_width(k * if s.width == 0 { 2 } else { s.width });
-                    if s.dashed {
-                        $chart
-                            .$method(std::iter::once(plotters::element::DashedPathElement::new(
-                                pts.into_iter(),
-                                7 * k,
-                                5 * k,
-                                style,
-                            )))
-                            .map_err(|e| err(&e))?;
-                    } else {
-                        $chart
-                            .$method(LineSeries::new(pts, style))
-                            .map_err(|e| err(&e))?;
-                    }
-                }
-            }};
-        }
-        // The series on one axis: bands first, then lines, then markers on top.
+        // The series on one axis, layer by layer.
         macro_rules! draw_all {
             ($chart:ident . $method:ident, $secondary:expr) => {
-                for pass in 0..3 {
-                    for (s, c) in self.series.iter().zip(&colours) {
-                        let kind = if !s.upper.is_empty() {
-                            0
-                        } else if s.markers {
-                            2
-                        } else {
-                            1
-                        };
-                        if s.secondary == $secondary && kind == pass {
-                            series_into!($chart.$method, s, *c);
+                for layer in 0..3 {
+                    for (s, &c) in self.series.iter().zip(canvas.colours) {
+                        if s.secondary != $secondary || s.layer() != layer {
+                            continue;
                         }
+                        let pts = s.drawable_points(log);
+                        let drawn = if !s.upper.is_empty() {
+                            let band =
+                                Polygon::new(s.band_outline(log), c.mix(BAND_ALPHA).filled());
+                            $chart.$method(std::iter::once(band))
+                        } else if s.markers {
+                            let size = s.marker_size();
+                            $chart.$method(
+                                pts.iter()
+                                    .map(|&p| marker_element(s.marker, p, size, c, s.hollow)),
+                            )
+                        } else if s.dashed {
+                            $chart.$method(std::iter::once(dashed(pts, s.line_style(c))))
+                        } else {
+                            $chart.$method(LineSeries::new(pts, s.line_style(c)))
+                        };
+                        drawn.map_err(|e| err(&e))?;
                     }
                 }
             };
-        }
-        // Arrowheads and point labels of the primary-axis series, in the canvas's pixels.
-        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
-        macro_rules! annotate {
-            ($chart:ident) => {{
-                let ki = k as i32;
-                let label_font = ("sans-serif", legend_px).into_font().color(&BLACK);
-                // Every marker is an obstacle to the labels.
-                for s in self.series.iter().filter(|s| s.markers && !s.secondary) {
-                    let r = ki * if s.width == 0 { 4 } else { s.width as i32 } + ki;
-                    for &p in s.points.iter().filter(|&&p| drawable(p, log)) {
-                        let (x, y) = $chart.backend_coord(&p);
-                        placed.push((x - r, y - r, x + r, y + r));
-                    }
-                }
-                for (s, c) in self.series.iter().zip(&colours) {
-                    if s.secondary {
-                        continue;
-                    }
-                    let px: Vec<Option<(i32, i32)>> = s
-                        .points
-                        .iter()
-                        .map(|&p| drawable(p, log).then(|| $chart.backend_coord(&p)))
-                        .collect();
-                    for &i in &s.arrows {
-                        if let Some(head) = arrowhead(&px, i, 5 * ki) {
-                            root.draw(&Polygon::new(head, c.filled()))
-                                .map_err(|e| err(&e))?;
-                        }
-                    }
-                    let h = (legend_px / 1.24) as i32;
-                    let width = |t: &str| (t.chars().count() as f64 * CHAR_EM * legend_px) as i32;
-                    let mut i = 0;
-                    while i < s.labels.len().min(px.len()) {
-                        // Points closer than a label's height share one label.
-                        let mut j = i + 1;
-                        let mut text = s.labels[i].clone();
-                        while let (Some(Some(a)), Some(Some(b))) = (px.get(i), px.get(j)) {
-                            if (a.0 - b.0).abs().max((a.1 - b.1).abs()) > h || j >= s.labels.len() {
-                                break;
-                            }
-                            if !s.labels[j].is_empty() {
-                                text = format!("{text}, {}", s.labels[j]);
-                            }
-                            j += 1;
-                        }
-                        if let (Some(p), false) = (px[i], text.is_empty()) {
-                            let (w, gap) = (width(&text), 4 * ki + h / 2);
-                            // Right of the point, above, below, left: a label to the left
-                            // reads as the right-hand label of the point before.
-                            let spots = [
-                                (p.0 + gap, p.1 - h / 2),
-                                (p.0 - w / 2, p.1 - gap - h),
-                                (p.0 - w / 2, p.1 + gap),
-                                (p.0 - gap - w, p.1 - h / 2),
-                            ];
-                            // Inside the plot, clear of the markers and the labels placed so far.
-                            let (xr, yr) = $chart.plotting_area().get_pixel_range();
-                            let inside = |&(x, y): &(i32, i32)| {
-                                x >= xr.start && x + w <= xr.end && y >= yr.start && y + h <= yr.end
-                            };
-                            let clear = |&(x, y): &(i32, i32)| {
-                                placed
-                                    .iter()
-                                    .all(|&(a, b, c, d)| x + w < a || x > c || y + h < b || y > d)
-                            };
-                            let (x, y) = spots
-                                .iter()
-                                .copied()
-                                .find(|s| inside(s) && clear(s))
-                                .or_else(|| spots.iter().copied().find(|s| inside(s)))
-                                .unwrap_or(spots[0]);
-                            placed.push((x, y, x + w, y + h));
-                            root.draw(&Text::new(text, (x, y), label_font.clone()))
-                                .map_err(|e| err(&e))?;
-                        }
-                        i = j;
-                    }
-                }
-            }};
         }
         macro_rules! primary {
             ($chart:ident) => {{
@@ -1045,12 +1090,13 @@ impl Chart<'_> {
                     .set_all_tick_mark_size(3 * k)
                     .x_labels(6)
                     .y_labels(6)
-                    .axis_desc_style(("sans-serif", axis_px))
-                    .label_style(("sans-serif", tick_px))
+                    .axis_desc_style(("sans-serif", fonts.axis))
+                    .label_style(("sans-serif", fonts.tick))
                     .draw()
                     .map_err(|e| err(&e))?;
                 draw_all!($chart.draw_series, false);
-                annotate!($chart);
+                let area = $chart.plotting_area().get_pixel_range();
+                self.annotate(canvas, &|p| $chart.backend_coord(&p), area)?;
             }};
         }
         macro_rules! build {
@@ -1071,8 +1117,8 @@ impl Chart<'_> {
                         .axis_style(BLACK.stroke_width(k))
                         .set_all_tick_mark_size(3 * k)
                         .y_labels(6)
-                        .axis_desc_style(("sans-serif", axis_px))
-                        .label_style(("sans-serif", tick_px))
+                        .axis_desc_style(("sans-serif", fonts.axis))
+                        .label_style(("sans-serif", fonts.tick))
                         .draw()
                         .map_err(|e| err(&e))?;
                     draw_all!(chart.draw_secondary_series, true);
@@ -1093,52 +1139,125 @@ impl Chart<'_> {
                 primary!(chart);
             }
         }
+        Ok(())
+    }
 
-        // The legend, in its own panel to the right of the plot.
+    /// The arrowheads and point labels of the primary-axis series, in the canvas's pixels:
+    /// `to_px` places a point of the data, `area` is the plot's pixel range. A label goes where
+    /// it stays inside the plot, clear of every marker and of the labels placed before it.
+    fn annotate(
+        &self,
+        canvas: &Canvas<'_, '_>,
+        to_px: &dyn Fn((f64, f64)) -> (i32, i32),
+        area: (std::ops::Range<i32>, std::ops::Range<i32>),
+    ) -> std::result::Result<(), String> {
+        use plotters::prelude::*;
+        let (ki, log, legend_px) = (SUPERSAMPLE as i32, self.log, canvas.fonts.legend);
+        let label_font = ("sans-serif", legend_px).into_font().color(&BLACK);
+        // Every marker is an obstacle to the labels.
+        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+        for s in self.series.iter().filter(|s| s.markers && !s.secondary) {
+            let r = ki * s.marker_size() + ki;
+            for &p in s.points.iter().filter(|&&p| drawable(p, log)) {
+                let (x, y) = to_px(p);
+                placed.push((x - r, y - r, x + r, y + r));
+            }
+        }
+        for (s, c) in self.series.iter().zip(canvas.colours) {
+            if s.secondary {
+                continue;
+            }
+            let px: Vec<Option<(i32, i32)>> = s
+                .points
+                .iter()
+                .map(|&p| drawable(p, log).then(|| to_px(p)))
+                .collect();
+            for &i in &s.arrows {
+                if let Some(head) = arrowhead(&px, i, 5 * ki) {
+                    canvas
+                        .root
+                        .draw(&Polygon::new(head, c.filled()))
+                        .map_err(|e| draw_error(&e))?;
+                }
+            }
+            let h = (legend_px / 1.24) as i32;
+            let width = |t: &str| (t.chars().count() as f64 * CHAR_EM * legend_px) as i32;
+            let mut i = 0;
+            while i < s.labels.len().min(px.len()) {
+                let (text, j) = s.shared_label(&px, i, h);
+                if let (Some(p), false) = (px[i], text.is_empty()) {
+                    let (w, gap) = (width(&text), 4 * ki + h / 2);
+                    // Right of the point, above, below, left: a label to the left reads as the
+                    // right-hand label of the point before.
+                    let spots = [
+                        (p.0 + gap, p.1 - h / 2),
+                        (p.0 - w / 2, p.1 - gap - h),
+                        (p.0 - w / 2, p.1 + gap),
+                        (p.0 - gap - w, p.1 - h / 2),
+                    ];
+                    // Inside the plot, clear of the markers and the labels placed so far.
+                    let (xr, yr) = &area;
+                    let inside = |&(x, y): &(i32, i32)| {
+                        x >= xr.start && x + w <= xr.end && y >= yr.start && y + h <= yr.end
+                    };
+                    let clear = |&(x, y): &(i32, i32)| {
+                        placed
+                            .iter()
+                            .all(|&(a, b, c, d)| x + w < a || x > c || y + h < b || y > d)
+                    };
+                    let (x, y) = spots
+                        .iter()
+                        .copied()
+                        .find(|s| inside(s) && clear(s))
+                        .or_else(|| spots.iter().copied().find(|s| inside(s)))
+                        .unwrap_or(spots[0]);
+                    placed.push((x, y, x + w, y + h));
+                    canvas
+                        .root
+                        .draw(&Text::new(text, (x, y), label_font.clone()))
+                        .map_err(|e| draw_error(&e))?;
+                }
+                i = j;
+            }
+        }
+        Ok(())
+    }
+
+    /// The legend, in its own panel (`legend_w` canvas pixels wide) right of the plot: a symbol
+    /// and the wrapped label of each `labelled` series, then the notes.
+    fn draw_legend(
+        &self,
+        canvas: &Canvas<'_, '_>,
+        area: &Area<'_>,
+        labelled: &[usize],
+        legend_w: u32,
+    ) -> std::result::Result<(), String> {
+        use plotters::prelude::*;
+        let (k, legend_px, note_px) = (SUPERSAMPLE, canvas.fonts.legend, canvas.fonts.note);
+        let err = draw_error;
         let font = ("sans-serif", legend_px).into_font().color(&BLACK);
         let ki = k as i32;
         let step = (legend_px * 1.45) as i32;
         let mut y = 12 * ki + step / 2;
-        for &i in &labelled {
-            let (s, c) = (&self.series[i], colours[i]);
+        for &i in labelled {
+            let (s, c) = (&self.series[i], canvas.colours[i]);
             let sym = (legend_px * 1.8) as i32;
-            if !s.upper.is_empty() {
+            let line = vec![(4 * ki, y), (4 * ki + sym, y)];
+            let drawn = if !s.upper.is_empty() {
                 let half = (legend_px * 0.35) as i32;
-                legend_area
-                    .draw(&Rectangle::new(
-                        [(4 * ki, y - half), (4 * ki + sym, y + half)],
-                        c.mix(BAND_ALPHA).filled(),
-                    ))
-                    .map_err(|e| err(&e))?;
+                area.draw(&Rectangle::new(
+                    [(4 * ki, y - half), (4 * ki + sym, y + half)],
+                    c.mix(BAND_ALPHA).filled(),
+                ))
             } else if s.markers {
-                let size = if s.width == 0 { 4 } else { s.width as i32 };
-                legend_area
-                    .draw(&marker_element(
-                        s.marker,
-                        (4 * ki + sym / 2, y),
-                        size,
-                        c,
-                        s.hollow,
-                    ))
-                    .map_err(|e| err(&e))?;
+                let at = (4 * ki + sym / 2, y);
+                area.draw(&marker_element(s.marker, at, s.marker_size(), c, s.hollow))
+            } else if s.dashed {
+                area.draw(&dashed(line, s.line_style(c)))
             } else {
-                let style = c.stroke_width(k * if s.width == 0 { 2 } else { s.width });
-                let line = vec![(4 * ki, y), (4 * ki + sym, y)];
-                if s.dashed {
-                    legend_area
-                        .draw(&plotters::element::DashedPathElement::new(
-                            line,
-                            7 * k,
-                            5 * k,
-                            style,
-                        ))
-                        .map_err(|e| err(&e))?;
-                } else {
-                    legend_area
-                        .draw(&PathElement::new(line, style))
-                        .map_err(|e| err(&e))?;
-                }
-            }
+                area.draw(&PathElement::new(line, s.line_style(c)))
+            };
+            drawn.map_err(|e| err(&e))?;
             // Labels wrap to the panel's width.
             let room = (legend_w as f64 - (12 * ki + sym) as f64) / (CHAR_EM * legend_px);
             for (n, line) in wrap(s.label, room.max(6.0) as usize)
@@ -1148,12 +1267,8 @@ impl Chart<'_> {
                 if n > 0 {
                     y += (legend_px * 1.2) as i32;
                 }
-                legend_area
-                    .draw(&Text::new(
-                        line,
-                        (8 * ki + sym, y - (legend_px * 0.5) as i32),
-                        font.clone(),
-                    ))
+                let at = (8 * ki + sym, y - (legend_px * 0.5) as i32);
+                area.draw(&Text::new(line, at, font.clone()))
                     .map_err(|e| err(&e))?;
             }
             y += step;
@@ -1165,18 +1280,13 @@ impl Chart<'_> {
         y += step / 3;
         for note in &self.notes {
             for line in wrap(note, chars) {
-                legend_area
-                    .draw(&Text::new(
-                        line,
-                        (4 * ki, y - (note_px * 0.5) as i32),
-                        note_font.clone(),
-                    ))
+                let at = (4 * ki, y - (note_px * 0.5) as i32);
+                area.draw(&Text::new(line, at, note_font.clone()))
                     .map_err(|e| err(&e))?;
                 y += (note_px * 1.3) as i32;
             }
             y += step / 4;
         }
-        root.present().map_err(|e| err(&e))?;
         Ok(())
     }
 }

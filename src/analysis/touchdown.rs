@@ -329,14 +329,19 @@ pub(crate) fn touchdown_signed(
             cause: Cause::Fold,
         });
     }
-    let max_power = match prev {
-        Some(p) => to_mw(solver.at_gap(p)?.power),
-        None => f64::NAN,
-    };
     Err(TransitionError::NoTouchdown {
-        max_power_mw: max_power,
+        max_power_mw: power_reached_mw(&solver, prev)?,
     }
     .into())
+}
+
+/// The heater power (mW) of the equilibrium at `last`, the last gap a scan reached; NaN where it
+/// reached none.
+fn power_reached_mw(solver: &EquilibriumSolver<'_>, last: Option<f64>) -> Result<f64> {
+    match last {
+        Some(d) => Ok(to_mw(solver.at_gap(d)?.power)),
+        None => Ok(f64::NAN),
+    }
 }
 
 /// A transition, or the error that says the head never leaves (or is already in) contact at
@@ -490,12 +495,8 @@ pub(crate) fn takeoff_at(
     if let Some(fold) = jump {
         return transition(fold, Cause::Fold, false);
     }
-    let min_power = match prev {
-        Some(p) => to_mw(solver.at_gap(p)?.power),
-        None => f64::NAN,
-    };
     Err(TransitionError::NoTakeOffInTable {
-        min_power_mw: min_power,
+        min_power_mw: power_reached_mw(&solver, prev)?,
     }
     .into())
 }

@@ -5,6 +5,7 @@
 use std::fmt::Write;
 
 use super::attitude::Equilibrium;
+use super::geometry::Bearing;
 
 /// Width of the figure, pt (3.5 in).
 const WIDTH_PT: f64 = 252.0;
@@ -89,23 +90,23 @@ impl Equilibrium {
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
     pub fn pressure_map_svg(&self) -> String {
-        let r = &self.reynolds;
-        let b = &r.bearing;
-        let g = &r.grid;
-        let (nx, _) = r.size();
-        let (l_mm, w_mm) = (b.length * 1e3, b.width * 1e3);
+        let b = &self.reynolds.bearing;
         let pw = WIDTH_PT - MARGIN[0] - MARGIN[1];
         let ph = pw * b.width / b.length;
-        let height = ph + MARGIN[2] + MARGIN[3];
-        let (x0, y0) = (MARGIN[0], MARGIN[2]);
+        let frame = Frame {
+            x0: MARGIN[0],
+            y0: MARGIN[2],
+            pw,
+            ph,
+            height: ph + MARGIN[2] + MARGIN[3],
+        };
         let lo = self.pressure.iter().cloned().fold(f64::INFINITY, f64::min);
         let hi = self
             .pressure
             .iter()
             .cloned()
             .fold(f64::NEG_INFINITY, f64::max);
-        let span = (hi - lo).max(1e-12);
-        let level = |p: f64| (((p - lo) / span) * (LEVELS - 1) as f64).round() as usize;
+        let height = frame.height;
         let mut s = String::new();
         let _ = write!(
             s,
@@ -114,8 +115,24 @@ impl Equilibrium {
              font-size=\"{FONT_PT}\" shape-rendering=\"crispEdges\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
             height / 72.0
         );
-        // The map: a raster of 0.5 pt, each pixel the pressure of the control volume at its
-        // centre, runs of one colour level merged. y up: row 0 at the bottom.
+        self.write_raster(&mut s, &frame, lo, hi);
+        frame.write_outlines(&mut s, b);
+        frame.write_axes(&mut s, b.length * 1e3, b.width * 1e3);
+        frame.write_colour_bar(&mut s, lo, hi);
+        s.push_str("</svg>\n");
+        s
+    }
+
+    /// The map: a raster of 0.5 pt, each pixel the pressure of the control volume at its
+    /// centre in the colour of its level between `lo` and `hi`, runs of one colour level merged.
+    /// y up: row 0 at the bottom.
+    fn write_raster(&self, s: &mut String, frame: &Frame, lo: f64, hi: f64) {
+        let r = &self.reynolds;
+        let (b, g) = (&r.bearing, &r.grid);
+        let (nx, _) = r.size();
+        let Frame { x0, y0, pw, ph, .. } = *frame;
+        let span = (hi - lo).max(1e-12);
+        let level = |p: f64| (((p - lo) / span) * (LEVELS - 1) as f64).round() as usize;
         let px = 0.5;
         let cols = (pw / px).round() as usize;
         let rows = (ph / px).round() as usize;
@@ -149,7 +166,24 @@ impl Equilibrium {
                 c = e;
             }
         }
-        // Region outlines.
+    }
+}
+
+/// Where the plot area sits in the figure (pt): its top-left corner, width and height, and the
+/// height of the whole figure.
+#[derive(Clone, Copy)]
+struct Frame {
+    x0: f64,
+    y0: f64,
+    pw: f64,
+    ph: f64,
+    height: f64,
+}
+
+impl Frame {
+    /// The regions' outlines, then the frame of the plot area.
+    fn write_outlines(&self, s: &mut String, b: &Bearing) {
+        let Frame { x0, y0, pw, ph, .. } = *self;
         let to_x = |x: f64| x0 + x / b.length * pw;
         let to_y = |y: f64| y0 + ph - y / b.width * ph;
         for p in &b.polygons {
@@ -170,7 +204,17 @@ impl Equilibrium {
             "<rect x=\"{x0}\" y=\"{y0}\" width=\"{pw:.2}\" height=\"{ph:.2}\" fill=\"none\" \
              stroke=\"black\" stroke-width=\"0.6\"/>"
         );
-        // Axes: length (mm) across, width (mm) up.
+    }
+
+    /// The axes: the slider's length `l_mm` across, its width `w_mm` up, with ticks and labels.
+    fn write_axes(&self, s: &mut String, l_mm: f64, w_mm: f64) {
+        let Frame {
+            x0,
+            y0,
+            pw,
+            ph,
+            height,
+        } = *self;
         let (xt, xd) = ticks(0.0, l_mm, 4);
         for t in xt {
             let x = x0 + t / l_mm * pw;
@@ -209,7 +253,12 @@ impl Equilibrium {
             x0 - 24.0,
             y0 + 0.5 * ph
         );
-        // Colour bar.
+    }
+
+    /// The colour bar right of the plot, from the pressure `lo` to `hi`, with ticks and label.
+    fn write_colour_bar(&self, s: &mut String, lo: f64, hi: f64) {
+        let Frame { x0, y0, pw, ph, .. } = *self;
+        let span = (hi - lo).max(1e-12);
         let (bx, bw) = (x0 + pw + 8.0, 7.0);
         let steps = 96;
         for k in 0..steps {
@@ -249,8 +298,6 @@ impl Equilibrium {
             WIDTH_PT - 4.0,
             y0 + 0.5 * ph
         );
-        s.push_str("</svg>\n");
-        s
     }
 }
 

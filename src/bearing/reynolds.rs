@@ -364,21 +364,14 @@ impl Reynolds {
     /// How the non-dimensional spacing of each control volume changes with the attitude's
     /// fly height (per m), pitch and roll (per rad).
     pub fn spacing_derivatives(&self) -> [Vec<f64>; 3] {
-        let (nx, ny) = self.size();
         let (l, w) = (self.bearing.length, self.bearing.width);
-        let mut d = [
-            Vec::with_capacity(nx * ny),
-            Vec::with_capacity(nx * ny),
-            Vec::with_capacity(nx * ny),
-        ];
-        for j in 0..ny {
-            for i in 0..nx {
-                d[0].push(1.0 / REFERENCE_SPACING);
-                d[1].push((l - self.grid.xc[i]) / REFERENCE_SPACING);
-                d[2].push((self.grid.yc[j] - 0.5 * w) / REFERENCE_SPACING);
-            }
-        }
-        d
+        self.per_cell(|i, j| {
+            [
+                1.0 / REFERENCE_SPACING,
+                (l - self.grid.xc[i]) / REFERENCE_SPACING,
+                (self.grid.yc[j] - 0.5 * w) / REFERENCE_SPACING,
+            ]
+        })
     }
 
     /// Smallest spacing over the grid's nodes (surface depth included), m.
@@ -614,7 +607,35 @@ impl Reynolds {
             stats.krylov_iterations += ks.iterations;
             stats.iterations += 1;
             let full = dp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if full <= tol {
+            let (accepted, tnorm) = if full <= tol {
+                (false, rnorm)
+            } else {
+                // Keep the pressure positive, then backtrack on the residual's norm.
+                let mut t: f64 = 1.0;
+                for c in 0..n {
+                    if dp[c] < 0.0 {
+                        t = t.min((MIN_PRESSURE_FRACTION - 1.0) * p[c] / dp[c]);
+                    }
+                }
+                let mut accepted = false;
+                let mut tnorm = rnorm;
+                for _ in 0..12 {
+                    for c in 0..n {
+                        trial[c] = p[c] + t * dp[c];
+                    }
+                    self.residual(&trial, h, &mut trial_r, None);
+                    tnorm = norm(&trial_r);
+                    if tnorm.is_finite() && tnorm <= (1.0 - 1e-4 * t) * rnorm {
+                        accepted = true;
+                        break;
+                    }
+                    t *= 0.5;
+                }
+                (accepted, tnorm)
+            };
+            // Converged, or the residual is at its round-off floor (the backtracking found no
+            // descent): the full step is the answer.
+            if full <= tol || (!accepted && full <= ROUND_OFF_UPDATE) {
                 for c in 0..n {
                     p[c] += dp[c];
                 }
@@ -623,41 +644,8 @@ impl Reynolds {
                 rnorm = norm(&r);
                 break;
             }
-            // Keep the pressure positive, then backtrack on the residual's norm.
-            let mut t: f64 = 1.0;
-            for c in 0..n {
-                if dp[c] < 0.0 {
-                    t = t.min((MIN_PRESSURE_FRACTION - 1.0) * p[c] / dp[c]);
-                }
-            }
-            let mut accepted = false;
-            let mut tnorm = rnorm;
-            for _ in 0..12 {
-                for c in 0..n {
-                    trial[c] = p[c] + t * dp[c];
-                }
-                self.residual(&trial, h, &mut trial_r, None);
-                tnorm = norm(&trial_r);
-                if tnorm.is_finite() && tnorm <= (1.0 - 1e-4 * t) * rnorm {
-                    accepted = true;
-                    break;
-                }
-                t *= 0.5;
-            }
-            if !accepted {
-                if full <= ROUND_OFF_UPDATE {
-                    // The residual is at its round-off floor: the full step is the answer.
-                    for c in 0..n {
-                        p[c] += dp[c];
-                    }
-                    stats.last_update = full;
-                    self.residual(p, h, &mut r, Some(&mut a));
-                    rnorm = norm(&r);
-                    break;
-                }
-                if !tnorm.is_finite() {
-                    return Err(BearingError::NonFiniteResidual.into());
-                }
+            if !accepted && !tnorm.is_finite() {
+                return Err(BearingError::NonFiniteResidual.into());
             }
             let mut upd: f64 = 0.0;
             for c in 0..n {
@@ -697,25 +685,42 @@ impl Reynolds {
         ]
     }
 
+    /// The loads (N, N m, N m) of a non-dimensional pressure field `x` with the weights `w`
+    /// ([`Reynolds::weights`]): each weighted sum times the ambient pressure and the length
+    /// squared.
+    fn weighted_loads(&self, w: &[Vec<f64>; 3], x: &[f64]) -> [f64; 3] {
+        let (l, pa) = (self.bearing.length, self.bearing.ambient_pressure);
+        w.each_ref()
+            .map(|wi| x.iter().zip(wi).map(|(a, b)| a * b).sum::<f64>() * pa * l * l)
+    }
+
     /// Weights of the loads: area, area × lever arm ahead of the pivot (m), area × lever arm to
     /// its `+y` side.
     fn weights(&self) -> [Vec<f64>; 3] {
-        let (nx, ny) = self.size();
         let [px, py] = self.bearing.pivot;
-        let mut w = [
+        self.per_cell(|i, j| {
+            let a = self.dx[i] * self.dy[j];
+            [a, a * (px - self.grid.xc[i]), a * (self.grid.yc[j] - py)]
+        })
+    }
+
+    /// Three quantities of every control volume, row by row: `f(i, j)` of the volume in column
+    /// `i` and row `j`.
+    fn per_cell(&self, f: impl Fn(usize, usize) -> [f64; 3]) -> [Vec<f64>; 3] {
+        let (nx, ny) = self.size();
+        let mut out = [
             Vec::with_capacity(nx * ny),
             Vec::with_capacity(nx * ny),
             Vec::with_capacity(nx * ny),
         ];
         for j in 0..ny {
             for i in 0..nx {
-                let a = self.dx[i] * self.dy[j];
-                w[0].push(a);
-                w[1].push(a * (px - self.grid.xc[i]));
-                w[2].push(a * (self.grid.yc[j] - py));
+                for (v, o) in f(i, j).into_iter().zip(&mut out) {
+                    o.push(v);
+                }
             }
         }
-        w
+        out
     }
 
     /// ```
@@ -773,8 +778,6 @@ impl Reynolds {
         let mut k = [[0.0; 3]; 3];
         let mut iterations = 0;
         let w = self.weights();
-        let l = self.bearing.length;
-        let pa = self.bearing.ambient_pressure;
         for q in 0..3 {
             self.check_interrupt(Solve::Sensitivity)?;
             let dmax = dh[q].iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -788,26 +791,10 @@ impl Reynolds {
             }
             self.residual(p, &hs, &mut rm, None);
             let rhs: Vec<f64> = (0..n).map(|c| -(rp[c] - rm[c]) / (2.0 * eps)).collect();
-            let stats = gmres(
-                &f.jacobian,
-                &f.ilu,
-                &rhs,
-                &mut dps[q],
-                rtol,
-                RESTART,
-                MAX_KRYLOV,
-            );
-            iterations += stats.iterations;
-            if stats.relative_residual > 10.0 * rtol {
-                return Err(BearingError::Krylov {
-                    solve: Solve::Sensitivity,
-                    relative_residual: stats.relative_residual,
-                    iterations: stats.iterations,
-                }
-                .into());
-            }
+            iterations += f.solve(&rhs, &mut dps[q], rtol, Solve::Sensitivity)?;
+            let loads = self.weighted_loads(&w, &dps[q]);
             for i in 0..3 {
-                k[i][q] = dps[q].iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>() * pa * l * l;
+                k[i][q] = loads[i];
             }
         }
         Ok((k, dps, iterations))
@@ -842,28 +829,10 @@ impl Reynolds {
                 }
             }
             let mut x = vec![0.0; n];
-            let stats = gmres(
-                &f.jacobian,
-                &f.ilu,
-                &rhs,
-                &mut x,
-                DAMPING_RTOL,
-                RESTART,
-                MAX_KRYLOV,
-            );
-            if stats.relative_residual > 10.0 * DAMPING_RTOL {
-                return Err(BearingError::Krylov {
-                    solve: Solve::Damping,
-                    relative_residual: stats.relative_residual,
-                    iterations: stats.iterations,
-                }
-                .into());
-            }
+            f.solve(&rhs, &mut x, DAMPING_RTOL, Solve::Damping)?;
+            let loads = self.weighted_loads(&w, &x);
             for i in 0..3 {
-                c[i][q] = -x.iter().zip(&w[i]).map(|(a, b)| a * b).sum::<f64>()
-                    * b.ambient_pressure
-                    * b.length
-                    * b.length;
+                c[i][q] = -loads[i];
             }
         }
         Ok(c)
@@ -928,6 +897,24 @@ pub struct Factored {
     pub jacobian: FivePoint,
     /// Its multigrid preconditioner.
     pub ilu: Multigrid,
+}
+
+impl Factored {
+    /// Solves `J x = rhs` by GMRES from the start in `x` to the relative tolerance `rtol`, and
+    /// returns the iterations; a residual left above ten times `rtol` is a
+    /// [`BearingError::Krylov`] of `solve`.
+    fn solve(&self, rhs: &[f64], x: &mut [f64], rtol: f64, solve: Solve) -> Result<usize> {
+        let stats = gmres(&self.jacobian, &self.ilu, rhs, x, rtol, RESTART, MAX_KRYLOV);
+        if stats.relative_residual > 10.0 * rtol {
+            return Err(BearingError::Krylov {
+                solve,
+                relative_residual: stats.relative_residual,
+                iterations: stats.iterations,
+            }
+            .into());
+        }
+        Ok(stats.iterations)
+    }
 }
 
 /// The multigrid preconditioner of `a`: the hierarchy of the last Newton step given the new

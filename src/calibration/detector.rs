@@ -170,111 +170,93 @@ impl FilteredRms {
     }
 }
 
-/// Acoustic-emission proxy: RMS of the high-pass filtered contact force above a threshold.
-///
-/// A real AE sensor hears the stress waves of asperity impacts; the lumped model has no impacts,
-/// so this proxy hears the part of the contact force that changes faster than the corner
-/// frequency: the burst of a jump into contact, and the modulation of the contact by an AC dither.
-///
-/// ```
-/// use hdi_tribology::calibration::{ContactForceRms, Sample, TouchdownDetector};
-/// let mut d = ContactForceRms::new(1e-5, 5e3, 5e-5)?;
-/// let mut seen = false;
-/// for i in 0..2000 {
-///     let t = i as f64 * 1e-6;
-///     // A contact force modulated at 21 kHz with 50 µN amplitude.
-///     let fc = 1e-4 + 5e-5 * (2.0 * std::f64::consts::PI * 2.1e4 * t).sin();
-///     seen = d.update(&Sample { t, contact_force: fc, ..Sample::default() });
-/// }
-/// assert!(seen && d.level() > 3e-5);
-/// # Ok::<(), hdi_tribology::Error>(())
-/// ```
-#[derive(Clone, Debug, PartialEq)]
-pub struct ContactForceRms(FilteredRms);
+/// Declares a detector that hears one signal of the [`Sample`] through a [`FilteredRms`]: the
+/// type (its docs first), its constructor with the threshold in `$unit`, and its
+/// [`TouchdownDetector`] implementation under `$label`.
+macro_rules! filtered_rms_detector {
+    ($(#[$doc:meta])* $name:ident, $label:literal, $signal:ident, $unit:literal) => {
+        $(#[$doc])*
+        #[derive(Clone, Debug, PartialEq)]
+        pub struct $name(FilteredRms);
 
-impl ContactForceRms {
-    /// Threshold (N, > 0) on the RMS, high-pass corner frequency (Hz, > 0) and RMS averaging time
-    /// (s, > 0).
-    pub fn new(threshold: f64, corner_frequency: f64, rms_time: f64) -> Result<Self> {
-        Ok(ContactForceRms(FilteredRms::new(
-            threshold,
-            corner_frequency,
-            rms_time,
-        )?))
-    }
+        impl $name {
+            #[doc = concat!(
+                "Threshold (", $unit, ", > 0) on the RMS, high-pass corner frequency (Hz, > 0) ",
+                "and RMS averaging time (s, > 0)."
+            )]
+            pub fn new(threshold: f64, corner_frequency: f64, rms_time: f64) -> Result<Self> {
+                Ok($name(FilteredRms::new(threshold, corner_frequency, rms_time)?))
+            }
+        }
+
+        impl TouchdownDetector for $name {
+            fn name(&self) -> &str {
+                $label
+            }
+            fn high_pass(&self) -> bool {
+                true
+            }
+            fn reset(&mut self) {
+                self.0.reset();
+            }
+            fn update(&mut self, s: &Sample) -> bool {
+                self.0.update(s.t, s.$signal)
+            }
+            fn level(&self) -> f64 {
+                self.0.rms
+            }
+        }
+    };
 }
 
-impl TouchdownDetector for ContactForceRms {
-    fn name(&self) -> &str {
-        "AE proxy (HPF contact-force RMS)"
-    }
-    fn high_pass(&self) -> bool {
-        true
-    }
-    fn reset(&mut self) {
-        self.0.reset();
-    }
-    fn update(&mut self, s: &Sample) -> bool {
-        self.0.update(s.t, s.contact_force)
-    }
-    fn level(&self) -> f64 {
-        self.0.rms
-    }
+filtered_rms_detector! {
+    /// Acoustic-emission proxy: RMS of the high-pass filtered contact force above a threshold.
+    ///
+    /// A real AE sensor hears the stress waves of asperity impacts; the lumped model has no
+    /// impacts, so this proxy hears the part of the contact force that changes faster than the
+    /// corner frequency: the burst of a jump into contact, and the modulation of the contact by an
+    /// AC dither.
+    ///
+    /// ```
+    /// use hdi_tribology::calibration::{ContactForceRms, Sample, TouchdownDetector};
+    /// let mut d = ContactForceRms::new(1e-5, 5e3, 5e-5)?;
+    /// let mut seen = false;
+    /// for i in 0..2000 {
+    ///     let t = i as f64 * 1e-6;
+    ///     // A contact force modulated at 21 kHz with 50 µN amplitude.
+    ///     let fc = 1e-4 + 5e-5 * (2.0 * std::f64::consts::PI * 2.1e4 * t).sin();
+    ///     seen = d.update(&Sample { t, contact_force: fc, ..Sample::default() });
+    /// }
+    /// assert!(seen && d.level() > 3e-5);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    ContactForceRms, "AE proxy (HPF contact-force RMS)", contact_force, "N"
 }
 
-/// Vibration detector: RMS of the high-pass filtered slider displacement above a threshold (a
-/// stand-in for the readback-modulation or PES-based detectors of drives).
-///
-/// ```
-/// use hdi_tribology::calibration::{Sample, TouchdownDetector, VibrationRms};
-/// let mut d = VibrationRms::new(5e-11, 5e3, 5e-5)?;
-/// // A slow drift of 1 nm over 2 ms leaves slope·τ ≈ 0.016 nm after the filter: not seen.
-/// let mut seen = false;
-/// for i in 0..2000 {
-///     let t = i as f64 * 1e-6;
-///     seen |= d.update(&Sample { t, displacement: 1e-9 * t / 2e-3, ..Sample::default() });
-/// }
-/// assert!(!seen);
-/// // A 0.2 nm vibration at 21 kHz on top is (RMS ≈ 0.14 nm).
-/// for i in 2000..4000 {
-///     let t = i as f64 * 1e-6;
-///     let y = 1e-9 * t / 2e-3 + 2e-10 * (2.0 * std::f64::consts::PI * 2.1e4 * t).sin();
-///     seen = d.update(&Sample { t, displacement: y, ..Sample::default() });
-/// }
-/// assert!(seen && d.level() > 1e-10);
-/// # Ok::<(), hdi_tribology::Error>(())
-/// ```
-#[derive(Clone, Debug, PartialEq)]
-pub struct VibrationRms(FilteredRms);
-
-impl VibrationRms {
-    /// Threshold (m, > 0) on the RMS, high-pass corner frequency (Hz, > 0) and RMS averaging time
-    /// (s, > 0).
-    pub fn new(threshold: f64, corner_frequency: f64, rms_time: f64) -> Result<Self> {
-        Ok(VibrationRms(FilteredRms::new(
-            threshold,
-            corner_frequency,
-            rms_time,
-        )?))
-    }
-}
-
-impl TouchdownDetector for VibrationRms {
-    fn name(&self) -> &str {
-        "vibration (HPF displacement RMS)"
-    }
-    fn high_pass(&self) -> bool {
-        true
-    }
-    fn reset(&mut self) {
-        self.0.reset();
-    }
-    fn update(&mut self, s: &Sample) -> bool {
-        self.0.update(s.t, s.displacement)
-    }
-    fn level(&self) -> f64 {
-        self.0.rms
-    }
+filtered_rms_detector! {
+    /// Vibration detector: RMS of the high-pass filtered slider displacement above a threshold (a
+    /// stand-in for the readback-modulation or PES-based detectors of drives).
+    ///
+    /// ```
+    /// use hdi_tribology::calibration::{Sample, TouchdownDetector, VibrationRms};
+    /// let mut d = VibrationRms::new(5e-11, 5e3, 5e-5)?;
+    /// // A slow drift of 1 nm over 2 ms leaves slope·τ ≈ 0.016 nm after the filter: not seen.
+    /// let mut seen = false;
+    /// for i in 0..2000 {
+    ///     let t = i as f64 * 1e-6;
+    ///     seen |= d.update(&Sample { t, displacement: 1e-9 * t / 2e-3, ..Sample::default() });
+    /// }
+    /// assert!(!seen);
+    /// // A 0.2 nm vibration at 21 kHz on top is (RMS ≈ 0.14 nm).
+    /// for i in 2000..4000 {
+    ///     let t = i as f64 * 1e-6;
+    ///     let y = 1e-9 * t / 2e-3 + 2e-10 * (2.0 * std::f64::consts::PI * 2.1e4 * t).sin();
+    ///     seen = d.update(&Sample { t, displacement: y, ..Sample::default() });
+    /// }
+    /// assert!(seen && d.level() > 1e-10);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    VibrationRms, "vibration (HPF displacement RMS)", displacement, "m"
 }
 
 /// Wraps a detector and also judges its level against its own baseline: contact when the inner

@@ -117,7 +117,8 @@ enum Role {
     Err(Quantity),
 }
 
-/// Column stems, their role and their units.
+/// Column stems of the x and the measured columns, their role and their units. The uncertainty
+/// of a measured column is the column of its stem and [`ERR`], in its units.
 const COLUMNS: &[(&str, Role, &[Unit])] = &[
     ("dc_voltage", Role::X(CurveKind::StaticVsDc), VOLTS),
     ("ac_amplitude", Role::X(CurveKind::CycleVsAc), VOLTS),
@@ -125,26 +126,28 @@ const COLUMNS: &[(&str, Role, &[Unit])] = &[
     ("touchdown_power", Role::Y(Quantity::TouchdownPower), WATTS),
     ("takeoff_power", Role::Y(Quantity::TakeoffPower), WATTS),
     (
-        "touchdown_power_err",
-        Role::Err(Quantity::TouchdownPower),
-        WATTS,
-    ),
-    (
-        "takeoff_power_err",
-        Role::Err(Quantity::TakeoffPower),
-        WATTS,
-    ),
-    (
         "contact_indicator",
         Role::Y(Quantity::ContactIndicator),
         NEWTONS,
     ),
-    (
-        "contact_indicator_err",
-        Role::Err(Quantity::ContactIndicator),
-        NEWTONS,
-    ),
 ];
+
+/// What ends the stem of an uncertainty column (`touchdown_power_err_mw`).
+const ERR: &str = "_err";
+
+/// The role and units of a column stem, an uncertainty's among them; `None` for an unknown one.
+fn column(stem: &str) -> Option<(Role, &'static [Unit])> {
+    match stem.strip_suffix(ERR) {
+        Some(measured) => COLUMNS.iter().find_map(|&(s, role, units)| match role {
+            Role::Y(q) if s == measured => Some((Role::Err(q), units)),
+            _ => None,
+        }),
+        None => COLUMNS
+            .iter()
+            .find(|(s, _, _)| *s == stem)
+            .map(|&(_, role, units)| (role, units)),
+    }
+}
 
 /// One measured column of a curve, in SI, with its optional 1σ uncertainties.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -210,18 +213,23 @@ fn classify(name: &str) -> Result<(Role, Unit), String> {
     let known = || {
         COLUMNS
             .iter()
-            .map(|(stem, _, units)| format!("{stem}_{}", units[0].suffix))
+            .flat_map(|&(stem, role, units)| {
+                let own = format!("{stem}_{}", units[0].suffix);
+                let err =
+                    matches!(role, Role::Y(_)).then(|| format!("{stem}{ERR}_{}", units[0].suffix));
+                std::iter::once(own).chain(err)
+            })
             .collect::<Vec<_>>()
             .join(", ")
     };
     let Some((stem, unit)) = name.rsplit_once('_') else {
         return Err(format!("unknown column; known columns: {}", known()));
     };
-    let Some((_, role, units)) = COLUMNS.iter().find(|(s, _, _)| *s == stem) else {
+    let Some((role, units)) = column(stem) else {
         return Err(format!("unknown column; known columns: {}", known()));
     };
     match units.iter().find(|u| u.suffix == unit) {
-        Some(u) => Ok((*role, *u)),
+        Some(u) => Ok((role, *u)),
         None => Err(format!(
             "unknown unit `{unit}` for {stem}; known units: {}",
             units
@@ -231,6 +239,218 @@ fn classify(name: &str) -> Result<(Role, Unit), String> {
                 .join(", ")
         )),
     }
+}
+
+/// A reader's error where it happened in the file `origin`.
+fn csv_error(origin: &str, e: csv::Error) -> DataError {
+    let line = e.position().map(|p| p.line());
+    let reason = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("{len} fields, the header has {expected_len}"),
+        _ => e.to_string(),
+    };
+    err(origin, line, None, reason)
+}
+
+/// The header of a data file: the names, the line they stand on, and the role and unit of each
+/// column.
+struct Header {
+    names: csv::StringRecord,
+    line: u64,
+    roles: Vec<(usize, Role, Unit)>,
+}
+
+/// The data rows of a file: the x values (SI), the line of each row, and each column's values
+/// (SI) by column.
+struct Rows {
+    x: Vec<f64>,
+    lines: Vec<u64>,
+    cols: BTreeMap<usize, Vec<f64>>,
+}
+
+impl Header {
+    /// Reads the header and classifies its columns, each quantity at most once.
+    fn read(rdr: &mut csv::Reader<&[u8]>, origin: &str) -> Result<Header, DataError> {
+        let header_line = rdr.position().line().max(1);
+        let names = rdr.headers().map_err(|e| csv_error(origin, e))?.clone();
+        let line = rdr.position().line().saturating_sub(1).max(header_line);
+        let mut roles: Vec<(usize, Role, Unit)> = Vec::new();
+        for (i, name) in names.iter().enumerate() {
+            let (role, unit) =
+                classify(name).map_err(|r| err(origin, Some(line), Some((i, name)), r))?;
+            if let Some((j, _, _)) = roles
+                .iter()
+                .find(|(_, r, _)| matches!((r, role), (Role::X(_), Role::X(_))) || *r == role)
+            {
+                return Err(err(
+                    origin,
+                    Some(line),
+                    Some((i, name)),
+                    format!("the same quantity as column {} (`{}`)", j + 1, &names[*j]),
+                ));
+            }
+            roles.push((i, role, unit));
+        }
+        Ok(Header { names, line, roles })
+    }
+
+    /// An error in the header of `origin`, about column `i` when given.
+    fn error(&self, origin: &str, i: Option<usize>, reason: String) -> DataError {
+        err(
+            origin,
+            Some(self.line),
+            i.map(|i| (i, &self.names[i])),
+            reason,
+        )
+    }
+
+    /// The x column: its index, the kind of curve it makes and its unit.
+    fn x_column(&self, origin: &str) -> Result<(usize, CurveKind, Unit), DataError> {
+        match self.roles.iter().find(|(_, r, _)| matches!(r, Role::X(_))) {
+            Some(&(xi, Role::X(kind), x_unit)) => Ok((xi, kind, x_unit)),
+            _ => Err(self.error(
+                origin,
+                None,
+                "missing column: no x column (`dc_voltage_v`, `ac_amplitude_v` or `heater_power_mw`)"
+                    .into(),
+            )),
+        }
+    }
+
+    /// The measured columns (index, quantity, unit), checked against the x column `xi` of
+    /// `kind`: at least one, of a quantity measured against that x, and every uncertainty
+    /// beside its own column.
+    fn measured_columns(
+        &self,
+        origin: &str,
+        xi: usize,
+        kind: CurveKind,
+    ) -> Result<Vec<(usize, Quantity, Unit)>, DataError> {
+        let indicator = kind == CurveKind::IndicatorVsPower;
+        let ys: Vec<(usize, Quantity, Unit)> = self
+            .roles
+            .iter()
+            .filter_map(|&(i, r, u)| match r {
+                Role::Y(q) => Some((i, q, u)),
+                _ => None,
+            })
+            .collect();
+        if ys.is_empty() {
+            return Err(self.error(
+                origin,
+                None,
+                if indicator {
+                    "missing column: no measured column (`contact_indicator_un`)".into()
+                } else {
+                    "missing column: no measured column (`touchdown_power_mw` or `takeoff_power_mw`)"
+                        .into()
+                },
+            ));
+        }
+        // The indicator is measured against power, the transitions against a voltage.
+        for &(i, q, _) in &ys {
+            if (q == Quantity::ContactIndicator) != indicator {
+                return Err(self.error(
+                    origin,
+                    Some(i),
+                    format!(
+                        "cannot be measured against `{}`: {}",
+                        &self.names[xi],
+                        if indicator {
+                            "against heater power give `contact_indicator_un`"
+                        } else {
+                            "the contact indicator is given against `heater_power_mw`"
+                        }
+                    ),
+                ));
+            }
+        }
+        for &(i, r, _) in &self.roles {
+            if let Role::Err(q) = r {
+                if !ys.iter().any(|y| y.1 == q) {
+                    return Err(self.error(
+                        origin,
+                        Some(i),
+                        format!(
+                            "missing column: an uncertainty of {} without the column itself",
+                            q.stem()
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(ys)
+    }
+
+    /// Reads the data rows under the header, each value checked, the x values (column `xi`)
+    /// each once; at least one row.
+    fn read_rows(
+        &self,
+        rdr: &mut csv::Reader<&[u8]>,
+        origin: &str,
+        xi: usize,
+    ) -> Result<Rows, DataError> {
+        let mut rows = Rows {
+            x: Vec::new(),
+            lines: Vec::new(),
+            cols: BTreeMap::new(),
+        };
+        let mut first_at: Vec<(f64, u64)> = Vec::new();
+        for rec in rdr.records() {
+            let rec = rec.map_err(|e| csv_error(origin, e))?;
+            let line = rec.position().map_or(0, |p| p.line());
+            for &(i, role, unit) in &self.roles {
+                let text = rec.get(i).unwrap_or("");
+                let at = Some((i, &self.names[i]));
+                let v = parse_value(text, role, unit)
+                    .map_err(|reason| err(origin, Some(line), at, reason))?;
+                if matches!(role, Role::X(_)) {
+                    let si = v * unit.to_si;
+                    if let Some((_, l0)) = first_at.iter().find(|(x0, _)| *x0 == si) {
+                        return Err(err(
+                            origin,
+                            Some(line),
+                            at,
+                            format!(
+                                "duplicate x value {text} {} (first at line {l0})",
+                                unit.suffix
+                            ),
+                        ));
+                    }
+                    first_at.push((si, line));
+                }
+                rows.cols.entry(i).or_default().push(v * unit.to_si);
+            }
+            rows.x.push(v_at(&rows.cols, xi));
+            rows.lines.push(line);
+        }
+        if rows.x.is_empty() {
+            return Err(err(origin, None, None, "no data rows".into()));
+        }
+        Ok(rows)
+    }
+}
+
+/// The value of one field (`text`, in the file's `unit`) of a column of `role`: a finite number,
+/// and above zero for an uncertainty; else why not.
+fn parse_value(text: &str, role: Role, unit: Unit) -> Result<f64, String> {
+    if text.is_empty() {
+        return Err("missing value".into());
+    }
+    let v: f64 = text
+        .parse()
+        .map_err(|_| format!("not a number: `{text}`"))?;
+    if !v.is_finite() {
+        return Err(format!("must be a finite number, got `{text}`"));
+    }
+    if matches!(role, Role::Err(_)) && v <= 0.0 {
+        return Err(format!(
+            "an uncertainty must be > 0, got {text} {}",
+            unit.suffix
+        ));
+    }
+    Ok(v)
 }
 
 impl DataSet {
@@ -249,161 +469,21 @@ impl DataSet {
             .comment(Some(b'#'))
             .trim(csv::Trim::All)
             .from_reader(text.as_bytes());
-        let csv_err = |e: csv::Error| {
-            let line = e.position().map(|p| p.line());
-            let reason = match e.kind() {
-                csv::ErrorKind::UnequalLengths {
-                    expected_len, len, ..
-                } => format!("{len} fields, the header has {expected_len}"),
-                _ => e.to_string(),
-            };
-            err(origin, line, None, reason)
-        };
-        let header_line = rdr.position().line().max(1);
-        let headers = rdr.headers().map_err(csv_err)?.clone();
-        let header_line = rdr.position().line().saturating_sub(1).max(header_line);
-        let mut roles = Vec::new();
-        for (i, name) in headers.iter().enumerate() {
-            let (role, unit) =
-                classify(name).map_err(|r| err(origin, Some(header_line), Some((i, name)), r))?;
-            if let Some((j, _, _)) = roles
-                .iter()
-                .find(|(_, r, _)| matches!((r, role), (Role::X(_), Role::X(_))) || *r == role)
-            {
-                return Err(err(
-                    origin,
-                    Some(header_line),
-                    Some((i, name)),
-                    format!("the same quantity as column {} (`{}`)", j + 1, &headers[*j]),
-                ));
-            }
-            roles.push((i, role, unit));
-        }
-        let at_header = |reason: String| err(origin, Some(header_line), None, reason);
-        let Some(&(xi, Role::X(kind), x_unit)) =
-            roles.iter().find(|(_, r, _)| matches!(r, Role::X(_)))
-        else {
-            return Err(at_header(
-                "missing column: no x column (`dc_voltage_v`, `ac_amplitude_v` or `heater_power_mw`)"
-                    .into(),
-            ));
-        };
-        let ys: Vec<(usize, Quantity, Unit)> = roles
-            .iter()
-            .filter_map(|&(i, r, u)| match r {
-                Role::Y(q) => Some((i, q, u)),
-                _ => None,
-            })
-            .collect();
-        if ys.is_empty() {
-            return Err(at_header(if kind == CurveKind::IndicatorVsPower {
-                "missing column: no measured column (`contact_indicator_un`)".into()
-            } else {
-                "missing column: no measured column (`touchdown_power_mw` or `takeoff_power_mw`)"
-                    .into()
-            }));
-        }
-        // The indicator is measured against power, the transitions against a voltage.
-        for &(i, q, _) in &ys {
-            if (q == Quantity::ContactIndicator) != (kind == CurveKind::IndicatorVsPower) {
-                return Err(err(
-                    origin,
-                    Some(header_line),
-                    Some((i, &headers[i])),
-                    format!(
-                        "cannot be measured against `{}`: {}",
-                        &headers[xi],
-                        if kind == CurveKind::IndicatorVsPower {
-                            "against heater power give `contact_indicator_un`"
-                        } else {
-                            "the contact indicator is given against `heater_power_mw`"
-                        }
-                    ),
-                ));
-            }
-        }
-        for &(i, r, _) in &roles {
-            if let Role::Err(q) = r {
-                if !ys.iter().any(|y| y.1 == q) {
-                    return Err(err(
-                        origin,
-                        Some(header_line),
-                        Some((i, &headers[i])),
-                        format!(
-                            "missing column: an uncertainty of {} without the column itself",
-                            q.stem()
-                        ),
-                    ));
-                }
-            }
-        }
-
-        let mut x = Vec::new();
-        let mut lines = Vec::new();
-        let mut cols: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
-        let mut first_at: Vec<(f64, u64)> = Vec::new();
-        for rec in rdr.records() {
-            let rec = rec.map_err(csv_err)?;
-            let line = rec.position().map_or(0, |p| p.line());
-            for &(i, role, unit) in &roles {
-                let name = &headers[i];
-                let text = rec.get(i).unwrap_or("");
-                let at = Some((i, name));
-                if text.is_empty() {
-                    return Err(err(origin, Some(line), at, "missing value".into()));
-                }
-                let v: f64 = text
-                    .parse()
-                    .map_err(|_| err(origin, Some(line), at, format!("not a number: `{text}`")))?;
-                if !v.is_finite() {
-                    return Err(err(
-                        origin,
-                        Some(line),
-                        at,
-                        format!("must be a finite number, got `{text}`"),
-                    ));
-                }
-                if matches!(role, Role::Err(_)) && v <= 0.0 {
-                    return Err(err(
-                        origin,
-                        Some(line),
-                        at,
-                        format!("an uncertainty must be > 0, got {text} {}", unit.suffix),
-                    ));
-                }
-                if matches!(role, Role::X(_)) {
-                    let si = v * unit.to_si;
-                    if let Some((_, l0)) = first_at.iter().find(|(x0, _)| *x0 == si) {
-                        return Err(err(
-                            origin,
-                            Some(line),
-                            at,
-                            format!(
-                                "duplicate x value {text} {} (first at line {l0})",
-                                unit.suffix
-                            ),
-                        ));
-                    }
-                    first_at.push((si, line));
-                }
-                cols.entry(i).or_default().push(v * unit.to_si);
-            }
-            x.push(v_at(&cols, xi));
-            lines.push(line);
-        }
-        if x.is_empty() {
-            return Err(err(origin, None, None, "no data rows".into()));
-        }
+        let header = Header::read(&mut rdr, origin)?;
+        let (xi, kind, x_unit) = header.x_column(origin)?;
+        let ys = header.measured_columns(origin, xi, kind)?;
+        let rows = header.read_rows(&mut rdr, origin, xi)?;
         let observed = ys
             .iter()
             .map(|&(i, q, unit)| {
-                let errors = roles
+                let errors = header
+                    .roles
                     .iter()
                     .find(|(_, r, _)| *r == Role::Err(q))
-                    .map(|(j, _, _)| cols[j].clone());
+                    .map(|(j, _, _)| rows.cols[j].clone());
                 Observed {
                     quantity: q,
-                    values: cols[&i].clone(),
+                    values: rows.cols[&i].clone(),
                     errors,
                     unit,
                 }
@@ -412,11 +492,11 @@ impl DataSet {
         Ok(DataSet {
             origin: origin.to_string(),
             kind,
-            x_name: headers[xi].to_string(),
-            x,
+            x_name: header.names[xi].to_string(),
+            x: rows.x,
             x_unit,
             observed,
-            lines,
+            lines: rows.lines,
         })
     }
 

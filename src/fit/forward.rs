@@ -133,6 +133,15 @@ impl<'a> Evaluator<'a> {
         SliderModel::from_scene_with_forces(scene, forces)
     }
 
+    /// The model of the static curves at `scene`: its tables no finer than the static
+    /// tolerance, and reaching the static scans' largest gap.
+    fn static_model(&self, scene: &Scene) -> Result<SliderModel> {
+        let mut s = scene.clone();
+        s.table.rel_tol = s.table.rel_tol.max(self.static_table_rel_tol);
+        s.table.d_max_m = s.table.d_max_m.or(self.static_d_max);
+        self.model(&s)
+    }
+
     /// Predictions for every data set, observed column and row (reused when `x` is the last
     /// point predicted).
     pub fn predict(&self, x: &[f64]) -> Result<Preds> {
@@ -159,39 +168,22 @@ impl<'a> Evaluator<'a> {
             let cols = match ds.kind {
                 _ if sets == Sets::NoTransitions && ds.is_transitions() => Vec::new(),
                 CurveKind::IndicatorVsPower => {
-                    if static_model.is_none() {
-                        let mut s = scene.clone();
-                        s.table.rel_tol = s.table.rel_tol.max(self.static_table_rel_tol);
-                        s.table.d_max_m = s.table.d_max_m.or(self.static_d_max);
-                        static_model = Some(self.model(&s)?);
-                    }
-                    predict_indicator(static_model.as_ref().expect("built above"), ds)?
+                    let m = built(&mut static_model, || self.static_model(&scene))?;
+                    predict_indicator(m, ds)?
                 }
                 CurveKind::StaticVsDc => {
-                    if static_model.is_none() {
-                        let mut s = scene.clone();
-                        s.table.rel_tol = s.table.rel_tol.max(self.static_table_rel_tol);
-                        s.table.d_max_m = s.table.d_max_m.or(self.static_d_max);
-                        static_model = Some(self.model(&s)?);
-                    }
-                    let m = static_model.as_ref().expect("built above");
+                    let m = built(&mut static_model, || self.static_model(&scene))?;
                     match predict_static(m, &scene, ds) {
                         Ok(c) => c,
                         // The coarse tables can lose a bracket of the scan: the scene's own.
                         Err(_) => {
-                            if dynamic_model.is_none() {
-                                dynamic_model = Some(self.model(&scene)?);
-                            }
-                            let m = dynamic_model.as_ref().expect("built above");
+                            let m = built(&mut dynamic_model, || self.model(&scene))?;
                             predict_static(m, &scene, ds)?
                         }
                     }
                 }
                 CurveKind::CycleVsAc => {
-                    if dynamic_model.is_none() {
-                        dynamic_model = Some(self.model(&scene)?);
-                    }
-                    let m = dynamic_model.as_ref().expect("built above");
+                    let m = built(&mut dynamic_model, || self.model(&scene))?;
                     predict_cycles(m, &scene, ds, &self.refinement)?
                 }
             };
@@ -347,6 +339,17 @@ pub(super) fn weights(data: &[DataSet]) -> Vec<f64> {
         }
     }
     w
+}
+
+/// The model in `slot`, built by `build` the first time it is asked for.
+fn built(
+    slot: &mut Option<SliderModel>,
+    build: impl FnOnce() -> Result<SliderModel>,
+) -> Result<&SliderModel> {
+    if slot.is_none() {
+        *slot = Some(build()?);
+    }
+    Ok(slot.as_ref().expect("built above"))
 }
 
 /// What the force tables depend on: the interface sections without the contact potential (which

@@ -369,6 +369,152 @@ fn decode_code<T: Copy>(list: &[T], r: &mut Reader<'_>) -> Result<T> {
 }
 type PerGap = [Option<Slot>; 2];
 
+/// Checks the arguments of [`InterfaceForces::build`]: a finite range `d_min < d_max`, and
+/// contact terms static.
+fn check_build(terms: &[Box<dyn InterfaceTerm>], (lo, hi): (f64, f64)) -> Result<()> {
+    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+        return Err(Error::invalid(
+            "table range",
+            format!("needs finite d_min < d_max, got ({lo}, {hi})"),
+        ));
+    }
+    for t in terms {
+        if t.kind() == TermKind::Contact && t.coupling() != Coupling::Static {
+            return Err(Error::invalid(
+                format!("term {}", t.name()),
+                "contact terms must be static",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The indices of the terms that `pick` picks.
+fn members(
+    terms: &[Box<dyn InterfaceTerm>],
+    pick: impl Fn(&dyn InterfaceTerm) -> bool,
+) -> Vec<usize> {
+    (0..terms.len())
+        .filter(|&i| pick(terms[i].as_ref()))
+        .collect()
+}
+
+/// The segment edges of the tables on `gap` over `range`: its ends and the kinks of the terms on
+/// that gap inside it, each once.
+fn table_edges(terms: &[Box<dyn InterfaceTerm>], gap: GapReference, range: (f64, f64)) -> Vec<f64> {
+    let (lo, hi) = range;
+    let mut cuts: Vec<f64> = terms
+        .iter()
+        .filter(|t| t.gap() == gap)
+        .flat_map(|t| t.kinks())
+        .filter(|&k| k.is_finite() && k > lo && k < hi)
+        .collect();
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-30));
+    let mut edges = vec![lo];
+    edges.extend(cuts);
+    edges.push(hi);
+    edges
+}
+
+/// A table per gap, kind and coupling that some term has, of those terms.
+type KindTables = Vec<(TermKind, Coupling, GapReference, Arc<Tabulated>)>;
+
+/// The tables of each gap, kind and coupling with terms, over the `edges` of their gap.
+fn per_kind_tables(
+    terms: &[Box<dyn InterfaceTerm>],
+    edges: &[Vec<f64>; 2],
+    opts: &TableOptions,
+) -> Result<KindTables> {
+    let mut by_kind = Vec::new();
+    for gap in GAPS {
+        for kind in KINDS {
+            for coupling in COUPLINGS {
+                let m = members(terms, |t| {
+                    t.gap() == gap && t.kind() == kind && t.coupling() == coupling
+                });
+                if !m.is_empty() {
+                    let e = &edges[gap.index()];
+                    let tab = Tabulated::build(terms, m, false, e, opts, Source::Exact)?;
+                    by_kind.push((kind, coupling, gap, Arc::new(tab)));
+                }
+            }
+        }
+    }
+    Ok(by_kind)
+}
+
+/// The tables the hot path reads on each gap: the static and per-V² sums, the contact force and
+/// the real contact area.
+struct GapTables {
+    static_part: ArcGap,
+    per_volt2: ArcGap,
+    contact: ArcGap,
+    area: ArcGap,
+}
+
+impl GapTables {
+    /// The sums from the per-kind tables `by_kind`, the contact force's table among them, and the
+    /// real contact area tabulated to `area_opts`.
+    fn build(
+        terms: &[Box<dyn InterfaceTerm>],
+        by_kind: &KindTables,
+        edges: &[Vec<f64>; 2],
+        opts: &TableOptions,
+        area_opts: &TableOptions,
+    ) -> Result<Self> {
+        let mut me = GapTables {
+            static_part: [None, None],
+            per_volt2: [None, None],
+            contact: [None, None],
+            area: [None, None],
+        };
+        for gap in GAPS {
+            let g = gap.index();
+            for (coupling, slot) in [
+                (Coupling::Static, &mut me.static_part[g]),
+                (Coupling::PerVoltSquared, &mut me.per_volt2[g]),
+            ] {
+                let m = members(terms, |t| t.gap() == gap && t.coupling() == coupling);
+                if m.is_empty() {
+                    continue;
+                }
+                // A single kind reuses its table; several kinds are summed from theirs. Summing
+                // tables (not re-integrating the sum) keeps each term's accuracy where the terms
+                // cancel: a direct table of the sum would chase quadrature rounding there.
+                let parts: Vec<Arc<Tabulated>> = by_kind
+                    .iter()
+                    .filter(|(_, c, gp, _)| *c == coupling && *gp == gap)
+                    .map(|(_, _, _, t)| Arc::clone(t))
+                    .collect();
+                *slot = Some(if parts.len() == 1 {
+                    Arc::clone(&parts[0])
+                } else {
+                    let e = &edges[g];
+                    Arc::new(Tabulated::build(
+                        terms,
+                        m,
+                        false,
+                        e,
+                        opts,
+                        Source::Parts(&parts),
+                    )?)
+                });
+            }
+            me.contact[g] = by_kind
+                .iter()
+                .find(|(k, _, gp, _)| *k == TermKind::Contact && *gp == gap)
+                .map(|(_, _, _, t)| Arc::clone(t));
+            let m = members(terms, |t| t.gap() == gap && t.has_contact_area());
+            if !m.is_empty() {
+                let tab = Tabulated::build(terms, m, true, &edges[g], area_opts, Source::Exact)?;
+                me.area[g] = Some(Arc::new(tab));
+            }
+        }
+        Ok(me)
+    }
+}
+
 /// All enabled terms, tabulated over the separation.
 ///
 /// Static terms are merged into one table per gap reference in use, voltage-driven terms likewise;
@@ -409,7 +555,7 @@ pub struct InterfaceForces {
     per_volt2: PerGap,
     contact: PerGap,
     area: PerGap,
-    by_kind: Vec<(TermKind, Coupling, GapReference, Arc<Tabulated>)>,
+    by_kind: KindTables,
     /// Static, per-V² and contact sums and the real contact area on one grid.
     fused: Option<Arc<Fused<4>>>,
     /// Whether the fused table's fourth function is the real contact area (else it is zero and
@@ -424,160 +570,76 @@ impl InterfaceForces {
         range: (f64, f64),
         opts: &TableOptions,
     ) -> Result<Self> {
-        let (lo, hi) = range;
-        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-            return Err(Error::invalid(
-                "table range",
-                format!("needs finite d_min < d_max, got ({lo}, {hi})"),
-            ));
-        }
-        for t in &terms {
-            if t.kind() == TermKind::Contact && t.coupling() != Coupling::Static {
-                return Err(Error::invalid(
-                    format!("term {}", t.name()),
-                    "contact terms must be static",
-                ));
-            }
-        }
+        check_build(&terms, range)?;
         let area_opts = TableOptions {
             abs_tol: opts.abs_tol * 1e-8,
             ..*opts
         };
-        let (gaps, kinds) = (GAPS, KINDS);
-        let select = |f: &dyn Fn(&dyn InterfaceTerm) -> bool| -> Vec<usize> {
-            (0..terms.len()).filter(|&i| f(terms[i].as_ref())).collect()
-        };
         // Every table on one gap shares the same cuts (the union of the kinks of its terms), so
         // that merged tables can be summed from per-kind tables node for node.
-        let edges_of = |gap: GapReference| -> Vec<f64> {
-            let mut cuts: Vec<f64> = terms
-                .iter()
-                .filter(|t| t.gap() == gap)
-                .flat_map(|t| t.kinks())
-                .filter(|&k| k.is_finite() && k > lo && k < hi)
-                .collect();
-            cuts.sort_by(f64::total_cmp);
-            cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-30));
-            let mut edges = vec![lo];
-            edges.extend(cuts);
-            edges.push(hi);
-            edges
-        };
-        let edges = [edges_of(GapReference::Bulge), edges_of(GapReference::Pad)];
-        let mut by_kind = Vec::new();
-        for gap in gaps {
-            for kind in kinds {
-                for coupling in COUPLINGS {
-                    let m =
-                        select(&|t| t.gap() == gap && t.kind() == kind && t.coupling() == coupling);
-                    if !m.is_empty() {
-                        let e = &edges[gap.index()];
-                        let tab = Tabulated::build(&terms, m, false, e, opts, Source::Exact)?;
-                        by_kind.push((kind, coupling, gap, Arc::new(tab)));
-                    }
-                }
-            }
-        }
-        let mut static_part: ArcGap = [None, None];
-        let mut per_volt2: ArcGap = [None, None];
-        let mut contact: ArcGap = [None, None];
-        let mut area: ArcGap = [None, None];
-        for gap in gaps {
-            let g = gap.index();
-            for (coupling, slot) in [
-                (Coupling::Static, &mut static_part[g]),
-                (Coupling::PerVoltSquared, &mut per_volt2[g]),
-            ] {
-                let m = select(&|t| t.gap() == gap && t.coupling() == coupling);
-                if m.is_empty() {
-                    continue;
-                }
-                // A single kind reuses its table; several kinds are summed from theirs. Summing
-                // tables (not re-integrating the sum) keeps each term's accuracy where the terms
-                // cancel: a direct table of the sum would chase quadrature rounding there.
-                let parts: Vec<Arc<Tabulated>> = by_kind
-                    .iter()
-                    .filter(|(_, c, gp, _)| *c == coupling && *gp == gap)
-                    .map(|(_, _, _, t)| Arc::clone(t))
-                    .collect();
-                *slot = Some(if parts.len() == 1 {
-                    Arc::clone(&parts[0])
-                } else {
-                    let e = &edges[g];
-                    Arc::new(Tabulated::build(
-                        &terms,
-                        m,
-                        false,
-                        e,
-                        opts,
-                        Source::Parts(&parts),
-                    )?)
-                });
-            }
-            contact[g] = by_kind
-                .iter()
-                .find(|(k, _, gp, _)| *k == TermKind::Contact && *gp == gap)
-                .map(|(_, _, _, t)| Arc::clone(t));
-            let m = select(&|t| t.gap() == gap && t.has_contact_area());
-            if !m.is_empty() {
-                let e = &edges[g];
-                let tab = Tabulated::build(&terms, m, true, e, &area_opts, Source::Exact)?;
-                area[g] = Some(Arc::new(tab));
-            }
-        }
+        let edges = GAPS.map(|gap| table_edges(&terms, gap, range));
+        let by_kind = per_kind_tables(&terms, &edges, opts)?;
+        let merged = GapTables::build(&terms, &by_kind, &edges, opts, &area_opts)?;
         let hot = |a: ArcGap| a.map(|t| t.map(Slot::new));
         let mut me = InterfaceForces {
             terms: Arc::new(terms),
             range,
-            static_part: hot(static_part),
-            per_volt2: hot(per_volt2),
-            contact: hot(contact),
-            area: hot(area),
+            static_part: hot(merged.static_part),
+            per_volt2: hot(merged.per_volt2),
+            contact: hot(merged.contact),
+            area: hot(merged.area),
             by_kind,
             fused: None,
             fused_area: false,
         };
-        // Fuse the three hot sums when everything sits on the bulge gap in one smooth piece, and
-        // the real contact area with them (to its own tolerance) when it does too: a
-        // right-hand side with frictional heating then reads everything from one interval.
-        let smooth = |p: &PerGap| p[0].as_ref().is_none_or(|s| s.single.is_some());
-        if !me.uses_pad_gap()
-            && smooth(&me.static_part)
-            && smooth(&me.per_volt2)
-            && smooth(&me.contact)
-        {
-            let area_fusable = me.area[0].as_ref().is_some_and(|s| s.single.is_some());
-            let build = |with_area: bool| {
-                Fused::build(
-                    |d| {
-                        let g = Gaps::same(d);
-                        let area = if with_area {
-                            me.sum(&me.area, g)
-                        } else {
-                            ForceEval::default()
-                        };
-                        let e = [me.static_part(g), me.per_volt2_part(g), me.contact(g), area];
-                        e.map(|x| (x.value, x.d_bulge))
-                    },
-                    lo,
-                    hi,
-                    [
-                        (opts.rel_tol, opts.abs_tol),
-                        (opts.rel_tol, opts.abs_tol),
-                        (opts.rel_tol, opts.abs_tol),
-                        (area_opts.rel_tol, area_opts.abs_tol),
-                    ],
-                )
-            };
-            // Should the area need more nodes than the budget, the forces are fused alone.
-            let (fused, with_area) = match area_fusable.then(|| build(true)).flatten() {
-                Some(f) => (Some(f), true),
-                None => (build(false), false),
-            };
-            me.fused_area = with_area;
-            me.fused = fused.map(Arc::new);
-        }
+        me.fuse(opts, &area_opts);
         Ok(me)
+    }
+
+    /// Fuses the three hot sums when everything sits on the bulge gap in one smooth piece, and
+    /// the real contact area with them (to its own tolerance `area_opts`) when it does too: a
+    /// right-hand side with frictional heating then reads everything from one interval.
+    fn fuse(&mut self, opts: &TableOptions, area_opts: &TableOptions) {
+        let smooth = |p: &PerGap| p[0].as_ref().is_none_or(|s| s.single.is_some());
+        if self.uses_pad_gap()
+            || !smooth(&self.static_part)
+            || !smooth(&self.per_volt2)
+            || !smooth(&self.contact)
+        {
+            return;
+        }
+        let me = &*self;
+        let (lo, hi) = me.range;
+        let area_fusable = me.area[0].as_ref().is_some_and(|s| s.single.is_some());
+        let build = |with_area: bool| {
+            Fused::build(
+                |d| {
+                    let g = Gaps::same(d);
+                    let area = if with_area {
+                        me.sum(&me.area, g)
+                    } else {
+                        ForceEval::default()
+                    };
+                    let e = [me.static_part(g), me.per_volt2_part(g), me.contact(g), area];
+                    e.map(|x| (x.value, x.d_bulge))
+                },
+                lo,
+                hi,
+                [
+                    (opts.rel_tol, opts.abs_tol),
+                    (opts.rel_tol, opts.abs_tol),
+                    (opts.rel_tol, opts.abs_tol),
+                    (area_opts.rel_tol, area_opts.abs_tol),
+                ],
+            )
+        };
+        // Should the area need more nodes than the budget, the forces are fused alone.
+        let (fused, with_area) = match area_fusable.then(|| build(true)).flatten() {
+            Some(f) => (Some(f), true),
+            None => (build(false), false),
+        };
+        self.fused_area = with_area;
+        self.fused = fused.map(Arc::new);
     }
 
     /// The value of [`InterfaceForces::sum`] alone (the same number).

@@ -1,7 +1,7 @@
 //! The slider as an ODE: state layout, right-hand side and analytic Jacobian.
 
 use super::{Dofs, Inputs, QuasiStaticBulge, SliderModel};
-use crate::force::{Gaps, MAX_TERM_STATES};
+use crate::force::{Gaps, HotValues, MAX_TERM_STATES};
 use crate::ode::OdeSystem;
 use crate::scene::MAX_DOF;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
@@ -39,6 +39,15 @@ pub struct StateLayout {
     len: usize,
 }
 
+/// The index of the next state of a vector `len` states long so far, when the state is `on`: the
+/// vector then grows by one.
+fn next_index(len: &mut usize, on: bool) -> Option<usize> {
+    on.then(|| {
+        *len += 1;
+        *len - 1
+    })
+}
+
 impl StateLayout {
     /// Positions and velocities of `dofs` coordinates first, then the optional states (no
     /// states of stateful terms; see [`StateLayout::of`]).
@@ -55,24 +64,12 @@ impl StateLayout {
         integrals: bool,
     ) -> Self {
         let mut len = 2 * dofs;
-        let mut next = |on: bool| {
-            on.then(|| {
-                len += 1;
-                len - 1
-            })
-        };
-        let delta = next(thermal_lag);
-        let lagged_force = next(interface_lag);
+        let delta = next_index(&mut len, thermal_lag);
+        let lagged_force = next_index(&mut len, interface_lag);
         let term_states = (len, terms);
         len += terms;
-        let mut next = |on: bool| {
-            on.then(|| {
-                len += 1;
-                len - 1
-            })
-        };
-        let contact_impulse = next(integrals);
-        let heat = next(integrals);
+        let contact_impulse = next_index(&mut len, integrals);
+        let heat = next_index(&mut len, integrals);
         StateLayout {
             dofs,
             delta,
@@ -327,6 +324,58 @@ impl SliderSystem {
         Local { g, f, hot }
     }
 
+    /// The interface force that drives the slider at state `s`: the lagged force where the state
+    /// keeps one, else the force `hot` of the gaps now.
+    fn interface_drive<D: Dim>(&self, s: &OVector<f64, D>, hot: &HotValues) -> f64
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        match self.layout.lagged_force {
+            Some(i) => s[i],
+            None => hot.interface,
+        }
+    }
+
+    /// The rates of the states besides the mechanical ones and the stateful terms', at time `t`
+    /// and state `s` with the interface's values `hot`: the protrusion's and the lagged force's
+    /// first-order lags, and the integrands of the contact impulse and of the heat.
+    fn lag_and_integral_rates<D: Dim>(
+        &self,
+        t: f64,
+        s: &OVector<f64, D>,
+        hot: &HotValues,
+        ds: &mut OVector<f64, D>,
+    ) where
+        DefaultAllocator: Allocator<D>,
+    {
+        let m = &*self.model;
+        let lay = self.layout;
+        if let Some(i) = lay.delta {
+            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - s[i]) / m.thermal_lag;
+        }
+        if let Some(i) = lay.lagged_force {
+            ds[i] = (hot.interface - s[i]) / m.interface_lag;
+        }
+        if let Some(i) = lay.contact_impulse {
+            ds[i] = hot.contact;
+        }
+        if let Some(i) = lay.heat {
+            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
+        }
+    }
+
+    /// The heater power's rate at time `t` (W/s) and the protrusion's rate it makes (m/s): the
+    /// protrusion moves with the programme only without a thermal lag (with one it is a state,
+    /// and its rate here is zero).
+    fn power_and_protrusion_rates(&self, t: f64) -> (f64, f64) {
+        let (_, p_rate) = self.inputs.heater.power_and_rate(t);
+        let delta_rate = match self.layout.delta {
+            Some(_) => 0.0,
+            None => self.model.protrusion(p_rate),
+        };
+        (p_rate, delta_rate)
+    }
+
     /// The derivative of the flash temperature (the heat state's rate) along the bulge gap at
     /// the point of `l`: the derivative of the interpolants the right-hand side reads.
     fn heat_slope(&self, l: &Local) -> f64 {
@@ -456,12 +505,7 @@ impl SliderSystem {
     {
         let m = &*self.model;
         dfdt.fill(0.0);
-        let (_, p_rate) = self.inputs.heater.power_and_rate(t);
-        // Protrusion moves with the programme only without a thermal lag.
-        let delta_rate = match self.layout.delta {
-            Some(_) => 0.0,
-            None => m.protrusion(p_rate),
-        };
+        let (p_rate, delta_rate) = self.power_and_protrusion_rates(t);
         let f_t =
             -l.f.d_bulge * delta_rate + self.inputs.voltage.squared_rate(t) * l.hot.per_volt2.value;
         match self.layout.lagged_force {
@@ -614,10 +658,7 @@ where
         let delta = self.protrusion(t, s);
         let g = m.gaps_offset(&q, delta, self.inputs.clearance_offset);
         let hot = m.hot_values(g, self.inputs.voltage.squared(t));
-        let mut drive = match lay.lagged_force {
-            Some(i) => s[i],
-            None => hot.interface,
-        };
+        let mut drive = self.interface_drive(s, &hot);
         if lay.term_states.1 > 0 {
             drive += self.term_rates(g, s, ds);
         }
@@ -627,18 +668,7 @@ where
             ds[i] = v[i];
             ds[lay.velocity(i)] = a[i];
         }
-        if let Some(i) = lay.delta {
-            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - delta) / m.thermal_lag;
-        }
-        if let Some(i) = lay.lagged_force {
-            ds[i] = (hot.interface - s[i]) / m.interface_lag;
-        }
-        if let Some(i) = lay.contact_impulse {
-            ds[i] = hot.contact;
-        }
-        if let Some(i) = lay.heat {
-            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
-        }
+        self.lag_and_integral_rates(t, s, &hot, ds);
         if let Some(b) = &self.inputs.base_motion {
             let a = b.acceleration_value(t);
             for &(i, r) in &self.base[..self.n_base] {
@@ -859,24 +889,10 @@ impl SliderSystem {
         };
         let hot = m.hot_values(g, self.inputs.voltage.squared(t));
         let v = s[lay.velocity(0)];
-        let drive = match lay.lagged_force {
-            Some(i) => s[i],
-            None => hot.interface,
-        };
+        let drive = self.interface_drive(s, &hot);
         ds[0] = v;
         ds[lay.velocity(0)] = (m.bearing().force(s[0], v) + drive) / m.structure.body_mass();
-        if let Some(i) = lay.delta {
-            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - s[i]) / m.thermal_lag;
-        }
-        if let Some(i) = lay.lagged_force {
-            ds[i] = (hot.interface - s[i]) / m.interface_lag;
-        }
-        if let Some(i) = lay.contact_impulse {
-            ds[i] = hot.contact;
-        }
-        if let Some(i) = lay.heat {
-            ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
-        }
+        self.lag_and_integral_rates(t, s, &hot, ds);
         if let Some(motion) = &self.inputs.base_motion {
             ds[lay.velocity(0)] -= motion.acceleration_value(t);
         }
@@ -917,11 +933,7 @@ impl SliderSystem {
         j[(v, 0)] = -m.bearing().stiffness(y0) / mass;
         j[(v, v)] = -m.bearing().damping(y0) / mass;
         // The protrusion's and the voltage's explicit rates, and the gap's rate they make.
-        let (_, p_rate) = self.inputs.heater.power_and_rate(t);
-        let delta_rate = match lay.delta {
-            Some(_) => 0.0,
-            None => m.protrusion(p_rate),
-        };
+        let (p_rate, delta_rate) = self.power_and_protrusion_rates(t);
         let f_t = self.inputs.voltage.squared_rate(t) * l.hot.per_volt2.value;
         let d_t = match lay.lagged_force {
             Some(_) => -delta_rate,

@@ -1,6 +1,6 @@
 //! Globally adaptive 21-point Gauss–Kronrod integration (G10/K21).
 
-use super::mapping::{mapped_eval, Mapping};
+use super::mapping::{mapped_eval, ordered_limits, Mapping};
 use super::QuadratureError;
 use super::{Estimate, QuadOptions};
 use crate::error::Stage;
@@ -182,47 +182,33 @@ pub fn integrate_with_breaks<F: FnMut(f64) -> f64>(
     breaks: &[f64],
     opts: &QuadOptions,
 ) -> Result<Estimate> {
-    adapt(f, a, b, breaks, opts, true)
+    integrate_adaptive(f, a, b, breaks, opts, Exhausted::Fail)
 }
 
-/// Like [`integrate_with_breaks`], but when the interval budget is exhausted (or
-/// an interval cannot be split) it returns the best estimate, whose `error`
-/// field then exceeds the target. Non-finite integrand values are still errors.
-pub(crate) fn integrate_best_effort<F: FnMut(f64) -> f64>(
-    f: F,
-    a: f64,
-    b: f64,
-    breaks: &[f64],
-    opts: &QuadOptions,
-) -> Result<Estimate> {
-    adapt(f, a, b, breaks, opts, false)
+/// What [`integrate_adaptive`] gives when its interval budget is spent (or an interval cannot be
+/// split) before the target is met.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Exhausted {
+    /// An error: [`QuadratureError::IntervalBudget`] or [`QuadratureError::CannotSplit`].
+    Fail,
+    /// The best estimate, whose `error` field then exceeds the target. Non-finite integrand
+    /// values are still errors.
+    BestEstimate,
 }
 
-fn adapt<F: FnMut(f64) -> f64>(
+/// [`integrate_with_breaks`], with what to do when the interval budget is spent.
+pub(crate) fn integrate_adaptive<F: FnMut(f64) -> f64>(
     mut f: F,
     a: f64,
     b: f64,
     breaks: &[f64],
     opts: &QuadOptions,
-    strict: bool,
+    exhausted: Exhausted,
 ) -> Result<Estimate> {
+    let strict = exhausted == Exhausted::Fail;
     opts.validate()?;
-    let (lo, hi, sign) = match a.partial_cmp(&b) {
-        None => {
-            return Err(Error::invalid(
-                "quad.limits",
-                format!("integration limits must not be NaN, got [{a}, {b}]"),
-            ))
-        }
-        Some(Ordering::Equal) => {
-            return Ok(Estimate {
-                value: 0.0,
-                error: 0.0,
-                evaluations: 0,
-            })
-        }
-        Some(Ordering::Less) => (a, b, 1.0),
-        Some(Ordering::Greater) => (b, a, -1.0),
+    let Some((lo, hi, sign)) = ordered_limits(a, b)? else {
+        return Ok(Estimate::EMPTY);
     };
     let (map, ta, tb) = Mapping::new(lo, hi)?;
     let mut cuts: Vec<f64> = breaks

@@ -3,6 +3,24 @@
 use super::QuadratureError;
 use crate::error::Stage;
 use crate::{Error, Result};
+use std::cmp::Ordering;
+
+/// The limits `a`, `b` of an integral in increasing order, and the sign that turns the integral
+/// over them into the one from `a` to `b` (−1 when `b < a`); `None` when `a = b`, where the
+/// integral is zero.
+pub(crate) fn ordered_limits(a: f64, b: f64) -> Result<Option<(f64, f64, f64)>> {
+    Ok(match a.partial_cmp(&b) {
+        None => {
+            return Err(Error::invalid(
+                "quad.limits",
+                format!("integration limits must not be NaN, got [{a}, {b}]"),
+            ))
+        }
+        Some(Ordering::Equal) => None,
+        Some(Ordering::Less) => Some((a, b, 1.0)),
+        Some(Ordering::Greater) => Some((b, a, -1.0)),
+    })
+}
 
 /// How the original variable `x` is obtained from the integration variable `t`.
 #[derive(Clone, Copy, Debug)]

@@ -17,8 +17,8 @@ mod table;
 mod tanh_sinh;
 
 pub use error::QuadratureError;
-pub(crate) use gauss_kronrod::integrate_best_effort;
 pub use gauss_kronrod::{integrate, integrate_with_breaks};
+pub(crate) use gauss_kronrod::{integrate_adaptive, Exhausted};
 pub(crate) use table::{hermite_bounds, Span};
 pub use table::{Table, TableOptions};
 pub use tanh_sinh::integrate_tanh_sinh;
@@ -80,4 +80,13 @@ pub struct Estimate {
     pub error: f64,
     /// Number of integrand evaluations used.
     pub evaluations: usize,
+}
+
+impl Estimate {
+    /// The integral over an empty range: zero, exactly, from no evaluation.
+    pub(crate) const EMPTY: Estimate = Estimate {
+        value: 0.0,
+        error: 0.0,
+        evaluations: 0,
+    };
 }

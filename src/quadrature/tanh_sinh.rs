@@ -1,11 +1,11 @@
 //! Tanh–sinh (double exponential) quadrature: an independent high-precision rule
 //! used to cross-check the Gauss–Kronrod results.
 
-use super::mapping::{mapped_eval, Mapping};
+use super::mapping::{mapped_eval, ordered_limits, Mapping};
 use super::QuadratureError;
 use super::{Estimate, QuadOptions};
 use crate::error::Stage;
-use crate::{Error, Result};
+use crate::Result;
 use std::f64::consts::FRAC_PI_2;
 
 const WHAT: Stage = Stage::TANH_SINH;
@@ -37,22 +37,8 @@ pub fn integrate_tanh_sinh<F: FnMut(f64) -> f64>(
     opts: &QuadOptions,
 ) -> Result<Estimate> {
     opts.validate()?;
-    let (lo, hi, sign) = match a.partial_cmp(&b) {
-        None => {
-            return Err(Error::invalid(
-                "quad.limits",
-                format!("integration limits must not be NaN, got [{a}, {b}]"),
-            ))
-        }
-        Some(std::cmp::Ordering::Equal) => {
-            return Ok(Estimate {
-                value: 0.0,
-                error: 0.0,
-                evaluations: 0,
-            })
-        }
-        Some(std::cmp::Ordering::Less) => (a, b, 1.0),
-        Some(std::cmp::Ordering::Greater) => (b, a, -1.0),
+    let Some((lo, hi, sign)) = ordered_limits(a, b)? else {
+        return Ok(Estimate::EMPTY);
     };
     let (map, ta, tb) = Mapping::new(lo, hi)?;
     let half = 0.5 * (tb - ta);

@@ -1,7 +1,7 @@
 //! A discrete ensemble of N asperity peaks ("the interaction is only with a few
 //! peaks"), given or drawn reproducibly from a continuous law.
 
-use super::empirical::MAX_INPUT_LEN;
+use super::empirical::{check_finite_heights, MAX_INPUT_LEN};
 use super::PeakDistribution;
 use crate::numerics::rng::Xoshiro256;
 use crate::quadrature::{Table, TableOptions};
@@ -44,12 +44,7 @@ impl Discrete {
                 format!("too many heights: {} > {MAX_INPUT_LEN}", heights.len()),
             ));
         }
-        if let Some((i, z)) = heights.iter().enumerate().find(|(_, z)| !z.is_finite()) {
-            return Err(Error::invalid(
-                field,
-                format!("height {i} is not finite: {z}"),
-            ));
-        }
+        check_finite_heights(field, &heights)?;
         heights.sort_by(f64::total_cmp);
         let n = heights.len() as f64;
         let mean = heights.iter().sum::<f64>() / n;

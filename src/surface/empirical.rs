@@ -41,6 +41,17 @@ fn check_len(field: &str, n: usize) -> Result<()> {
     Ok(())
 }
 
+/// Every one of `heights` finite; else an error naming `field` and the first that is not.
+pub(super) fn check_finite_heights(field: &str, heights: &[f64]) -> Result<()> {
+    match heights.iter().enumerate().find(|(_, z)| !z.is_finite()) {
+        Some((i, z)) => Err(Error::invalid(
+            field,
+            format!("height {i} is not finite: {z}"),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// `(b − d)^{q} − (a − d)^{q}` for d ≤ a < b, without cancellation when the bin
 /// is narrow compared with its distance from d.
 fn power_difference(a: f64, b: f64, d: f64, q: f64) -> f64 {
@@ -162,12 +173,7 @@ impl Empirical {
                 format!("needs at least 2 heights, got {}", sample.len()),
             ));
         }
-        if let Some((i, z)) = sample.iter().enumerate().find(|(_, z)| !z.is_finite()) {
-            return Err(Error::invalid(
-                field,
-                format!("height {i} is not finite: {z}"),
-            ));
-        }
+        check_finite_heights(field, sample)?;
         let mut sorted = sample.to_vec();
         sorted.sort_by(f64::total_cmp);
         let n = sorted.len();

@@ -1,6 +1,6 @@
 //! Partial moments of continuous peak laws by adaptive quadrature of the density.
 
-use crate::quadrature::{integrate_best_effort, QuadOptions};
+use crate::quadrature::{integrate_adaptive, Exhausted, QuadOptions};
 
 /// Quadrature settings for partial moments: a relative target one decade below
 /// the promised 1e-12 so that the result meets it; the absolute floor only
@@ -73,7 +73,7 @@ pub(crate) fn partial_moment(shape: &Shape<'_>, d: f64, p: f64) -> f64 {
             .copied()
             .filter(|&z| z > start && z < upper)
             .collect();
-        integrate_best_effort(
+        integrate_adaptive(
             |z| {
                 let f = pdf(z);
                 if f == 0.0 {
@@ -86,6 +86,7 @@ pub(crate) fn partial_moment(shape: &Shape<'_>, d: f64, p: f64) -> f64 {
             upper,
             &breaks,
             &OPTS,
+            Exhausted::BestEstimate,
         )
     } else {
         let breaks: Vec<f64> = shape
@@ -95,7 +96,7 @@ pub(crate) fn partial_moment(shape: &Shape<'_>, d: f64, p: f64) -> f64 {
             .map(|&z| (z - d).sqrt())
             .collect();
         let q = 2.0 * p + 1.0;
-        integrate_best_effort(
+        integrate_adaptive(
             |v| {
                 let f = pdf(d + v * v);
                 if f == 0.0 {
@@ -108,6 +109,7 @@ pub(crate) fn partial_moment(shape: &Shape<'_>, d: f64, p: f64) -> f64 {
             reach.sqrt(),
             &breaks,
             &OPTS,
+            Exhausted::BestEstimate,
         )
     };
     // The densities are finite everywhere, so the only failure left would be a
