@@ -50,11 +50,13 @@ pub use disk::{DiskSpec, Harmonic};
 pub use error::DriveError;
 pub use heads::{head_seed, MultiDrive, MultiPlant};
 pub use plant::{
-    scene_zone, spec_zone, zone_at, Ambient, Command, Drive, DriveOptions, Plant, DEFAULT_RADIUS,
+    scene_zone, spec_zone, zone_at, Ambient, Command, Drive, DriveOptions, PeriodReport, Plant,
+    DEFAULT_RADIUS, MAX_STEPS_PER_PERIOD,
 };
 pub use replay::{
     check_commands, read_commands, replay, replay_each, replay_heads, replay_heads_each,
-    sensor_row, whole_periods, CommandRow, ReplaySummary, MAX_REPLAY_PERIODS, SENSOR_COLUMNS,
+    sensor_row, whole_periods, BoundedSummary, CommandRow, ReplaySummary, MAX_REPLAY_PERIODS,
+    SENSOR_COLUMNS,
 };
 pub use roc::{touchdown_roc, RocPoint};
 pub use sensors::{

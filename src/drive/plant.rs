@@ -212,7 +212,24 @@ pub struct DriveOptions {
     /// Largest integration step (s); `None`: unlimited (a step may span many controller
     /// periods; the sensors are read on its interpolant).
     pub max_step: Option<f64>,
+    /// The bounded mode, for firmware in the loop: `Some(n)` advances each period in at most
+    /// `n` steps: the error control never asks for a step shorter than an `n`-th of the period
+    /// and accepts a step of that length whatever its error estimate
+    /// ([`Integrator::set_step_floor`](crate::ode::Integrator::set_step_floor)), so a period's
+    /// cost has an upper bound whatever the disk and the dither do; the estimate comes back as
+    /// a flag ([`PeriodReport::error_estimate`], above 1 when a step missed the tolerances)
+    /// instead of as more steps. Where the tolerances allow longer steps they are taken, as
+    /// without the bound. `None` (the default): adaptive steps under the tolerances.
+    /// docs/clearance.md, "The bounded mode", gives its cost and accuracy. 1 to
+    /// [`MAX_STEPS_PER_PERIOD`]; the method must be Radau5 ([`DriveOptions::bounded`] sets
+    /// both). Radau5's Newton iteration may still shorten a step below the bound where it
+    /// fails to converge: in the periods of a snap into contact, not in flight or in a held
+    /// contact.
+    pub steps_per_period: Option<usize>,
 }
+
+/// Most steps a period may take in the bounded mode ([`DriveOptions::steps_per_period`]).
+pub const MAX_STEPS_PER_PERIOD: usize = 64;
 
 impl Default for DriveOptions {
     /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift;
@@ -231,11 +248,28 @@ impl Default for DriveOptions {
             atol_displacement_flight: 1e-14,
             contact_force_tolerance: 4e-8,
             max_step: None,
+            steps_per_period: None,
         }
     }
 }
 
 impl DriveOptions {
+    /// The same options in the bounded mode: at most `steps_per_period` steps a period, with
+    /// Radau5 ([`DriveOptions::steps_per_period`]).
+    ///
+    /// ```
+    /// use hdi_tribology::{drive::DriveOptions, ode::Method};
+    /// let o = DriveOptions::default().bounded(8);
+    /// assert_eq!((o.steps_per_period, o.method), (Some(8), Method::Radau5));
+    /// ```
+    pub fn bounded(self, steps_per_period: usize) -> Self {
+        DriveOptions {
+            steps_per_period: Some(steps_per_period),
+            method: Method::Radau5,
+            ..self
+        }
+    }
+
     /// The same options with the displacement tolerances given in picometres: `contact_pm` near
     /// contact ([`atol_displacement`](DriveOptions::atol_displacement), by default the one these
     /// options hold) and `flight_pm` in flight
@@ -447,6 +481,8 @@ pub struct Plant {
     seed: u64,
     disk_spec: DiskSpec,
     rpm: f64,
+    /// [`DriveOptions::steps_per_period`].
+    steps_per_period: Option<usize>,
 }
 
 impl std::fmt::Debug for Plant {
@@ -558,6 +594,25 @@ impl Plant {
         if let Some(h) = opts.max_step {
             crate::error::check_positive("max_step", h)?;
         }
+        if let Some(n) = opts.steps_per_period {
+            if !(1..=MAX_STEPS_PER_PERIOD).contains(&n) {
+                return Err(Error::invalid(
+                    "steps_per_period",
+                    format!("must be 1 to {MAX_STEPS_PER_PERIOD}, got {n}"),
+                ));
+            }
+            if opts.method != Method::Radau5 {
+                return Err(Error::invalid(
+                    "method",
+                    format!(
+                        "the bounded mode (steps_per_period) runs Radau5 (a linearly implicit \
+                         step of Rodas5P at the bound is thrown deep into the asperities in \
+                         contact), got {}; DriveOptions::bounded sets both",
+                        opts.method.name()
+                    ),
+                ));
+            }
+        }
         if base.thermal_lag() == 0.0 {
             base = base.with_thermal_lag(opts.heater_time_constant);
         }
@@ -584,10 +639,17 @@ impl Plant {
         // 50 µs (the contact sensor resolves about 0.2 µN of contact force per period in
         // contact; the flash temperature is a truth value only, hundreds of kelvin in contact).
         let (impulse, heat) = (3e-8 * 5e-5, 0.1 * 5e-5);
+        // The bounded mode takes its steps whatever the tolerance: one tolerance, for the
+        // error estimate.
+        let flight = if opts.steps_per_period.is_some() {
+            opts.atol_displacement
+        } else {
+            opts.atol_displacement_flight
+        };
         let tol = TolRule::new(
             &probe.tolerances(1.0, 0.0, 0.0),
             &probe.tolerances(0.0, impulse, heat),
-            (opts.atol_displacement, opts.atol_displacement_flight),
+            (opts.atol_displacement, flight),
             opts.contact_force_tolerance,
         );
         // Beyond these the relative tolerance allows ten times the absolute one.
@@ -634,6 +696,7 @@ impl Plant {
             seed,
             disk_spec: opts.disk,
             rpm,
+            steps_per_period: opts.steps_per_period,
         })
     }
 
@@ -690,6 +753,12 @@ impl Plant {
         &self.sensors
     }
 
+    /// The bounded mode's steps per period ([`DriveOptions::steps_per_period`]); `None` for
+    /// adaptive steps.
+    pub fn steps_per_period(&self) -> Option<usize> {
+        self.steps_per_period
+    }
+
     /// The spindle speed (rpm): the zone's disk speed at its radius.
     pub fn rpm(&self) -> f64 {
         self.rpm
@@ -717,6 +786,10 @@ pub struct Drive {
     integ: SizedIntegrator,
     sensors: SensorState,
     t: f64,
+    /// The run of equal periods the time is counted in: it began at `runs.0` (s), the period is
+    /// `runs.1` (s) and `runs.2` of them have passed, so that the time is `runs.0 + runs.2 ·
+    /// runs.1`, one rounding from the exact value, not a sum of periods whose rounding grows.
+    runs: (f64, f64, u64),
     /// The command and ambient clearance the integrator's system holds (`None` before the first
     /// period).
     held: Option<(Command, f64)>,
@@ -729,6 +802,37 @@ pub struct Drive {
     tol: TolState,
     /// The states of the model's stateful terms at the drive's time.
     terms: TermStates,
+    /// How the last period was advanced.
+    period: PeriodReport,
+}
+
+/// How the solver advanced one period ([`Drive::last_period`]).
+///
+/// ```
+/// use hdi_tribology::drive::{Command, DiskSpec, DriveOptions, Plant, scene_zone};
+/// use hdi_tribology::scene::Scene;
+/// let scene = Scene::paper();
+/// let zone = scene_zone(&scene, 0.025)?;
+/// // The bounded mode: at most two steps a period, whatever the disk does.
+/// let opts = DriveOptions::default().bounded(2);
+/// let mut drive = Plant::new(&scene, &zone, 1, opts)?.into_drive()?;
+/// for _ in 0..20 {
+///     drive.step(&Command::heater_mw(65.0), 50e-6)?;
+///     let p = drive.last_period();
+///     assert!(p.steps <= 2);
+///     println!("error estimate {:.2}", p.error_estimate); // above 1: the tolerance was missed
+/// }
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct PeriodReport {
+    /// Steps that ended within the period (0 when one step spans it; in the bounded mode at
+    /// most [`DriveOptions::steps_per_period`]).
+    pub steps: usize,
+    /// The largest weighted error estimate of those steps (of the one spanning the period when
+    /// none ended in it), against the drive's tolerances: at most 1 under adaptive control; in
+    /// the bounded mode, above 1 where a step missed them.
+    pub error_estimate: f64,
 }
 
 /// The states of the stateful terms, copied out of a state vector.
@@ -787,11 +891,13 @@ impl Drive {
             plant,
             integ,
             t: 0.0,
+            runs: (0.0, f64::NAN, 0),
             held: None,
             unchanged: 0,
             integrals0: (0.0, 0.0),
             tol,
             terms,
+            period: PeriodReport::default(),
         })
     }
 
@@ -808,7 +914,10 @@ impl Drive {
     /// [`Drive::step`] of a command and period already checked.
     pub(crate) fn step_checked(&mut self, command: &Command, dt: f64) -> Result<Sensors> {
         let plant = &*self.plant;
-        let (t0, t1) = (self.t, self.t + dt);
+        if dt != self.runs.1 {
+            self.runs = (self.t, dt, 0);
+        }
+        let (t0, t1) = (self.t, self.runs.0 + (self.runs.2 + 1) as f64 * dt);
         let ambient = plant.ambient.temperature(t0);
         let clearance = plant.ambient.clearance_per_kelvin * ambient;
         let changed = self.held != Some((*command, clearance));
@@ -819,6 +928,7 @@ impl Drive {
             t1,
             max_steps: plant.max_steps,
             land: self.unchanged < 2,
+            floor: plant.steps_per_period.map(|n| dt / n as f64),
             settling: self.unchanged < SETTLE_PERIODS,
             rebase: plant.rebase,
         };
@@ -829,7 +939,8 @@ impl Drive {
         });
         let tol = plant.tol.adapts().then_some((&plant.tol, &mut self.tol));
         let (truth, integrals, terms) = with_sized!(&mut self.integ, it => {
-            let y1 = advance(it, &layout, set, &mut self.integrals0, span, tol)?;
+            let (y1, period) = advance(it, &layout, set, &mut self.integrals0, span, tol)?;
+            self.period = period;
             let terms = TermStates::of(&layout, y1.as_slice());
             let s = it.system();
             let integrals = (
@@ -842,6 +953,7 @@ impl Drive {
         self.held = Some((*command, clearance));
         self.integrals0 = integrals;
         self.t = t1;
+        self.runs.2 += 1;
         let friction_power =
             plant.base.friction().coefficient * plant.zone.disk_speed * truth.mean_contact_force;
         let heater_power = command.heater_power();
@@ -890,6 +1002,12 @@ impl Drive {
     /// Simulated time so far (s).
     pub fn time(&self) -> f64 {
         self.t
+    }
+
+    /// How the solver advanced the last period: its steps and error estimate (the flag of the
+    /// bounded mode, [`DriveOptions::steps_per_period`]).
+    pub fn last_period(&self) -> PeriodReport {
+        self.period
     }
 
     /// Solver work so far.
@@ -1031,6 +1149,8 @@ struct Span {
     rebase: [f64; 2],
     /// Within `SETTLE_PERIODS` of a new command: the contact tolerance throughout.
     settling: bool,
+    /// The bounded mode's shortest step (s).
+    floor: Option<f64>,
 }
 
 /// Periods after a new command that run at the contact tolerance: a command past the
@@ -1066,11 +1186,14 @@ fn advance<D: Dim>(
     integrals0: &mut (f64, f64),
     span: Span,
     tol: Option<(&TolRule, &mut TolState)>,
-) -> Result<OVector<f64, D>>
+) -> Result<(OVector<f64, D>, PeriodReport)>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     let Span { t0, t1, rebase, .. } = span;
+    if let Some(floor) = span.floor {
+        it.set_step_floor(Some(floor))?;
+    }
     let integrals = [layout.contact_impulse, layout.heat];
     let grown = integrals
         .iter()
@@ -1104,12 +1227,12 @@ where
         }
         it.reinit(t0, y)?;
     }
-    let slope = run_period(it, span, tol.is_some())?;
+    let mut ran = run_period(it, span, tol.is_some())?;
     if let Some((rule, st)) = tol {
         let need = if span.settling {
             rule.range.0
         } else {
-            slope.map_or(st.atol, |s| rule.required(s))
+            ran.slope.map_or(st.atol, |s| rule.required(s))
         };
         if need < 0.5 * st.atol {
             // Too loose for this period: again from its start at the contact tolerance.
@@ -1124,26 +1247,52 @@ where
                 it.set_tf(t1)?;
             }
             it.reinit(t0, y0)?;
-            run_period(it, span, false)?;
+            ran = run_period(it, span, false)?;
         } else if need < st.atol || need >= 2.0 * st.atol {
             st.atol = need;
             rule.apply(need, it)?;
         }
         let y1 = end_state(it, t1)?;
         st.y0[..y1.len()].copy_from_slice(y1.as_slice());
-        return Ok(y1);
+        return Ok((y1, ran.report(it)));
     }
-    end_state(it, t1)
+    Ok((end_state(it, t1)?, ran.report(it)))
+}
+
+/// What one run over a period saw.
+struct PeriodRun {
+    /// The largest contact-force slope at the step ends, when asked for and a step ended.
+    slope: Option<f64>,
+    /// Steps that ended in the period and their largest error estimate.
+    steps: usize,
+    error: f64,
+}
+
+impl PeriodRun {
+    /// The report of the period: the error of the step spanning it when none ended in it.
+    fn report<D: Dim>(&self, it: &Integrator<'static, D, SliderSystem>) -> PeriodReport
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        PeriodReport {
+            steps: self.steps,
+            error_estimate: if self.steps == 0 {
+                it.last_error()
+            } else {
+                self.error
+            },
+        }
+    }
 }
 
 /// Steps until the integrator's time reaches `t1` (the end time set for landing or a horizon
-/// ahead). With `slopes`, returns the largest contact-force slope at the step ends (`None`
+/// ahead). With `slopes`, finds the largest contact-force slope at the step ends (`None`
 /// when no step ended: the last one spans the period).
 fn run_period<D: Dim>(
     it: &mut Integrator<'static, D, SliderSystem>,
     span: Span,
     slopes: bool,
-) -> Result<Option<f64>>
+) -> Result<PeriodRun>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
@@ -1162,23 +1311,29 @@ where
     }
     let mut budget = PeriodBudget {
         steps: 0,
+        error: 0.0,
         max_steps,
         t0,
         t1,
     };
+    let mut slope = Slope(None);
     if slopes {
-        let mut slope = Slope(None);
         crate::sim::run(it, Some(t1), &mut (&mut budget, &mut slope), Error::from)?;
-        Ok(slope.0)
     } else {
         crate::sim::run(it, Some(t1), &mut budget, Error::from)?;
-        Ok(None)
     }
+    Ok(PeriodRun {
+        slope: slope.0,
+        steps: budget.steps,
+        error: budget.error,
+    })
 }
 
 /// A period's step budget: more than `max_steps` steps short of `t1` end the drive's step.
+/// It also keeps the largest error estimate of the period's steps.
 struct PeriodBudget {
     steps: usize,
+    error: f64,
     max_steps: usize,
     t0: f64,
     t1: f64,
@@ -1187,6 +1342,7 @@ struct PeriodBudget {
 impl Observer for PeriodBudget {
     fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow> {
         self.steps += 1;
+        self.error = self.error.max(step.error);
         let Self {
             max_steps, t0, t1, ..
         } = *self;

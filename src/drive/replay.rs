@@ -319,6 +319,21 @@ pub struct ReplaySummary {
     /// Heads run (each period gives one row per head); written only when more than one.
     #[serde(skip_serializing_if = "is_one")]
     pub heads: usize,
+    /// In the bounded mode ([`DriveOptions::steps_per_period`](super::DriveOptions)), how far
+    /// its fixed steps were from the tolerances; written only in that mode.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bounded: Option<BoundedSummary>,
+}
+
+/// The error flags of a replay in the bounded mode, over every period and head.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct BoundedSummary {
+    /// Steps per period.
+    pub steps_per_period: usize,
+    /// Periods (of any head) whose error estimate was above 1: a step missed the tolerances.
+    pub periods_over_tolerance: usize,
+    /// The largest error estimate of a period.
+    pub max_error_estimate: f64,
 }
 
 fn is_one(n: &usize) -> bool {
@@ -479,6 +494,14 @@ pub fn replay_heads_each(
     let mut commands = vec![Command::default(); heads];
     let mut sensors = vec![Sensors::default(); heads];
     let mut reference = vec![None; heads];
+    let mut bounded = plant
+        .head(0)
+        .and_then(|p| p.steps_per_period())
+        .map(|n| BoundedSummary {
+            steps_per_period: n,
+            periods_over_tolerance: 0,
+            max_error_estimate: 0.0,
+        });
     let mut k = 0usize;
     for n in 0..periods {
         let t0 = n as f64 * dt;
@@ -496,12 +519,20 @@ pub fn replay_heads_each(
         for (h, s) in sensors.iter().enumerate() {
             let lr0 = *reference[h].get_or_insert(s.readback.log_ratio());
             each(h, &sensor_row(s, lr0, wavelengths[h]))?;
+            if let Some(b) = bounded.as_mut() {
+                let e = drive
+                    .head(h)
+                    .map_or(f64::NAN, |d| d.last_period().error_estimate);
+                b.max_error_estimate = b.max_error_estimate.max(e);
+                b.periods_over_tolerance += usize::from(!(e <= 1.0));
+            }
         }
     }
     Ok(ReplaySummary {
         periods,
         simulated_time: drive.time(),
         heads,
+        bounded,
     })
 }
 

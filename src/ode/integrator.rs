@@ -281,6 +281,10 @@ where
     /// are evaluated again before the next step.
     events_stale: bool,
     err_prev: f64,
+    /// Error estimate of the last accepted step (NaN before the first).
+    err_last: f64,
+    /// Shortest step the error control may ask for (`set_step_floor`); 0: none.
+    h_floor: f64,
     last_rejected: bool,
     fails: (usize, FailKind),
     /// Non-finite trial steps seen recently (forgotten after a run of accepted steps): a step
@@ -395,6 +399,8 @@ where
             needs_restart: true,
             events_stale: false,
             err_prev: 1.0,
+            err_last: f64::NAN,
+            h_floor: 0.0,
             last_rejected: false,
             fails: (0, FailKind::NonFinite),
             recent_nonfinite: 0,
@@ -461,6 +467,7 @@ where
                     &mut self.ctx,
                 ),
             }
+            .max(self.h_floor)
             .min(h_max);
             self.h_needs_init = false;
         }
@@ -548,6 +555,61 @@ where
                 self.active == 1
             }
         }
+    }
+
+    /// The weighted RMS error estimate of the last accepted step, against the tolerances in
+    /// force when it was taken: at most 1 under adaptive control, any size with fixed steps
+    /// ([`set_step_floor`](Integrator::set_step_floor)); NaN before the first step.
+    pub fn last_error(&self) -> f64 {
+        self.err_last
+    }
+
+    /// Bounds the cost of a span from the next step on: the error control never asks for a
+    /// step shorter than `floor`, and a step it would shorten below it is taken at `floor` and
+    /// accepted whatever its error estimate ([`last_error`](Integrator::last_error) tells how
+    /// far it was from the tolerances). A span of length `L` then takes at most `L / floor`
+    /// steps, plus the rejected trials on the way down to the floor (at most
+    /// `log(h / floor) / log 5` for a step that began at `h`), and a span the error control
+    /// can cross in longer steps still does. Steps may still be shortened below the floor to
+    /// land on the end time, a kink or an event, and a step whose state or right-hand side is
+    /// not finite, or whose Newton iteration fails, is still tried again shorter. `None`
+    /// removes the floor.
+    ///
+    /// ```
+    /// use hdi_tribology::nalgebra::{Vector1, U1};
+    /// use hdi_tribology::ode::{Integrator, Method, OdeSystem, Options};
+    /// /// y' = -y.
+    /// struct Decay;
+    /// impl OdeSystem<U1> for Decay {
+    ///     fn rhs(&self, _t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>) {
+    ///         dy[0] = -y[0];
+    ///     }
+    /// }
+    /// let opts = Options::default().rtol(1e-12).atol(1e-14);
+    /// let mut it = Integrator::new(Decay, 0.0, Vector1::new(1.0), 1.0, Method::Rodas5P, &opts)?;
+    /// it.set_step_floor(Some(0.25))?;
+    /// it.advance_to(1.0)?;
+    /// // At most four steps, each over this tight tolerance, none of them repeated shorter.
+    /// assert!(it.stats().accepted <= 4);
+    /// assert!(it.last_error() > 1.0);
+    /// assert!((it.state()[0] - (-1.0f64).exp()).abs() < 1e-4);
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`OdeError::InvalidInput`] naming `floor` when it is not positive and finite.
+    pub fn set_step_floor(&mut self, floor: Option<f64>) -> Result<(), OdeError> {
+        self.h_floor = match floor {
+            Some(f) if f.is_finite() && f > 0.0 => f,
+            Some(f) => {
+                return Err(OdeError::invalid(
+                    "floor",
+                    format!("a step floor must be positive and finite, got {f}"),
+                ))
+            }
+            None => 0.0,
+        };
+        Ok(())
     }
 
     /// Work counters so far (all steps since [`new`](Integrator::new), across reinits).
@@ -803,6 +865,7 @@ where
             return self.step_with(events);
         };
         self.fails.0 = 0;
+        self.err_last = err;
         self.accepted_run += 1;
         if self.accepted_run >= 50 {
             self.recent_nonfinite = 0;
@@ -872,6 +935,8 @@ where
         let sys = &self.sys;
         let t = self.t;
         let mut h = self.h;
+        // The error control has asked for the step floor (`set_step_floor`).
+        let mut floored = false;
         loop {
             let attempts = self.ctx.stats.accepted + self.ctx.stats.rejected;
             if super::Cancel::requested() {
@@ -937,11 +1002,17 @@ where
                     continue;
                 }
             };
-            if err > 1.0 && self.adaptive {
+            // A step at the floor (or stretched from it onto the stop) is accepted whatever its
+            // error.
+            if err > 1.0 && self.adaptive && !floored && h > self.h_floor {
                 self.fails.0 = 0;
                 self.ctx.stats.rejected += 1;
                 let fac = (SAFETY * err.powf(-1.0 / k)).max(FAC_MIN);
                 h *= fac;
+                if h <= self.h_floor {
+                    h = self.h_floor;
+                    floored = true;
+                }
                 self.last_rejected = true;
                 continue;
             }
@@ -1064,6 +1135,7 @@ where
         if self.adaptive {
             h_next = stepper
                 .propose(h, h * fac.clamp(FAC_MIN, fac_max))
+                .max(self.h_floor)
                 .min(h_max);
         } else if let Some(h0) = self.h_init {
             h_next = h0.min(h_max);

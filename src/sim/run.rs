@@ -39,6 +39,9 @@ pub struct StepView<'a> {
     pub state: &'a [f64],
     /// What the integrator reported of the step.
     pub status: StepStatus,
+    /// The step's weighted error estimate against the tolerances (at most 1 under adaptive
+    /// control; any size with fixed steps).
+    pub error: f64,
     /// The integrator's counts so far.
     pub stats: Stats,
     /// The step's interpolant.
@@ -148,6 +151,7 @@ where
             t: it.t(),
             state: it.state().as_slice(),
             status,
+            error: it.last_error(),
             stats: it.stats(),
             last_step: it.last_step(),
             system: it.system(),

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use hdi_tribology::drive::{
     read_commands, replay_heads, spec_zone, whole_periods, DiskSpec, DriveOptions, MultiPlant,
+    ReplaySummary,
 };
 
 use hdi_tribology::scene::DriveSpec;
@@ -104,6 +105,13 @@ pub struct Args {
     /// where the head snaps into contact) [default: --atol-pm].
     #[arg(long, value_name = "PM", value_parser = positive, allow_hyphen_values = true)]
     atol_flight_pm: Option<f64>,
+    /// The bounded mode, for firmware in the loop: at most N Radau5 steps a period, a step of
+    /// a period's N-th accepted whatever its error (1 to 64; 8 keeps every sensor within a
+    /// tenth of its noise once in contact; docs/clearance.md, "The bounded mode"). Periods
+    /// whose error estimate passed the tolerances are counted in the summary and warned about
+    /// [default: adaptive steps].
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    steps_per_period: Option<i64>,
 }
 
 /// The drive of the scene's `[drive]` section with the flags over it (each flag checked and
@@ -143,6 +151,35 @@ fn drive_spec(a: &Args, scene: &hdi_tribology::scene::Scene) -> Result<DriveSpec
     Ok(spec)
 }
 
+/// `--steps-per-period`, checked as written.
+fn steps_per_period(n: i64) -> Result<usize, CliError> {
+    let max = hdi_tribology::drive::MAX_STEPS_PER_PERIOD;
+    usize::try_from(n)
+        .ok()
+        .filter(|n| (1..=max).contains(n))
+        .ok_or_else(|| {
+            CliError::Usage(format!(
+                "invalid value for --steps-per-period: must be 1 to {max}, got {n}"
+            ))
+        })
+}
+
+/// The bounded mode's periods that missed the tolerances, on standard error.
+fn warn_bounded(summary: &ReplaySummary) {
+    if let Some(b) = summary.bounded {
+        if b.periods_over_tolerance > 0 {
+            common::warn(&format!(
+                "--steps-per-period {}: {} of {} periods missed the tolerances (largest error \
+                 estimate {:.3}; 1 is the tolerance)",
+                b.steps_per_period,
+                b.periods_over_tolerance,
+                summary.periods * summary.heads,
+                b.max_error_estimate
+            ));
+        }
+    }
+}
+
 pub fn run(a: Args) -> Result<(), CliError> {
     let scene = a.scene.load()?;
     let spec = drive_spec(&a, &scene)?;
@@ -158,6 +195,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )
         // Both are positive numbers by now: what is left is a flag that does not fit the other.
         .map_err(|e| CliError::Usage(e.to_string()))?;
+    let opts = match a.steps_per_period {
+        Some(n) => opts.bounded(steps_per_period(n)?),
+        None => opts,
+    };
     let shown = a.commands.display().to_string();
     let file = std::fs::File::open(&a.commands)
         .map_err(|e| CliError::Failed(format!("--commands {shown}: {e}")))?;
@@ -187,6 +228,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 Ok(())
             })?;
             drop(progress);
+            if let Some(s) = &summary {
+                warn_bounded(s);
+            }
             common::print_json(&summary)
         }
         None => {
@@ -196,8 +240,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 inner: &mut buf,
                 progress: &progress,
             };
-            replay_heads(&plant, &rows, dt, w)?;
+            let summary = replay_heads(&plant, &rows, dt, w)?;
             drop(progress);
+            warn_bounded(&summary);
             common::write_stdout(&buf)
         }
     }
