@@ -524,7 +524,8 @@ pub fn replay_heads_each(
                     .head(h)
                     .map_or(f64::NAN, |d| d.last_period().error_estimate);
                 b.max_error_estimate = b.max_error_estimate.max(e);
-                b.periods_over_tolerance += usize::from(!(e <= 1.0));
+                // A NaN estimate (no step yet) counts as a miss.
+                b.periods_over_tolerance += usize::from(e.is_nan() || e > 1.0);
             }
         }
     }
