@@ -275,3 +275,43 @@ fn hdi_drive_heads_replays_every_head() {
     assert_ne!(head("1"), head0);
     assert_ne!(head("1"), head("2"));
 }
+
+/// `--steps-per-period`: the bounded mode's summary counts the periods that missed the
+/// tolerances and says so on standard error; a bound out of range is a usage error naming the
+/// flag, and nothing is written.
+#[test]
+fn hdi_drive_bounded_mode_flags_its_misses() {
+    let cmds = tmp("dither.csv");
+    std::fs::write(
+        &cmds,
+        "time_s,heater_mw,voltage_dc_v,voltage_ac_v,ac_frequency_khz\n0,68,0,0.5,10.5\n0.002,68,0,0.5,10.5\n",
+    )
+    .unwrap();
+    let out = tmp("bounded.csv");
+    let run = |n: &str, out: &std::path::Path| {
+        Command::new(env!("CARGO_BIN_EXE_hdi"))
+            .args(["drive", "--paper", "--steps-per-period", n, "--commands"])
+            .arg(&cmds)
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap()
+    };
+    let o = run("2", &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let b = &summary["bounded"];
+    assert_eq!(b["steps_per_period"], 2);
+    let missed = b["periods_over_tolerance"].as_u64().unwrap();
+    assert!(missed > 0 && b["max_error_estimate"].as_f64().unwrap() > 1.0);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!("{missed} of 40 periods missed")),
+        "{err}"
+    );
+    let never = tmp("never-bounded.csv");
+    let o = run("65", &never);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--steps-per-period"));
+    assert!(!never.exists());
+}
