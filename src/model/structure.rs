@@ -115,17 +115,31 @@ impl Structure {
         [c_pitch, c_coupling]: [f64; 2],
         trailing_edge: f64,
     ) -> Result<Self> {
+        Self::heave_pitch(
+            [body_mass, inertia],
+            [[0.0, c_coupling], [c_coupling, c_pitch]],
+            [[0.0, k_coupling], [k_coupling, k_pitch]],
+            trailing_edge,
+            ("structure", Kind::Symmetric),
+        )
+    }
+
+    /// Body heave and pitch (`[mass, inertia]`) with the off-heave damping `c` and stiffness
+    /// `k`, the bulge at `trailing_edge` from the pivot; the matrices checked as `coefficients`
+    /// and named under `prefix`.
+    fn heave_pitch(
+        [body_mass, inertia]: [f64; 2],
+        c: [[f64; 2]; 2],
+        k: [[f64; 2]; 2],
+        trailing_edge: f64,
+        (prefix, coefficients): (&str, Kind),
+    ) -> Result<Self> {
         check_positive("slider.mass_kg", body_mass)?;
         check_positive("structure.inertia_kg_m2", inertia)?;
         check_finite("structure.trailing_edge_m", trailing_edge)?;
-        let mut s = Self::build(
-            2,
-            &[[body_mass, 0.0], [0.0, inertia]],
-            &[[0.0, c_coupling], [c_coupling, c_pitch]],
-            &[[0.0, k_coupling], [k_coupling, k_pitch]],
-            &[1.0, trailing_edge],
-            "structure",
-        )?;
+        let mass = [[body_mass, 0.0], [0.0, inertia]];
+        let bulge = [1.0, trailing_edge];
+        let mut s = Self::build_as(2, &mass, &c, &k, &bulge, prefix, coefficients)?;
         if trailing_edge != 0.0 {
             s.length_scale[1] = trailing_edge.abs();
         }
@@ -165,24 +179,14 @@ impl Structure {
         c: [[f64; 2]; 2],
         trailing_edge: f64,
     ) -> Result<Self> {
-        check_positive("slider.mass_kg", body_mass)?;
-        check_positive("structure.inertia_kg_m2", inertia)?;
-        check_finite("structure.trailing_edge_m", trailing_edge)?;
         let off = |m: [[f64; 2]; 2]| [[0.0, m[0][1]], [m[1][0], m[1][1]]];
-        let mut s = Self::build_as(
-            2,
-            &[[body_mass, 0.0], [0.0, inertia]],
-            &off(c),
-            &off(k),
-            &[1.0, trailing_edge],
-            "air_bearing",
-            Kind::Film,
-        )?;
-        if trailing_edge != 0.0 {
-            s.length_scale[1] = trailing_edge.abs();
-        }
-        s.base[0] = 1.0;
-        Ok(s)
+        Self::heave_pitch(
+            [body_mass, inertia],
+            off(c),
+            off(k),
+            trailing_edge,
+            ("air_bearing", Kind::Film),
+        )
     }
 
     /// Any structure of 1 to [`MAX_DOF`] coordinates: `M`, `C`, `K` (rows) and the bulge
