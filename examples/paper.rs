@@ -102,7 +102,9 @@ pub fn run(options: &Options, out: &Path) -> Res<Summary> {
     let model = SliderModel::from_scene(&scene)?;
     let static_opts = StaticOptions::from_scene(&scene);
     let stat = static_hysteresis(&model, &static_opts)?;
-    let amplitudes: Vec<f64> = (0..=10).map(|i| i as f64 * 0.1).collect();
+    // From integer counts, each the decimal it names: i / 10 is 0.3 where i · 0.1 is
+    // 0.30000000000000004.
+    let amplitudes: Vec<f64> = (0..=10).map(|i| f64::from(i) / 10.0).collect();
     // Where the AC makes contact intermittent, the running mean hovers near F_th and the
     // detected powers depend on the tolerance: each amplitude is rerun with a tenfold tighter
     // tolerance until touchdown and take-off move by less than 1 % of the rigid slider's static
@@ -269,7 +271,7 @@ fn rigid_slider(
     )?;
 
     // Fig. 2(b): clearance change against DC voltage.
-    let volts: Vec<f64> = (-10..=10).map(|i| i as f64 * 0.1).collect();
+    let volts: Vec<f64> = (-10..=10).map(|i| f64::from(i) / 10.0).collect();
     let fh = clearance_change(model, &volts, &static_opts)?;
     let dfh: Vec<f64> = fh.iter().map(|c| c.clearance_change).collect();
     let fit = parabola_fit(&volts, &dfh);

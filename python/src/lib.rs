@@ -709,8 +709,9 @@ fn forces<'py>(
             format!("must be finite, got {protrusion_nm:?} nm"),
         ));
     }
-    let gaps: Vec<f64> = flat.iter().map(|&g| units::nm(g)).collect();
-    let protrusion = units::nm(protrusion_nm);
+    // in metres as typed in nm, as `hdi forces --gaps-nm`: 1.1 nm is 1.1e-9 m
+    let gaps: Vec<f64> = flat.iter().map(|&g| units::shift_decimal(g, -9)).collect();
+    let protrusion = units::shift_decimal(protrusion_nm, -9);
     let (scene, model) = model_of(py, target)?;
     let (lo, hi) = model.forces().table_range();
     let volt2 = scene.dc_volt2();
@@ -936,11 +937,11 @@ fn cycle_setup(
     }
     // as `hdi cycle`: a new rtol scales the absolute tolerance with it unless that is given
     if let Some(r) = rtol {
-        opts.solver.atol_displacement *= r / opts.solver.rtol;
-        opts.solver.rtol = r;
+        opts.solver = opts.solver.with_rtol(r);
     }
     if let Some(a) = atol_nm {
-        opts.solver.atol_displacement = units::nm(a);
+        // in metres as typed in nm, as `hdi cycle --atol-nm`
+        opts.solver.atol_displacement = units::shift_decimal(a, -9);
     }
     let programme = if triggered {
         HeaterProgramme::triggered_from_scene(&scene)
