@@ -1207,6 +1207,25 @@ mod tests {
         let table = std::fs::read_to_string(dir.path().join("fig4_triggered_sweep.csv")).unwrap();
         let header = table.lines().next().unwrap();
         assert!(header.starts_with("v_ac_v,") && !header.contains("wall_seconds"));
+        // The amplitudes as a user types them, from integer counts: 0.3, not 0.30000000000000004.
+        let amplitudes: Vec<&str> = table
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap())
+            .collect();
+        let typed: Vec<String> = (0..=10)
+            .map(|i| match i {
+                0 => "0".into(),
+                10 => "1".into(),
+                i => format!("0.{i}"),
+            })
+            .collect();
+        assert_eq!(amplitudes, typed);
+        // A missing value is an empty field: the indicator before its window has filled.
+        let series = std::fs::read_to_string(dir.path().join("fig3a_forces_0V.csv")).unwrap();
+        assert!(series.lines().next().unwrap().ends_with(",indicator_n"));
+        assert!(series.lines().nth(1).unwrap().ends_with(','));
+        assert!(!series.contains("NaN"));
         for name in [
             "fig1_indicator_vs_power.svg",
             "fig1_indicator_vs_absolute_power.svg",
