@@ -1,5 +1,7 @@
 //! Physical constants and unit helpers: SI inside, engineering units at the edges.
 
+use std::io::Write;
+
 /// Vacuum permittivity ε₀ in F/m (CODATA 2018).
 pub const EPSILON_0: f64 = 8.854_187_812_8e-12;
 
@@ -115,6 +117,16 @@ struct Decimal {
     exp: i32,
 }
 
+/// The shortest decimal text of a finite `x` that reads back to it, split into its mantissa
+/// (`"-1.25"`, `"0.0011"`) and power of ten.
+fn shortest(x: f64, buf: &mut ryu::Buffer) -> (&str, i32) {
+    let s = buf.format_finite(x);
+    match s.split_once('e') {
+        Some((m, e)) => (m, e.parse().unwrap_or(0)),
+        None => (s, 0),
+    }
+}
+
 impl Decimal {
     /// The decimal `x` is written as (`0.1` is 1·10⁻¹, not the binary value nearest to it);
     /// `None` for a value that is not finite.
@@ -122,15 +134,17 @@ impl Decimal {
         if !x.is_finite() {
             return None;
         }
-        let s = format!("{x:e}");
-        let (mantissa, exp) = s.split_once('e')?;
-        let exp: i32 = exp.parse().ok()?;
+        let mut buf = ryu::Buffer::new();
+        let (mantissa, exp) = shortest(x, &mut buf);
         let (int, frac) = mantissa.split_once('.').unwrap_or((mantissa, ""));
-        let digits: i128 = format!("{int}{frac}").parse().ok()?;
-        Some(Decimal {
-            digits,
-            exp: exp - i32::try_from(frac.len()).ok()?,
-        })
+        let mut digits: i128 = format!("{int}{frac}").parse().ok()?;
+        let mut exp = exp - i32::try_from(frac.len()).ok()?;
+        // No trailing zeros (`1.0` is 1·10⁰, `100.0` is 1·10²).
+        while digits != 0 && digits % 10 == 0 {
+            digits /= 10;
+            exp += 1;
+        }
+        Some(Decimal { digits, exp })
     }
 
     /// The `f64` nearest to this decimal (correctly rounded by the parser).
@@ -209,14 +223,24 @@ fn power_of_ten(factor: f64) -> Option<i32> {
 /// assert!(shift_decimal(f64::INFINITY, 3).is_infinite());
 /// ```
 pub fn shift_decimal(x: f64, k: i32) -> f64 {
-    match Decimal::of(x) {
-        Some(d) => Decimal {
-            exp: d.exp.saturating_add(k),
-            ..d
-        }
-        .value(),
-        None => x * 10f64.powi(k),
+    if !x.is_finite() {
+        return x * 10f64.powi(k);
     }
+    // The shortest decimal with its exponent moved, read back: no allocation (`forces` takes
+    // arrays of gaps through here).
+    let mut buf = ryu::Buffer::new();
+    let (mantissa, exp) = shortest(x, &mut buf);
+    let mut text = [0u8; 64];
+    let mut w = &mut text[..];
+    let room = w.len();
+    if write!(w, "{mantissa}e{}", i64::from(exp) + i64::from(k)).is_err() {
+        return x * 10f64.powi(k);
+    }
+    let used = room - w.len();
+    std::str::from_utf8(&text[..used])
+        .ok()
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(x * 10f64.powi(k))
 }
 
 /// `x · factor` for a unit's factor: exact in decimal ([`shift_decimal`]) when `factor` is a
@@ -385,6 +409,38 @@ mod tests {
         }
         assert_ne!(r, 1e-10);
         assert_eq!(geometric_point(1e-8, 0.1, 2), 1e-10);
+    }
+
+    /// Against the standard library's own shortest decimal (`{:e}`), its exponent moved in the
+    /// text: random doubles of every magnitude, and decimals of few digits.
+    #[test]
+    fn shifts_agree_with_the_standard_librarys_shortest_text() {
+        let reference = |x: f64, k: i32| -> f64 {
+            let s = format!("{x:e}");
+            let (m, e) = s.split_once('e').unwrap();
+            typed(&format!("{m}e{}", e.parse::<i32>().unwrap() + k))
+        };
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for i in 0..20_000 {
+            let x = if i % 2 == 0 {
+                f64::from_bits(next() >> 2) // positive, below 2, down to the subnormals
+            } else {
+                typed(&format!(
+                    "{}e{}",
+                    next() % 100_000,
+                    (next() % 40) as i32 - 20
+                ))
+            };
+            for k in [-12, -9, -3, 3, 9] {
+                assert_eq!(shift_decimal(x, k), reference(x, k), "{x:e} e{k}");
+            }
+        }
     }
 
     #[test]
