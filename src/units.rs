@@ -240,7 +240,7 @@ pub fn shift_decimal(x: f64, k: i32) -> f64 {
     std::str::from_utf8(&text[..used])
         .ok()
         .and_then(|t| t.parse().ok())
-        .unwrap_or(x * 10f64.powi(k))
+        .unwrap_or_else(|| x * 10f64.powi(k))
 }
 
 /// `x · factor` for a unit's factor: exact in decimal ([`shift_decimal`]) when `factor` is a
