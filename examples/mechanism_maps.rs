@@ -766,9 +766,16 @@ fn read_points(path: &Path) -> Res<Vec<Point>> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut out = Vec::new();
     for line in text.lines().skip(1) {
+        // A missing value is an empty field (maps written before that: `NaN`).
         let v: Vec<f64> = line
             .split(',')
-            .map(|c| c.parse::<f64>())
+            .map(|c| {
+                if c.is_empty() {
+                    Ok(f64::NAN)
+                } else {
+                    c.parse::<f64>()
+                }
+            })
             .collect::<Result<_, _>>()?;
         // Maps written before the `model` column have 11 fields: every point the full model's.
         let (v, model) = match v.len() {

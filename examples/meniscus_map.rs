@@ -246,7 +246,8 @@ fn write_csv(path: &Path, axis: Axis, points: &[Point]) -> Res<()> {
             "{},{},{},{},{},{},{:.3},{}",
             p.v_ac,
             if p.param.is_nan() {
-                "none".to_string()
+                // the row without menisci: no value, an empty field
+                String::new()
             } else {
                 format!("{:.6}", p.param * unit)
             },
@@ -537,7 +538,7 @@ mod tests {
         assert_eq!(csv.lines().count(), 1 + 2 * 3);
         assert!(std::fs::read_to_string(dir.path().join("thickness.svg"))?.contains("<svg"));
         let plain = setup.cycle(&setup.plain, false)?;
-        let row = csv.lines().find(|l| l.starts_with("0,none")).unwrap();
+        let row = csv.lines().find(|l| l.starts_with("0,,")).unwrap();
         assert!(row.contains(&fmt_mw(plain.touchdown.map(|d| d.power))));
         Ok(())
     }

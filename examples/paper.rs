@@ -102,7 +102,9 @@ pub fn run(options: &Options, out: &Path) -> Res<Summary> {
     let model = SliderModel::from_scene(&scene)?;
     let static_opts = StaticOptions::from_scene(&scene);
     let stat = static_hysteresis(&model, &static_opts)?;
-    let amplitudes: Vec<f64> = (0..=10).map(|i| i as f64 * 0.1).collect();
+    // From integer counts, each the decimal it names: i / 10 is 0.3 where i · 0.1 is
+    // 0.30000000000000004.
+    let amplitudes: Vec<f64> = (0..=10).map(|i| f64::from(i) / 10.0).collect();
     // Where the AC makes contact intermittent, the running mean hovers near F_th and the
     // detected powers depend on the tolerance: each amplitude is rerun with a tenfold tighter
     // tolerance until touchdown and take-off move by less than 1 % of the rigid slider's static
@@ -269,7 +271,7 @@ fn rigid_slider(
     )?;
 
     // Fig. 2(b): clearance change against DC voltage.
-    let volts: Vec<f64> = (-10..=10).map(|i| i as f64 * 0.1).collect();
+    let volts: Vec<f64> = (-10..=10).map(|i| f64::from(i) / 10.0).collect();
     let fh = clearance_change(model, &volts, &static_opts)?;
     let dfh: Vec<f64> = fh.iter().map(|c| c.clearance_change).collect();
     let fit = parabola_fit(&volts, &dfh);
@@ -1205,6 +1207,25 @@ mod tests {
         let table = std::fs::read_to_string(dir.path().join("fig4_triggered_sweep.csv")).unwrap();
         let header = table.lines().next().unwrap();
         assert!(header.starts_with("v_ac_v,") && !header.contains("wall_seconds"));
+        // The amplitudes as a user types them, from integer counts: 0.3, not 0.30000000000000004.
+        let amplitudes: Vec<&str> = table
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap())
+            .collect();
+        let typed: Vec<String> = (0..=10)
+            .map(|i| match i {
+                0 => "0".into(),
+                10 => "1".into(),
+                i => format!("0.{i}"),
+            })
+            .collect();
+        assert_eq!(amplitudes, typed);
+        // A missing value is an empty field: the indicator before its window has filled.
+        let series = std::fs::read_to_string(dir.path().join("fig3a_forces_0V.csv")).unwrap();
+        assert!(series.lines().next().unwrap().ends_with(",indicator_n"));
+        assert!(series.lines().nth(1).unwrap().ends_with(','));
+        assert!(!series.contains("NaN"));
         for name in [
             "fig1_indicator_vs_power.svg",
             "fig1_indicator_vs_absolute_power.svg",

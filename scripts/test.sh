@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every test of the repository: the Rust crate's (with all features: the `hdi` program, plots,
 # rayon), then the Python package built into its own virtual environment and its pytest suite.
-# A fresh machine needs only Rust and CPython >= 3.9: maturin, numpy and pytest come from PyPI.
+# A fresh machine needs only Rust and CPython >= 3.9: maturin, numpy, pytest and pandas (for the
+# tests of `to_dataframe`, an optional dependency of the package) come from PyPI.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -31,9 +32,9 @@ py="${PYTHON:-python3}"
 if [ ! -x "$venv/bin/python" ]; then
   "$py" -m venv "$venv"
 fi
-if ! "$venv/bin/python" -c "import maturin, numpy, pytest" >/dev/null 2>&1; then
+if ! "$venv/bin/python" -c "import maturin, numpy, pytest, pandas" >/dev/null 2>&1; then
   "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
-    "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7"
+    "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" "pandas>=1.3"
 fi
 # Build and install the package with the README's own command, `pip install ./python`: pip
 # fetches maturin into an isolated build environment as a user's pip does, so the build

@@ -2,7 +2,9 @@
 //!
 //! Tables go through the [`csv`] crate. Real numbers are written in the shortest form that reads
 //! back to the same `f64` (plain decimals between 1e-4 and 1e15, exponent form outside), counts
-//! as integers and flags as `true`/`false`; a missing value is an empty field. Physical
+//! as integers and flags as `true`/`false`; a missing value (`None`, or `NaN` in a column of
+//! reals) is an empty field, which spreadsheets, pandas and `numpy.genfromtxt` read as missing
+//! (NaN). Physical
 //! quantities carry their SI unit as a suffix of the column name (`v_dc_v`, `power_w`, `d_m`).
 //! Every file is written whole under a temporary name beside it and renamed into place, so a
 //! failure leaves neither a half-written table nor a temporary file behind.
@@ -31,7 +33,7 @@ impl Column {
     }
     fn cell(&self, row: usize) -> String {
         match self {
-            Column::Real(v) => real_cell(v[row]),
+            Column::Real(v) => missing_or_real(v[row]),
             Column::Optional(v) => v[row].map_or(String::new(), real_cell),
             Column::Integer(v) => v[row].to_string(),
             Column::Flag(v) => v[row].to_string(),
@@ -39,8 +41,18 @@ impl Column {
     }
 }
 
+/// A CSV cell of a column of reals: empty for `NaN` (a missing value), else [`real_cell`].
+fn missing_or_real(v: f64) -> String {
+    if v.is_nan() {
+        String::new()
+    } else {
+        real_cell(v)
+    }
+}
+
 /// A real number in the shortest form that reads back to the same `f64`: plain decimal for
-/// magnitudes in [1e-4, 1e15), exponent form outside; `NaN`, `inf`, `-inf` as such.
+/// magnitudes in [1e-4, 1e15), exponent form outside; `NaN`, `inf`, `-inf` as such (a CSV
+/// column writes `NaN` as an empty field: [`CsvTable::real`]).
 ///
 /// ```
 /// use hdi_tribology::report::real_cell;
@@ -98,7 +110,15 @@ impl CsvTable {
         self
     }
 
-    /// Adds a column of real numbers (`NaN` is written as `NaN`).
+    /// Adds a column of real numbers; `NaN` stands for a missing value and is written as an
+    /// empty field, as [`CsvTable::optional`] writes `None` (`inf` and `-inf` as such).
+    ///
+    /// ```
+    /// use hdi_tribology::report::CsvTable;
+    /// let t = CsvTable::new().real("indicator_n", [f64::NAN, 2.5e-5, f64::INFINITY]);
+    /// assert_eq!(t.to_csv_string()?, "indicator_n\n\"\"\n2.5e-5\ninf\n");
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     pub fn real(self, header: &str, values: impl IntoIterator<Item = f64>) -> Self {
         self.push(header, Column::Real(values.into_iter().collect()))
     }

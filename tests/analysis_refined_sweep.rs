@@ -133,13 +133,19 @@ fn three_agreeing_runs_mean_three_agreeing_runs() {
             ac_amplitude: v_ac,
             ..model.voltage()
         });
-        // Tightened as the refinement does, one factor at a time (the same rounding).
+        // Run k at the paper scene's tolerances (rtol 1e-6, atol 1e-14 m) tightened k times by
+        // 0.1, as the decimals they are: rtol 1e-(6+k), atol 1e-(14+k) m.
+        assert_eq!(
+            (opts.solver.rtol, opts.solver.atol_displacement),
+            (1e-6, 1e-14)
+        );
+        let decimal = |e: usize| format!("1e-{e}").parse::<f64>().unwrap();
+        assert_eq!(r.rtol, decimal(6 + r.runs - 1), "{v_ac} V");
+        assert_eq!(r.atol, decimal(14 + r.runs - 1), "{v_ac} V");
         let run = |k: usize| {
             let mut o = opts;
-            for _ in 0..k {
-                o.solver.rtol *= refine.factor;
-                o.solver.atol_displacement *= refine.factor;
-            }
+            o.solver.rtol = decimal(6 + k);
+            o.solver.atol_displacement = decimal(14 + k);
             simulate_cycle(&m, &programme, &o).unwrap()
         };
         let cycles: Vec<_> = (r.runs - 3..r.runs).map(run).collect();

@@ -5,7 +5,8 @@ are in engineering units where their name says so (``power_mw``, ``gaps_nm``, ``
 results carry their SI unit in their name (``power_w``, ``d_m``, ``total_n``), with the same
 value in mW, nm or µN beside them (``power_mw``, ``d_nm``, ``total_un``). Each result is the
 crate's one representation of it, the JSON the ``hdi`` program prints: ``to_dict()`` gives it
-back, results compare by value and pickle.
+back, results compare by value and pickle, and ``to_dataframe`` makes a pandas table of those
+whose shape is one (pandas optional).
 
 >>> import hdi_tribology as hdi
 >>> model = hdi.Model(hdi.Scene.paper())
@@ -38,6 +39,7 @@ from ._core import (
     static_hysteresis,
 )
 from ._drive import Drive, MultiDrive
+from ._tables import to_dataframe
 from ._results import (
     Calibration,
     Cycle,
@@ -103,4 +105,5 @@ __all__ = [
     "simulate_cycle",
     "simulated_dither",
     "static_hysteresis",
+    "to_dataframe",
 ]

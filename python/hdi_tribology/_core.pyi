@@ -131,6 +131,9 @@ class LinearResponse:
     def to_dict(self) -> Dict[str, Any]:
         """The response as plain values: equilibrium, modes, stable, gain_at_2f_m_per_n,
         force_at_2f_n, dither_amplitude_m."""
+    def __eq__(self, other: object) -> bool:
+        """Equal when every number is, the state-space matrices included. A response pickles
+        (every number it holds) and comes back equal."""
 
 SENSOR_COLUMNS: List[str]
 """The columns of a sensor stream (``replay``, ``hdi drive``), units in their names."""
@@ -339,6 +342,10 @@ class AirBearing:
     def x_um(self) -> npt.NDArray[np.float64]: ...
     @property
     def y_um(self) -> npt.NDArray[np.float64]: ...
+    def to_dict(self) -> Dict[str, Any]:
+        """Every attribute as plain values (``pressure_pa`` as ``ny`` lists of ``nx``); the
+        result pickles as this dict and comes back equal."""
+    def __eq__(self, other: object) -> bool: ...
 
 def bearing(geometry: Union[str, "os.PathLike[str]"], *, cells: Optional[int] = None,
             radius_mm: Optional[float] = None, rpm: Optional[float] = None,

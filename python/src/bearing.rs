@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use hdi_tribology::bearing::attitude::LevelReport;
 use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec, Interrupt};
 use hdi_tribology::ode::Cancel;
 use numpy::{PyArray1, PyArrayMethods};
@@ -14,6 +15,7 @@ use super::{invalid, on_own_thread, to_py_err, OrPy};
 
 /// The equilibrium of a slider on its air bearing (see `bearing`).
 #[pyclass(module = "hdi_tribology", frozen)]
+#[derive(PartialEq)]
 pub struct AirBearing {
     /// Fly height at the trailing edge's centre (surface depth 0), nm.
     #[pyo3(get)]
@@ -108,6 +110,100 @@ impl AirBearing {
     #[getter]
     fn y_um<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_vec(py, self.y_um.clone())
+    }
+    /// Every attribute as plain Python values: the numbers, `stiffness` and `damping` as lists
+    /// of rows, `converged`, `cells`, `convergence`, and `pressure_pa` (a list of `ny` rows of
+    /// `nx`), `x_um`, `y_um` as lists. `AirBearing._from_dict` gives the result back.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in [
+            ("fly_height_nm", self.fly_height_nm),
+            ("pitch_urad", self.pitch_urad),
+            ("roll_urad", self.roll_urad),
+            ("trailing_edge_spacing_nm", self.trailing_edge_spacing_nm),
+            ("bulge_spacing_nm", self.bulge_spacing_nm),
+            ("min_spacing_nm", self.min_spacing_nm),
+            ("load_mn", self.load_mn),
+            ("pitch_moment_un_m", self.pitch_moment_un_m),
+            ("roll_moment_un_m", self.roll_moment_un_m),
+            ("bearing_number", self.bearing_number),
+        ] {
+            d.set_item(k, v)?;
+        }
+        d.set_item("stiffness", self.stiffness)?;
+        d.set_item("damping", self.damping)?;
+        d.set_item("imbalance", self.imbalance)?;
+        d.set_item("tolerance", self.tolerance)?;
+        d.set_item("converged", self.converged())?;
+        d.set_item("cells", self.cells)?;
+        d.set_item("convergence", self.convergence(py)?)?;
+        let rows: Vec<Vec<f64>> = self
+            .pressure_pa
+            .chunks(self.cells.0.max(1))
+            .map(<[f64]>::to_vec)
+            .collect();
+        d.set_item("pressure_pa", rows)?;
+        d.set_item("x_um", self.x_um.clone())?;
+        d.set_item("y_um", self.y_um.clone())?;
+        Ok(d)
+    }
+    /// The result from its `to_dict()` (for pickle).
+    #[staticmethod]
+    fn _from_dict(d: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let get = |k: &str| -> PyResult<Bound<'_, PyAny>> {
+            d.get_item(k)?
+                .ok_or_else(|| invalid(k, "missing from the AirBearing's dict"))
+        };
+        let levels = get("convergence")?
+            .extract::<Vec<Bound<'_, PyDict>>>()?
+            .iter()
+            .map(|l| {
+                let at = |k: &str| -> PyResult<Bound<'_, PyAny>> {
+                    l.get_item(k)?
+                        .ok_or_else(|| invalid(k, "missing from a convergence entry"))
+                };
+                Ok(LevelReport {
+                    cells: at("cells")?.extract()?,
+                    iterations: at("newton_steps")?.extract()?,
+                    pressure_iterations: at("pressure_newton_steps")?.extract()?,
+                    krylov_iterations: at("krylov_iterations")?.extract()?,
+                    imbalance: at("relative_imbalance")?.extract()?,
+                })
+            })
+            .collect::<PyResult<_>>()?;
+        let rows: Vec<Vec<f64>> = get("pressure_pa")?.extract()?;
+        Ok(AirBearing {
+            fly_height_nm: get("fly_height_nm")?.extract()?,
+            pitch_urad: get("pitch_urad")?.extract()?,
+            roll_urad: get("roll_urad")?.extract()?,
+            trailing_edge_spacing_nm: get("trailing_edge_spacing_nm")?.extract()?,
+            bulge_spacing_nm: get("bulge_spacing_nm")?.extract()?,
+            min_spacing_nm: get("min_spacing_nm")?.extract()?,
+            load_mn: get("load_mn")?.extract()?,
+            pitch_moment_un_m: get("pitch_moment_un_m")?.extract()?,
+            roll_moment_un_m: get("roll_moment_un_m")?.extract()?,
+            bearing_number: get("bearing_number")?.extract()?,
+            stiffness: get("stiffness")?.extract()?,
+            damping: get("damping")?.extract()?,
+            imbalance: get("imbalance")?.extract()?,
+            tolerance: get("tolerance")?.extract()?,
+            levels,
+            cells: get("cells")?.extract()?,
+            pressure_pa: rows.concat(),
+            x_um: get("x_um")?.extract()?,
+            y_um: get("y_um")?.extract()?,
+        })
+    }
+    /// Equal when every attribute is (the pressure field and the convergence included).
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.cast::<AirBearing>().is_ok_and(|o| self == o.get())
+    }
+    /// Pickles as its `to_dict()`.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
+        let d = slf.get().to_dict(slf.py())?;
+        Ok((slf.get_type().getattr("_from_dict")?, (d,)))
     }
     fn __repr__(&self) -> String {
         format!(

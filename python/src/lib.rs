@@ -16,6 +16,7 @@ use std::sync::{Arc, RwLock};
 use std::time::Duration;
 
 use hdi_tribology::analysis::record::{CycleRecord, StaticRecord};
+use hdi_tribology::analysis::StateSpace;
 use hdi_tribology::analysis::{
     self, CycleOptions, HeaterProgramme, Refinement, ScanGrid, StaticOptions,
 };
@@ -30,10 +31,12 @@ use hdi_tribology::drive::{
 };
 use hdi_tribology::fit::{DataSet, FitOptions, FreeParameter};
 use hdi_tribology::force::{Gaps, RelaxingState};
-use hdi_tribology::model::{SliderModel, Voltage};
+use hdi_tribology::model::{Dofs, SliderModel, Voltage};
 use hdi_tribology::ode::Cancel;
+use hdi_tribology::scene::MAX_DOF;
 use hdi_tribology::scene::{DriveSpec, FieldPath, PathError};
 use hdi_tribology::units;
+use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
@@ -709,8 +712,9 @@ fn forces<'py>(
             format!("must be finite, got {protrusion_nm:?} nm"),
         ));
     }
-    let gaps: Vec<f64> = flat.iter().map(|&g| units::nm(g)).collect();
-    let protrusion = units::nm(protrusion_nm);
+    // in metres as typed in nm, as `hdi forces --gaps-nm`: 1.1 nm is 1.1e-9 m
+    let gaps: Vec<f64> = flat.iter().map(|&g| units::shift_decimal(g, -9)).collect();
+    let protrusion = units::shift_decimal(protrusion_nm, -9);
     let (scene, model) = model_of(py, target)?;
     let (lo, hi) = model.forces().table_range();
     let volt2 = scene.dc_volt2();
@@ -936,11 +940,11 @@ fn cycle_setup(
     }
     // as `hdi cycle`: a new rtol scales the absolute tolerance with it unless that is given
     if let Some(r) = rtol {
-        opts.solver.atol_displacement *= r / opts.solver.rtol;
-        opts.solver.rtol = r;
+        opts.solver = opts.solver.with_rtol(r);
     }
     if let Some(a) = atol_nm {
-        opts.solver.atol_displacement = units::nm(a);
+        // in metres as typed in nm, as `hdi cycle --atol-nm`
+        opts.solver.atol_displacement = units::shift_decimal(a, -9);
     }
     let programme = if triggered {
         HeaterProgramme::triggered_from_scene(&scene)
@@ -1185,6 +1189,111 @@ struct LinearResponse {
     dofs: usize,
 }
 
+/// One mode as pickled: eigenvalue (re, im), frequency, damping ratio, shape (`MAX_DOF`).
+type ModeState = (f64, f64, f64, f64, Vec<f64>);
+/// An equilibrium as pickled: d, y, q (`MAX_DOF`), protrusion, power, stiffness, interface
+/// force, contact force.
+type EquilibriumState = (f64, f64, Vec<f64>, f64, f64, f64, f64, f64);
+/// A whole response as pickled: every number it holds, so it comes back to the bit: dofs, the
+/// equilibrium, the modes, stable, gain at 2f, force at 2f, dither, the state's size n, A
+/// (row by row), u and c.
+type ResponseState = (
+    usize,
+    EquilibriumState,
+    Vec<ModeState>,
+    bool,
+    f64,
+    f64,
+    f64,
+    usize,
+    Vec<f64>,
+    Vec<f64>,
+    Vec<f64>,
+);
+
+impl LinearResponse {
+    fn state(&self) -> ResponseState {
+        let r = &self.inner;
+        let e = &r.equilibrium;
+        let ss = &r.state_space;
+        let n = ss.a.nrows();
+        (
+            self.dofs,
+            (
+                e.d,
+                e.y,
+                e.q.iter().copied().collect(),
+                e.protrusion,
+                e.power,
+                e.stiffness,
+                e.interface_force,
+                e.contact_force,
+            ),
+            r.modes
+                .iter()
+                .map(|m| (m.re, m.im, m.frequency, m.damping_ratio, m.shape.to_vec()))
+                .collect(),
+            r.stable,
+            r.gain_at_2f,
+            r.force_at_2f,
+            r.dither_amplitude,
+            n,
+            (0..n)
+                .flat_map(|i| (0..n).map(move |j| (i, j)))
+                .map(|(i, j)| ss.a[(i, j)])
+                .collect(),
+            ss.input.iter().copied().collect(),
+            ss.output.iter().copied().collect(),
+        )
+    }
+
+    fn from_state(s: ResponseState) -> PyResult<Self> {
+        let (dofs, e, modes, stable, gain, force, dither, n, a, input, output) = s;
+        let bad = |what: &str| invalid("state", format!("not a pickled LinearResponse: {what}"));
+        let coordinates = |v: &[f64], what: &str| -> PyResult<[f64; MAX_DOF]> {
+            v.try_into().map_err(|_| bad(what))
+        };
+        if a.len() != n * n || input.len() != n || output.len() != n {
+            return Err(bad("the state-space matrices do not fit their size"));
+        }
+        let (d, y, q, protrusion, power, stiffness, interface_force, contact_force) = e;
+        let inner = analysis::LinearResponse {
+            equilibrium: analysis::Equilibrium {
+                d,
+                y,
+                q: Dofs::from(coordinates(&q, "q")?),
+                protrusion,
+                power,
+                stiffness,
+                interface_force,
+                contact_force,
+            },
+            modes: modes
+                .into_iter()
+                .map(|(re, im, frequency, damping_ratio, shape)| {
+                    Ok(analysis::Mode {
+                        re,
+                        im,
+                        frequency,
+                        damping_ratio,
+                        shape: coordinates(&shape, "shape")?,
+                    })
+                })
+                .collect::<PyResult<_>>()?,
+            stable,
+            gain_at_2f: gain,
+            force_at_2f: force,
+            dither_amplitude: dither,
+            state_space: StateSpace {
+                a: DMatrix::from_row_slice(n, n, &a),
+                input: DVector::from_vec(input),
+                output: DVector::from_vec(output),
+            },
+        };
+        Ok(LinearResponse { inner, dofs })
+    }
+}
+
 #[pymethods]
 impl LinearResponse {
     /// The equilibrium (under the mean V²).
@@ -1275,6 +1384,22 @@ impl LinearResponse {
                 .collect::<PyResult<_>>()?,
         );
         json_to_py(py, &v)
+    }
+    /// Equal when every number is: the equilibrium, the modes, the figures at 2f and the
+    /// state-space matrices.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<LinearResponse>()
+            .is_ok_and(|o| self.dofs == o.get().dofs && self.inner == o.get().inner)
+    }
+    /// Pickles every number it holds: it comes back equal, to the bit.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (ResponseState,))> {
+        Ok((slf.get_type().getattr("_from_state")?, (slf.get().state(),)))
+    }
+    /// The response from the state `__reduce__` gives (for pickle).
+    #[staticmethod]
+    fn _from_state(state: ResponseState) -> PyResult<Self> {
+        Self::from_state(state)
     }
     fn __repr__(&self) -> String {
         format!(

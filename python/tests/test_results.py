@@ -25,7 +25,10 @@ def test_forces_arrays(paper_model):
     assert f["in_table_range"].dtype == np.bool_ and f["in_table_range"].shape == (17,)
     for k in FORCE_KEYS:
         assert f[k].shape == (17,) and f[k].dtype == np.float64, k
-    assert np.array_equal(f["d_m"], gaps * 1e-9)
+    # in metres on the decimal of each gap in nm (1.1 nm is 1.1e-9 m, where 1.1 * 1e-9 is
+    # 1.1000000000000001e-9): the shortest text of each, shifted by nine places
+    assert f["d_m"].tolist() == [float(f"{g!r}e-9") for g in gaps.tolist()]
+    assert np.allclose(f["d_m"], gaps * 1e-9, rtol=2.3e-16, atol=0)
     # the parts add up to the total, and contact pushes away, more at smaller gaps
     parts = f["intermolecular_n"] + f["contact_n"] + f["electrostatic_n"] + f["other_n"]
     assert np.allclose(parts, f["total_n"], rtol=1e-12, atol=1e-18)

@@ -302,18 +302,23 @@ pub struct SolverSettings {
 impl SolverSettings {
     /// The settings at relative tolerance `rtol`, the displacement's absolute tolerance scaled
     /// with it (`atol · rtol / rtol₀`): the one rule by which a new rtol tightens or loosens
-    /// the whole error control, as `hdi cycle --rtol` and Python's `rtol=` apply it.
+    /// the whole error control, as `hdi cycle --rtol` and Python's `rtol=` apply it. The ratio
+    /// is taken on the decimals the tolerances are written as where it is one
+    /// ([`units::proportional`](crate::units::proportional)): atol `1e-14` at rtol `1e-6` scales
+    /// to `7e-15` at `7e-7`, not `6.999999999999999e-15`.
     ///
     /// ```
     /// use hdi_tribology::{analysis::CycleOptions, scene::Scene};
     /// let s = CycleOptions::from_scene(&Scene::paper())?.solver;
+    /// assert_eq!((s.rtol, s.atol_displacement), (1e-6, 1e-14));
+    /// assert_eq!(s.with_rtol(7e-7).atol_displacement, 7e-15); // 1e-14 * (7e-7 / 1e-6) is 6.999999999999999e-15
     /// let tight = s.with_rtol(s.rtol / 10.0);
     /// assert!((tight.atol_displacement - s.atol_displacement / 10.0).abs() < 1e-30);
     /// # Ok::<(), hdi_tribology::Error>(())
     /// ```
     pub fn with_rtol(self, rtol: f64) -> Self {
         SolverSettings {
-            atol_displacement: self.atol_displacement * (rtol / self.rtol),
+            atol_displacement: crate::units::proportional(self.atol_displacement, rtol, self.rtol),
             rtol,
             ..self
         }
@@ -430,7 +435,8 @@ pub struct TimeSeries {
     pub total: Vec<f64>,
     /// Flash temperature rise (K).
     pub temperature_rise: Vec<f64>,
-    /// Running mean of the contact force over the detector window (N); NaN before `T_w`.
+    /// Running mean of the contact force over the detector window (N); NaN before `T_w` (an
+    /// empty field in the CSV).
     pub indicator: Vec<f64>,
     /// The states of the model's stateful terms ([`crate::force::StatefulTerm`]), one series
     /// per state in the order of the terms; empty without such terms (not in the CSV).
@@ -438,7 +444,8 @@ pub struct TimeSeries {
 }
 
 impl TimeSeries {
-    /// Writes the series as CSV, one row per step, SI units in the column names.
+    /// Writes the series as CSV, one row per step, SI units in the column names; `indicator_n`
+    /// is an empty field (a missing value) before the detector's window has filled.
     ///
     /// ```no_run
     /// # fn f(r: &hdi_tribology::analysis::CycleResult) -> hdi_tribology::Result<()> {

@@ -24,7 +24,7 @@ pub use equilibrium::{
 };
 pub use protocol::Protocol;
 pub use pull_in::{clearance_change, pull_in_voltage, ClearanceChange, PullIn};
-pub use response::{linear_response, LinearResponse, Mode};
+pub use response::{linear_response, LinearResponse, Mode, StateSpace};
 pub use sensitivity::transition_shift;
 pub use sweep::{ac_sweep, ac_sweep_refined, RefinedCycle, Refinement};
 pub use touchdown::{

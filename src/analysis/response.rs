@@ -67,8 +67,35 @@ pub struct Mode {
     pub shape: [f64; MAX_DOF],
 }
 
+/// The linearised slider `ẋ = A x + u f`, with the bulge displacement `cᵀ x`: what
+/// [`LinearResponse::transfer`] evaluates, `H(iω) = cᵀ (iω − A)⁻¹ u`. The state is the
+/// slider's own (every coordinate of its structure, their velocities, and the lags of the scene
+/// if it has them), in SI units.
+///
+/// ```
+/// use hdi_tribology::{analysis::linear_response, model::SliderModel, scene::Scene};
+/// let r = linear_response(&SliderModel::from_scene(&Scene::paper())?, 0.06)?;
+/// let ss = &r.state_space;
+/// // At ω = 0, H is the static compliance cᵀ(−A)⁻¹u.
+/// let static_compliance = ss.output.dot(&ss.a.clone().lu().solve(&ss.input).unwrap());
+/// assert!((r.transfer(0.0).re + static_compliance).abs() <= 1e-9 * static_compliance.abs());
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateSpace {
+    /// `A`: the Jacobian of the slider's equations of motion at the equilibrium.
+    pub a: DMatrix<f64>,
+    /// `u`: the state's rate per unit interface force (per N).
+    pub input: DVector<f64>,
+    /// `c`: the bulge displacement of a state (m per unit of each state).
+    pub output: DVector<f64>,
+}
+
 /// The linear response about the flying equilibrium at one heater power.
-#[derive(Clone, Debug, Serialize)]
+///
+/// Compares by value (`==`), the state-space matrices included; every field is public, so a
+/// response saved field by field (as the Python package pickles it) is rebuilt to the bit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LinearResponse {
     /// The equilibrium (under the mean `V²`).
     pub equilibrium: Equilibrium,
@@ -85,12 +112,9 @@ pub struct LinearResponse {
     /// Predicted dither amplitude of the bulge at `2f` (m).
     #[serde(rename = "dither_amplitude_m")]
     pub dither_amplitude: f64,
+    /// The linearised system behind [`LinearResponse::transfer`] (not serialized).
     #[serde(skip)]
-    a: DMatrix<f64>,
-    #[serde(skip)]
-    input: DVector<f64>,
-    #[serde(skip)]
-    output: DVector<f64>,
+    pub state_space: StateSpace,
 }
 
 /// `(iω − A)⁻¹ u`, or NaN where singular.
@@ -114,10 +138,11 @@ fn resolvent(
 impl LinearResponse {
     /// `H(iω)` (m/N): bulge displacement per unit interface force at angular frequency `omega`.
     pub fn transfer(&self, omega: f64) -> Complex64 {
-        let u = self.input.map(|x| Complex64::new(x, 0.0));
-        resolvent(&self.a, Complex64::new(0.0, omega), &u)
+        let ss = &self.state_space;
+        let u = ss.input.map(|x| Complex64::new(x, 0.0));
+        resolvent(&ss.a, Complex64::new(0.0, omega), &u)
             .map_or(Complex64::new(f64::NAN, f64::NAN), |x| {
-                x.iter().zip(self.output.iter()).map(|(x, c)| x * c).sum()
+                x.iter().zip(ss.output.iter()).map(|(x, c)| x * c).sum()
             })
     }
 }
@@ -281,9 +306,7 @@ pub fn linear_response(model: &SliderModel, power: f64) -> Result<LinearResponse
         gain_at_2f: 0.0,
         force_at_2f,
         dither_amplitude: 0.0,
-        a,
-        input,
-        output,
+        state_space: StateSpace { a, input, output },
     };
     r.gain_at_2f = r.transfer(2.0 * PI * 2.0 * v.frequency).norm();
     r.dither_amplitude = r.gain_at_2f * force_at_2f;

@@ -18,7 +18,7 @@ use super::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
 use crate::error::{check_finite, check_positive, Result};
 use crate::model::{SliderModel, Voltage};
 use crate::ode::Stats;
-use crate::Error;
+use crate::{units, Error};
 
 /// Runs `programme` once per AC amplitude (V), at the model's frequency and DC voltage.
 ///
@@ -122,6 +122,21 @@ impl Refinement {
             max_runs: 4,
             agreeing_runs: 2,
         }
+    }
+
+    /// The tolerance of run `run` (0 for the first) that starts from `first`: `first ·
+    /// factor^run`, taken on the decimals they are written as ([`units::geometric_point`]), so
+    /// the tolerances reported read as typed (`1e-10`, not `1.0000000000000002e-10`).
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::sweep::Refinement;
+    /// let r = Refinement::new(6e-5);
+    /// assert_eq!(r.tolerance(1e-8, 0), 1e-8);
+    /// assert_eq!(r.tolerance(1e-8, 2), 1e-10);
+    /// assert_eq!(r.tolerance(3e-16, 4), 3e-20);
+    /// ```
+    pub fn tolerance(&self, first: f64, run: usize) -> f64 {
+        units::geometric_point(first, self.factor, u32::try_from(run).unwrap_or(u32::MAX))
     }
 
     fn validate(&self) -> Result<()> {
@@ -228,8 +243,10 @@ pub fn ac_sweep_refined(
         // Successive runs that agree, the last one included.
         let mut agreeing = 1;
         loop {
-            o.solver.rtol *= refine.factor;
-            o.solver.atol_displacement *= refine.factor;
+            // Run k's tolerances from the first's and the integer k, as the decimals they are:
+            // 1e-8 tightened twice by 0.1 is 1e-10 (not 1.0000000000000002e-10).
+            o.solver.rtol = refine.tolerance(opts.solver.rtol, runs);
+            o.solver.atol_displacement = refine.tolerance(opts.solver.atol_displacement, runs);
             let next = simulate_cycle(m, programme, &o)?;
             runs += 1;
             stats += &next.stats;

@@ -10,6 +10,7 @@ use crate::drive::{
 use crate::error::{check_non_negative, check_not_below, check_positive, Error, Result};
 use crate::model::SliderModel;
 use crate::ode::{Method, Stats};
+use crate::units::{grid_point, shift_decimal};
 use serde::Serialize;
 
 /// The heater staircase: levels `start_power + k·step` up to `max_power`, each reached by a linear
@@ -137,17 +138,17 @@ impl CalibrationOptions {
     }
 
     /// [`CalibrationOptions::new`] with every power in milliwatts, as firmware tables hold
-    /// them.
+    /// them, each taken to watts on the decimal it is written as
+    /// ([`shift_decimal`](crate::units::shift_decimal)): 60.1 mW is `0.0601` W.
     ///
     /// ```
     /// use hdi_tribology::calibration::CalibrationOptions;
-    /// let o = CalibrationOptions::from_mw(60.0, 0.5, 90.0, 5.0);
-    /// use hdi_tribology::units::mw;
-    /// assert_eq!(o, CalibrationOptions::new(mw(60.0), mw(0.5), mw(90.0), mw(5.0)));
+    /// let o = CalibrationOptions::from_mw(60.1, 0.5, 90.0, 5.0);
+    /// assert_eq!(o, CalibrationOptions::new(0.0601, 0.0005, 0.09, 0.005));
     /// ```
     pub fn from_mw(start_mw: f64, step_mw: f64, max_mw: f64, margin_mw: f64) -> Self {
-        use crate::units::mw;
-        CalibrationOptions::new(mw(start_mw), mw(step_mw), mw(max_mw), mw(margin_mw))
+        let w = |x| shift_decimal(x, -3);
+        CalibrationOptions::new(w(start_mw), w(step_mw), w(max_mw), w(margin_mw))
     }
 
     fn validate(&self) -> Result<()> {
@@ -288,14 +289,16 @@ pub fn calibrate(
     };
     let mut drive = Plant::from_model(model, 0.025, 0, drive_opts)?.into_drive()?;
     let v = model.voltage();
+    // The staircase counts in mW: the levels' powers as written, in the other unit.
+    let to_mw = |x| shift_decimal(x, 3);
     let settings = StaircaseSettings {
-        start_power_mw: sc.start_power * 1e3,
-        step_mw: sc.step * 1e3,
-        max_power_mw: sc.max_power * 1e3,
+        start_power_mw: to_mw(sc.start_power),
+        step_mw: to_mw(sc.step),
+        max_power_mw: to_mw(sc.max_power),
         settle_time_s: sc.settle_time,
         measure_time_s: sc.measure_time,
         find_takeoff: opts.find_takeoff,
-        margin_mw: opts.margin * 1e3,
+        margin_mw: to_mw(opts.margin),
         dither_amplitude_v: v.ac_amplitude,
         dither_frequency_khz: if v.ac_amplitude != 0.0 {
             v.frequency * 1e-3
@@ -322,10 +325,11 @@ pub fn calibrate(
     let outcome = staircase.outcome().clone();
     let mut steps = std::mem::take(&mut staircase.detector_mut().steps);
     // The staircase counts in mW; the powers reported are those of the levels in W, as
-    // `Staircase` defines them.
+    // `Staircase` defines them: level k is `start + k·step` on the decimals typed (0.0745 W,
+    // not 0.07450000000000001).
     let level_power = |p_mw: f64| {
         let k = ((p_mw - settings.start_power_mw) / settings.step_mw).round();
-        sc.start_power + k * sc.step
+        grid_point(sc.start_power, sc.step, k as i64)
     };
     for s in &mut steps {
         s.power = level_power(s.power * 1e3);
@@ -335,7 +339,7 @@ pub fn calibrate(
     let Some(touchdown_power) = outcome.touchdown_power_mw.map(level_power) else {
         return Err(super::CalibrationError::NoTouchdown {
             detector: name,
-            max_power_mw: crate::units::to_mw(sc.max_power),
+            max_power_mw: to_mw(sc.max_power),
         }
         .into());
     };
@@ -345,7 +349,7 @@ pub fn calibrate(
         // there is no touchdown power to find and no contrast to measure.
         return Err(super::CalibrationError::ContactAtStart {
             detector: name,
-            start_power_mw: crate::units::to_mw(sc.start_power),
+            start_power_mw: to_mw(sc.start_power),
         }
         .into());
     }
@@ -357,7 +361,7 @@ pub fn calibrate(
             f64::INFINITY
         }
     };
-    let set_power = touchdown_power - opts.margin;
+    let set_power = grid_point(touchdown_power, opts.margin, -1);
     if set_power < 0.0 {
         return Err(Error::invalid(
             "margin",

@@ -176,7 +176,7 @@ impl Resolved {
 
     /// Sets the parameter, and the fields linked to it, to `x` in its unit.
     pub(super) fn write(&self, scene: &mut Value, x: f64) {
-        let si = x * self.field.factor();
+        let si = crate::units::rescale(x, self.field.factor());
         self.field.write_si(scene, si);
         for l in &self.linked {
             l.write_si(scene, si);
@@ -191,7 +191,9 @@ pub(super) fn resolve(base: &Value, p: &FreeParameter) -> Result<Resolved> {
         .map_err(|e| Error::invalid(field.clone(), e.reason()))?;
     let si = path.get(base).and_then(Value::as_f64).unwrap_or(f64::NAN);
     let linked = linked_fields(base, &path);
-    let start = p.start.unwrap_or(si / path.factor());
+    let start = p
+        .start
+        .unwrap_or_else(|| crate::units::unscale(si, path.factor()));
     let unit = path.unit();
     let bad = |what: &str, v: f64| {
         Error::invalid(

@@ -374,7 +374,9 @@ impl DriveSpec {
         };
         check(f, value, shown, f.unit, 1.0)?;
         if let Some(slot) = self.slot(f.path) {
-            *slot = Some(value * f.factor);
+            // On the decimal given, as the scene reader converts the same field written in the
+            // file (`--runout-nm 500` and `runout_nm = 500` are both 5e-7 m).
+            *slot = Some(crate::units::rescale(value, f.factor));
         }
         Ok(())
     }

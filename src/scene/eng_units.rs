@@ -226,9 +226,10 @@ fn path(prefix: &str, key: &str) -> String {
     }
 }
 
-/// Scales `x` (from the file, in the engineering unit) to SI, refusing overflow.
+/// Scales `x` (from the file, in the engineering unit) to SI on the decimal the file writes
+/// (100 nm is 1e-7 m, not 1.0000000000000001e-7), refusing overflow.
 fn scale(x: f64, f: f64, field: &str, unit: &str) -> Result<f64> {
-    let y = x * f;
+    let y = crate::units::rescale(x, f);
     if x.is_finite() && !y.is_finite() {
         return Err(Error::invalid(
             field,

@@ -270,7 +270,11 @@ impl FieldPath {
         if !self.is_renamed() {
             return Ok(v.clone());
         }
-        let scale = |x: &Value| x.as_f64().map(|x| Value::from(x / self.factor));
+        // On the decimal the scene holds: 7e-10 m reads 0.7 nm (not 0.7000000000000001).
+        let scale = |x: &Value| {
+            x.as_f64()
+                .map(|x| Value::from(crate::units::unscale(x, self.factor)))
+        };
         let scaled = match v {
             Value::Null => Some(Value::Null),
             Value::Array(xs) => xs

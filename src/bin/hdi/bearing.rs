@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use hdi_tribology::bearing::{solve_attitude, AttitudeOptions, BearingSpec, Equilibrium};
+use hdi_tribology::report::CsvTable;
 use serde::Serialize;
 
 use crate::common::{self, CliError, Output};
@@ -141,21 +142,28 @@ fn report(eq: &Equilibrium) -> Result<Report, CliError> {
     })
 }
 
-fn pressure_csv(eq: &Equilibrium) -> String {
+/// The pressure field as CSV, one row per control volume, through the crate's one CSV writer
+/// (a missing value an empty field).
+fn pressure_csv(eq: &Equilibrium) -> Result<String, CliError> {
     let r = &eq.reynolds;
     let (nx, _) = r.size();
-    let mut s = String::from("x_um,y_um,pressure_over_ambient\n");
-    for (j, y) in r.grid.yc.iter().enumerate() {
-        for (i, x) in r.grid.xc.iter().enumerate() {
-            s.push_str(&format!(
-                "{},{},{}\n",
-                x * 1e6,
-                y * 1e6,
-                eq.pressure[j * nx + i]
-            ));
-        }
-    }
-    s
+    let cells = || {
+        r.grid.yc.iter().enumerate().flat_map(move |(j, &y)| {
+            r.grid
+                .xc
+                .iter()
+                .enumerate()
+                .map(move |(i, &x)| (i, j, x, y))
+        })
+    };
+    Ok(CsvTable::new()
+        .real("x_um", cells().map(|(_, _, x, _)| x * 1e6))
+        .real("y_um", cells().map(|(_, _, _, y)| y * 1e6))
+        .real(
+            "pressure_over_ambient",
+            cells().map(|(i, j, _, _)| eq.pressure[j * nx + i]),
+        )
+        .to_csv_string()?)
 }
 
 pub fn run(a: Args) -> Result<(), CliError> {
@@ -189,7 +197,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     if let Some((svg, csv)) = files {
         svg.write(eq.pressure_map_svg().as_bytes())?;
         if let Some(csv) = csv {
-            csv.write(pressure_csv(&eq).as_bytes())?;
+            csv.write(pressure_csv(&eq)?.as_bytes())?;
         }
     }
     common::print_json(&rep)

@@ -10,7 +10,7 @@ use hdi_tribology::analysis::{
 };
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
-use hdi_tribology::units::{fmt_short, mw as from_mw, nm as from_nm};
+use hdi_tribology::units::{fmt_short, mw as from_mw, shift_decimal};
 
 /// One touchdown/take-off cycle under the scene's fixed heater programme (or the
 /// touchdown-triggered protocol), JSON, each key with its unit: scene, programme (fixed or
@@ -98,7 +98,8 @@ impl CycleArgs {
             opts.solver = opts.solver.with_rtol(r);
         }
         if let Some(a) = self.atol_nm {
-            opts.solver.atol_displacement = from_nm(a);
+            // In metres as typed in nm: 0.01 nm is 1e-11 m (not 1.0000000000000001e-11).
+            opts.solver.atol_displacement = shift_decimal(a, -9);
         }
         let programme = if self.triggered {
             HeaterProgramme::triggered_from_scene(scene)
@@ -141,7 +142,7 @@ impl CycleArgs {
                 ..Refinement::new(from_mw(self.refine_mw))
             };
             // The last run must stay in the solver's range too: checked before the first.
-            let last = opts.solver.rtol * refine.factor.powi(i32::from(self.max_runs) - 1);
+            let last = refine.tolerance(opts.solver.rtol, usize::from(self.max_runs) - 1);
             let min = hdi_tribology::ode::MIN_RTOL;
             if last < min {
                 let from = match self.rtol {

@@ -1,7 +1,7 @@
 //! `hdi forces`: every interface force at given bulge gaps.
 
 use hdi_tribology::force::{Breakdown, Gaps};
-use hdi_tribology::units::nm as from_nm;
+use hdi_tribology::units::shift_decimal;
 use serde::Serialize;
 
 use crate::common::{self, list, number, CliError, List, SceneArgs};
@@ -31,6 +31,11 @@ pub struct Args {
     protrusion_nm: Option<f64>,
 }
 
+/// Nanometres to metres on the decimal typed ([`shift_decimal`]).
+fn from_nm(x: f64) -> f64 {
+    shift_decimal(x, -9)
+}
+
 #[derive(Serialize)]
 struct Row {
     d_m: f64,
@@ -46,6 +51,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         (None, Some(List(n))) => (
             "--gaps-nm",
             n.clone(),
+            // In metres as typed in nm: 1.1 nm is 1.1e-9 m (not 1.1000000000000001e-9).
             n.iter().map(|&x| from_nm(x)).collect(),
         ),
         (None, None) => return Err(CliError::Usage("give --gaps or --gaps-nm".into())),
