@@ -315,3 +315,32 @@ fn hdi_drive_bounded_mode_flags_its_misses() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--steps-per-period"));
     assert!(!never.exists());
 }
+
+/// The sensor file's times come back as typed: the k-th period at 20 kHz ends at k / 20 000 s,
+/// the nearest double to the decimal (`0.00015`, not `0.00015000000000000001`), however long
+/// the run; at 25 kHz likewise.
+#[test]
+fn hdi_drive_times_are_the_decimals_of_the_periods() {
+    let cmds = tmp("times.csv");
+    std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.1,60,0\n").unwrap();
+    for (rate, hz) in [("20", 20_000.0), ("25", 25_000.0)] {
+        let o = Command::new(env!("CARGO_BIN_EXE_hdi"))
+            .args(["drive", "--paper", "--flat-disk", "--rate-khz", rate, "--commands"])
+            .arg(&cmds)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = String::from_utf8(o.stdout).unwrap();
+        let times: Vec<&str> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap())
+            .collect();
+        for (k, t) in times.iter().enumerate() {
+            let exact = (k + 1) as f64 / hz;
+            assert_eq!(t.parse::<f64>().unwrap(), exact, "period {}", k + 1);
+        }
+        assert_eq!(*times.last().unwrap(), "0.1");
+        assert_eq!(times[2], if hz == 20_000.0 { "0.00015" } else { "0.00012" });
+    }
+}

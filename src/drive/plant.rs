@@ -786,10 +786,8 @@ pub struct Drive {
     integ: SizedIntegrator,
     sensors: SensorState,
     t: f64,
-    /// The run of equal periods the time is counted in: it began at `runs.0` (s), the period is
-    /// `runs.1` (s) and `runs.2` of them have passed, so that the time is `runs.0 + runs.2 ·
-    /// runs.1`, one rounding from the exact value, not a sum of periods whose rounding grows.
-    runs: (f64, f64, u64),
+    /// The run of equal periods the time is counted in ([`PeriodClock`]).
+    runs: PeriodClock,
     /// The command and ambient clearance the integrator's system holds (`None` before the first
     /// period).
     held: Option<(Command, f64)>,
@@ -891,7 +889,7 @@ impl Drive {
             plant,
             integ,
             t: 0.0,
-            runs: (0.0, f64::NAN, 0),
+            runs: PeriodClock::new(),
             held: None,
             unchanged: 0,
             integrals0: (0.0, 0.0),
@@ -914,10 +912,7 @@ impl Drive {
     /// [`Drive::step`] of a command and period already checked.
     pub(crate) fn step_checked(&mut self, command: &Command, dt: f64) -> Result<Sensors> {
         let plant = &*self.plant;
-        if dt != self.runs.1 {
-            self.runs = (self.t, dt, 0);
-        }
-        let (t0, t1) = (self.t, self.runs.0 + (self.runs.2 + 1) as f64 * dt);
+        let (t0, t1) = (self.t, self.runs.end_of_next(self.t, dt));
         let ambient = plant.ambient.temperature(t0);
         let clearance = plant.ambient.clearance_per_kelvin * ambient;
         let changed = self.held != Some((*command, clearance));
@@ -953,7 +948,7 @@ impl Drive {
         self.held = Some((*command, clearance));
         self.integrals0 = integrals;
         self.t = t1;
-        self.runs.2 += 1;
+        self.runs.periods += 1;
         let friction_power =
             plant.base.friction().coefficient * plant.zone.disk_speed * truth.mean_contact_force;
         let heater_power = command.heater_power();
@@ -1028,6 +1023,47 @@ impl Drive {
     /// The slider model of the zone (with the heater time constant the drive uses).
     pub fn model(&self) -> &SliderModel {
         &self.plant.base
+    }
+}
+
+/// The drive's time over a run of equal periods: the run began at `start` (s) with periods of
+/// `dt` (s), and `periods` of them have passed. The time is `start + k / rate` when the rate
+/// `1/dt` is a whole number of hertz up to rounding (20 kHz: the 3rd period ends at 0.00015 s,
+/// as typed), else `start + k·dt`: one rounding from the exact value either way, not a sum of
+/// periods whose rounding grows.
+#[derive(Clone, Copy, Debug)]
+struct PeriodClock {
+    start: f64,
+    dt: f64,
+    rate: Option<f64>,
+    periods: u64,
+}
+
+impl PeriodClock {
+    fn new() -> Self {
+        PeriodClock {
+            start: 0.0,
+            dt: f64::NAN,
+            rate: None,
+            periods: 0,
+        }
+    }
+
+    /// The end of the next period of length `dt` from `t` (a new run when `dt` changes).
+    fn end_of_next(&mut self, t: f64, dt: f64) -> f64 {
+        if dt != self.dt {
+            let f = 1.0 / dt;
+            let r = f.round();
+            let whole = (f - r).abs() <= 4.0 * f64::EPSILON * r;
+            *self = PeriodClock {
+                start: t,
+                dt,
+                rate: whole.then_some(r),
+                periods: 0,
+            };
+        }
+        let k = (self.periods + 1) as f64;
+        self.start + self.rate.map_or(k * dt, |r| k / r)
     }
 }
 
