@@ -325,7 +325,14 @@ fn hdi_drive_times_are_the_decimals_of_the_periods() {
     std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.1,60,0\n").unwrap();
     for (rate, hz) in [("20", 20_000.0), ("25", 25_000.0)] {
         let o = Command::new(env!("CARGO_BIN_EXE_hdi"))
-            .args(["drive", "--paper", "--flat-disk", "--rate-khz", rate, "--commands"])
+            .args([
+                "drive",
+                "--paper",
+                "--flat-disk",
+                "--rate-khz",
+                rate,
+                "--commands",
+            ])
             .arg(&cmds)
             .output()
             .unwrap();

@@ -609,6 +609,10 @@ where
             }
             None => 0.0,
         };
+        // The next step too.
+        if self.h < self.h_floor {
+            self.h = self.h_floor;
+        }
         Ok(())
     }
 
