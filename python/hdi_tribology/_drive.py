@@ -20,7 +20,10 @@ class Drive:
     ``ambient_period_s``, ``ambient_clearance_per_kelvin_nm``, ``ambient_step_k``,
     ``ambient_step_time_s``, ``ae_gain_v_per_sqrt_w``, ``ae_bandwidth_khz``, ``ae_noise_v``,
     ``contact_noise_ohm``, ``readback_wavelength_nm`` (``heads`` must be 1: one ``Drive`` is
-    one head; ``MultiDrive`` steps several). ``flat_disk`` drops the run-out and waviness. ``atol_pm`` (default 0.01) and
+    one head; ``MultiDrive`` steps several), and ``steps_per_period`` (the bounded mode for
+    firmware in the loop: at most that many Radau5 steps a period, a step at the bound
+    accepted whatever its error; ``last_period`` gives the flag; docs/clearance.md, "The
+    bounded mode"). ``flat_disk`` drops the run-out and waviness. ``atol_pm`` (default 0.01) and
     ``atol_flight_pm`` (default ``atol_pm``, at least ``atol_pm``) are the integration's
     displacement tolerances near contact and in flight (pm). The same seed gives the same disk
     and the same sensor noise, bit for bit; stepping it with the commands of a command file
@@ -76,6 +79,13 @@ class Drive:
     def seed(self) -> int:
         """Seed of the disk's random waviness and of the sensor noise."""
         return self._native().seed
+
+    @property
+    def last_period(self) -> Dict[str, Any]:
+        """How the last period was advanced: ``steps`` (ended in it) and ``error_estimate``
+        (the weighted error estimate against the tolerances: at most 1 under adaptive control;
+        in the bounded mode, above 1 where a step missed them)."""
+        return self._native().last_period
 
     def __repr__(self) -> str:
         name, radius_mm = self._native().zone

@@ -1616,9 +1616,23 @@ fn plant_of(
         Heads::Model(_) => DriveSpec::default(),
     };
     let mut heads_given = false;
+    let mut bounded = None;
     if let Some(kw) = settings {
         for (k, v) in kw.iter() {
             let key: String = k.extract()?;
+            if key == "steps_per_period" {
+                // The bounded mode (`DriveOptions::bounded`), checked with the drive's options.
+                let n: i64 = v
+                    .extract()
+                    .map_err(|_| invalid(&key, "must be a whole number of steps"))?;
+                let max = hdi_tribology::drive::MAX_STEPS_PER_PERIOD;
+                let n = usize::try_from(n)
+                    .ok()
+                    .filter(|n| (1..=max).contains(n))
+                    .ok_or_else(|| invalid(&key, format!("must be 1 to {max}, got {n}")))?;
+                bounded = Some(n);
+                continue;
+            }
             if key == "waviness_orders" {
                 let o: [u32; 2] = v.extract()?;
                 spec.set_waviness_orders(o, &key).py()?;
@@ -1666,9 +1680,12 @@ fn plant_of(
     if flat_disk {
         opts.disk = DiskSpec::flat();
     }
-    let opts = opts
+    let mut opts = opts
         .with_tolerances_pm(atol_pm[0], atol_pm[1], ["atol_pm", "atol_flight_pm"])
         .py()?;
+    if let Some(n) = bounded {
+        opts = opts.bounded(n);
+    }
     let radius = spec.radius_m.unwrap_or(DEFAULT_RADIUS);
     let n = spec.heads as usize;
     // A `Model` drives as it is (its terms with memory included), a `Scene` at its own zone.
@@ -1857,6 +1874,13 @@ impl PyDrive {
     #[getter]
     fn seed(&self) -> u64 {
         self.inner.plant().seed()
+    }
+
+    /// How the last period was advanced: a dict of `steps` and `error_estimate` (the bounded
+    /// mode's flag: above 1 where a step missed the tolerances).
+    #[getter]
+    fn last_period<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(py, &to_value(&self.inner.last_period())?)
     }
 
     /// The zone's scene name and radius (mm).

@@ -255,3 +255,24 @@ def test_replay_of_several_heads_matches_the_cli(tmp_path, paper_scene, hdi_cli)
     one = hdi.replay(paper_scene, [0.0, 0.0005, 0.001], [60.0, 66.0, 66.0], [0.0] * 3, seed=3)
     for name in hdi.SENSOR_COLUMNS:
         assert py[name][py["head"] == 0].tolist() == one[name].tolist(), name
+
+
+def test_the_bounded_mode_bounds_the_steps_and_flags_the_misses(paper_scene):
+    # A 0.5 V dither at 4 steps a period misses the tolerances, and says so; without the bound
+    # the same periods take more steps, each within them.
+    bounded = hdi.Drive(paper_scene, steps_per_period=4)
+    free = hdi.Drive(paper_scene)
+    flags, steps = [], []
+    for _ in range(40):
+        bounded.step(68.0, ac_amplitude_v=0.5, ac_frequency_khz=10.5)
+        free.step(68.0, ac_amplitude_v=0.5, ac_frequency_khz=10.5)
+        flags.append(bounded.last_period["error_estimate"])
+        steps.append((bounded.last_period["steps"], free.last_period["steps"]))
+    assert all(b <= 5 for b, _ in steps)
+    assert max(f for _, f in steps) > 8
+    assert any(f > 1.0 for f in flags)
+    assert free.last_period["error_estimate"] <= 1.0
+    for bad in (0, 65):
+        with pytest.raises(hdi.InvalidInputError) as e:
+            hdi.Drive(paper_scene, steps_per_period=bad)
+        assert e.value.field == "steps_per_period"
