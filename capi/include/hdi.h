@@ -35,7 +35,7 @@
 
 // The version of the ABI this header describes: a program built against one version must be
 // run with a library of the same version (check [`hdi_abi_version`] at start-up).
-#define HDI_ABI_VERSION 2
+#define HDI_ABI_VERSION 3
 
 // What a call did. `HDI_STATUS_OK` is 0; every other value is a failure, with its message
 // from [`hdi_last_error`].
@@ -314,6 +314,10 @@ typedef struct HdiDriveConfig {
   double contact_force_tolerance_un;
   // Largest integration step (µs, > 0), or 0 for no limit (the default).
   double max_step_us;
+  // The bounded mode for firmware in the loop: at most this many Radau5 steps a period (1
+  // to 64), a step at the bound accepted whatever its error, the error estimate returned by
+  // [`hdi_drive_last_period`] as a flag; 0 for adaptive steps (the default).
+  uint32_t steps_per_period;
 } HdiDriveConfig;
 
 // One controller period's command.
@@ -377,6 +381,15 @@ typedef struct HdiSensors {
   // The true values.
   struct HdiTruth truth;
 } HdiSensors;
+
+// How the solver advanced a head's last period ([`hdi_drive_last_period`]).
+typedef struct HdiPeriod {
+  // Steps that ended within the period (0 when one step spans it).
+  uint32_t steps;
+  // The largest weighted error estimate of those steps against the tolerances: at most 1
+  // under adaptive control; in the bounded mode, above 1 where a step missed them.
+  double error_estimate;
+} HdiPeriod;
 
 #ifdef __cplusplus
 extern "C" {
@@ -550,6 +563,13 @@ enum HdiStatus hdi_drive_heads(struct HdiDrive *drive, uint32_t *heads);
 // # Safety
 // `time_s` is `NULL` or valid for writes.
 enum HdiStatus hdi_drive_time(struct HdiDrive *drive, double *time_s);
+
+// How the solver advanced the last period of head `head` (0 to heads − 1): its steps and error
+// estimate, the flag of the bounded mode (`config.steps_per_period`).
+//
+// # Safety
+// `out` is `NULL` or valid for writes.
+enum HdiStatus hdi_drive_last_period(struct HdiDrive *drive, uint32_t head, struct HdiPeriod *out);
 
 // The slider model of the drive's zone (with the heater lag the drive uses) as a new model
 // handle, with the scene's analysis protocol: its static touchdown is the one the drive's

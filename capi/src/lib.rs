@@ -52,7 +52,7 @@ use std::ffi::{c_char, CStr};
 
 /// The version of the ABI this header describes: a program built against one version must be
 /// run with a library of the same version (check [`hdi_abi_version`] at start-up).
-pub const HDI_ABI_VERSION: u32 = 2;
+pub const HDI_ABI_VERSION: u32 = 3;
 
 /// What a call did. `HDI_STATUS_OK` is 0; every other value is a failure, with its message
 /// from [`hdi_last_error`].
@@ -372,6 +372,21 @@ pub struct HdiDriveConfig {
     pub contact_force_tolerance_un: f64,
     /// Largest integration step (µs, > 0), or 0 for no limit (the default).
     pub max_step_us: f64,
+    /// The bounded mode for firmware in the loop: at most this many Radau5 steps a period (1
+    /// to 64), a step at the bound accepted whatever its error, the error estimate returned by
+    /// [`hdi_drive_last_period`] as a flag; 0 for adaptive steps (the default).
+    pub steps_per_period: u32,
+}
+
+/// How the solver advanced a head's last period ([`hdi_drive_last_period`]).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HdiPeriod {
+    /// Steps that ended within the period (0 when one step spans it).
+    pub steps: u32,
+    /// The largest weighted error estimate of those steps against the tolerances: at most 1
+    /// under adaptive control; in the bounded mode, above 1 where a step missed them.
+    pub error_estimate: f64,
 }
 
 /// Options of the static analyses.
@@ -1092,6 +1107,7 @@ fn config_of(o: &DriveOptions, heads: u32, radius: f64, rpm: Option<f64>) -> Hdi
         atol_flight_pm: o.atol_displacement_flight * 1e12,
         contact_force_tolerance_un: to_micro(o.contact_force_tolerance),
         max_step_us: o.max_step.map_or(0.0, to_micro),
+        steps_per_period: o.steps_per_period.map_or(0, |n| n as u32),
     }
 }
 
@@ -1383,6 +1399,17 @@ unsafe fn drive_options(scene: &Scene, c: &HdiDriveConfig) -> Result<Built, Fail
         ),
         max_step,
         ..lib
+    };
+    let max = hdi_tribology::drive::MAX_STEPS_PER_PERIOD;
+    let opts = match c.steps_per_period as usize {
+        0 => opts,
+        n if n <= max => opts.bounded(n),
+        n => {
+            return Err(Failure::invalid(
+                "config.steps_per_period",
+                format!("must be 0 (adaptive) or 1 to {max}, got {n}"),
+            ))
+        }
     };
     Ok(Built {
         heads: heads as usize,
@@ -1696,6 +1723,38 @@ pub unsafe extern "C" fn hdi_drive_time(drive: *mut HdiDrive, time_s: *mut f64) 
         let out = unsafe { out_ref(time_s, "time_s") }?;
         // SAFETY: held exclusively.
         *out = unsafe { &*d.get().drive.get() }.time();
+        Ok(())
+    })
+}
+
+/// How the solver advanced the last period of head `head` (0 to heads − 1): its steps and error
+/// estimate, the flag of the bounded mode (`config.steps_per_period`).
+///
+/// # Safety
+/// `out` is `NULL` or valid for writes.
+#[no_mangle]
+pub unsafe extern "C" fn hdi_drive_last_period(
+    drive: *mut HdiDrive,
+    head: u32,
+    out: *mut HdiPeriod,
+) -> HdiStatus {
+    call(|| {
+        let d = acquire(drive.cast_const(), "drive", Access::Exclusive)?;
+        // SAFETY: the caller's contract.
+        let out = unsafe { out_ref(out, "out") }?;
+        // SAFETY: held exclusively.
+        let drive = unsafe { &*d.get().drive.get() };
+        let Some(h) = drive.head(head as usize) else {
+            return Err(Failure::invalid(
+                "head",
+                format!("the drive has heads 0 to {}, got {head}", drive.heads() - 1),
+            ));
+        };
+        let p = h.last_period();
+        *out = HdiPeriod {
+            steps: p.steps as u32,
+            error_estimate: p.error_estimate,
+        };
         Ok(())
     })
 }

@@ -612,3 +612,68 @@ fn several_heads_are_stepped_together() {
     ok(unsafe { hdi_drive_free(one) });
     ok(unsafe { hdi_scene_free(scene) });
 }
+
+/// The bounded mode through the C ABI: the same drive as the Rust `DriveOptions::bounded`, to
+/// the bit; each period's steps and error estimate from `hdi_drive_last_period`; a bound out of
+/// range and a head out of range are named.
+#[test]
+fn the_bounded_mode_reports_its_flag() {
+    let scene = paper();
+    let mut config = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_drive_config_default(config.as_mut_ptr()) });
+    let mut config: HdiDriveConfig = unsafe { config.assume_init() };
+    assert_eq!(config.steps_per_period, 0);
+    let mut drive = null_mut();
+    config.steps_per_period = 65;
+    let st = unsafe { hdi_drive_new(scene, &config, 1, &mut drive) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(
+        last_error().contains("config.steps_per_period"),
+        "{}",
+        last_error()
+    );
+    config.steps_per_period = 4;
+    ok(unsafe { hdi_drive_new(scene, &config, 1, &mut drive) });
+    let s = Scene::paper();
+    let plant = Plant::new(
+        &s,
+        &zone_at(&s, 0.025, None).unwrap(),
+        1,
+        DriveOptions::default().bounded(4),
+    )
+    .unwrap();
+    let mut rust = plant.drive().unwrap();
+    let cmd = HdiCommand {
+        heater_power_mw: 68.0,
+        ac_amplitude_v: 0.5,
+        ac_frequency_khz: 10.5,
+        ..HdiCommand::default()
+    };
+    let rcmd = Command::heater_mw(68.0).with_dither(0.5, 10.5);
+    let mut missed = 0;
+    for k in 0..40 {
+        let mut out = HdiSensors::default();
+        ok(unsafe { hdi_drive_step(drive, &cmd, 50e-6, &mut out) });
+        let r = rust.step(&rcmd, 50e-6).unwrap();
+        same_sensors(k, &out, &r);
+        let mut p = HdiPeriod::default();
+        ok(unsafe { hdi_drive_last_period(drive, 0, &mut p) });
+        let q = rust.last_period();
+        assert_eq!(
+            (p.steps as usize, p.error_estimate),
+            (q.steps, q.error_estimate)
+        );
+        assert!(p.steps <= 5);
+        missed += usize::from(p.error_estimate > 1.0);
+    }
+    assert!(
+        missed > 0,
+        "the dither at 4 steps a period misses the tolerances"
+    );
+    let mut p = HdiPeriod::default();
+    let st = unsafe { hdi_drive_last_period(drive, 1, &mut p) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("head"), "{}", last_error());
+    ok(unsafe { hdi_drive_free(drive) });
+    ok(unsafe { hdi_scene_free(scene) });
+}
