@@ -1400,16 +1400,10 @@ unsafe fn drive_options(scene: &Scene, c: &HdiDriveConfig) -> Result<Built, Fail
         max_step,
         ..lib
     };
-    let max = hdi_tribology::drive::MAX_STEPS_PER_PERIOD;
-    let opts = match c.steps_per_period as usize {
+    // The plant checks the range (`config_field` names it as the config does).
+    let opts = match c.steps_per_period {
         0 => opts,
-        n if n <= max => opts.bounded(n),
-        n => {
-            return Err(Failure::invalid(
-                "config.steps_per_period",
-                format!("must be 0 (adaptive) or 1 to {max}, got {n}"),
-            ))
-        }
+        n => opts.bounded(n as usize),
     };
     Ok(Built {
         heads: heads as usize,
@@ -1433,6 +1427,7 @@ fn config_field(field: &str) -> Option<String> {
         "atol_displacement_flight" => "config.atol_flight_pm",
         "contact_force_tolerance" => "config.contact_force_tolerance_un",
         "max_step" => "config.max_step_us",
+        "steps_per_period" => "config.steps_per_period",
         "disk.random_orders" => "config.disk.random_order_min, config.disk.random_order_max",
         "disk.harmonics" => "config.disk.harmonics[].order",
         other

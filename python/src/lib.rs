@@ -1621,15 +1621,11 @@ fn plant_of(
         for (k, v) in kw.iter() {
             let key: String = k.extract()?;
             if key == "steps_per_period" {
-                // The bounded mode (`DriveOptions::bounded`), checked with the drive's options.
-                let n: i64 = v
+                // The bounded mode (`DriveOptions::bounded`): the plant checks the range and
+                // names `steps_per_period`, as written here.
+                let n: usize = v
                     .extract()
-                    .map_err(|_| invalid(&key, "must be a whole number of steps"))?;
-                let max = hdi_tribology::drive::MAX_STEPS_PER_PERIOD;
-                let n = usize::try_from(n)
-                    .ok()
-                    .filter(|n| (1..=max).contains(n))
-                    .ok_or_else(|| invalid(&key, format!("must be 1 to {max}, got {n}")))?;
+                    .map_err(|_| invalid(&key, "must be a whole number of steps, at least 1"))?;
                 bounded = Some(n);
                 continue;
             }

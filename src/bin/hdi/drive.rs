@@ -110,8 +110,10 @@ pub struct Args {
     /// tenth of its noise once in contact; docs/clearance.md, "The bounded mode"). Periods
     /// whose error estimate passed the tolerances are counted in the summary and warned about
     /// [default: adaptive steps].
-    #[arg(long, value_name = "N", allow_hyphen_values = true)]
-    steps_per_period: Option<i64>,
+    #[arg(long, value_name = "N", allow_hyphen_values = true,
+          value_parser = clap::value_parser!(u32)
+              .range(1..=hdi_tribology::drive::MAX_STEPS_PER_PERIOD as i64))]
+    steps_per_period: Option<u32>,
 }
 
 /// The drive of the scene's `[drive]` section with the flags over it (each flag checked and
@@ -151,19 +153,6 @@ fn drive_spec(a: &Args, scene: &hdi_tribology::scene::Scene) -> Result<DriveSpec
     Ok(spec)
 }
 
-/// `--steps-per-period`, checked as written.
-fn steps_per_period(n: i64) -> Result<usize, CliError> {
-    let max = hdi_tribology::drive::MAX_STEPS_PER_PERIOD;
-    usize::try_from(n)
-        .ok()
-        .filter(|n| (1..=max).contains(n))
-        .ok_or_else(|| {
-            CliError::Usage(format!(
-                "invalid value for --steps-per-period: must be 1 to {max}, got {n}"
-            ))
-        })
-}
-
 /// The bounded mode's periods that missed the tolerances, on standard error.
 fn warn_bounded(summary: &ReplaySummary) {
     if let Some(b) = summary.bounded {
@@ -196,7 +185,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         // Both are positive numbers by now: what is left is a flag that does not fit the other.
         .map_err(|e| CliError::Usage(e.to_string()))?;
     let opts = match a.steps_per_period {
-        Some(n) => opts.bounded(steps_per_period(n)?),
+        Some(n) => opts.bounded(n as usize),
         None => opts,
     };
     let shown = a.commands.display().to_string();
