@@ -303,6 +303,8 @@ impl Setup {
         // A bounce below the force tables at more than twice the even step pace stops at once,
         // not after the step pace's start allowance of exact-quadrature steps.
         opts.stop_outside_tables = true;
+        // The maps show powers, not the lag's energy audit, which would cost a tenth more.
+        opts.energy_audit = false;
         let base = SliderModel::from_scene(scene)?;
         Ok(Setup {
             slopes: ForceSlopes::of(base.forces()),

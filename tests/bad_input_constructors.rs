@@ -456,6 +456,7 @@ fn cycles_reject_bad_detectors_solvers_and_programmes() {
         solver: sol,
         keep_series: false,
         stop_outside_tables: false,
+        energy_audit: true,
     };
     for x in BAD {
         let mut d = base.detector;

@@ -133,7 +133,8 @@ class Cycle(Result):
     ``v_ac_v``, ``touchdown``/``takeoff`` (Detection or None), ``hysteresis_w``,
     ``mean_temperature_rise_k``, ``duration_s``, ``stats``, ``wall_seconds``, ``rtol``,
     ``atol_m``, ``runs``, ``power_change_w``, ``temperature_change_k``, ``total_stats``,
-    ``total_wall_seconds``, ``status`` and ``flags``."""
+    ``total_wall_seconds``, ``status`` and ``flags``; with an interface lag also ``lag_work_j``
+    and ``damping_work_j`` (the lag's energy audit)."""
 
     _nested = {"touchdown": Detection, "takeoff": Detection}
 

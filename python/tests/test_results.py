@@ -129,3 +129,12 @@ def test_sweep_does_not_depend_on_threads(paper_model):
     # equal by value: every key but the wall-clock times
     assert one == two
     assert [c.v_ac_v for c in one] == amps
+
+
+def test_cycle_reports_the_lag_energy_audit_only_with_a_lag(paper_scene, paper_model):
+    lagged = hdi.Model(paper_scene.with_values({"slider.interface_lag_s": 2e-8}))
+    c = hdi.simulate_cycle(lagged, series=False)["cycle"]
+    # below c/K the lag gives back part of what the damping takes out, never more
+    assert 0 < c.lag_work_j < c.damping_work_j
+    plain = hdi.simulate_cycle(paper_model, series=False)["cycle"]
+    assert "lag_work_j" not in plain and "damping_work_j" not in plain

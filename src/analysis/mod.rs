@@ -5,6 +5,7 @@
 //! with [`crate::ode`].
 
 pub mod cycle;
+pub mod energy;
 pub mod equilibrium;
 pub mod protocol;
 pub mod pull_in;
@@ -19,6 +20,7 @@ pub use cycle::{
     simulate_cycle, CycleOptions, CycleResult, Detection, Detector, HeaterProgramme,
     SolverSettings, TimeSeries,
 };
+pub use energy::LagEnergy;
 pub use equilibrium::{
     flying_equilibrium, s_curve, Equilibrium, EquilibriumSolver, Fold, SCurve, ScanGrid,
 };

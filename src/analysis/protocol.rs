@@ -89,7 +89,8 @@ impl StaticOptions {
 
 impl CycleOptions {
     /// The detector and solver settings of a scene, without time series and without the stop
-    /// below the force tables ([`CycleOptions::stop_outside_tables`]).
+    /// below the force tables ([`CycleOptions::stop_outside_tables`]), with the energy audit of
+    /// an interface lag ([`CycleOptions::energy_audit`]).
     pub fn from_scene(scene: &Scene) -> Result<Self> {
         let method: Method = scene
             .solver
@@ -110,6 +111,7 @@ impl CycleOptions {
             },
             keep_series: false,
             stop_outside_tables: false,
+            energy_audit: true,
         })
     }
 }

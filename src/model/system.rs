@@ -124,6 +124,20 @@ impl StateLayout {
     }
 }
 
+/// The slider's parts of the energy audit of an interface lag
+/// ([`SliderSystem::lag_audit_parts`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LagAuditParts {
+    /// The interface lag `τ` (s).
+    pub tau: f64,
+    /// The lagged force's index in the state.
+    pub lagged: usize,
+    /// The bulge influence vector `b`: the interface force does work at the rate `F bᵀq̇`.
+    pub bulge: Dofs,
+    /// `C + c e₀e₀ᵀ`: the damping takes out `q̇ᵀ(C + c e₀e₀ᵀ)q̇`.
+    pub damping: super::structure::DofMatrix,
+}
+
 /// A state of rest: coordinates, protrusion and the interface force there (the static equilibria
 /// of `analysis` give one).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -312,6 +326,26 @@ impl SliderSystem {
         DefaultAllocator: Allocator<D>,
     {
         self.model.bearing().force(s[0], s[self.layout.velocity(0)])
+    }
+
+    /// What the energy audit of an interface lag needs of the slider (`analysis::energy`): the
+    /// lag `τ` (s), the lagged force's index, the bulge vector `b` and the damping matrix
+    /// `C + c e₀e₀ᵀ` (the structure's and the air bearing's, `c` at the body heave `y`). `None`
+    /// without a lag state, or with a quasi-static bulge (whose bulge does not move on its own).
+    pub(crate) fn lag_audit_parts(&self, y: f64) -> Option<LagAuditParts> {
+        let lagged = self.layout.lagged_force?;
+        if self.model.quasi_static.is_some() {
+            return None;
+        }
+        let st = &self.model.structure;
+        let mut damping = st.damping_block();
+        damping[(0, 0)] += self.model.bearing().damping(y);
+        Some(LagAuditParts {
+            tau: self.model.interface_lag,
+            lagged,
+            bulge: st.bulge_vector(),
+            damping,
+        })
     }
 
     fn local<D: Dim>(&self, t: f64, s: &OVector<f64, D>) -> Local

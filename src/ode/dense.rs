@@ -44,6 +44,43 @@ pub struct StepPolynomial<'a> {
     pub coeffs: &'a [f64],
 }
 
+impl StepPolynomial<'_> {
+    /// The interpolated state at `t` (inside the step) into `out`, one entry per component.
+    ///
+    /// ```
+    /// use hdi_tribology::ode::{FnSystem, Integrator, Method, Options};
+    /// use nalgebra::Vector1;
+    /// let sys = FnSystem::new(|_t, y: &Vector1<f64>, dy: &mut Vector1<f64>| dy[0] = -y[0]);
+    /// let o = Options::default().rtol(1e-10).atol(1e-12).dense(true);
+    /// let mut it = Integrator::new(sys, 0.0, Vector1::new(1.0), 1.0, Method::Tsit5, &o)?;
+    /// it.step()?;
+    /// let p = it.last_step();
+    /// let mut y = [0.0];
+    /// p.state_at(p.t0 + 0.5 * p.h, &mut y);
+    /// assert!((y[0] - (-(p.t0 + 0.5 * p.h)).exp()).abs() < 1e-8);
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    pub fn state_at(&self, t: f64, out: &mut [f64]) {
+        let theta = self.theta(t);
+        let n = self.n;
+        out[..n].fill(0.0);
+        for a in self.coeffs.chunks_exact(n.max(1)).rev() {
+            for (o, c) in out[..n].iter_mut().zip(a) {
+                *o = *o * theta + c;
+            }
+        }
+    }
+
+    #[inline]
+    fn theta(&self, t: f64) -> f64 {
+        if self.h != 0.0 {
+            (t - self.t0) / self.h
+        } else {
+            0.0
+        }
+    }
+}
+
 impl StepPoly {
     /// This interpolant, as the public view.
     pub(crate) fn view(&self) -> StepPolynomial<'_> {
