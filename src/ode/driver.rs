@@ -68,7 +68,9 @@ where
         SaveAt::Final => {}
     }
 
-    let mut it = Integrator::build(sys, t0, y0, tf, method, opts, need_poly)?;
+    let mut it = Integrator::new(sys, t0, y0, tf, method, opts)?;
+    // Step interpolants for the events and the output times too, not only for dense output.
+    it.ctx.need_poly = need_poly;
     it.init_events(events);
     observe(t0, it.state());
     let mut work = sol.y_end.clone();
