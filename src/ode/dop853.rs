@@ -3,7 +3,9 @@
 //! continuous extension from 3 extra stages (computed only when interpolation is needed).
 
 use super::dense::StepPoly;
-use super::stepper::{all_finite, stage_spectral_radius, zeros_like, Ctx, FailKind, Step, Stepper, Trial};
+use super::stepper::{
+    all_finite, stage_spectral_radius, zeros_like, Ctx, FailKind, Step, Stepper, Trial,
+};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 

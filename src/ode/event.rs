@@ -101,7 +101,6 @@ where
         self
     }
 
-
     pub(crate) fn inside_checks(&self) -> usize {
         self.inside
     }

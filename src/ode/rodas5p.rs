@@ -5,7 +5,9 @@
 use super::dense::StepPoly;
 use super::jacobian::{eval_jacobian_and_time_derivative, Radius};
 use super::lu::Lu;
-use super::stepper::{add_scaled, all_finite, sum_into, zeros_like, Ctx, FailKind, Step, Stepper, Trial};
+use super::stepper::{
+    add_scaled, all_finite, sum_into, zeros_like, Ctx, FailKind, Step, Stepper, Trial,
+};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 

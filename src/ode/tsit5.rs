@@ -2,7 +2,9 @@
 //! 770–775): 7 stages with FSAL, 4th-order continuous extension.
 
 use super::dense::StepPoly;
-use super::stepper::{all_finite, stage_spectral_radius, zeros_like, Ctx, FailKind, Step, Stepper, Trial};
+use super::stepper::{
+    all_finite, stage_spectral_radius, zeros_like, Ctx, FailKind, Step, Stepper, Trial,
+};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
