@@ -95,6 +95,19 @@
 #![warn(rustdoc::all)]
 #![cfg_attr(docsrs, feature(doc_cfg))]
 
+/// Builder methods that set one field each: `name(arg: T) => field = value;` makes
+/// `pub fn name(mut self, arg: T) -> Self` that sets `self.field = value`, and `name() => …`
+/// one without an argument. Defined before the modules, so that every module can use it.
+macro_rules! setters {
+    ($($(#[$doc:meta])* $name:ident($($arg:ident: $ty:ty)?) => $field:ident = $value:expr;)*) => {$(
+        $(#[$doc])*
+        pub fn $name(mut self $(, $arg: $ty)?) -> Self {
+            self.$field = $value;
+            self
+        }
+    )*};
+}
+
 pub mod analysis;
 pub mod bearing;
 pub mod cache;

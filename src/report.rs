@@ -361,17 +361,6 @@ pub struct Series<'a> {
     pub arrows: Vec<usize>,
 }
 
-/// Builder methods that switch one `bool` field of [`Series`] on.
-macro_rules! flag_setters {
-    ($($(#[$doc:meta])* $name:ident => $field:ident,)*) => {$(
-        $(#[$doc])*
-        pub fn $name(mut self) -> Self {
-            self.$field = true;
-            self
-        }
-    )*};
-}
-
 impl<'a> Series<'a> {
     /// A solid line through `points`.
     pub fn line(label: &'a str, points: Vec<(f64, f64)>) -> Self {
@@ -402,38 +391,23 @@ impl<'a> Series<'a> {
             ..Self::line(label, lower)
         }
     }
-    /// With a text beside each point (`labels[i]` beside `points[i]`; empty for none).
-    pub fn point_labels(mut self, labels: Vec<String>) -> Self {
-        self.labels = labels;
-        self
-    }
-    /// With arrowheads at these point indices, pointing along the line.
-    pub fn arrows(mut self, at: Vec<usize>) -> Self {
-        self.arrows = at;
-        self
-    }
-    /// With this colour.
-    pub fn colour(mut self, c: Colour) -> Self {
-        self.colour = Some(c);
-        self
-    }
-    /// With this marker symbol.
-    pub fn marker(mut self, m: Marker) -> Self {
-        self.marker = m;
-        self
-    }
-    /// With this line width (marker size) in pixels.
-    pub fn width(mut self, px: u32) -> Self {
-        self.width = px;
-        self
-    }
-    flag_setters! {
+    setters! {
+        /// With a text beside each point (`labels[i]` beside `points[i]`; empty for none).
+        point_labels(labels: Vec<String>) => labels = labels;
+        /// With arrowheads at these point indices, pointing along the line.
+        arrows(at: Vec<usize>) => arrows = at;
+        /// With this colour.
+        colour(c: Colour) => colour = Some(c);
+        /// With this marker symbol.
+        marker(m: Marker) => marker = m;
+        /// With this line width (marker size) in pixels.
+        width(px: u32) => width = px;
         /// Markers as outlines only.
-        hollow => hollow,
+        hollow() => hollow = true;
         /// Dashed line.
-        dashed => dashed,
+        dashed() => dashed = true;
         /// On the second y axis.
-        on_secondary => secondary,
+        on_secondary() => secondary = true;
     }
 }
 

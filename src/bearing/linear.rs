@@ -367,33 +367,26 @@ fn coarsen_into(a: &FivePoint, c: &mut FivePoint) {
             let k = j * nx + i;
             let kc = jc * mx + ic;
             c.diag[kc] += a.diag[k];
-            if i > 0 {
-                if agg(i - 1, mx) == ic {
-                    c.diag[kc] += a.west[k];
+            // A link within the aggregate adds to the coarse diagonal, one out of it to the
+            // coarse link.
+            let mut link = |coarse: &mut Vec<f64>, a: f64, within: bool| {
+                if within {
+                    c.diag[kc] += a;
                 } else {
-                    c.west[kc] += a.west[k];
+                    coarse[kc] += a;
                 }
+            };
+            if i > 0 {
+                link(&mut c.west, a.west[k], agg(i - 1, mx) == ic);
             }
             if i + 1 < nx {
-                if agg(i + 1, mx) == ic {
-                    c.diag[kc] += a.east[k];
-                } else {
-                    c.east[kc] += a.east[k];
-                }
+                link(&mut c.east, a.east[k], agg(i + 1, mx) == ic);
             }
             if j > 0 {
-                if agg(j - 1, my) == jc {
-                    c.diag[kc] += a.south[k];
-                } else {
-                    c.south[kc] += a.south[k];
-                }
+                link(&mut c.south, a.south[k], agg(j - 1, my) == jc);
             }
             if j + 1 < ny {
-                if agg(j + 1, my) == jc {
-                    c.diag[kc] += a.north[k];
-                } else {
-                    c.north[kc] += a.north[k];
-                }
+                link(&mut c.north, a.north[k], agg(j + 1, my) == jc);
             }
         }
     }

@@ -8,6 +8,7 @@ use std::sync::{Mutex, OnceLock};
 use crate::bearing::geometry::{MAX_CELLS, MIN_CELLS};
 use crate::bearing::{solve_attitude, AttitudeOptions, BearingSpec, Equilibrium};
 use crate::error::{check_finite, check_non_negative, check_positive};
+use crate::numerics::cubic_hermite;
 use crate::{Error, Result};
 
 /// Air bearing: force (N, positive = away from the disk) at displacement `y` (m, positive = away
@@ -466,18 +467,9 @@ impl ReynoldsBearing {
         if t == 0.0 {
             return (self.f[k], self.df[k]);
         }
-        let (t2, t3) = (t * t, t * t * t);
         let (f0, f1, d0, d1) = (self.f[k], self.f[k + 1], self.df[k] * h, self.df[k + 1] * h);
-        let f = (2.0 * t3 - 3.0 * t2 + 1.0) * f0
-            + (t3 - 2.0 * t2 + t) * d0
-            + (-2.0 * t3 + 3.0 * t2) * f1
-            + (t3 - t2) * d1;
-        let df = ((6.0 * t2 - 6.0 * t) * f0
-            + (3.0 * t2 - 4.0 * t + 1.0) * d0
-            + (-6.0 * t2 + 6.0 * t) * f1
-            + (3.0 * t2 - 2.0 * t) * d1)
-            / h;
-        (f, df)
+        let (f, df_dt) = cubic_hermite(t, f0, d0, f1, d1);
+        (f, df_dt / h)
     }
 }
 

@@ -68,7 +68,15 @@ impl Structure {
     /// ```
     pub fn rigid(mass: f64) -> Result<Self> {
         check_positive("slider.mass_kg", mass)?;
-        let mut s = Self::build(1, &[[mass]], &[[0.0]], &[[0.0]], &[1.0], "structure")?;
+        let mut s = Self::build(
+            1,
+            &[[mass]],
+            &[[0.0]],
+            &[[0.0]],
+            &[1.0],
+            "structure",
+            Kind::Symmetric,
+        )?;
         s.base[0] = 1.0;
         Ok(s)
     }
@@ -97,6 +105,7 @@ impl Structure {
             &[[k, -k], [-k, k]],
             &[0.0, 1.0],
             "structure",
+            Kind::Symmetric,
         )?;
         // Both coordinates are absolute translations: a disk translation moves both.
         s.base[0] = 1.0;
@@ -139,7 +148,7 @@ impl Structure {
         check_finite("structure.trailing_edge_m", trailing_edge)?;
         let mass = [[body_mass, 0.0], [0.0, inertia]];
         let bulge = [1.0, trailing_edge];
-        let mut s = Self::build_as(2, &mass, &c, &k, &bulge, prefix, coefficients)?;
+        let mut s = Self::build(2, &mass, &c, &k, &bulge, prefix, coefficients)?;
         if trailing_edge != 0.0 {
             s.length_scale[1] = trailing_edge.abs();
         }
@@ -234,6 +243,7 @@ impl Structure {
             &rows(stiffness),
             &b,
             "structure",
+            Kind::Symmetric,
         )?;
         s.base = s.rigid_translation();
         Ok(s)
@@ -295,19 +305,10 @@ impl Structure {
         }
     }
 
+    /// The structure of `n` coordinates with these matrices (their first `n` rows and columns)
+    /// and bulge influence, errors naming `{prefix}.mass` etc.; the damping and stiffness checked
+    /// as `coefficients`.
     fn build<const R: usize>(
-        n: usize,
-        mass: &[[f64; R]],
-        damping: &[[f64; R]],
-        stiffness: &[[f64; R]],
-        bulge: &[f64],
-        prefix: &str,
-    ) -> Result<Self> {
-        Self::build_as(n, mass, damping, stiffness, bulge, prefix, Kind::Symmetric)
-    }
-
-    /// [`Structure::build`] with the damping and stiffness checked as `coefficients`.
-    fn build_as<const R: usize>(
         n: usize,
         mass: &[[f64; R]],
         damping: &[[f64; R]],

@@ -3,7 +3,9 @@
 //! continuous extension from 3 extra stages (computed only when interpolation is needed).
 
 use super::dense::StepPoly;
-use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
+use super::stepper::{
+    all_finite, stage_spectral_radius, zeros_like, Ctx, FailKind, Step, Stepper, Trial,
+};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
@@ -462,28 +464,16 @@ where
         8.0
     }
 
-    fn is_stiff(&self) -> bool {
-        false
-    }
-
     fn restart(&mut self, sys: &S, t: f64, y: &OVector<f64, D>, ctx: &mut Ctx<D>) {
-        sys.rhs(t, y, &mut self.k[0]);
-        ctx.stats.rhs_evals += 1;
+        ctx.rhs(sys, t, y, &mut self.k[0]);
     }
 
     fn f0(&self) -> &OVector<f64, D> {
         &self.k[0]
     }
 
-    fn attempt(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        y_new: &mut OVector<f64, D>,
-        ctx: &mut Ctx<D>,
-    ) -> Trial {
+    fn attempt(&mut self, sys: &S, step: Step<'_, D>, ctx: &mut Ctx<D>) -> Trial {
+        let Step { t, h, y, y_new } = step;
         for (s, &cs) in C.iter().enumerate().take(12).skip(1) {
             Self::stage_input(&self.k, s, y, h, &mut self.stage);
             let (_, rest) = self.k.split_at_mut(s);
@@ -522,14 +512,8 @@ where
         // `stage` and `y_new`; their difference quotient estimates the spectral radius.
         // Only `Auto` asks for it.
         if ctx.want_stiffness {
-            let (mut num, mut den) = (0.0, 0.0);
-            for i in 0..n {
-                let dk = self.k[12][i] - self.k[11][i];
-                let dy = y_new[i] - self.stage[i];
-                num += dk * dk;
-                den += dy * dy;
-            }
-            self.h_rho = (den > 0.0).then(|| h.abs() * (num / den).sqrt());
+            self.h_rho = stage_spectral_radius(&self.k[12], &self.k[11], y_new, &self.stage)
+                .map(|r| h.abs() * r);
         }
         let mut deno = s5 + 0.01 * s3;
         if deno.is_nan() || deno <= 0.0 {
@@ -540,16 +524,9 @@ where
         }
     }
 
-    fn accept(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        y_new: &OVector<f64, D>,
-        poly: &mut StepPoly,
-        ctx: &mut Ctx<D>,
-    ) {
+    fn accept(&mut self, sys: &S, step: &Step<'_, D>, poly: &mut StepPoly, ctx: &mut Ctx<D>) {
+        let Step { t, h, y, .. } = *step;
+        let y_new = &*step.y_new;
         if ctx.need_poly {
             for (s, &cs) in C.iter().enumerate().skip(13) {
                 Self::stage_input(&self.k, s, y, h, &mut self.stage);

@@ -1,5 +1,5 @@
-//! [`solve`](super::solve): the [`Integrator`] run to the end, with the output the options
-//! ask for (saved states, dense output, located events).
+//! [`solve`](super::solve) and [`solve_observed`]: the [`Integrator`] run to the end, with the
+//! output the options ask for (saved states, dense output, located events).
 
 use super::dense::DenseOutput;
 use super::error::OdeError;
@@ -10,10 +10,36 @@ use super::solution::{Solution, Stats};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
-/// Integrates from `t0` to `tf` (or a terminal event) and collects the output; `observe` sees
-/// the start and every accepted step.
+/// [`solve`](super::solve), calling `observe(t, y)` at the start and after every accepted step
+/// (after an acting event's change, for a step it cut): results streamed without saving every
+/// step (`SaveAt::Final`), as a per-step callback of DifferentialEquations.jl does.
+///
+/// ```
+/// use hdi_tribology::ode::{solve_observed, FnSystem, Method, Options, SaveAt};
+/// use nalgebra::Vector2;
+///
+/// // A harmonic oscillator: keep only the largest |x| seen and the number of steps.
+/// let osc = FnSystem::new(|_t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>| {
+///     dy[0] = y[1];
+///     dy[1] = -y[0];
+/// });
+/// let (mut peak, mut calls) = (0.0f64, 0);
+/// let opts = Options::default().rtol(1e-9).save(SaveAt::Final);
+/// let sol = solve_observed(&osc, 0.0, Vector2::new(1.0, 0.0), 10.0, Method::Dop853, &opts, &mut [],
+///     |_t, y| {
+///         peak = peak.max(y[0].abs());
+///         calls += 1;
+///     })?;
+/// assert_eq!(calls, sol.stats.accepted + 1);
+/// assert_eq!(sol.t.len(), 1); // nothing saved but the end
+/// assert!((peak - 1.0).abs() < 1e-6);
+/// # Ok::<(), hdi_tribology::ode::OdeError>(())
+/// ```
+///
+/// # Errors
+/// As [`solve`](super::solve).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn run<D: Dim, S: OdeSystem<D> + ?Sized>(
+pub fn solve_observed<D: Dim, S: OdeSystem<D> + ?Sized>(
     sys: &S,
     t0: f64,
     y0: OVector<f64, D>,
@@ -21,7 +47,7 @@ pub(crate) fn run<D: Dim, S: OdeSystem<D> + ?Sized>(
     method: Method,
     opts: &Options,
     events: &mut [Event<'_, D>],
-    observe: &mut dyn FnMut(f64, &OVector<f64, D>),
+    mut observe: impl FnMut(f64, &OVector<f64, D>),
 ) -> Result<Solution<D>, OdeError>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
@@ -68,7 +94,9 @@ where
         SaveAt::Final => {}
     }
 
-    let mut it = Integrator::build(sys, t0, y0, tf, method, opts, need_poly)?;
+    let mut it = Integrator::new(sys, t0, y0, tf, method, opts)?;
+    // Step interpolants for the events and the output times too, not only for dense output.
+    it.ctx.need_poly = need_poly;
     it.init_events(events);
     observe(t0, it.state());
     let mut work = sol.y_end.clone();

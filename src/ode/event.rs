@@ -101,15 +101,6 @@ where
         self
     }
 
-    /// Also checks the sign of `g` at `n` evenly spaced points inside each step (on the
-    /// interpolant), so that a pair of roots within one step is not missed. 0 (only the step
-    /// ends) by default; [`affect`](Event::affect) sets 4 when none was set, because right
-    /// after an action `g` starts at zero and a long step could carry it out and back.
-    pub fn check_inside(mut self, n: usize) -> Self {
-        self.inside = n;
-        self
-    }
-
     pub(crate) fn inside_checks(&self) -> usize {
         self.inside
     }
@@ -125,16 +116,16 @@ where
         }
     }
 
-    /// Sets the direction.
-    pub fn direction(mut self, d: Direction) -> Self {
-        self.direction = d;
-        self
-    }
-
-    /// Makes the event stop the integration (`true`) or only be recorded (`false`).
-    pub fn terminal(mut self, terminal: bool) -> Self {
-        self.terminal = terminal;
-        self
+    setters! {
+        /// Also checks the sign of `g` at `n` evenly spaced points inside each step (on the
+        /// interpolant), so that a pair of roots within one step is not missed. 0 (only the step
+        /// ends) by default; [`affect`](Event::affect) sets 4 when none was set, because right
+        /// after an action `g` starts at zero and a long step could carry it out and back.
+        check_inside(n: usize) => inside = n;
+        /// Sets the direction.
+        direction(d: Direction) => direction = d;
+        /// Makes the event stop the integration (`true`) or only be recorded (`false`).
+        terminal(terminal: bool) => terminal = terminal;
     }
 
     /// Whether the event stops the integration.

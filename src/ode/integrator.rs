@@ -11,7 +11,7 @@ use super::options::{Method, Options};
 use super::radau5::Radau5;
 use super::rodas5p::Rodas5P;
 use super::solution::Stats;
-use super::stepper::{all_finite, Ctx, FailKind, Stepper, Trial};
+use super::stepper::{all_finite, Ctx, FailKind, Step, Stepper, Trial};
 use super::system::OdeSystem;
 use super::tsit5::Tsit5;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
@@ -317,19 +317,6 @@ where
         method: Method,
         opts: &Options,
     ) -> Result<Self, OdeError> {
-        Self::build(sys, t0, y0, tf, method, opts, opts.dense)
-    }
-
-    /// Shared constructor; `need_poly` says whether step interpolants are built.
-    pub(crate) fn build(
-        sys: S,
-        t0: f64,
-        y0: OVector<f64, D>,
-        tf: f64,
-        method: Method,
-        opts: &Options,
-        need_poly: bool,
-    ) -> Result<Self, OdeError> {
         opts.validate(y0.len())?;
         if y0.is_empty() {
             return Err(OdeError::invalid(
@@ -362,7 +349,7 @@ where
             rtol: opts.rtol,
             stats: Stats::default(),
             want_stiffness: switching,
-            need_poly,
+            need_poly: opts.dense,
         };
         let mut kinks: Vec<f64> = opts.t_stops.clone();
         kinks.sort_by(f64::total_cmp);
@@ -879,15 +866,13 @@ where
             self.ctx.stats.stiff_steps += 1;
         }
         let stepper = self.steppers.get::<S>(self.active);
-        stepper.accept(
-            &self.sys,
+        let step = Step {
             t,
-            &self.y,
             h,
-            &self.y_new,
-            &mut self.poly,
-            &mut self.ctx,
-        );
+            y: &self.y,
+            y_new: &mut self.y_new,
+        };
+        stepper.accept(&self.sys, &step, &mut self.poly, &mut self.ctx);
         self.have_poly = self.ctx.need_poly;
         let t_new = if hit_stop { stop } else { t + h };
 
@@ -974,7 +959,13 @@ where
             let stepper = self.steppers.get::<S>(self.active);
             let k = stepper.error_order();
             let stiff = stepper.is_stiff();
-            let trial = stepper.attempt(sys, t, &self.y, h, &mut self.y_new, &mut self.ctx);
+            let step = Step {
+                t,
+                h,
+                y: &self.y,
+                y_new: &mut self.y_new,
+            };
+            let trial = stepper.attempt(sys, step, &mut self.ctx);
             let err = match trial {
                 Trial::Done { err } if err.is_finite() => err,
                 Trial::Done { .. } => {
@@ -1358,8 +1349,7 @@ where
     h0 = h0.min(h_max);
     let mut y1 = y.clone();
     y1.axpy(h0, f0, 1.0);
-    sys.rhs(t + h0, &y1, work);
-    ctx.stats.rhs_evals += 1;
+    ctx.rhs(sys, t + h0, &y1, work);
     let mut diff = work.clone();
     diff -= f0;
     let d2 = ctx.norm_at(&diff, y) / h0;

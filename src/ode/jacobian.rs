@@ -74,8 +74,7 @@ fn difference_time_derivative<D: Dim, S: OdeSystem<D> + ?Sized>(
     let delta = f64::EPSILON.sqrt() * t.abs().max(h.abs()).max(f64::MIN_POSITIVE);
     let tp = t + delta;
     let delta = tp - t;
-    sys.rhs(tp, y, dfdt);
-    ctx.stats.rhs_evals += 1;
+    ctx.rhs(sys, tp, y, dfdt);
     *dfdt -= f0;
     *dfdt /= delta;
 }

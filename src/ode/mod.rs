@@ -47,6 +47,7 @@ mod tsit5;
 
 pub use cancel::{Cancel, CANCEL_CHECK_INTERVAL};
 pub use dense::{DenseOutput, StepPolynomial};
+pub use driver::solve_observed;
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
 pub use integrator::{Integrator, StepStatus};
@@ -102,49 +103,4 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     solve_observed(sys, t0, y0, tf, method, opts, events, |_, _| {})
-}
-
-/// [`solve`], calling `observe(t, y)` at the start and after every accepted step (after an
-/// acting event's change, for a step it cut): results streamed without saving every step
-/// (`SaveAt::Final`), as a per-step callback of DifferentialEquations.jl does.
-///
-/// ```
-/// use hdi_tribology::ode::{solve_observed, FnSystem, Method, Options, SaveAt};
-/// use nalgebra::Vector2;
-///
-/// // A harmonic oscillator: keep only the largest |x| seen and the number of steps.
-/// let osc = FnSystem::new(|_t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>| {
-///     dy[0] = y[1];
-///     dy[1] = -y[0];
-/// });
-/// let (mut peak, mut calls) = (0.0f64, 0);
-/// let opts = Options::default().rtol(1e-9).save(SaveAt::Final);
-/// let sol = solve_observed(&osc, 0.0, Vector2::new(1.0, 0.0), 10.0, Method::Dop853, &opts, &mut [],
-///     |_t, y| {
-///         peak = peak.max(y[0].abs());
-///         calls += 1;
-///     })?;
-/// assert_eq!(calls, sol.stats.accepted + 1);
-/// assert_eq!(sol.t.len(), 1); // nothing saved but the end
-/// assert!((peak - 1.0).abs() < 1e-6);
-/// # Ok::<(), hdi_tribology::ode::OdeError>(())
-/// ```
-///
-/// # Errors
-/// As [`solve`].
-#[allow(clippy::too_many_arguments)]
-pub fn solve_observed<D: Dim, S: OdeSystem<D> + ?Sized>(
-    sys: &S,
-    t0: f64,
-    y0: OVector<f64, D>,
-    tf: f64,
-    method: Method,
-    opts: &Options,
-    events: &mut [Event<'_, D>],
-    mut observe: impl FnMut(f64, &OVector<f64, D>),
-) -> Result<Solution<D>, OdeError>
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    driver::run(sys, t0, y0, tf, method, opts, events, &mut observe)
 }

@@ -215,66 +215,31 @@ impl Default for Options {
 }
 
 impl Options {
-    /// Sets the relative tolerance.
-    pub fn rtol(mut self, rtol: f64) -> Self {
-        self.rtol = rtol;
-        self
-    }
-    /// Sets one absolute tolerance for all components.
-    pub fn atol(mut self, atol: f64) -> Self {
-        self.atol = Tolerance::Scalar(atol);
-        self
-    }
-    /// Sets one absolute tolerance per component.
-    pub fn atol_per_component(mut self, atol: Vec<f64>) -> Self {
-        self.atol = Tolerance::PerComponent(atol);
-        self
-    }
-    /// Sets the initial step size.
-    pub fn h_init(mut self, h: f64) -> Self {
-        self.h_init = Some(h);
-        self
-    }
-    /// Sets the largest step size.
-    pub fn h_max(mut self, h: f64) -> Self {
-        self.h_max = h;
-        self
-    }
-    /// Sets the step size floor.
-    pub fn h_min(mut self, h: f64) -> Self {
-        self.h_min = h;
-        self
-    }
-    /// Sets the budget of step attempts.
-    pub fn max_steps(mut self, n: usize) -> Self {
-        self.max_steps = n;
-        self
-    }
-    /// Sets the times where the right-hand side has kinks.
-    pub fn t_stops(mut self, t: Vec<f64>) -> Self {
-        self.t_stops = t;
-        self
-    }
-    /// Sets what to save.
-    pub fn save(mut self, save: SaveAt) -> Self {
-        self.save = save;
-        self
-    }
-    /// Turns dense output on or off.
-    pub fn dense(mut self, dense: bool) -> Self {
-        self.dense = dense;
-        self
-    }
-    /// Sets the time tolerance of event location.
-    pub fn event_tol(mut self, tol: f64) -> Self {
-        self.event_tol = tol;
-        self
-    }
-
-    /// Turns step size control on (default) or off (constant steps of `h_init`).
-    pub fn adaptive(mut self, adaptive: bool) -> Self {
-        self.adaptive = adaptive;
-        self
+    setters! {
+        /// Sets the relative tolerance.
+        rtol(rtol: f64) => rtol = rtol;
+        /// Sets one absolute tolerance for all components.
+        atol(atol: f64) => atol = Tolerance::Scalar(atol);
+        /// Sets one absolute tolerance per component.
+        atol_per_component(atol: Vec<f64>) => atol = Tolerance::PerComponent(atol);
+        /// Sets the initial step size.
+        h_init(h: f64) => h_init = Some(h);
+        /// Sets the largest step size.
+        h_max(h: f64) => h_max = h;
+        /// Sets the step size floor.
+        h_min(h: f64) => h_min = h;
+        /// Sets the budget of step attempts.
+        max_steps(n: usize) => max_steps = n;
+        /// Sets the times where the right-hand side has kinks.
+        t_stops(t: Vec<f64>) => t_stops = t;
+        /// Sets what to save.
+        save(save: SaveAt) => save = save;
+        /// Turns dense output on or off.
+        dense(dense: bool) => dense = dense;
+        /// Sets the time tolerance of event location.
+        event_tol(tol: f64) => event_tol = tol;
+        /// Turns step size control on (default) or off (constant steps of `h_init`).
+        adaptive(adaptive: bool) => adaptive = adaptive;
     }
 
     /// Checks every option for a state of dimension `n`.

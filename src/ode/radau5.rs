@@ -7,7 +7,7 @@
 use super::dense::StepPoly;
 use super::jacobian::{eval_jacobian, Radius};
 use super::lu::Lu;
-use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
+use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Step, Stepper, Trial};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, Matrix3, OMatrix, OVector, Vector3};
 use num_complex::Complex64;
@@ -255,8 +255,7 @@ where
         ctx: &mut Ctx<D>,
     ) -> Result<(), Trial> {
         if !self.f0_valid {
-            sys.rhs(t, y, &mut self.f0);
-            ctx.stats.rhs_evals += 1;
+            ctx.rhs(sys, t, y, &mut self.f0);
             self.f0_valid = true;
         }
         if !all_finite(&self.f0) {
@@ -448,8 +447,7 @@ where
         if err >= 1.0 && (self.first || self.last_rejected) {
             self.tmp.copy_from(y);
             self.tmp += &self.cont;
-            sys.rhs(t, &self.tmp, &mut self.cont);
-            ctx.stats.rhs_evals += 1;
+            ctx.rhs(sys, t, &self.tmp, &mut self.cont);
             self.cont += &self.f2;
             self.lu_re.solve_mut(&mut self.cont);
             ctx.stats.lin_solves += 1;
@@ -472,13 +470,8 @@ where
         4.0
     }
 
-    fn is_stiff(&self) -> bool {
-        true
-    }
-
     fn restart(&mut self, sys: &S, t: f64, y: &OVector<f64, D>, ctx: &mut Ctx<D>) {
-        sys.rhs(t, y, &mut self.f0);
-        ctx.stats.rhs_evals += 1;
+        ctx.rhs(sys, t, y, &mut self.f0);
         self.f0_valid = true;
         self.jac_stale = true;
         self.h_prev = None;
@@ -489,15 +482,8 @@ where
         &self.f0
     }
 
-    fn attempt(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        y_new: &mut OVector<f64, D>,
-        ctx: &mut Ctx<D>,
-    ) -> Trial {
+    fn attempt(&mut self, sys: &S, step: Step<'_, D>, ctx: &mut Ctx<D>) -> Trial {
+        let Step { t, h, y, y_new } = step;
         if let Err(failed) = self.prepare(sys, t, y, h, ctx) {
             return failed;
         }
@@ -517,16 +503,8 @@ where
         Trial::Done { err }
     }
 
-    fn accept(
-        &mut self,
-        _sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        _y_new: &OVector<f64, D>,
-        poly: &mut StepPoly,
-        ctx: &mut Ctx<D>,
-    ) {
+    fn accept(&mut self, _sys: &S, step: &Step<'_, D>, poly: &mut StepPoly, ctx: &mut Ctx<D>) {
+        let Step { t, h, y, .. } = *step;
         let k = consts();
         if ctx.need_poly {
             poly.begin(t, h, 3);

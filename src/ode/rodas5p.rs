@@ -5,7 +5,9 @@
 use super::dense::StepPoly;
 use super::jacobian::{eval_jacobian_and_time_derivative, Radius};
 use super::lu::Lu;
-use super::stepper::{add_scaled, all_finite, sum_into, zeros_like, Ctx, FailKind, Stepper, Trial};
+use super::stepper::{
+    add_scaled, all_finite, sum_into, zeros_like, Ctx, FailKind, Step, Stepper, Trial,
+};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 
@@ -265,13 +267,8 @@ where
         5.0
     }
 
-    fn is_stiff(&self) -> bool {
-        true
-    }
-
     fn restart(&mut self, sys: &S, t: f64, y: &OVector<f64, D>, ctx: &mut Ctx<D>) {
-        sys.rhs(t, y, &mut self.f0);
-        ctx.stats.rhs_evals += 1;
+        ctx.rhs(sys, t, y, &mut self.f0);
         self.f0_valid = true;
         self.jac_valid = false;
         self.lu.invalidate();
@@ -281,19 +278,11 @@ where
         &self.f0
     }
 
-    fn attempt(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        y_new: &mut OVector<f64, D>,
-        ctx: &mut Ctx<D>,
-    ) -> Trial {
+    fn attempt(&mut self, sys: &S, step: Step<'_, D>, ctx: &mut Ctx<D>) -> Trial {
+        let Step { t, h, y, y_new } = step;
         let fail = |kind| Trial::Failed { factor: 0.25, kind };
         if !self.f0_valid {
-            sys.rhs(t, y, &mut self.f0);
-            ctx.stats.rhs_evals += 1;
+            ctx.rhs(sys, t, y, &mut self.f0);
             self.f0_valid = true;
         }
         if !all_finite(&self.f0) {
@@ -362,8 +351,7 @@ where
                 } else {
                     add_scaled(&mut self.u, 1.0, &done[s - 1]);
                 }
-                sys.rhs(t + C[s] * h, &self.u, ks);
-                ctx.stats.rhs_evals += 1;
+                ctx.rhs(sys, t + C[s] * h, &self.u, ks);
             }
             for (j, kj) in done.iter().enumerate() {
                 add_scaled(ks, CC[s][j] * inv_h, kj);
@@ -391,16 +379,9 @@ where
         Trial::Done { err }
     }
 
-    fn accept(
-        &mut self,
-        _sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        y_new: &OVector<f64, D>,
-        poly: &mut StepPoly,
-        ctx: &mut Ctx<D>,
-    ) {
+    fn accept(&mut self, _sys: &S, step: &Step<'_, D>, poly: &mut StepPoly, ctx: &mut Ctx<D>) {
+        let Step { t, h, y, .. } = *step;
+        let y_new = &*step.y_new;
         self.f0_valid = false;
         self.jac_valid = false;
         if !ctx.need_poly {

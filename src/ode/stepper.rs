@@ -36,10 +36,37 @@ where
         (s / n.max(1) as f64).sqrt()
     }
 
+    /// `f(t, y)` into `out`, counted.
+    #[inline]
+    pub fn rhs<S: OdeSystem<D> + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &OVector<f64, D>,
+        out: &mut OVector<f64, D>,
+    ) where
+        DefaultAllocator: Allocator<D, D>,
+    {
+        sys.rhs(t, y, out);
+        self.stats.rhs_evals += 1;
+    }
+
     /// Weighted RMS norm of a vector relative to the scale of `y`.
     pub fn norm_at(&self, v: &OVector<f64, D>, y: &OVector<f64, D>) -> f64 {
         self.err_norm(v, y, y)
     }
+}
+
+/// A step of size `h` from `(t, y)`: what the integration loop hands a method to attempt
+/// (which writes the new state into `y_new`) and to accept (which reads it there).
+pub(crate) struct Step<'a, D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    pub t: f64,
+    pub h: f64,
+    pub y: &'a OVector<f64, D>,
+    pub y_new: &'a mut OVector<f64, D>,
 }
 
 /// Outcome of one step attempt.
@@ -68,8 +95,11 @@ where
     /// Exponent base of the step size controller: order of the error estimate plus one.
     fn error_order(&self) -> f64;
 
-    /// Whether this is a stiff (implicit or linearly implicit) method.
-    fn is_stiff(&self) -> bool;
+    /// Whether this is a stiff (implicit or linearly implicit) method: one whose stability
+    /// region holds the whole negative real axis.
+    fn is_stiff(&self) -> bool {
+        self.stability_boundary() == f64::INFINITY
+    }
 
     /// (Re)starts at `(t, y)`: evaluates and keeps `f(t, y)`; drops reusable data that is no
     /// longer valid (after a kink in the right-hand side or a method switch).
@@ -78,30 +108,12 @@ where
     /// `f(t, y)` at the current point.
     fn f0(&self) -> &OVector<f64, D>;
 
-    /// Attempts a step of size `h` from `(t, y)`, writing the new state into `y_new`.
-    fn attempt(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        y_new: &mut OVector<f64, D>,
-        ctx: &mut Ctx<D>,
-    ) -> Trial;
+    /// Attempts `step`, writing the new state into `step.y_new`.
+    fn attempt(&mut self, sys: &S, step: Step<'_, D>, ctx: &mut Ctx<D>) -> Trial;
 
-    #[allow(clippy::too_many_arguments)]
-    /// Called after the last attempt was accepted: writes the step interpolant into `poly` and
-    /// moves the method's state to the new point.
-    fn accept(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        y_new: &OVector<f64, D>,
-        poly: &mut StepPoly,
-        ctx: &mut Ctx<D>,
-    );
+    /// Called after the last attempt, `step`, was accepted: writes the step interpolant into
+    /// `poly` and moves the method's state to the new point.
+    fn accept(&mut self, sys: &S, step: &Step<'_, D>, poly: &mut StepPoly, ctx: &mut Ctx<D>);
 
     /// Stiffness indicator of the last accepted step: for explicit methods `h·ρ` (ρ estimated
     /// spectral radius), for stiff methods `ρ`, or a lower bound of it (see
@@ -138,6 +150,29 @@ where
     DefaultAllocator: Allocator<D>,
 {
     v.as_slice().iter().all(|x| x.is_finite())
+}
+
+/// Spectral radius estimate of an explicit step from two stages at the same time: the
+/// derivatives `k_b`, `k_a` at the inputs `y_b`, `y_a` give `ρ ≈ ‖k_b − k_a‖ / ‖y_b − y_a‖`
+/// (`None` when the inputs coincide).
+#[inline]
+pub(crate) fn stage_spectral_radius<D: Dim>(
+    k_b: &OVector<f64, D>,
+    k_a: &OVector<f64, D>,
+    y_b: &OVector<f64, D>,
+    y_a: &OVector<f64, D>,
+) -> Option<f64>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..y_b.len() {
+        let dk = k_b[i] - k_a[i];
+        let dy = y_b[i] - y_a[i];
+        num += dk * dk;
+        den += dy * dy;
+    }
+    (den > 0.0).then(|| (num / den).sqrt())
 }
 
 /// Zero vector shaped like `y`.

@@ -2,7 +2,9 @@
 //! 770–775): 7 stages with FSAL, 4th-order continuous extension.
 
 use super::dense::StepPoly;
-use super::stepper::{all_finite, zeros_like, Ctx, FailKind, Stepper, Trial};
+use super::stepper::{
+    all_finite, stage_spectral_radius, zeros_like, Ctx, FailKind, Step, Stepper, Trial,
+};
 use super::system::OdeSystem;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
@@ -138,28 +140,16 @@ where
         5.0
     }
 
-    fn is_stiff(&self) -> bool {
-        false
-    }
-
     fn restart(&mut self, sys: &S, t: f64, y: &OVector<f64, D>, ctx: &mut Ctx<D>) {
-        sys.rhs(t, y, &mut self.k[0]);
-        ctx.stats.rhs_evals += 1;
+        ctx.rhs(sys, t, y, &mut self.k[0]);
     }
 
     fn f0(&self) -> &OVector<f64, D> {
         &self.k[0]
     }
 
-    fn attempt(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        y_new: &mut OVector<f64, D>,
-        ctx: &mut Ctx<D>,
-    ) -> Trial {
+    fn attempt(&mut self, sys: &S, step: Step<'_, D>, ctx: &mut Ctx<D>) -> Trial {
+        let Step { t, h, y, y_new } = step;
         for s in 1..7 {
             let (done, rest) = self.k.split_at_mut(s);
             let target = if s < 6 { &mut self.stage } else { &mut *y_new };
@@ -193,29 +183,14 @@ where
         if ctx.want_stiffness {
             // h·ρ ≈ h‖k7 − k6‖ / ‖y_new − Y6‖ where stage 6 and 7 are both at t + h.
             // `stage` still holds the input of stage 6 (the last one written there).
-            let mut num = 0.0;
-            let mut den = 0.0;
-            for i in 0..y.len() {
-                let dk = self.k[6][i] - self.k[5][i];
-                let dy = y_new[i] - self.stage[i];
-                num += dk * dk;
-                den += dy * dy;
-            }
-            self.h_rho = (den > 0.0).then(|| h * (num / den).sqrt());
+            self.h_rho =
+                stage_spectral_radius(&self.k[6], &self.k[5], y_new, &self.stage).map(|r| h * r);
         }
         Trial::Done { err }
     }
 
-    fn accept(
-        &mut self,
-        _sys: &S,
-        t: f64,
-        y: &OVector<f64, D>,
-        h: f64,
-        _y_new: &OVector<f64, D>,
-        poly: &mut StepPoly,
-        ctx: &mut Ctx<D>,
-    ) {
+    fn accept(&mut self, _sys: &S, step: &Step<'_, D>, poly: &mut StepPoly, ctx: &mut Ctx<D>) {
+        let Step { t, h, y, .. } = *step;
         // FSAL: the last stage is f at the new point.
         if !ctx.need_poly {
             self.k.swap(0, 6);

@@ -40,16 +40,27 @@ fn mills_tail(x: f64) -> f64 {
 /// the sign of x, so there is no cancellation.
 fn phi_series(x: f64) -> f64 {
     let x2 = x * x;
-    let mut term = x;
-    let mut sum = x;
-    let mut k = 3.0;
-    while k < 400.0 {
-        term *= x2 / k;
+    sum_series(x, (3..400).step_by(2), |term, k| Some(term * (x2 / k)))
+}
+
+/// The sum of a series from its first term `first`, the next term being `next(term, k)` for
+/// each index `k` of `ks` in turn, until a term falls below 1e-17 of the sum or `next` gives
+/// `None` (an asymptotic series whose terms stopped falling).
+fn sum_series(
+    first: f64,
+    ks: impl Iterator<Item = u32>,
+    mut next: impl FnMut(f64, f64) -> Option<f64>,
+) -> f64 {
+    let (mut term, mut sum) = (first, first);
+    for k in ks {
+        let Some(t) = next(term, f64::from(k)) else {
+            break;
+        };
+        term = t;
         sum += term;
         if term.abs() < 1e-17 * sum.abs() {
             break;
         }
-        k += 2.0;
     }
     sum
 }
@@ -125,40 +136,24 @@ const BESSEL_ASYMPTOTIC_FROM: f64 = 25.0;
 /// Power series Σ (x²/4)^k / (k! (k+ν)!) for ν = 0, 1 (all terms positive).
 fn bessel_series(x: f64, nu: u32) -> f64 {
     let q = 0.25 * x * x;
-    let mut term = 1.0;
-    let mut sum = term;
-    let mut k = 1.0;
-    while k < 500.0 {
-        term *= q / (k * (k + f64::from(nu)));
-        sum += term;
-        if term < 1e-17 * sum {
-            break;
-        }
-        k += 1.0;
-    }
-    sum
+    sum_series(1.0, 1..500, |term, k| {
+        Some(term * (q / (k * (k + f64::from(nu)))))
+    })
 }
 
-/// Asymptotic expansion of e^{−x} I_ν(x)·√(2πx) for large x, ν = 0, 1.
+/// Asymptotic expansion of e^{−x} I_ν(x)·√(2πx) for large x, ν = 0, 1, summed while its terms
+/// fall.
 fn bessel_asymptotic(x: f64, nu: u32) -> f64 {
     let mu = 4.0 * f64::from(nu * nu);
-    let mut term = 1.0;
-    let mut sum = 1.0;
-    let mut k = 1.0;
-    while k < 200.0 {
+    sum_series(1.0, 1..200, |term, k| {
         let odd = 2.0 * k - 1.0;
         let next = -term * (mu - odd * odd) / (8.0 * k * x);
         if next.abs() >= term.abs() {
-            break;
+            None
+        } else {
+            Some(next)
         }
-        term = next;
-        sum += term;
-        if term.abs() < 1e-17 * sum.abs() {
-            break;
-        }
-        k += 1.0;
-    }
-    sum
+    })
 }
 
 /// Exponentially scaled modified Bessel function of the first kind, order 0:

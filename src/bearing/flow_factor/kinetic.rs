@@ -399,55 +399,66 @@ fn panels(h: f64, res: &Resolution) -> Vec<(f64, f64)> {
     bounds.windows(2).map(|p| (p[0], p[1])).collect()
 }
 
-/// Adds `scale·∫ T₋₁(d + u) ℓ_j(e + dir·u) du` over `0 ≤ u ≤ len` to `out[j]`, for the
-/// Lagrange basis of the panel (`nodes`, barycentric weights `bary`). `d ≥ 0` is the distance
-/// of the singular point from the end `e`.
-#[allow(clippy::too_many_arguments)]
-fn add_endpoint_integral(
-    e: f64,
-    dir: f64,
-    len: f64,
-    d: f64,
-    nodes: &[f64],
-    bary: &[f64],
-    rule: &(Vec<f64>, Vec<f64>),
-    out: &mut [f64],
-) {
-    if len <= 0.0 {
-        return;
-    }
-    let (gx, gw) = rule;
-    let mut basis = vec![0.0; nodes.len()];
-    let mut accumulate = |u: f64, weight: f64, basis: &mut [f64]| {
-        let kernel = t_minus1(d + u) * weight;
-        lagrange(e + dir * u, nodes, bary, basis);
-        for (o, l) in out.iter_mut().zip(basis.iter()) {
-            *o += kernel * l;
+/// The Lagrange basis of one panel (its `nodes` and barycentric weights `bary`) with the Gauss
+/// rule (nodes, weights on [−1, 1]) of the product rules for the kernel's singular point.
+struct NearRule<'a> {
+    nodes: &'a [f64],
+    bary: &'a [f64],
+    rule: &'a (Vec<f64>, Vec<f64>),
+}
+
+impl NearRule<'_> {
+    /// Adds `scale·∫ T₋₁(d + u) ℓ_j(e + dir·u) du` over `0 ≤ u ≤ len` to `out[j]`. `d ≥ 0` is
+    /// the distance of the singular point from the end `e`.
+    fn add_endpoint_integral(&self, e: f64, dir: f64, len: f64, d: f64, out: &mut [f64]) {
+        if len <= 0.0 {
+            return;
         }
-    };
-    if d <= 0.0 {
-        // u = len·v^q: the logarithm becomes v^{q−1} ln v, smooth enough for Gauss.
-        const Q: i32 = 6;
-        for (x, w) in gx.iter().zip(gw) {
-            let v = 0.5 * (x + 1.0);
-            let u = len * v.powi(Q);
-            let du = len * f64::from(Q) * v.powi(Q - 1) * 0.5 * w;
-            accumulate(u, du, &mut basis);
-        }
-    } else {
-        // u = d(e^w − 1): ln(d + u) = ln d + w is linear in w; chunks of at most 2 in w.
-        let big_w = (len / d).ln_1p();
-        let chunks = (big_w / 2.0).ceil().max(1.0) as usize;
-        let cw = big_w / chunks as f64;
-        for c in 0..chunks {
-            let w0 = cw * c as f64;
+        let (gx, gw) = self.rule;
+        let mut basis = vec![0.0; self.nodes.len()];
+        let mut accumulate = |u: f64, weight: f64, basis: &mut [f64]| {
+            let kernel = t_minus1(d + u) * weight;
+            lagrange(e + dir * u, self.nodes, self.bary, basis);
+            for (o, l) in out.iter_mut().zip(basis.iter()) {
+                *o += kernel * l;
+            }
+        };
+        if d <= 0.0 {
+            // u = len·v^q: the logarithm becomes v^{q−1} ln v, smooth enough for Gauss.
+            const Q: i32 = 6;
             for (x, w) in gx.iter().zip(gw) {
-                let ww = w0 + 0.5 * cw * (x + 1.0);
-                let ew = ww.exp();
-                let u = d * (ew - 1.0);
-                let du = d * ew * 0.5 * cw * w;
+                let v = 0.5 * (x + 1.0);
+                let u = len * v.powi(Q);
+                let du = len * f64::from(Q) * v.powi(Q - 1) * 0.5 * w;
                 accumulate(u, du, &mut basis);
             }
+        } else {
+            // u = d(e^w − 1): ln(d + u) = ln d + w is linear in w; chunks of at most 2 in w.
+            let big_w = (len / d).ln_1p();
+            let chunks = (big_w / 2.0).ceil().max(1.0) as usize;
+            let cw = big_w / chunks as f64;
+            for c in 0..chunks {
+                let w0 = cw * c as f64;
+                for (x, w) in gx.iter().zip(gw) {
+                    let ww = w0 + 0.5 * cw * (x + 1.0);
+                    let ew = ww.exp();
+                    let u = d * (ew - 1.0);
+                    let du = d * ew * 0.5 * cw * w;
+                    accumulate(u, du, &mut basis);
+                }
+            }
+        }
+    }
+
+    /// Adds `∫_a^b T₋₁(|σ − s|) ℓ_j(s) ds` to `out[j]`.
+    fn add_near(&self, a: f64, b: f64, sigma: f64, out: &mut [f64]) {
+        if sigma > a && sigma < b {
+            self.add_endpoint_integral(sigma, 1.0, b - sigma, 0.0, out);
+            self.add_endpoint_integral(sigma, -1.0, sigma - a, 0.0, out);
+        } else if sigma <= a {
+            self.add_endpoint_integral(a, 1.0, b - a, a - sigma, out);
+        } else {
+            self.add_endpoint_integral(b, -1.0, b - a, sigma - b, out);
         }
     }
 }
@@ -467,26 +478,6 @@ fn lagrange(x: f64, nodes: &[f64], bary: &[f64], out: &mut [f64]) {
         denom += *o;
     }
     out.iter_mut().for_each(|o| *o /= denom);
-}
-
-/// Adds `∫_a^b T₋₁(|σ − s|) ℓ_j(s) ds` to `out[j]`.
-fn add_near(
-    a: f64,
-    b: f64,
-    sigma: f64,
-    nodes: &[f64],
-    bary: &[f64],
-    rule: &(Vec<f64>, Vec<f64>),
-    out: &mut [f64],
-) {
-    if sigma > a && sigma < b {
-        add_endpoint_integral(sigma, 1.0, b - sigma, 0.0, nodes, bary, rule, out);
-        add_endpoint_integral(sigma, -1.0, sigma - a, 0.0, nodes, bary, rule, out);
-    } else if sigma <= a {
-        add_endpoint_integral(a, 1.0, b - a, a - sigma, nodes, bary, rule, out);
-    } else {
-        add_endpoint_integral(b, -1.0, b - a, sigma - b, nodes, bary, rule, out);
-    }
 }
 
 /// Panels closer than this many half-widths (centre to singular point) get the product rules.
@@ -533,10 +524,15 @@ pub(crate) fn solve(d: f64, res: &Resolution) -> f64 {
             let c = 0.5 * (panel.a + panel.b);
             let r = 0.5 * (panel.b - panel.a);
             let pn = &nodes[panel.first..panel.first + p];
+            let near = NearRule {
+                nodes: pn,
+                bary: &bary_ref,
+                rule: &rule,
+            };
             local.iter_mut().for_each(|v| *v = 0.0);
             for sigma in [t, d - t] {
                 if (sigma - c).abs() < NEAR * r {
-                    add_near(panel.a, panel.b, sigma, pn, &bary_ref, &rule, &mut local);
+                    near.add_near(panel.a, panel.b, sigma, &mut local);
                 } else {
                     for j in 0..p {
                         let s = pn[j];

@@ -30,6 +30,7 @@ pub use kinetic::Resolution;
 use serde::{Deserialize, Serialize};
 use std::sync::OnceLock;
 
+use crate::numerics::cubic_hermite;
 use kinetic::{EULER_GAMMA, SQRT_PI};
 
 /// Viscous slip coefficient of the BGK model with diffuse reflection, `σ_P = 1.016191`, in
@@ -326,16 +327,7 @@ impl FlowFactor {
         let t = s - i as f64;
         let (g0, g1) = (self.g[i], self.g[i + 1]);
         let (m0, m1) = (self.slope[i] * self.h, self.slope[i + 1] * self.h);
-        let t2 = t * t;
-        let t3 = t2 * t;
-        let g = (2.0 * t3 - 3.0 * t2 + 1.0) * g0
-            + (t3 - 2.0 * t2 + t) * m0
-            + (-2.0 * t3 + 3.0 * t2) * g1
-            + (t3 - t2) * m1;
-        let dg_dt = (6.0 * t2 - 6.0 * t) * g0
-            + (3.0 * t2 - 4.0 * t + 1.0) * m0
-            + (-6.0 * t2 + 6.0 * t) * g1
-            + (3.0 * t2 - 2.0 * t) * m1;
+        let (g, dg_dt) = cubic_hermite(t, g0, m0, g1, m1);
         (g, dg_dt / (self.h * d))
     }
 
