@@ -957,7 +957,7 @@ where
         .direction(ode::Direction::Falling)
         .terminal(true);
     let end = initial_programme.end_time();
-    let mut audit = Audit::of(problem.system(), opts.energy_audit);
+    let audit = Audit::of(problem.system(), opts.energy_audit);
     let it = problem
         .integrator(t0, y0.clone(), end)
         .map_err(|e| explain_ode_error(model, opts, e))?
@@ -967,24 +967,21 @@ where
         rec: Record::new(t0, &y0, q, opts.keep_series),
         watch: None,
     };
-    let mut guards = Guards {
+    let guards = Guards {
         model,
         opts,
         span: (t0, end - t0),
         below_since: None,
     };
+    // The guards and the energy audit see every step after the recorder.
+    let mut checks = (guards, audit);
     let ode_err = |e| explain_ode_error(model, opts, e);
 
     let final_programme;
     let search_from;
     match triggered {
         None => {
-            sim::run(
-                &mut it,
-                None,
-                &mut (&mut recorder, &mut guards, &mut audit),
-                ode_err,
-            )?;
+            sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
             final_programme = initial_programme.clone();
             search_from = final_programme.end_of_hold();
         }
@@ -996,12 +993,7 @@ where
                 checked: t0,
                 found: None,
             });
-            sim::run(
-                &mut it,
-                None,
-                &mut (&mut recorder, &mut guards, &mut audit),
-                ode_err,
-            )?;
+            sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
             let Some(t_td) = recorder.watch.take().and_then(|w| w.found) else {
                 return Err(CycleError::NoTriggeredTouchdown {
                     max_power_mw: crate::units::to_mw(initial_programme.power(end)),
@@ -1022,15 +1014,10 @@ where
                 if t_peak < it.tf() {
                     it.set_tf(t_peak).map_err(ode_err)?;
                 }
-                sim::run(
-                    &mut it,
-                    None,
-                    &mut (&mut recorder, &mut guards, &mut audit),
-                    ode_err,
-                )?;
+                sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
             } else if it.t() > t_peak {
                 let y = it.interpolate(t_peak).map_err(ode_err)?;
-                audit.cut(it.last_step(), it.system(), t_peak);
+                checks.1.cut(it.last_step(), it.system(), t_peak);
                 let rec = &mut recorder.rec;
                 rec.truncate(t_peak);
                 if rec.times.last().is_some_and(|&t| t < t_peak) {
@@ -1044,12 +1031,7 @@ where
             it.system_mut()
                 .set_inputs(model.inputs(final_programme.clone()));
             it.set_tf(t_end).map_err(ode_err)?;
-            sim::run(
-                &mut it,
-                None,
-                &mut (&mut recorder, &mut guards, &mut audit),
-                ode_err,
-            )?;
+            sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
             search_from = t_peak;
         }
     }
@@ -1092,7 +1074,7 @@ where
         stats: it.stats(),
         wall_seconds: clock.elapsed().as_secs_f64(),
         series,
-        lag_energy: audit.energy(),
+        lag_energy: checks.1.energy(),
     })
 }
 
