@@ -1,7 +1,10 @@
 //! `Drive::step` at a 20 kHz controller rate against real time: in flight and in contact, on a
 //! flat and on the default wavy disk, with and without an AC dither, and with a command that
-//! changes every period; at the default tolerance (0.01 pm throughout) and with 1 pm in flight
-//! (`DriveOptions::atol_displacement_flight`). Prints a table.
+//! changes every period; at the default tolerance (0.01 pm throughout), with the exponential
+//! scheme (`DriveScheme::Exponential`, right after the default on the same case) and with 1 pm
+//! in flight (`DriveOptions::atol_displacement_flight`). Prints a table; the last column is the
+//! share of the timed periods the exponential scheme advanced itself (the rest it left to the
+//! integrator).
 //!
 //! `cargo bench --bench drive`. Each case settles 20 ms at its heater power, then times blocks
 //! of 200 periods (10 ms of drive time) for at least 1 s; the table gives the fastest block's
@@ -11,7 +14,7 @@
 #[path = "../examples/common/timing.rs"]
 mod timing;
 
-use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, Plant};
+use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, DriveScheme, Plant};
 use hdi_tribology::scene::Scene;
 use std::time::Duration;
 
@@ -21,30 +24,43 @@ const BLOCK: usize = 200;
 fn main() {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).expect("zone");
-    println!("| flight atol | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("| scheme | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period | exponential periods |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let configs = [
-        ("0.01 pm", DriveOptions::default().atol_displacement),
-        ("1 pm", 1e-12),
+        ("0.01 pm", DriveOptions::default()),
+        (
+            "exponential",
+            DriveOptions {
+                scheme: DriveScheme::Exponential,
+                ..DriveOptions::default()
+            },
+        ),
+        (
+            "1 pm flight",
+            DriveOptions {
+                atol_displacement_flight: 1e-12,
+                ..DriveOptions::default()
+            },
+        ),
     ];
-    for (atol_name, flight) in configs {
-        for (disk_name, disk) in [("flat", DiskSpec::flat()), ("wavy", DiskSpec::default())] {
-            let plant = Plant::new(
-                &scene,
-                &zone,
-                1,
-                DriveOptions {
+    for (disk_name, disk) in [("flat", DiskSpec::flat()), ("wavy", DiskSpec::default())] {
+        let plants: Vec<(&str, Plant)> = configs
+            .iter()
+            .map(|(name, o)| {
+                let o = DriveOptions {
                     disk: disk.clone(),
-                    atol_displacement_flight: flight,
-                    ..DriveOptions::default()
-                },
-            )
-            .expect("plant");
+                    ..o.clone()
+                };
+                (*name, Plant::new(&scene, &zone, 1, o).expect("plant"))
+            })
+            .collect();
+        {
             for (state, mw) in [("flight", 70.0), ("contact", 80.0)] {
                 // Held commands, with and without dither; then a command that changes every period
                 // (a heater dithered by ±1 µW, alternating): the worst case, a restart per period.
                 for (dither, alternate) in [(None, false), (Some((0.5, 10.5)), false), (None, true)]
                 {
+                    for (atol_name, plant) in &plants {
                     let mut d = plant.drive().expect("drive");
                     let mut cmd = Command::heater_mw(mw);
                     if let Some((a, f)) = dither {
@@ -54,6 +70,7 @@ fn main() {
                         d.step(&cmd, DT).expect("settle");
                     }
                     let s0 = d.stats().accepted;
+                    let e0 = d.scheme_counts().exponential;
                     let t0 = d.time();
                     let mut k = 0usize;
                     let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
@@ -70,13 +87,14 @@ fn main() {
                     });
                     let periods = (d.time() - t0) / DT;
                     let steps = (d.stats().accepted - s0) as f64 / periods;
+                    let exp_share = (d.scheme_counts().exponential - e0) as f64 / periods;
                     let last = last.expect("ran");
                     // The state the case claims: in contact the true contact force is far above F_th.
                     let in_contact = (last.truth.mean_contact_force_un * 1e-6) > 5e-5;
                     assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
                     let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
                     println!(
-                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} |",
+                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} |",
                     match (dither, alternate) {
                         (Some((a, f)), _) => format!("{a} V, {:.1} kHz", f / 1e3),
                         (None, true) => "off, ±1 µW every period".to_string(),
@@ -86,8 +104,10 @@ fn main() {
                     cpu * 1e6,
                     DT / wall,
                     DT / cpu,
-                    steps
+                    steps,
+                    exp_share
                 );
+                    }
                 }
             }
         }

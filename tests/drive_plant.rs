@@ -3,7 +3,7 @@
 
 use hdi_tribology::analysis::{flying_equilibrium, ScanGrid};
 use hdi_tribology::drive::{
-    scene_zone, Command, DiskSpec, Drive, DriveOptions, Plant, SensorSpec, Sensors,
+    scene_zone, Command, DiskSpec, Drive, DriveOptions, DriveScheme, Plant, SensorSpec, Sensors,
 };
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
@@ -150,6 +150,15 @@ struct Deviation {
 /// contact and back, a dither, and a command that changes every period, besides runs of
 /// unchanged commands. Both see the same noise.
 fn deviation(opts: DriveOptions) -> Deviation {
+    deviation_after(opts, &[]).0
+}
+
+/// [`deviation`] with `prelude` run first, and the fast drive's counts of the exponential
+/// scheme over the whole run.
+fn deviation_after(
+    opts: DriveOptions,
+    prelude: &[Command],
+) -> (Deviation, hdi_tribology::drive::SchemeCounts) {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).unwrap();
     let fast = Plant::new(&scene, &zone, 5, opts).unwrap();
@@ -167,7 +176,7 @@ fn deviation(opts: DriveOptions) -> Deviation {
         },
     )
     .unwrap();
-    let mut programme: Vec<Command> = Vec::new();
+    let mut programme: Vec<Command> = prelude.to_vec();
     for mw in [62.0, 68.0, 72.0, 76.0, 78.0, 74.0, 70.0] {
         programme.extend(std::iter::repeat_n(Command::heater_mw(mw), 60));
     }
@@ -220,11 +229,12 @@ fn deviation(opts: DriveOptions) -> Deviation {
         dev.steps,
         b.stats().accepted
     );
+    println!("{:?}", a.scheme_counts());
     assert!(
         dev.contact_periods > 50,
         "the programme should reach contact"
     );
-    dev
+    (dev, a.scheme_counts())
 }
 
 /// 0.1 µN of period-mean contact force (the contact sensor resolves ~0.2 µN per period in
@@ -306,4 +316,45 @@ fn a_drive_is_owned() {
     }
     let mut d = owned(plant(1, DiskSpec::flat()).into_drive().unwrap());
     assert!(d.step(&Command::heater_mw(60.0), DT).unwrap().truth.gap_nm > 0.0);
+}
+
+/// The exponential scheme (an option): one exponential step per period where its error
+/// estimate meets the contact tolerances, the integrator elsewhere. On this programme every
+/// sensor agrees with the tight reference within the same fractions of its noise as the
+/// default, and most periods are exponential.
+#[test]
+fn the_exponential_scheme_keeps_the_sensors_within_their_noise() {
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..DriveOptions::default()
+    };
+    let (dev, counts) = deviation_after(o, &[]);
+    let gap = dev.gap_flight.max(dev.gap_contact);
+    assert!(gap < 1e-13, "gap differs by {gap} m");
+    sensors_within_their_noise(&dev);
+    let rb_noise = (2.0f64).sqrt() * SensorSpec::default().readback.noise;
+    assert!(
+        dev.readback < 0.05 * rb_noise,
+        "read-back log ratio differs by {}",
+        dev.readback
+    );
+    assert!(counts.exponential > 0, "{counts:?}");
+}
+
+/// The near-fold case of docs/clearance.md ("Accuracy"): 600 periods held at 74.3 mW, just
+/// below the touchdown fold, where the disk's waviness snaps the head into contact, then the
+/// programme. The exponential scheme must see the snap (its estimate) and leave it to the
+/// integrator: the sensors stay within the default's bounds.
+#[test]
+fn the_exponential_scheme_holds_near_the_fold() {
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..DriveOptions::default()
+    };
+    let hold = vec![Command::heater_mw(74.3); 600];
+    let (dev, counts) = deviation_after(o, &hold);
+    let gap = dev.gap_flight.max(dev.gap_contact);
+    assert!(gap < 1e-13, "gap differs by {gap} m");
+    sensors_within_their_noise(&dev);
+    assert!(counts.fallbacks > 0, "{counts:?}");
 }
