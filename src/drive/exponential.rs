@@ -33,8 +33,22 @@ use num_complex::Complex64;
 use std::f64::consts::PI;
 
 /// Relative change of the held Jacobian (largest entry change over the largest entry of its
-/// row) beyond which a refresh also rebuilds the disk's table.
-pub(crate) const REBUILD_SHIFT: f64 = 0.05;
+/// row, the integrals' rows aside) beyond which a refresh also rebuilds the disk's table. The
+/// table's response is off by about this fraction of its size when the held Jacobian has
+/// moved this far from the one it was built with, and that error oscillates at the disk's
+/// frequencies within a period, where the step's estimate cannot see it: 1e-4 of the ~15 pm
+/// the default waviness moves the gap is a sixth of the 0.01 pm displacement tolerance.
+pub(crate) const REBUILD_SHIFT: f64 = 1e-4;
+
+/// Substep levels: a period is `1`, `2`, `4`, `8` or `16` exponential steps.
+pub(crate) const LEVELS: usize = 5;
+
+/// Periods in a row with an estimate below [`CALM_ERROR`] after which the scheme tries half as
+/// many substeps.
+pub(crate) const CALM: usize = 32;
+
+/// See [`CALM`].
+pub(crate) const CALM_ERROR: f64 = 0.25;
 
 /// Most periods run by the integrator after consecutive misses before the exponential step is
 /// tried again.
@@ -73,46 +87,52 @@ fn response(j: &DMatrix<f64>, w: f64, u: &[Complex64]) -> Option<Vec<Complex64>>
 }
 
 impl Periodic {
-    /// The response to the disk's motion `u = −r ẅ` on the velocities `base` (`(index, r)`).
+    /// The response to the disk's motion `u = −r ẅ` on the velocities `base` (`(index, r)`):
+    /// each harmonic's `C_k` solved for, then the values and slopes at the nodes summed by an
+    /// inverse fast Fourier transform over the revolution (the nodes are a power of two).
     fn of_disk(disk: &Disk, j: &DMatrix<f64>, base: &[(usize, f64)]) -> Option<Self> {
         let n = j.nrows();
-        let mut values = vec![0.0; NODES * n];
-        let mut slopes = vec![0.0; NODES * n];
-        let mut active = vec![false; n];
-        let mut u = vec![Complex64::new(0.0, 0.0); n];
+        let zero = Complex64::new(0.0, 0.0);
+        // Per component, the spectrum of p over the orders of the revolution.
+        let mut spectra = vec![vec![zero; NODES]; n];
+        let mut u = vec![zero; n];
         for h in disk.harmonics() {
             let w = h.order as f64 * disk.omega();
             // ẅ = −A ω² sin(ωt + φ) = Re(i A ω² e^{iφ} e^{iωt}).
-            let acc = Complex64::new(0.0, h.amplitude * w * w) * Complex64::from_polar(1.0, h.phase);
-            u.iter_mut().for_each(|x| *x = Complex64::new(0.0, 0.0));
+            let acc =
+                Complex64::new(0.0, h.amplitude * w * w) * Complex64::from_polar(1.0, h.phase);
+            u.iter_mut().for_each(|x| *x = zero);
             for &(i, r) in base {
                 u[i] = -r * acc;
             }
             let c = response(j, w, &u)?;
-            let on: Vec<usize> = (0..n).filter(|&k| c[k].norm() > 0.0).collect();
-            for &k in &on {
-                active[k] = true;
+            for (k, ck) in c.iter().enumerate() {
+                spectra[k][h.order as usize % NODES] += ck;
             }
-            let d_theta = 2.0 * PI * h.order as f64 / NODES as f64;
-            let step = Complex64::from_polar(1.0, d_theta);
-            let mut z = Complex64::new(1.0, 0.0);
-            for i in 0..NODES {
-                // Rotate node by node; re-anchor exactly every 64 nodes.
-                z = if i % 64 == 0 {
-                    Complex64::from_polar(1.0, d_theta * i as f64)
-                } else {
-                    z * step
-                };
-                for &k in &on {
-                    let v = c[k] * z;
-                    values[i * n + k] += v.re;
-                    slopes[i * n + k] -= w * v.im;
-                }
+        }
+        let active: Vec<usize> = (0..n)
+            .filter(|&k| spectra[k].iter().any(|c| c.norm() > 0.0))
+            .collect();
+        let mut values = vec![0.0; NODES * n];
+        let mut slopes = vec![0.0; NODES * n];
+        let mut buf = vec![zero; NODES];
+        for &k in &active {
+            buf.copy_from_slice(&spectra[k]);
+            inverse_fft(&mut buf);
+            for (i, b) in buf.iter().enumerate() {
+                values[i * n + k] = b.re;
+            }
+            for (m, b) in buf.iter_mut().enumerate() {
+                *b = Complex64::new(0.0, m as f64 * disk.omega()) * spectra[k][m];
+            }
+            inverse_fft(&mut buf);
+            for (i, b) in buf.iter().enumerate() {
+                slopes[i * n + k] = b.re;
             }
         }
         Some(Periodic {
             n,
-            active: (0..n).filter(|&k| active[k]).collect(),
+            active,
             values,
             slopes,
         })
@@ -150,6 +170,34 @@ impl Periodic {
             p[c] += h00 * p0 + h10 * hn * m0 + h01 * p1 + h11 * hn * m1;
             dp[c] += d00 * p0 + d10 * m0 + d01 * p1 + d11 * m1;
         }
+    }
+}
+
+/// `x_i ← Σ_m x_m e^{2πi m i / N}` in place (no `1/N`), `N` a power of two: the iterative
+/// radix-2 Cooley–Tukey transform with its twiddles re-anchored exactly at each stage.
+fn inverse_fft(x: &mut [Complex64]) {
+    let n = x.len();
+    debug_assert!(n.is_power_of_two());
+    let bits = n.trailing_zeros();
+    for i in 0..n {
+        let r = i.reverse_bits() >> (usize::BITS - bits);
+        if r > i {
+            x.swap(i, r);
+        }
+    }
+    let mut len = 2;
+    while len <= n {
+        let half = len / 2;
+        let step = 2.0 * PI / len as f64;
+        for start in (0..n).step_by(len) {
+            for k in 0..half {
+                let w = Complex64::from_polar(1.0, step * k as f64);
+                let (a, b) = (x[start + k], x[start + k + half] * w);
+                x[start + k] = a + b;
+                x[start + k + half] = a - b;
+            }
+        }
+        len *= 2;
     }
 }
 
@@ -218,6 +266,7 @@ pub(crate) struct ExpScheme {
     /// Positions at `0..dofs`; the contact impulse's index.
     dofs: usize,
     impulse: Option<usize>,
+    heat: Option<usize>,
     /// A bound on how far the known forcings move the gaps (m): the sum over the positions of
     /// their responses' largest magnitude.
     reach: f64,
@@ -225,7 +274,14 @@ pub(crate) struct ExpScheme {
     atol: Vec<f64>,
     /// `(index, r)` of the velocities a disk translation moves.
     base: Vec<(usize, f64)>,
-    stepper: Option<ExponentialStepper>,
+    /// Steppers of `h / 2^l`, `l < LEVELS`, for the held Jacobian (none before the first
+    /// refresh).
+    steppers: Vec<ExponentialStepper>,
+    /// The level of substeps in use, the level of the last step, and how many calm periods in a
+    /// row it has had (see [`ExpScheme::attempt`]).
+    level: usize,
+    last_level: usize,
+    calm: usize,
     disk: Option<Periodic>,
     /// The Jacobian the disk's table was built with.
     disk_j: Option<DMatrix<f64>>,
@@ -261,11 +317,15 @@ impl ExpScheme {
         ExpScheme {
             dofs: layout.dofs,
             impulse: layout.contact_impulse,
+            heat: layout.heat,
             reach: 0.0,
             rtol,
             atol,
             base,
-            stepper: None,
+            steppers: Vec::new(),
+            level: 0,
+            last_level: 0,
+            calm: 0,
             disk: None,
             disk_j: None,
             dither: None,
@@ -292,7 +352,7 @@ impl ExpScheme {
         }
     }
 
-    /// The Jacobian at `(t, x)`, the per-`V²` vector `e` there, and everything built on them
+    /// The Jacobian at `(t, x − p(t))`, the per-`V²` vector `e` there, and everything built on them
     /// (the stepper of period `h`, the dither's response; the disk's table when there is none
     /// or `J` moved by more than [`REBUILD_SHIFT`] from the one it was built with).
     fn refresh<D: Dim>(&mut self, sys: &SliderSystem, disk: &Disk, t: f64, x: &OVector<f64, D>, h: f64) -> bool
@@ -301,20 +361,34 @@ impl ExpScheme {
     {
         let n = x.len();
         let dim = x.shape_generic().0;
+        // Linearised about the state less the known forcings' responses (as held so far): the
+        // slow state, whose Jacobian does not swing with the disk's phase.
+        Self::known(disk, &self.disk, &self.dither, t, &mut self.p, &mut self.dp);
+        let slow = OVector::<f64, D>::from_iterator_generic(
+            dim,
+            nalgebra::U1,
+            x.iter().zip(self.p.iter()).map(|(a, b)| a - b),
+        );
         let mut jd = OMatrix::<f64, D, D>::zeros_generic(dim, dim);
-        OdeSystem::<D>::jacobian(sys, t, x, &mut jd);
+        OdeSystem::<D>::jacobian(sys, t, &slow, &mut jd);
         let j = DMatrix::from_iterator(n, n, jd.iter().copied());
         if j.iter().any(|v| !v.is_finite()) {
             return false;
         }
-        let Ok(stepper) = ExponentialStepper::new(&j, h) else {
-            return false;
-        };
-        self.stepper = Some(stepper);
+        self.steppers.clear();
+        for l in 0..LEVELS {
+            let Ok(s) = ExponentialStepper::new(&j, h / (1 << l) as f64) else {
+                return false;
+            };
+            self.steppers.push(s);
+        }
         self.counts.refreshes += 1;
+        // The integrals' rows (their columns are zero) do not move the other states: a change
+        // there leaves the table's mechanical response as it was.
+        let integral = |r: usize| self.impulse == Some(r) || self.heat == Some(r);
         let shifted = match &self.disk_j {
             None => true,
-            Some(jp) => (0..n).any(|r| {
+            Some(jp) => (0..n).filter(|&r| !integral(r)).any(|r| {
                 let scale = (0..n).map(|c| jp[(r, c)].abs()).fold(0.0, f64::max);
                 (0..n).any(|c| (j[(r, c)] - jp[(r, c)]).abs() > REBUILD_SHIFT * scale)
             }),
@@ -330,7 +404,7 @@ impl ExpScheme {
         self.dither = None;
         let v = sys.inputs().voltage;
         if v.ac_amplitude != 0.0 && v.frequency > 0.0 {
-            let e = per_volt2(sys, t, x);
+            let e = per_volt2(sys, t, &slow);
             self.dither = Dither::new(v, &j, &e);
             if self.dither.is_none() {
                 return false;
@@ -352,7 +426,7 @@ impl ExpScheme {
     /// frequencies, where the step's estimate (from the period's ends) cannot see it. Its
     /// effect on the contact impulse over a period, `h A |F_c′(d − A) − F_c′(d + A)| / 4`, must
     /// be within the impulse's tolerance.
-    fn straight<D: Dim>(&self, sys: &SliderSystem, t: f64, x: &OVector<f64, D>, h: f64) -> bool
+    pub(crate) fn straight<D: Dim>(&self, sys: &SliderSystem, t: f64, x: &OVector<f64, D>, h: f64) -> bool
     where
         DefaultAllocator: Allocator<D>,
     {
@@ -387,18 +461,30 @@ impl ExpScheme {
         }
     }
 
-    /// One exponential step over `[t0, t0 + h]` from `x0`: the state at its end and the error
-    /// estimate.
-    fn step<D: Dim>(&mut self, sys: &SliderSystem, disk: &Disk, t0: f64, h: f64, x0: &OVector<f64, D>) -> (OVector<f64, D>, f64)
+    /// `2^level` exponential steps over `[t0, t0 + h]` from `x0`: the state at its end and the
+    /// largest error estimate.
+    fn step<D: Dim>(
+        &mut self,
+        sys: &SliderSystem,
+        disk: &Disk,
+        t0: f64,
+        h: f64,
+        x0: &OVector<f64, D>,
+        level: usize,
+    ) -> (OVector<f64, D>, f64)
     where
         DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {
         let n = x0.len();
         let dim = x0.shape_generic().0;
+        if level != self.last_level {
+            self.steppers[level].forget();
+            self.last_level = level;
+        }
         let ExpScheme {
             rtol,
             atol,
-            stepper,
+            steppers,
             disk: table,
             dither,
             p,
@@ -408,39 +494,45 @@ impl ExpScheme {
             z1,
             ..
         } = self;
-        let stepper = stepper.as_mut().expect("built");
-        Self::known(disk, table, dither, t0, p, dp);
-        let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
-        OdeSystem::<D>::rhs(sys, t0, x0, &mut fx);
-        for i in 0..n {
-            z0[i] = x0[i] - p[i];
-            f0[i] = fx[i] - dp[i];
-        }
+        let stepper = &mut steppers[level];
+        let m = 1usize << level;
+        let hs = h / m as f64;
         let (table, dither) = (&*table, &*dither);
-        let mut pw = [0.0; MAX_STATE];
-        let mut dpw = [0.0; MAX_STATE];
-        let f = |t: f64, z: &[f64], dz: &mut [f64]| {
-            let (pw, dpw) = (&mut pw[..n], &mut dpw[..n]);
-            Self::known(disk, table, dither, t, pw, dpw);
-            let x = OVector::<f64, D>::from_iterator_generic(
-                dim,
-                nalgebra::U1,
-                z.iter().zip(pw.iter()).map(|(a, b)| a + b),
-            );
-            let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
-            OdeSystem::<D>::rhs(sys, t, &x, &mut fx);
+        let mut x = x0.clone();
+        let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
+        let mut err = 0.0f64;
+        for k in 0..m {
+            let ts = t0 + k as f64 * hs;
+            Self::known(disk, table, dither, ts, p, dp);
+            OdeSystem::<D>::rhs(sys, ts, &x, &mut fx);
             for i in 0..n {
-                dz[i] = fx[i] - dpw[i];
+                z0[i] = x[i] - p[i];
+                f0[i] = fx[i] - dp[i];
             }
-        };
-        let err = stepper.step(t0, z0, f0, f, (*rtol, atol), z1);
-        Self::known(disk, table, dither, t0 + h, p, dp);
-        let x1 = OVector::<f64, D>::from_iterator_generic(
-            dim,
-            nalgebra::U1,
-            z1.iter().zip(p.iter()).map(|(a, b)| a + b),
-        );
-        (x1, err)
+            let mut pw = [0.0; MAX_STATE];
+            let mut dpw = [0.0; MAX_STATE];
+            let f = |t: f64, z: &[f64], dz: &mut [f64]| {
+                let (pw, dpw) = (&mut pw[..n], &mut dpw[..n]);
+                Self::known(disk, table, dither, t, pw, dpw);
+                let x = OVector::<f64, D>::from_iterator_generic(
+                    dim,
+                    nalgebra::U1,
+                    z.iter().zip(pw.iter()).map(|(a, b)| a + b),
+                );
+                let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
+                OdeSystem::<D>::rhs(sys, t, &x, &mut fx);
+                for i in 0..n {
+                    dz[i] = fx[i] - dpw[i];
+                }
+            };
+            err = err.max(stepper.step(ts, z0, f0, f, (*rtol, atol), z1));
+            let te = if k + 1 == m { t0 + h } else { ts + hs };
+            Self::known(disk, table, dither, te, p, dp);
+            for i in 0..n {
+                x[i] = z1[i] + p[i];
+            }
+        }
+        (x, err)
     }
 
     /// Tries one period `[t0, t0 + h]` from `x0`: the stepper as held, then, on a miss, once
@@ -449,7 +541,7 @@ impl ExpScheme {
     where
         DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {
-        let stale = match (&self.stepper, &self.dither) {
+        let stale = match (self.steppers.first(), &self.dither) {
             (None, _) => true,
             (Some(s), _) if s.h() != h => true,
             (_, d) => {
@@ -461,9 +553,6 @@ impl ExpScheme {
                 }
             }
         };
-        if !self.straight(sys, t0, x0, h) {
-            return self.missed();
-        }
         let mut fresh = false;
         if stale {
             if !self.refresh(sys, disk, t0, x0, h) {
@@ -471,23 +560,45 @@ impl ExpScheme {
             }
             fresh = true;
         }
-        let (mut x1, mut err) = self.step(sys, disk, t0, h, x0);
-        if !(err <= 1.0) && !fresh {
-            if !self.refresh(sys, disk, t0, x0, h) {
-                return self.missed();
+        let mut level = self.level;
+        let (x1, err) = loop {
+            let (x1, err) = self.step(sys, disk, t0, h, x0, level);
+            if err <= 1.0 {
+                break (x1, err);
             }
-            (x1, err) = self.step(sys, disk, t0, h, x0);
-        }
+            if !fresh {
+                if !self.refresh(sys, disk, t0, x0, h) {
+                    return self.missed();
+                }
+                fresh = true;
+            } else if level + 1 < LEVELS {
+                level += 1;
+            } else {
+                break (x1, err);
+            }
+        };
         if err <= 1.0 && x1.iter().all(|v| v.is_finite()) {
             self.backoff = 0;
             self.counts.exponential += 1;
+            // Up at once when the period needed it; down after CALM periods well within the
+            // tolerances.
+            if level != self.level || err > CALM_ERROR {
+                self.calm = 0;
+            } else {
+                self.calm += 1;
+            }
+            self.level = level;
+            if self.calm >= CALM && self.level > 0 {
+                self.level -= 1;
+                self.calm = 0;
+            }
             Attempt::Done(x1, err)
         } else {
             self.missed()
         }
     }
 
-    fn missed<D: Dim>(&mut self) -> Attempt<D>
+    pub(crate) fn missed<D: Dim>(&mut self) -> Attempt<D>
     where
         DefaultAllocator: Allocator<D>,
     {
@@ -495,7 +606,7 @@ impl ExpScheme {
         self.backoff = (2 * self.backoff).clamp(1, MAX_SKIP);
         self.skip = self.backoff;
         self.owned = None;
-        if let Some(s) = self.stepper.as_mut() {
+        for s in &mut self.steppers {
             s.forget();
         }
         Attempt::Missed
@@ -527,4 +638,28 @@ where
     };
     let (one, zero) = (at(1.0), at(0.0));
     one.iter().zip(zero.iter()).map(|(a, b)| a - b).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The transform against the direct sum.
+    #[test]
+    fn the_fft_is_the_direct_sum() {
+        let n = 64;
+        let x: Vec<Complex64> = (0..n)
+            .map(|m| Complex64::new((m as f64 * 0.37).sin(), (m as f64 * 1.3).cos()))
+            .collect();
+        let mut y = x.clone();
+        inverse_fft(&mut y);
+        for (i, yi) in y.iter().enumerate() {
+            let direct: Complex64 = x
+                .iter()
+                .enumerate()
+                .map(|(m, xm)| xm * Complex64::from_polar(1.0, 2.0 * PI * (m * i) as f64 / n as f64))
+                .sum();
+            assert!((yi - direct).norm() < 1e-12, "{i}");
+        }
+    }
 }

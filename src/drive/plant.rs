@@ -1390,14 +1390,13 @@ fn advance_exponential<D: Dim>(
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    // The integrator's periods end their last step on the period's end: a restart's first
-    // step is not let run on over several periods of the disk's motion.
-    let landed = Span { land: true, ..span };
     if exp.skips() {
-        return advance(it, layout, set, integrals0, landed, tol, None);
+        return advance(it, layout, set, integrals0, span, tol, None);
     }
     let Span { t0, rebase, .. } = span;
-    let mut x0 = match exp.owned.take() {
+    let owned = exp.owned.take();
+    let from_integrator = owned.is_none();
+    let mut x0 = match owned {
         Some(x) => OVector::<f64, D>::from_iterator_generic(
             D::from_usize(layout.len()),
             nalgebra::U1,
@@ -1406,35 +1405,70 @@ where
         None if it.t() > t0 => it.interpolate(t0)?,
         None => it.state().clone(),
     };
+    if !exp.straight(it.system(), t0, &x0, dt) {
+        let _ = exp.missed::<D>();
+        if from_integrator {
+            // The integrator holds the state: the period as the default drive runs it.
+            return advance(it, layout, set, integrals0, span, tol, None);
+        }
+    } else {
+        if let Some(held) = set {
+            held.apply(it.system_mut());
+        }
+        rebase_integrals(layout, rebase, &mut x0, integrals0);
+        match exp.attempt(it.system(), disk, t0, dt, &x0) {
+            Attempt::Done(x1, err) => {
+                let mut x = [0.0; MAX_STATE];
+                x[..x1.len()].copy_from_slice(x1.as_slice());
+                exp.owned = Some(x);
+                return Ok((
+                    x1,
+                    PeriodReport {
+                        steps: 1,
+                        error_estimate: err,
+                        exponential: true,
+                    },
+                ));
+            }
+            Attempt::Missed => {
+                // The integrator from the same start; its last step ends on the period's end,
+                // so that the restart's first step does not run on over several periods of the
+                // disk's motion.
+                let landed = Span { land: true, ..span };
+                return advance(it, layout, None, integrals0, landed, tol, Some(x0));
+            }
+        }
+    }
+    // The scheme held the state and the contact force is not straight enough: the integrator
+    // from the same start, under the new command.
+    rebase_integrals(layout, rebase, &mut x0, integrals0);
     if let Some(held) = set {
         held.apply(it.system_mut());
     }
+    let landed = Span { land: true, ..span };
+    advance(it, layout, None, integrals0, landed, tol, Some(x0))
+}
+
+/// Sets the period integrals of `x` back to zero once either has grown past its bound (see
+/// [`advance`]).
+fn rebase_integrals<D: Dim>(
+    layout: &StateLayout,
+    rebase: [f64; 2],
+    x: &mut OVector<f64, D>,
+    integrals0: &mut (f64, f64),
+) where
+    DefaultAllocator: Allocator<D>,
+{
     let integrals = [layout.contact_impulse, layout.heat];
     if integrals
         .iter()
         .zip(rebase)
-        .any(|(i, bound)| i.is_some_and(|i| x0[i].abs() > bound))
+        .any(|(i, bound)| i.is_some_and(|i| x[i].abs() > bound))
     {
         for i in integrals.into_iter().flatten() {
-            x0[i] = 0.0;
+            x[i] = 0.0;
         }
         *integrals0 = (0.0, 0.0);
-    }
-    match exp.attempt(it.system(), disk, t0, dt, &x0) {
-        Attempt::Done(x1, err) => {
-            let mut x = [0.0; MAX_STATE];
-            x[..x1.len()].copy_from_slice(x1.as_slice());
-            exp.owned = Some(x);
-            Ok((
-                x1,
-                PeriodReport {
-                    steps: 1,
-                    error_estimate: err,
-                    exponential: true,
-                },
-            ))
-        }
-        Attempt::Missed => advance(it, layout, None, integrals0, landed, tol, Some(x0)),
     }
 }
 
