@@ -61,6 +61,19 @@ fn main() {
                 for (dither, alternate) in [(None, false), (Some((0.5, 10.5)), false), (None, true)]
                 {
                     for (atol_name, plant) in &plants {
+                        // `DRIVE_BENCH_ONLY=exponential/flat/flight/held` runs the cases whose
+                        // label contains the value (a profile of one case).
+                        let label = format!(
+                            "{atol_name}/{disk_name}/{state}/{}",
+                            match (dither, alternate) {
+                                (Some(_), _) => "dither",
+                                (None, true) => "changed",
+                                (None, false) => "held",
+                            }
+                        );
+                        if std::env::var("DRIVE_BENCH_ONLY").is_ok_and(|o| !label.contains(&o)) {
+                            continue;
+                        }
                     let mut d = plant.drive().expect("drive");
                     let mut cmd = Command::heater_mw(mw);
                     if let Some((a, f)) = dither {

@@ -39,7 +39,7 @@
 //! ```
 
 use super::OdeError;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, DVectorView};
 
 /// The exponential of a square matrix: Padé's [6/6] approximant of `e^{A/2^s}`, squared `s`
 /// times, with `s` the least that brings the 1-norm of `A/2^s` to 1/2 or below (a relative
@@ -167,6 +167,8 @@ pub struct ExponentialStepper {
     /// The remainder's change over the previous step, when it ended where the next begins.
     d_prev: DVector<f64>,
     have_prev: bool,
+    corr: DVector<f64>,
+    curv: DVector<f64>,
 }
 
 impl ExponentialStepper {
@@ -187,6 +189,8 @@ impl ExponentialStepper {
             d: DVector::zeros(n),
             d_prev: DVector::zeros(n),
             have_prev: false,
+            corr: DVector::zeros(n),
+            curv: DVector::zeros(n),
         })
     }
 
@@ -232,36 +236,32 @@ impl ExponentialStepper {
         let n = self.dim();
         assert!(y0.len() == n && f0.len() == n && y1.len() == n && tol.1.len() == n);
         let h = self.h;
+        let (y0v, f0v) = (DVectorView::from_slice(y0, n), DVectorView::from_slice(f0, n));
         // a = y0 + h φ1 f0.
-        for i in 0..n {
-            let mut s = 0.0;
-            for (j, fj) in f0.iter().enumerate() {
-                s += self.phi1[(i, j)] * fj;
-            }
-            self.ya[i] = y0[i] + h * s;
-        }
+        self.ya.copy_from(&y0v);
+        self.ya.gemv(h, &self.phi1, &f0v, 1.0);
         f(t0 + h, self.ya.as_slice(), self.fa.as_mut_slice());
         // d = F(a) − F(y0) − A (a − y0).
-        for i in 0..n {
-            let mut s = 0.0;
-            for j in 0..n {
-                s += self.a[(i, j)] * (self.ya[j] - y0[j]);
-            }
-            self.d[i] = self.fa[i] - f0[i] - s;
+        self.corr.copy_from(&self.ya);
+        self.corr -= &y0v;
+        self.d.copy_from(&self.fa);
+        self.d -= &f0v;
+        self.d.gemv(-1.0, &self.a, &self.corr, 1.0);
+        // The correction φ2 d (times h below), and φ2 (d − d₋₁) for the estimate.
+        self.corr.gemv(1.0, &self.phi2, &self.d, 0.0);
+        if self.have_prev {
+            self.fa.copy_from(&self.d);
+            self.fa -= &self.d_prev;
+            self.curv.gemv(1.0, &self.phi2, &self.fa, 0.0);
+        } else {
+            self.curv.fill(0.0);
         }
         let (rtol, atol) = tol;
         let mut err = 0.0f64;
         for i in 0..n {
-            let (mut s, mut c) = (0.0, 0.0);
-            for j in 0..n {
-                s += self.phi2[(i, j)] * self.d[j];
-                if self.have_prev {
-                    c += self.phi2[(i, j)] * (self.d[j] - self.d_prev[j]);
-                }
-            }
-            let corr = h * s;
+            let corr = h * self.corr[i];
             y1[i] = self.ya[i] + corr;
-            let e = corr.abs().max(h * c.abs());
+            let e = corr.abs().max(h * self.curv[i].abs());
             let sc = atol[i] + rtol * y0[i].abs().max(y1[i].abs());
             err = err.max(e / sc);
         }
