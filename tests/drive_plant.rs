@@ -146,7 +146,8 @@ struct Deviation {
 }
 
 /// Runs `opts` and a tight reference (Radau5 at `rtol` 1e-10 and 1e-17 m, steps no longer than
-/// a quarter period) through one programme on the default wavy disk: a heater staircase into
+/// a quarter period) through one programme on the disk of `opts` (the default wavy disk unless
+/// the test says otherwise): a heater staircase into
 /// contact and back, a dither, and a command that changes every period, besides runs of
 /// unchanged commands. Both see the same noise.
 fn deviation(opts: DriveOptions) -> Deviation {
@@ -161,12 +162,14 @@ fn deviation_after(
 ) -> (Deviation, hdi_tribology::drive::SchemeCounts) {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).unwrap();
+    let disk = opts.disk.clone();
     let fast = Plant::new(&scene, &zone, 5, opts).unwrap();
     let tight = Plant::new(
         &scene,
         &zone,
         5,
         DriveOptions {
+            disk,
             method: hdi_tribology::ode::Method::Radau5,
             rtol: 1e-10,
             atol_displacement: 1e-17,
@@ -357,4 +360,32 @@ fn the_exponential_scheme_holds_near_the_fold() {
     assert!(gap < 1e-13, "gap differs by {gap} m");
     sensors_within_their_noise(&dev);
     assert!(counts.fallbacks > 0, "{counts:?}");
+}
+
+/// On a flat disk the exponential scheme advances the periods after each new command itself
+/// and leaves held commands to the integrator's spanning steps: every sensor within the same
+/// fractions of its noise of the tight reference, in flight and in contact, and the gap within
+/// one displacement tolerance of the default drive's own deviation on the same programme.
+#[test]
+fn the_exponential_scheme_on_a_flat_disk() {
+    let flat = DriveOptions {
+        disk: DiskSpec::flat(),
+        ..DriveOptions::default()
+    };
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..flat.clone()
+    };
+    let (dev, counts) = deviation_after(o, &[]);
+    let (default, _) = deviation_after(flat.clone(), &[]);
+    let (gap, gap_default) = (
+        dev.gap_flight.max(dev.gap_contact),
+        default.gap_flight.max(default.gap_contact),
+    );
+    assert!(
+        gap < gap_default + flat.atol_displacement,
+        "gap differs by {gap} m (the default by {gap_default} m)"
+    );
+    sensors_within_their_noise(&dev);
+    assert!(counts.exponential > 0 && counts.spanned > 50, "{counts:?}");
 }

@@ -254,7 +254,10 @@ pub struct SchemeCounts {
     pub fallbacks: u64,
     /// Periods run by the integrator without a try, after misses (see the module docs).
     pub skipped: u64,
-    /// Refreshes of the held Jacobian, and rebuilds of the disk's table among them.
+    /// Periods of a command held on a flat disk without a dither, past the four after each
+    /// change: left to the integrator, whose steps span them.
+    pub spanned: u64,
+    /// Refreshes of the held Jacobian.
     pub refreshes: u64,
     /// Rebuilds of the disk's response table.
     pub rebuilds: u64,

@@ -1394,6 +1394,27 @@ where
         return advance(it, layout, set, integrals0, span, tol, None);
     }
     let Span { t0, rebase, .. } = span;
+    // A held command on a flat disk without a dither: nothing moves within the periods, and
+    // the integrator's steps span many of them at the cost of the read-out alone.
+    let still = disk.is_flat()
+        && set.is_none()
+        && !span.settling
+        && it.system().inputs().voltage.ac_amplitude == 0.0;
+    if still {
+        exp.counts.spanned += 1;
+        return match exp.owned.take() {
+            None => advance(it, layout, None, integrals0, span, tol, None),
+            Some(x) => {
+                let mut x0 = OVector::<f64, D>::from_iterator_generic(
+                    D::from_usize(layout.len()),
+                    nalgebra::U1,
+                    x.iter().copied(),
+                );
+                rebase_integrals(layout, rebase, &mut x0, integrals0);
+                advance(it, layout, None, integrals0, span, tol, Some(x0))
+            }
+        };
+    }
     let owned = exp.owned.take();
     let from_integrator = owned.is_none();
     let mut x0 = match owned {
