@@ -75,40 +75,41 @@ fn main() {
                         if std::env::var("DRIVE_BENCH_ONLY").is_ok_and(|o| !label.contains(&o)) {
                             continue;
                         }
-                    let mut d = plant.drive().expect("drive");
-                    let mut cmd = Command::heater_mw(mw);
-                    if let Some((a, f)) = dither {
-                        cmd = cmd.with_dither(a, f);
-                    }
-                    for _ in 0..400 {
-                        d.step(&cmd, DT).expect("settle");
-                    }
-                    let s0 = d.stats().accepted;
-                    let (e0, sp0) = (d.scheme_counts().exponential, d.scheme_counts().spanned);
-                    let t0 = d.time();
-                    let mut k = 0usize;
-                    let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
-                        let mut s = None;
-                        for _ in 0..BLOCK {
-                            let mut c = cmd;
-                            if alternate {
-                                k += 1;
-                                c.heater_power_mw += if k.is_multiple_of(2) { 1e-3 } else { -1e-3 };
-                            }
-                            s = Some(d.step(&c, DT).expect("step"));
+                        let mut d = plant.drive().expect("drive");
+                        let mut cmd = Command::heater_mw(mw);
+                        if let Some((a, f)) = dither {
+                            cmd = cmd.with_dither(a, f);
                         }
-                        s
-                    });
-                    let periods = (d.time() - t0) / DT;
-                    let steps = (d.stats().accepted - s0) as f64 / periods;
-                    let exp_share = (d.scheme_counts().exponential - e0) as f64 / periods;
-                    let spanned = (d.scheme_counts().spanned - sp0) as f64 / periods;
-                    let last = last.expect("ran");
-                    // The state the case claims: in contact the true contact force is far above F_th.
-                    let in_contact = (last.truth.mean_contact_force_un * 1e-6) > 5e-5;
-                    assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
-                    let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
-                    println!(
+                        for _ in 0..400 {
+                            d.step(&cmd, DT).expect("settle");
+                        }
+                        let s0 = d.stats().accepted;
+                        let (e0, sp0) = (d.scheme_counts().exponential, d.scheme_counts().spanned);
+                        let t0 = d.time();
+                        let mut k = 0usize;
+                        let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
+                            let mut s = None;
+                            for _ in 0..BLOCK {
+                                let mut c = cmd;
+                                if alternate {
+                                    k += 1;
+                                    c.heater_power_mw +=
+                                        if k.is_multiple_of(2) { 1e-3 } else { -1e-3 };
+                                }
+                                s = Some(d.step(&c, DT).expect("step"));
+                            }
+                            s
+                        });
+                        let periods = (d.time() - t0) / DT;
+                        let steps = (d.stats().accepted - s0) as f64 / periods;
+                        let exp_share = (d.scheme_counts().exponential - e0) as f64 / periods;
+                        let spanned = (d.scheme_counts().spanned - sp0) as f64 / periods;
+                        let last = last.expect("ran");
+                        // The state the case claims: in contact the true contact force is far above F_th.
+                        let in_contact = (last.truth.mean_contact_force_un * 1e-6) > 5e-5;
+                        assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
+                        let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
+                        println!(
                     "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} / {:.2} |",
                     match (dither, alternate) {
                         (Some((a, f)), _) => format!("{a} V, {:.1} kHz", f / 1e3),

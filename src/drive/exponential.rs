@@ -245,7 +245,29 @@ impl Dither {
     }
 }
 
-/// What the exponential scheme did so far.
+/// What the exponential scheme did so far ([`crate::drive::Drive::scheme_counts`]).
+///
+/// ```
+/// use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, DriveScheme, Plant};
+/// use hdi_tribology::scene::Scene;
+/// let scene = Scene::paper();
+/// let opts = DriveOptions {
+///     scheme: DriveScheme::Exponential,
+///     disk: DiskSpec::flat(),
+///     ..DriveOptions::default()
+/// };
+/// let mut drive = Plant::new(&scene, &scene_zone(&scene, 0.025)?, 1, opts)?.into_drive()?;
+/// // A command that changes every period, the firmware case.
+/// for k in 0..200 {
+///     let mw = 70.0 + if k % 2 == 0 { 1e-3 } else { -1e-3 };
+///     drive.step(&Command::heater_mw(mw), 50e-6)?;
+/// }
+/// let c = drive.scheme_counts();
+/// // Each period is counted once, by whoever advanced it.
+/// assert_eq!(c.exponential + c.fallbacks + c.skipped + c.spanned, 200);
+/// assert!(c.exponential > 100, "{c:?}");
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct SchemeCounts {
     /// Periods advanced by one exponential step.
@@ -315,7 +337,12 @@ where
 }
 
 impl ExpScheme {
-    pub(crate) fn new(layout: &StateLayout, rtol: f64, atol: Vec<f64>, base: Vec<(usize, f64)>) -> Self {
+    pub(crate) fn new(
+        layout: &StateLayout,
+        rtol: f64,
+        atol: Vec<f64>,
+        base: Vec<(usize, f64)>,
+    ) -> Self {
         let n = atol.len();
         ExpScheme {
             dofs: layout.dofs,
@@ -358,7 +385,14 @@ impl ExpScheme {
     /// The Jacobian at `(t, x − p(t))`, the per-`V²` vector `e` there, and everything built on them
     /// (the stepper of period `h`, the dither's response; the disk's table when there is none
     /// or `J` moved by more than [`REBUILD_SHIFT`] from the one it was built with).
-    fn refresh<D: Dim>(&mut self, sys: &SliderSystem, disk: &Disk, t: f64, x: &OVector<f64, D>, h: f64) -> bool
+    fn refresh<D: Dim>(
+        &mut self,
+        sys: &SliderSystem,
+        disk: &Disk,
+        t: f64,
+        x: &OVector<f64, D>,
+        h: f64,
+    ) -> bool
     where
         DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {
@@ -416,7 +450,10 @@ impl ExpScheme {
         self.reach = (0..self.dofs)
             .map(|k| {
                 let table = self.disk.as_ref().map_or(0.0, |d| d.largest(k));
-                let lines = self.dither.as_ref().map_or(0.0, |d| d.c1[k].norm() + d.c2[k].norm());
+                let lines = self
+                    .dither
+                    .as_ref()
+                    .map_or(0.0, |d| d.c1[k].norm() + d.c2[k].norm());
                 table + lines
             })
             .sum();
@@ -429,7 +466,13 @@ impl ExpScheme {
     /// frequencies, where the step's estimate (from the period's ends) cannot see it. Its
     /// effect on the contact impulse over a period, `h A |F_c′(d − A) − F_c′(d + A)| / 4`, must
     /// be within the impulse's tolerance.
-    pub(crate) fn straight<D: Dim>(&self, sys: &SliderSystem, t: f64, x: &OVector<f64, D>, h: f64) -> bool
+    pub(crate) fn straight<D: Dim>(
+        &self,
+        sys: &SliderSystem,
+        t: f64,
+        x: &OVector<f64, D>,
+        h: f64,
+    ) -> bool
     where
         DefaultAllocator: Allocator<D>,
     {
@@ -453,7 +496,14 @@ impl ExpScheme {
     }
 
     /// `p(t)` and `p′(t)` of the known forcings into the work vectors.
-    fn known(disk: &Disk, table: &Option<Periodic>, dither: &Option<Dither>, t: f64, p: &mut [f64], dp: &mut [f64]) {
+    fn known(
+        disk: &Disk,
+        table: &Option<Periodic>,
+        dither: &Option<Dither>,
+        t: f64,
+        p: &mut [f64],
+        dp: &mut [f64],
+    ) {
         p.iter_mut().for_each(|x| *x = 0.0);
         dp.iter_mut().for_each(|x| *x = 0.0);
         if let Some(d) = table {
@@ -540,7 +590,14 @@ impl ExpScheme {
 
     /// Tries one period `[t0, t0 + h]` from `x0`: the stepper as held, then, on a miss, once
     /// more after a refresh at `(t0, x0)`.
-    pub(crate) fn attempt<D: Dim>(&mut self, sys: &SliderSystem, disk: &Disk, t0: f64, h: f64, x0: &OVector<f64, D>) -> Attempt<D>
+    pub(crate) fn attempt<D: Dim>(
+        &mut self,
+        sys: &SliderSystem,
+        disk: &Disk,
+        t0: f64,
+        h: f64,
+        x0: &OVector<f64, D>,
+    ) -> Attempt<D>
     where
         DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {
@@ -660,7 +717,9 @@ mod tests {
             let direct: Complex64 = x
                 .iter()
                 .enumerate()
-                .map(|(m, xm)| xm * Complex64::from_polar(1.0, 2.0 * PI * (m * i) as f64 / n as f64))
+                .map(|(m, xm)| {
+                    xm * Complex64::from_polar(1.0, 2.0 * PI * (m * i) as f64 / n as f64)
+                })
                 .sum();
             assert!((yi - direct).norm() < 1e-12, "{i}");
         }

@@ -52,8 +52,8 @@ pub use error::DriveError;
 pub use exponential::SchemeCounts;
 pub use heads::{head_seed, MultiDrive, MultiPlant};
 pub use plant::{
-    scene_zone, spec_zone, zone_at, Ambient, Command, Drive, DriveOptions, DriveScheme, PeriodReport, Plant,
-    DEFAULT_RADIUS, MAX_STEPS_PER_PERIOD,
+    scene_zone, spec_zone, zone_at, Ambient, Command, Drive, DriveOptions, DriveScheme,
+    PeriodReport, Plant, DEFAULT_RADIUS, MAX_STEPS_PER_PERIOD,
 };
 pub use replay::{
     check_commands, read_commands, replay, replay_each, replay_heads, replay_heads_each,

@@ -1076,7 +1076,9 @@ impl Drive {
     /// What the exponential scheme did so far ([`DriveScheme::Exponential`]; all zero under
     /// the integrator).
     pub fn scheme_counts(&self) -> SchemeCounts {
-        self.exp.as_ref().map_or(SchemeCounts::default(), |e| e.counts)
+        self.exp
+            .as_ref()
+            .map_or(SchemeCounts::default(), |e| e.counts)
     }
 
     /// Solver work so far.

@@ -103,6 +103,9 @@ pub fn expm(a: &DMatrix<f64>) -> Result<DMatrix<f64>, OdeError> {
     Ok(e)
 }
 
+/// `e^{hA}`, `φ₁(hA)` and `φ₂(hA)`, in this order.
+pub type PhiFunctions = (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>);
+
 /// `e^{hA}`, `φ₁(hA)` and `φ₂(hA)` of a square matrix `A` and a step `h`, from one exponential
 /// of the augmented matrix `[[hA, I, 0], [0, 0, I], [0, 0, 0]]`.
 ///
@@ -122,7 +125,7 @@ pub fn expm(a: &DMatrix<f64>) -> Result<DMatrix<f64>, OdeError> {
 pub fn phi_functions(
     a: &DMatrix<f64>,
     h: f64,
-) -> Result<(DMatrix<f64>, DMatrix<f64>, DMatrix<f64>), OdeError> {
+) -> Result<PhiFunctions, OdeError> {
     if !(h.is_finite() && h > 0.0) {
         return Err(OdeError::invalid(
             "h",
@@ -236,7 +239,10 @@ impl ExponentialStepper {
         let n = self.dim();
         assert!(y0.len() == n && f0.len() == n && y1.len() == n && tol.1.len() == n);
         let h = self.h;
-        let (y0v, f0v) = (DVectorView::from_slice(y0, n), DVectorView::from_slice(f0, n));
+        let (y0v, f0v) = (
+            DVectorView::from_slice(y0, n),
+            DVectorView::from_slice(f0, n),
+        );
         // a = y0 + h φ1 f0.
         self.ya.copy_from(&y0v);
         self.ya.gemv(h, &self.phi1, &f0v, 1.0);
@@ -290,7 +296,11 @@ mod tests {
         let exact = &v * DMatrix::from_diagonal(&DVector::from_vec(e_l)) * &vi;
         let e = expm(&a).unwrap();
         let scale = exact.amax();
-        assert!((&e - &exact).amax() < 1e-12 * scale, "{}", (&e - &exact).amax());
+        assert!(
+            (&e - &exact).amax() < 1e-12 * scale,
+            "{}",
+            (&e - &exact).amax()
+        );
     }
 
     /// φ-functions of a damped oscillator's matrix against their defining series, summed at a

@@ -50,7 +50,7 @@ pub use cancel::{Cancel, CANCEL_CHECK_INTERVAL};
 pub use dense::{DenseOutput, StepPolynomial};
 pub use error::OdeError;
 pub use event::{Direction, Event, EventHit};
-pub use exponential::{expm, phi_functions, ExponentialStepper};
+pub use exponential::{expm, phi_functions, ExponentialStepper, PhiFunctions};
 pub use integrator::{Integrator, StepStatus};
 pub use options::{Method, Options, SaveAt, Tolerance, MIN_RTOL};
 pub use problem::OdeProblem;
