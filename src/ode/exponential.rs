@@ -39,7 +39,7 @@
 //! ```
 
 use super::OdeError;
-use nalgebra::{DMatrix, DVector, DVectorView};
+use nalgebra::{DMatrix, DVector};
 
 /// The exponential of a square matrix: Padé's [6/6] approximant of `e^{A/2^s}`, squared `s`
 /// times, with `s` the least that brings the 1-norm of `A/2^s` to 1/2 or below (a relative
@@ -122,10 +122,7 @@ pub type PhiFunctions = (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>);
 ///
 /// # Errors
 /// As [`expm`]; [`OdeError::InvalidInput`] naming `h` when it is not positive and finite.
-pub fn phi_functions(
-    a: &DMatrix<f64>,
-    h: f64,
-) -> Result<PhiFunctions, OdeError> {
+pub fn phi_functions(a: &DMatrix<f64>, h: f64) -> Result<PhiFunctions, OdeError> {
     if !(h.is_finite() && h > 0.0) {
         return Err(OdeError::invalid(
             "h",
@@ -161,8 +158,6 @@ pub fn phi_functions(
 pub struct ExponentialStepper {
     h: f64,
     a: DMatrix<f64>,
-    phi1: DMatrix<f64>,
-    phi2: DMatrix<f64>,
     /// Work: the exponential Euler state, the right-hand side there, a difference.
     ya: DVector<f64>,
     fa: DVector<f64>,
@@ -172,6 +167,10 @@ pub struct ExponentialStepper {
     have_prev: bool,
     corr: DVector<f64>,
     curv: DVector<f64>,
+    /// `φ₁`, `A` and `φ₂` row by row (row-major), for the products.
+    rows1: Vec<f64>,
+    rows_a: Vec<f64>,
+    rows2: Vec<f64>,
 }
 
 impl ExponentialStepper {
@@ -185,8 +184,6 @@ impl ExponentialStepper {
         Ok(ExponentialStepper {
             h,
             a: a.clone(),
-            phi1,
-            phi2,
             ya: DVector::zeros(n),
             fa: DVector::zeros(n),
             d: DVector::zeros(n),
@@ -194,6 +191,9 @@ impl ExponentialStepper {
             have_prev: false,
             corr: DVector::zeros(n),
             curv: DVector::zeros(n),
+            rows1: phi1.transpose().as_slice().to_vec(),
+            rows_a: a.transpose().as_slice().to_vec(),
+            rows2: phi2.transpose().as_slice().to_vec(),
         })
     }
 
@@ -239,28 +239,47 @@ impl ExponentialStepper {
         let n = self.dim();
         assert!(y0.len() == n && f0.len() == n && y1.len() == n && tol.1.len() == n);
         let h = self.h;
-        let (y0v, f0v) = (
-            DVectorView::from_slice(y0, n),
-            DVectorView::from_slice(f0, n),
-        );
-        // a = y0 + h φ1 f0.
-        self.ya.copy_from(&y0v);
-        self.ya.gemv(h, &self.phi1, &f0v, 1.0);
+        let dot = |row: &[f64], v: &[f64]| -> f64 { row.iter().zip(v).map(|(a, b)| a * b).sum() };
+        // a = y0 + h φ1 f0 (rows of the row-major copies).
+        for ((a, row), y) in self.ya.iter_mut().zip(self.rows1.chunks_exact(n)).zip(y0) {
+            *a = y + h * dot(row, f0);
+        }
         f(t0 + h, self.ya.as_slice(), self.fa.as_mut_slice());
         // d = F(a) − F(y0) − A (a − y0).
-        self.corr.copy_from(&self.ya);
-        self.corr -= &y0v;
-        self.d.copy_from(&self.fa);
-        self.d -= &f0v;
-        self.d.gemv(-1.0, &self.a, &self.corr, 1.0);
+        for ((c, a), y) in self.corr.iter_mut().zip(self.ya.iter()).zip(y0) {
+            *c = a - y;
+        }
+        for (((d, row), fa), f0) in self
+            .d
+            .iter_mut()
+            .zip(self.rows_a.chunks_exact(n))
+            .zip(self.fa.iter())
+            .zip(f0)
+        {
+            *d = fa - f0 - dot(row, self.corr.as_slice());
+        }
         // The correction φ2 d (times h below), and φ2 (d − d₋₁) for the estimate.
-        self.corr.gemv(1.0, &self.phi2, &self.d, 0.0);
-        if self.have_prev {
-            self.fa.copy_from(&self.d);
-            self.fa -= &self.d_prev;
-            self.curv.gemv(1.0, &self.phi2, &self.fa, 0.0);
-        } else {
-            self.curv.fill(0.0);
+        for ((dd, d), p) in self
+            .fa
+            .iter_mut()
+            .zip(self.d.iter())
+            .zip(self.d_prev.iter())
+        {
+            *dd = d - p;
+        }
+        let prev = self.have_prev;
+        for ((c, k), row) in self
+            .corr
+            .iter_mut()
+            .zip(self.curv.iter_mut())
+            .zip(self.rows2.chunks_exact(n))
+        {
+            *c = dot(row, self.d.as_slice());
+            *k = if prev {
+                dot(row, self.fa.as_slice())
+            } else {
+                0.0
+            };
         }
         let (rtol, atol) = tol;
         let mut err = 0.0f64;
