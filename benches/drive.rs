@@ -112,7 +112,7 @@ fn main() {
                         println!(
                     "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} / {:.2} |",
                     match (dither, alternate) {
-                        (Some((a, f)), _) => format!("{a} V, {:.1} kHz", f / 1e3),
+                        (Some((a, f)), _) => format!("{a} V, {f:.1} kHz"),
                         (None, true) => "off, ±1 µW every period".to_string(),
                         (None, false) => "off".to_string(),
                     },
