@@ -389,3 +389,33 @@ fn the_exponential_scheme_on_a_flat_disk() {
     sensors_within_their_noise(&dev);
     assert!(counts.exponential > 0 && counts.spanned > 50, "{counts:?}");
 }
+
+/// The exponential scheme's sensor stream is the same from run to run, to the bit, over a
+/// programme that moves between its own steps, the integrator and back.
+#[test]
+fn the_exponential_scheme_replays_to_the_bit() {
+    let scene = Scene::paper();
+    let zone = scene_zone(&scene, 0.025).unwrap();
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..DriveOptions::default()
+    };
+    let run = || {
+        let mut d = Plant::new(&scene, &zone, 3, o.clone())
+            .unwrap()
+            .into_drive()
+            .unwrap();
+        let mut bits = Vec::new();
+        for k in 0..300 {
+            let mw = if k < 150 { 70.0 } else { 78.0 } + 1e-3 * (k % 2) as f64;
+            let s = d.step(&Command::heater_mw(mw), DT).unwrap();
+            bits.extend([s.contact_resistance_ohm, s.truth.gap_nm].map(f64::to_bits));
+        }
+        (bits, d.scheme_counts())
+    };
+    let (a, ca) = run();
+    let (b, cb) = run();
+    assert!(ca.exponential > 0 && ca.fallbacks > 0, "{ca:?}");
+    assert_eq!(ca, cb);
+    assert_eq!(a, b);
+}
