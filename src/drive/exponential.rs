@@ -1,27 +1,32 @@
-//! The drive's exponential scheme ([`DriveScheme::Exponential`](super::DriveScheme)): one
-//! exponential step per period, with the slider's Jacobian held across periods and the known
-//! periodic forcings (the disk's waviness, an AC dither) taken out exactly by their particular
-//! solutions; the existing integrator for the periods whose error estimate misses the
-//! tolerances.
+//! The drive's exponential scheme ([`DriveScheme::Exponential`](super::DriveScheme)): each
+//! period one exponential step, or 2 to 16 substeps, with the slider's Jacobian held across
+//! periods and the known periodic forcings (the disk's waviness, an AC dither) taken out exactly
+//! by their particular solutions; the existing integrator for the periods the scheme cannot
+//! answer for.
 //!
-//! The split. With `J` the slider's Jacobian at some state (held), the forcings that are known
-//! functions of time are the disk's motion, `u_d(t) = −r ẅ(t)` on the accelerations, and the
-//! dither's part of the interface force, `u_v(t) = e (V(t)² − mean)` with `e = ∂f/∂(V²)` at the
-//! state where `J` was taken. Each is a sum of sinusoids (the disk's harmonics; `V²` has its
+//! The split. With `J` the slider's Jacobian (held), taken at the slow state (the state less
+//! the known forcings' responses, so that it does not swing with the disk's phase), the
+//! forcings that are known functions of time are the disk's motion, `u_d(t) = −r ẅ(t)` on the
+//! accelerations, and the dither's part of the interface force, `u_v(t) = e (V(t)² − mean)`
+//! with `e = ∂f/∂(V²)` there. Each is a sum of sinusoids (the disk's harmonics; `V²` has its
 //! lines at `ω` and `2ω`), so `p′ = J p + u` has the periodic solution
 //! `p(t) = Σ Re(C_k e^{iω_k t})` with `(iω_k − J) C_k = U_k`. The state is integrated as
 //! `z = x − p(t)`: `z′ = f(t, z + p) − p′(t)`, whose remainder `z′ − J z` holds what is left
-//! of the nonlinear interface forces, the mean voltage and the heater, smooth over a period in
-//! flight. The disk's `p` is tabulated over a revolution on the disk's own grid (cubic Hermite
-//! from exact values and slopes) for the `J` it was built with; the dither's is summed per
-//! evaluation (two lines).
+//! of the nonlinear forces, the mean voltage and the heater. The disk's `p` is tabulated over
+//! a revolution on the disk's own grid (values and slopes by an inverse FFT, cubic Hermite
+//! between the nodes) for the `J` it was built with; the dither's is summed per evaluation
+//! (two lines).
 //!
-//! The step is [`crate::ode::ExponentialStepper`]'s (ETD2RK) on `z` over the whole period, at
-//! the drive's contact tolerances. A period whose estimate is above 1 is tried again with the
-//! Jacobian taken afresh at its start (and, when that moved `J` by more than
-//! [`REBUILD_SHIFT`], the disk's table rebuilt); if it still misses, the period is run by the
-//! integrator from the same start, as the default drive runs it, and the following periods
-//! too, for a number that doubles with each consecutive miss, up to [`MAX_SKIP`].
+//! The step is [`crate::ode::ExponentialStepper`]'s (ETD2RK) on `z`, at the drive's contact
+//! tolerances, per component. Before it, a check of the contact force's curvature over the
+//! forcings' reach ([`ExpScheme::straight`]) refuses what the estimate cannot see. A period
+//! whose estimate is above 1 is tried again with the Jacobian taken afresh at its start (the
+//! disk's table rebuilt when that moved `J` by more than [`REBUILD_SHIFT`]), then with twice
+//! the substeps, up to [`LEVELS`]; if it still misses, the period is run by the integrator
+//! from the same start, as the default drive runs it, and the following periods too, for a
+//! number that doubles with each consecutive miss, up to [`MAX_SKIP`]. A held command on a
+//! flat disk without a dither is left to the integrator (`src/drive/plant.rs`), whose steps
+//! span many periods there.
 
 use super::disk::{Disk, NODES};
 use super::plant::MAX_STATE;

@@ -246,14 +246,20 @@ pub enum DriveScheme {
     /// span periods while the command holds.
     #[default]
     Integrator,
-    /// One exponential step per period (ETD2RK, [`crate::ode::ExponentialStepper`]) with the
-    /// slider's Jacobian held across periods and refreshed when a period misses the
-    /// tolerances; the disk's waviness and an AC dither are taken out by their exact periodic
-    /// responses to the held linear part. A period whose error estimate still misses the
-    /// drive's contact tolerances ([`DriveOptions::atol_displacement`], `rtol`) is run by the
-    /// integrator from the same start and flagged ([`PeriodReport::exponential`] false), as
-    /// are, after consecutive misses, a doubling number of the following periods (up to 64).
-    /// docs/clearance.md, "The exponential scheme", gives its cost and accuracy.
+    /// One exponential step per period, or 2 to 16 substeps where the period needs them
+    /// (ETD2RK, [`crate::ode::ExponentialStepper`]), with the slider's Jacobian held across
+    /// periods and refreshed when a period misses the tolerances; the disk's waviness and an
+    /// AC dither are taken out by their exact periodic responses to the held linear part. A
+    /// period whose error estimate still misses the drive's contact tolerances
+    /// ([`DriveOptions::atol_displacement`], `rtol`), or where the contact force curves too
+    /// much over the gaps the disk and the dither sweep, is run by the integrator from the
+    /// same start and flagged ([`PeriodReport::exponential`] false), as are, after
+    /// consecutive misses, a doubling number of the following periods (up to 64). A held
+    /// command on a flat disk without a dither is left to the integrator after the four
+    /// periods that follow each change (its steps span many periods there);
+    /// [`Drive::scheme_counts`] counts each kind of period. Faster than the integrator where
+    /// the command changes every period; docs/clearance.md, "The exponential scheme", gives
+    /// its cost and accuracy.
     Exponential,
 }
 

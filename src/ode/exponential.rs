@@ -1,42 +1,6 @@
 //! Exponential integration with a held matrix: the matrix exponential of a small dense matrix,
-//! the φ-functions, and a second-order exponential step with an error estimate.
-//!
-//! For `y' = F(t, y)` and a matrix `A` near `∂F/∂y` (held over many steps, refreshed by the
-//! caller), one step of length `h` is the exponential time differencing scheme ETD2RK of Cox and
-//! Matthews (J. Comput. Phys. 176, 2002) written for the whole right-hand side, with the
-//! remainder `g(t, y) = F(t, y) − A y`:
-//!
-//! ```text
-//! a  = y₀ + h φ₁(hA) F(t₀, y₀)                                  (exponential Euler)
-//! y₁ = a + h φ₂(hA) (F(t₀ + h, a) − F(t₀, y₀) − A (a − y₀))
-//! ```
-//!
-//! with `φ₁(z) = (eᶻ − 1)/z` and `φ₂(z) = (eᶻ − 1 − z)/z²`. It is exact for `y' = A y + c` with a
-//! constant `c` and of second order otherwise, whatever the stiffness of `A`. The step's error
-//! estimate takes, component by component, the larger of two terms: the difference `y₁ − a`,
-//! the first-order scheme's error, and, when the previous step of the same length ended where
-//! this one starts, `h φ₂(hA) (d − d₋₁)` with `d = F(t₀ + h, a) − F(t₀, y₀) − A (a − y₀)` the
-//! remainder's change over the step: the second difference of the remainder, about six times
-//! the error of the linear interpolation of the remainder the scheme rests on. The first term
-//! misses a remainder whose slope vanishes within the step; the second one sees its curvature. The φ-functions of `hA` come together
-//! from one exponential of an augmented matrix (Al-Mohy and Higham, SIAM J. Sci. Comput. 33,
-//! 2011, §2): `exp([[hA, I, 0], [0, 0, I], [0, 0, 0]])` has `e^{hA}`, `φ₁(hA)` and `φ₂(hA)` in
-//! its first block row. The exponential is Padé's [6/6] approximant with scaling and squaring.
-//!
-//! ```
-//! use hdi_tribology::nalgebra::DMatrix;
-//! use hdi_tribology::ode::ExponentialStepper;
-//! // y' = -1000 y + 1: stiff, and exact in one step of any length.
-//! let a = DMatrix::from_element(1, 1, -1000.0);
-//! let mut s = ExponentialStepper::new(&a, 0.1)?;
-//! let f = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -1000.0 * y[0] + 1.0;
-//! let (mut y1, mut f0) = ([0.0], [0.0]);
-//! f(0.0, &[0.0], &mut f0);
-//! let err = s.step(0.0, &[0.0], &f0, f, (1e-10, &[1e-12]), &mut y1);
-//! let exact = (1.0 - (-100.0f64).exp()) / 1000.0;
-//! assert!((y1[0] - exact).abs() < 1e-15 && err < 1e-3);
-//! # Ok::<(), hdi_tribology::ode::OdeError>(())
-//! ```
+//! the φ-functions, and a second-order exponential step with an error estimate
+//! ([`ExponentialStepper`]).
 
 use super::OdeError;
 use nalgebra::{DMatrix, DVector};
@@ -150,10 +114,47 @@ pub fn phi_functions(a: &DMatrix<f64>, h: f64) -> Result<PhiFunctions, OdeError>
     ))
 }
 
-/// Steps of one length `h` of the second-order exponential scheme (module documentation)
-/// with a held matrix `A`: the φ-functions are computed once, each step then costs one
-/// right-hand side besides the one at its start, and three products of an `n × n` matrix with
-/// a vector. Nothing is allocated per step.
+/// Steps of one length `h` of a second-order exponential scheme with a held matrix `A`: the
+/// φ-functions are computed once, each step then costs one right-hand side besides the one at
+/// its start, and three products of an `n × n` matrix with a vector. Nothing is allocated per
+/// step.
+///
+/// For `y' = F(t, y)` and a matrix `A` near `∂F/∂y` (held over many steps, refreshed by the
+/// caller), one step of length `h` is the exponential time differencing scheme ETD2RK of Cox and
+/// Matthews (J. Comput. Phys. 176, 2002) written for the whole right-hand side, with the
+/// remainder `g(t, y) = F(t, y) − A y`:
+///
+/// ```text
+/// a  = y₀ + h φ₁(hA) F(t₀, y₀)                                  (exponential Euler)
+/// y₁ = a + h φ₂(hA) (F(t₀ + h, a) − F(t₀, y₀) − A (a − y₀))
+/// ```
+///
+/// with `φ₁(z) = (eᶻ − 1)/z` and `φ₂(z) = (eᶻ − 1 − z)/z²`. It is exact for `y' = A y + c` with a
+/// constant `c` and of second order otherwise, whatever the stiffness of `A`. The step's error
+/// estimate takes, component by component, the larger of two terms: the difference `y₁ − a`,
+/// the first-order scheme's error, and, when the previous step of the same length ended where
+/// this one starts, `h φ₂(hA) (d − d₋₁)` with `d = F(t₀ + h, a) − F(t₀, y₀) − A (a − y₀)` the
+/// remainder's change over the step: the second difference of the remainder, about six times
+/// the error of the linear interpolation of the remainder the scheme rests on. The first term
+/// misses a remainder whose slope vanishes within the step; the second one sees its curvature. The φ-functions of `hA` come together
+/// from one exponential of an augmented matrix (Al-Mohy and Higham, SIAM J. Sci. Comput. 33,
+/// 2011, §2): `exp([[hA, I, 0], [0, 0, I], [0, 0, 0]])` has `e^{hA}`, `φ₁(hA)` and `φ₂(hA)` in
+/// its first block row. The exponential is Padé's [6/6] approximant with scaling and squaring.
+///
+/// ```
+/// use hdi_tribology::nalgebra::DMatrix;
+/// use hdi_tribology::ode::ExponentialStepper;
+/// // y' = -1000 y + 1: stiff, and exact in one step of any length.
+/// let a = DMatrix::from_element(1, 1, -1000.0);
+/// let mut s = ExponentialStepper::new(&a, 0.1)?;
+/// let f = |_t: f64, y: &[f64], dy: &mut [f64]| dy[0] = -1000.0 * y[0] + 1.0;
+/// let (mut y1, mut f0) = ([0.0], [0.0]);
+/// f(0.0, &[0.0], &mut f0);
+/// let err = s.step(0.0, &[0.0], &f0, f, (1e-10, &[1e-12]), &mut y1);
+/// let exact = (1.0 - (-100.0f64).exp()) / 1000.0;
+/// assert!((y1[0] - exact).abs() < 1e-15 && err < 1e-3);
+/// # Ok::<(), hdi_tribology::ode::OdeError>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct ExponentialStepper {
     h: f64,
@@ -219,7 +220,7 @@ impl ExponentialStepper {
     }
 
     /// One step from `(t0, y0)`, `f0 = F(t0, y0)`, to `y1` at `t0 + h`; `f(t, y, dy)` writes
-    /// `F(t, y)` into `dy`. Returns the error estimate (module documentation): its largest
+    /// `F(t, y)` into `dy`. Returns the error estimate (see the type's documentation): its largest
     /// component weighted by `atol_i + rtol·max(|y0_i|, |y1_i|)` (`tol = (rtol, atol)`), a
     /// max norm, so that at most 1 meets every component's tolerance. A non-finite right-hand side
     /// gives an infinite estimate. The next step takes this one as its previous step (see
