@@ -136,8 +136,8 @@ pub fn phi_functions(a: &DMatrix<f64>, h: f64) -> Result<PhiFunctions, OdeError>
 /// this one starts, `h φ₂(hA) (d − d₋₁)` with `d = F(t₀ + h, a) − F(t₀, y₀) − A (a − y₀)` the
 /// remainder's change over the step: the second difference of the remainder, about six times
 /// the error of the linear interpolation of the remainder the scheme rests on. The first term
-/// misses a remainder whose slope vanishes within the step; the second one sees its curvature. The φ-functions of `hA` come together
-/// from one exponential of an augmented matrix (Al-Mohy and Higham, SIAM J. Sci. Comput. 33,
+/// misses a remainder whose slope vanishes within the step; the second one sees its curvature.
+/// The φ-functions of `hA` come together from one exponential of an augmented matrix (Al-Mohy and Higham, SIAM J. Sci. Comput. 33,
 /// 2011, §2): `exp([[hA, I, 0], [0, 0, I], [0, 0, 0]])` has `e^{hA}`, `φ₁(hA)` and `φ₂(hA)` in
 /// its first block row. The exponential is Padé's [6/6] approximant with scaling and squaring.
 ///
