@@ -1,7 +1,11 @@
 //! `Drive::step` at a 20 kHz controller rate against real time: in flight and in contact, on a
 //! flat and on the default wavy disk, with and without an AC dither, and with a command that
-//! changes every period; at the default tolerance (0.01 pm throughout) and with 1 pm in flight
-//! (`DriveOptions::atol_displacement_flight`). Prints a table.
+//! changes every period; at the default tolerance (0.01 pm throughout), with the exponential
+//! scheme (`DriveScheme::Exponential`, right after the default on the same case) and with 1 pm
+//! in flight (`DriveOptions::atol_displacement_flight`). Prints a table; the last column gives
+//! the shares of the timed periods the exponential scheme advanced itself and left to the
+//! integrator's spanning steps (a held command on a flat disk); the rest it left to the
+//! integrator after misses.
 //!
 //! `cargo bench --bench drive`. Each case settles 20 ms at its heater power, then times blocks
 //! of 200 periods (10 ms of drive time) for at least 1 s; the table gives the fastest block's
@@ -11,7 +15,7 @@
 #[path = "../examples/common/timing.rs"]
 mod timing;
 
-use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, Plant};
+use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, DriveScheme, Plant};
 use hdi_tribology::scene::Scene;
 use std::time::Duration;
 
@@ -21,64 +25,94 @@ const BLOCK: usize = 200;
 fn main() {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).expect("zone");
-    println!("| flight atol | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("| scheme | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period | exponential / spanned periods |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let configs = [
-        ("0.01 pm", DriveOptions::default().atol_displacement),
-        ("1 pm", 1e-12),
+        ("0.01 pm", DriveOptions::default()),
+        (
+            "exponential",
+            DriveOptions {
+                scheme: DriveScheme::Exponential,
+                ..DriveOptions::default()
+            },
+        ),
+        (
+            "1 pm flight",
+            DriveOptions {
+                atol_displacement_flight: 1e-12,
+                ..DriveOptions::default()
+            },
+        ),
     ];
-    for (atol_name, flight) in configs {
-        for (disk_name, disk) in [("flat", DiskSpec::flat()), ("wavy", DiskSpec::default())] {
-            let plant = Plant::new(
-                &scene,
-                &zone,
-                1,
-                DriveOptions {
+    for (disk_name, disk) in [("flat", DiskSpec::flat()), ("wavy", DiskSpec::default())] {
+        let plants: Vec<(&str, Plant)> = configs
+            .iter()
+            .map(|(name, o)| {
+                let o = DriveOptions {
                     disk: disk.clone(),
-                    atol_displacement_flight: flight,
-                    ..DriveOptions::default()
-                },
-            )
-            .expect("plant");
+                    ..o.clone()
+                };
+                (*name, Plant::new(&scene, &zone, 1, o).expect("plant"))
+            })
+            .collect();
+        {
             for (state, mw) in [("flight", 70.0), ("contact", 80.0)] {
                 // Held commands, with and without dither; then a command that changes every period
                 // (a heater dithered by ±1 µW, alternating): the worst case, a restart per period.
                 for (dither, alternate) in [(None, false), (Some((0.5, 10.5)), false), (None, true)]
                 {
-                    let mut d = plant.drive().expect("drive");
-                    let mut cmd = Command::heater_mw(mw);
-                    if let Some((a, f)) = dither {
-                        cmd = cmd.with_dither(a, f);
-                    }
-                    for _ in 0..400 {
-                        d.step(&cmd, DT).expect("settle");
-                    }
-                    let s0 = d.stats().accepted;
-                    let t0 = d.time();
-                    let mut k = 0usize;
-                    let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
-                        let mut s = None;
-                        for _ in 0..BLOCK {
-                            let mut c = cmd;
-                            if alternate {
-                                k += 1;
-                                c.heater_power_mw += if k.is_multiple_of(2) { 1e-3 } else { -1e-3 };
+                    for (atol_name, plant) in &plants {
+                        // `DRIVE_BENCH_ONLY=exponential/flat/flight/held` runs the cases whose
+                        // label contains the value (a profile of one case).
+                        let label = format!(
+                            "{atol_name}/{disk_name}/{state}/{}",
+                            match (dither, alternate) {
+                                (Some(_), _) => "dither",
+                                (None, true) => "changed",
+                                (None, false) => "held",
                             }
-                            s = Some(d.step(&c, DT).expect("step"));
+                        );
+                        if std::env::var("DRIVE_BENCH_ONLY").is_ok_and(|o| !label.contains(&o)) {
+                            continue;
                         }
-                        s
-                    });
-                    let periods = (d.time() - t0) / DT;
-                    let steps = (d.stats().accepted - s0) as f64 / periods;
-                    let last = last.expect("ran");
-                    // The state the case claims: in contact the true contact force is far above F_th.
-                    let in_contact = (last.truth.mean_contact_force_un * 1e-6) > 5e-5;
-                    assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
-                    let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
-                    println!(
-                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} |",
+                        let mut d = plant.drive().expect("drive");
+                        let mut cmd = Command::heater_mw(mw);
+                        if let Some((a, f)) = dither {
+                            cmd = cmd.with_dither(a, f);
+                        }
+                        for _ in 0..400 {
+                            d.step(&cmd, DT).expect("settle");
+                        }
+                        let s0 = d.stats().accepted;
+                        let (e0, sp0) = (d.scheme_counts().exponential, d.scheme_counts().spanned);
+                        let t0 = d.time();
+                        let mut k = 0usize;
+                        let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
+                            let mut s = None;
+                            for _ in 0..BLOCK {
+                                let mut c = cmd;
+                                if alternate {
+                                    k += 1;
+                                    c.heater_power_mw +=
+                                        if k.is_multiple_of(2) { 1e-3 } else { -1e-3 };
+                                }
+                                s = Some(d.step(&c, DT).expect("step"));
+                            }
+                            s
+                        });
+                        let periods = (d.time() - t0) / DT;
+                        let steps = (d.stats().accepted - s0) as f64 / periods;
+                        let exp_share = (d.scheme_counts().exponential - e0) as f64 / periods;
+                        let spanned = (d.scheme_counts().spanned - sp0) as f64 / periods;
+                        let last = last.expect("ran");
+                        // The state the case claims: in contact the true contact force is far above F_th.
+                        let in_contact = (last.truth.mean_contact_force_un * 1e-6) > 5e-5;
+                        assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
+                        let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
+                        println!(
+                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} / {:.2} |",
                     match (dither, alternate) {
-                        (Some((a, f)), _) => format!("{a} V, {:.1} kHz", f / 1e3),
+                        (Some((a, f)), _) => format!("{a} V, {f:.1} kHz"),
                         (None, true) => "off, ±1 µW every period".to_string(),
                         (None, false) => "off".to_string(),
                     },
@@ -86,8 +120,11 @@ fn main() {
                     cpu * 1e6,
                     DT / wall,
                     DT / cpu,
-                    steps
+                    steps,
+                    exp_share,
+                    spanned
                 );
+                    }
                 }
             }
         }

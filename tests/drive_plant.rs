@@ -3,7 +3,7 @@
 
 use hdi_tribology::analysis::{flying_equilibrium, ScanGrid};
 use hdi_tribology::drive::{
-    scene_zone, Command, DiskSpec, Drive, DriveOptions, Plant, SensorSpec, Sensors,
+    scene_zone, Command, DiskSpec, Drive, DriveOptions, DriveScheme, Plant, SensorSpec, Sensors,
 };
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
@@ -146,18 +146,30 @@ struct Deviation {
 }
 
 /// Runs `opts` and a tight reference (Radau5 at `rtol` 1e-10 and 1e-17 m, steps no longer than
-/// a quarter period) through one programme on the default wavy disk: a heater staircase into
+/// a quarter period) through one programme on the disk of `opts` (the default wavy disk unless
+/// the test says otherwise): a heater staircase into
 /// contact and back, a dither, and a command that changes every period, besides runs of
 /// unchanged commands. Both see the same noise.
 fn deviation(opts: DriveOptions) -> Deviation {
+    deviation_after(opts, &[]).0
+}
+
+/// [`deviation`] with `prelude` run first, and the fast drive's counts of the exponential
+/// scheme over the whole run.
+fn deviation_after(
+    opts: DriveOptions,
+    prelude: &[Command],
+) -> (Deviation, hdi_tribology::drive::SchemeCounts) {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).unwrap();
+    let disk = opts.disk.clone();
     let fast = Plant::new(&scene, &zone, 5, opts).unwrap();
     let tight = Plant::new(
         &scene,
         &zone,
         5,
         DriveOptions {
+            disk,
             method: hdi_tribology::ode::Method::Radau5,
             rtol: 1e-10,
             atol_displacement: 1e-17,
@@ -167,7 +179,7 @@ fn deviation(opts: DriveOptions) -> Deviation {
         },
     )
     .unwrap();
-    let mut programme: Vec<Command> = Vec::new();
+    let mut programme: Vec<Command> = prelude.to_vec();
     for mw in [62.0, 68.0, 72.0, 76.0, 78.0, 74.0, 70.0] {
         programme.extend(std::iter::repeat_n(Command::heater_mw(mw), 60));
     }
@@ -220,11 +232,12 @@ fn deviation(opts: DriveOptions) -> Deviation {
         dev.steps,
         b.stats().accepted
     );
+    println!("{:?}", a.scheme_counts());
     assert!(
         dev.contact_periods > 50,
         "the programme should reach contact"
     );
-    dev
+    (dev, a.scheme_counts())
 }
 
 /// 0.1 µN of period-mean contact force (the contact sensor resolves ~0.2 µN per period in
@@ -306,4 +319,103 @@ fn a_drive_is_owned() {
     }
     let mut d = owned(plant(1, DiskSpec::flat()).into_drive().unwrap());
     assert!(d.step(&Command::heater_mw(60.0), DT).unwrap().truth.gap_nm > 0.0);
+}
+
+/// The exponential scheme (an option): one exponential step per period where its error
+/// estimate meets the contact tolerances, the integrator elsewhere. On this programme every
+/// sensor agrees with the tight reference within the same fractions of its noise as the
+/// default, and most periods are exponential.
+#[test]
+fn the_exponential_scheme_keeps_the_sensors_within_their_noise() {
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..DriveOptions::default()
+    };
+    let (dev, counts) = deviation_after(o, &[]);
+    let gap = dev.gap_flight.max(dev.gap_contact);
+    assert!(gap < 1e-13, "gap differs by {gap} m");
+    sensors_within_their_noise(&dev);
+    let rb_noise = (2.0f64).sqrt() * SensorSpec::default().readback.noise;
+    assert!(
+        dev.readback < 0.05 * rb_noise,
+        "read-back log ratio differs by {}",
+        dev.readback
+    );
+    assert!(counts.exponential > 0, "{counts:?}");
+}
+
+/// The near-fold case of docs/clearance.md ("Accuracy"): 600 periods held at 74.3 mW, just
+/// below the touchdown fold, where the disk's waviness snaps the head into contact, then the
+/// programme. The exponential scheme must see the snap (its estimate) and leave it to the
+/// integrator: the sensors stay within the default's bounds.
+#[test]
+fn the_exponential_scheme_holds_near_the_fold() {
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..DriveOptions::default()
+    };
+    let hold = vec![Command::heater_mw(74.3); 600];
+    let (dev, counts) = deviation_after(o, &hold);
+    let gap = dev.gap_flight.max(dev.gap_contact);
+    assert!(gap < 1e-13, "gap differs by {gap} m");
+    sensors_within_their_noise(&dev);
+    assert!(counts.fallbacks > 0, "{counts:?}");
+}
+
+/// On a flat disk the exponential scheme advances the periods after each new command itself
+/// and leaves held commands to the integrator's spanning steps: every sensor within the same
+/// fractions of its noise of the tight reference, in flight and in contact, and the gap within
+/// one displacement tolerance of the default drive's own deviation on the same programme.
+#[test]
+fn the_exponential_scheme_on_a_flat_disk() {
+    let flat = DriveOptions {
+        disk: DiskSpec::flat(),
+        ..DriveOptions::default()
+    };
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..flat.clone()
+    };
+    let (dev, counts) = deviation_after(o, &[]);
+    let (default, _) = deviation_after(flat.clone(), &[]);
+    let (gap, gap_default) = (
+        dev.gap_flight.max(dev.gap_contact),
+        default.gap_flight.max(default.gap_contact),
+    );
+    assert!(
+        gap < gap_default + flat.atol_displacement,
+        "gap differs by {gap} m (the default by {gap_default} m)"
+    );
+    sensors_within_their_noise(&dev);
+    assert!(counts.exponential > 0 && counts.spanned > 50, "{counts:?}");
+}
+
+/// The exponential scheme's sensor stream is the same from run to run, to the bit, over a
+/// programme that moves between its own steps, the integrator and back.
+#[test]
+fn the_exponential_scheme_replays_to_the_bit() {
+    let scene = Scene::paper();
+    let zone = scene_zone(&scene, 0.025).unwrap();
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..DriveOptions::default()
+    };
+    let run = || {
+        let mut d = Plant::new(&scene, &zone, 3, o.clone())
+            .unwrap()
+            .into_drive()
+            .unwrap();
+        let mut bits = Vec::new();
+        for k in 0..300 {
+            let mw = if k < 150 { 70.0 } else { 78.0 } + 1e-3 * (k % 2) as f64;
+            let s = d.step(&Command::heater_mw(mw), DT).unwrap();
+            bits.extend([s.contact_resistance_ohm, s.truth.gap_nm].map(f64::to_bits));
+        }
+        (bits, d.scheme_counts())
+    };
+    let (a, ca) = run();
+    let (b, cb) = run();
+    assert!(ca.exponential > 0 && ca.fallbacks > 0, "{ca:?}");
+    assert_eq!(ca, cb);
+    assert_eq!(a, b);
 }

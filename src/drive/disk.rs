@@ -104,7 +104,7 @@ impl DiskSpec {
 
 /// Highest harmonic order the per-revolution table resolves (16 nodes per period).
 const MAX_ORDER: u32 = 512;
-const NODES: usize = 16 * MAX_ORDER as usize;
+pub(crate) const NODES: usize = 16 * MAX_ORDER as usize;
 
 /// The disk surface tabulated once per revolution: height, velocity, acceleration and jerk at
 /// evenly spaced angles, interpolated by cubic Hermite polynomials (so a right-hand side costs a
@@ -115,6 +115,10 @@ pub(crate) struct Disk {
     /// `(w, ẇ, ẅ, w⃛)` at the nodes.
     nodes: Vec<[f64; 4]>,
     flat: bool,
+    /// The harmonics summed into the table (nonzero amplitudes only).
+    harmonics: Vec<Harmonic>,
+    /// The spindle's angular speed (rad/s).
+    omega: f64,
 }
 
 impl Disk {
@@ -167,16 +171,32 @@ impl Disk {
                 v[3] -= h.amplitude * w * w * w * c;
             }
         }
+        all.retain(|h| h.amplitude != 0.0);
         Ok(Disk {
             period: 60.0 / rpm,
             nodes,
             flat,
+            harmonics: all,
+            omega,
         })
     }
 
     /// The node interval holding `t` and the position in it, `s ∈ [0, 1)`.
+    /// The harmonics of the surface (those of nonzero amplitude): the height is
+    /// `Σ amplitude · sin(order · Ω t + phase)`, `Ω` = [`Disk::omega`].
+    pub(crate) fn harmonics(&self) -> &[Harmonic] {
+        &self.harmonics
+    }
+
+    /// The angular speed of the spindle (rad/s).
+    pub(crate) fn omega(&self) -> f64 {
+        self.omega
+    }
+
+    /// The node of the table at `t`, the fraction of the node interval past it, and the
+    /// interval (s): the grid of every table over a revolution ([`NODES`] nodes).
     #[inline]
-    fn locate(&self, t: f64) -> (usize, f64, f64) {
+    pub(crate) fn locate(&self, t: f64) -> (usize, f64, f64) {
         let h = self.period / NODES as f64;
         let x = t / h;
         let k = x.floor();

@@ -33,6 +33,7 @@
 mod controller;
 mod disk;
 mod error;
+mod exponential;
 mod heads;
 mod plant;
 mod replay;
@@ -48,10 +49,11 @@ pub use controller::{
 };
 pub use disk::{DiskSpec, Harmonic};
 pub use error::DriveError;
+pub use exponential::SchemeCounts;
 pub use heads::{head_seed, MultiDrive, MultiPlant};
 pub use plant::{
-    scene_zone, spec_zone, zone_at, Ambient, Command, Drive, DriveOptions, PeriodReport, Plant,
-    DEFAULT_RADIUS, MAX_STEPS_PER_PERIOD,
+    scene_zone, spec_zone, zone_at, Ambient, Command, Drive, DriveOptions, DriveScheme,
+    PeriodReport, Plant, DEFAULT_RADIUS, MAX_STEPS_PER_PERIOD,
 };
 pub use replay::{
     check_commands, read_commands, replay, replay_each, replay_heads, replay_heads_each,

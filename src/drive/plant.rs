@@ -1,6 +1,7 @@
 //! The simulated drive: the slider of a scene in a zone, stepped at the controller's rate.
 
 use super::disk::{Disk, DiskSpec};
+use super::exponential::{Attempt, ExpScheme, SchemeCounts};
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
 use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
@@ -226,6 +227,40 @@ pub struct DriveOptions {
     /// fails to converge: in the periods of a snap into contact, not in flight or in a held
     /// contact.
     pub steps_per_period: Option<usize>,
+    /// How each period is advanced: the adaptive integrator (the default) or one exponential
+    /// step with the Jacobian held across periods ([`DriveScheme`]).
+    pub scheme: DriveScheme,
+}
+
+/// How the drive advances a period ([`DriveOptions::scheme`]).
+///
+/// ```
+/// use hdi_tribology::drive::{DriveOptions, DriveScheme};
+/// assert_eq!(DriveOptions::default().scheme, DriveScheme::Integrator);
+/// let o = DriveOptions { scheme: DriveScheme::Exponential, ..DriveOptions::default() };
+/// assert_ne!(o, DriveOptions::default());
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum DriveScheme {
+    /// The adaptive integrator ([`DriveOptions::method`]): steps under the error control, which
+    /// span periods while the command holds.
+    #[default]
+    Integrator,
+    /// One exponential step per period, or 2 to 16 substeps where the period needs them
+    /// (ETD2RK, [`crate::ode::ExponentialStepper`]), with the slider's Jacobian held across
+    /// periods and refreshed when a period misses the tolerances; the disk's waviness and an
+    /// AC dither are taken out by their exact periodic responses to the held linear part. A
+    /// period whose error estimate still misses the drive's contact tolerances
+    /// ([`DriveOptions::atol_displacement`], `rtol`), or where the contact force curves too
+    /// much over the gaps the disk and the dither sweep, is run by the integrator from the
+    /// same start and flagged ([`PeriodReport::exponential`] false), as are, after
+    /// consecutive misses, a doubling number of the following periods (up to 64). A held
+    /// command on a flat disk without a dither is left to the integrator after the four
+    /// periods that follow each change (its steps span many periods there);
+    /// [`Drive::scheme_counts`] counts each kind of period. Faster than the integrator where
+    /// the command changes every period; docs/clearance.md, "The exponential scheme", gives
+    /// its cost and accuracy.
+    Exponential,
 }
 
 /// Most steps a period may take in the bounded mode ([`DriveOptions::steps_per_period`]).
@@ -249,6 +284,7 @@ impl Default for DriveOptions {
             contact_force_tolerance: 4e-8,
             max_step: None,
             steps_per_period: None,
+            scheme: DriveScheme::Integrator,
         }
     }
 }
@@ -483,6 +519,11 @@ pub struct Plant {
     rpm: f64,
     /// [`DriveOptions::steps_per_period`].
     steps_per_period: Option<usize>,
+    /// [`DriveOptions::scheme`].
+    scheme: DriveScheme,
+    /// `(velocity index, r)` of the coordinates a disk translation moves.
+    base_moved: Vec<(usize, f64)>,
+    rtol: f64,
 }
 
 impl std::fmt::Debug for Plant {
@@ -672,14 +713,15 @@ impl Plant {
             friction_power: friction * base.contact_force(base.gaps(&eq.q, eq.protrusion)),
             ambient: 0.0,
         };
-        let mut bases = [(0usize, 0.0); crate::scene::MAX_DOF];
-        let mut n_base = 0;
-        for (i, &r) in base.structure().base_influence().iter().enumerate() {
-            if r != 0.0 {
-                bases[n_base] = (layout.velocity(i), r);
-                n_base += 1;
-            }
-        }
+        let base_moved = base
+            .structure()
+            .base_influence()
+            .iter()
+            .take(layout.dofs)
+            .enumerate()
+            .filter(|(_, &r)| r != 0.0)
+            .map(|(i, &r)| (layout.velocity(i), r))
+            .collect();
         Ok(Plant {
             problem,
             disk,
@@ -697,6 +739,9 @@ impl Plant {
             disk_spec: opts.disk,
             rpm,
             steps_per_period: opts.steps_per_period,
+            scheme: opts.scheme,
+            base_moved,
+            rtol: opts.rtol,
         })
     }
 
@@ -802,6 +847,8 @@ pub struct Drive {
     terms: TermStates,
     /// How the last period was advanced.
     period: PeriodReport,
+    /// The exponential scheme's state ([`DriveScheme::Exponential`]).
+    exp: Option<ExpScheme>,
 }
 
 /// How the solver advanced one period ([`Drive::last_period`]).
@@ -833,6 +880,10 @@ pub struct PeriodReport {
     /// none ended in it), against the drive's tolerances: at most 1 under adaptive control; in
     /// the bounded mode, above 1 where a step missed them.
     pub error_estimate: f64,
+    /// Whether the period was advanced by one exponential step ([`DriveScheme::Exponential`]);
+    /// false under the integrator, and, with the exponential scheme, in a period it left to
+    /// the integrator (its estimate missed the tolerances, or the misses before it).
+    pub exponential: bool,
 }
 
 /// The states of the stateful terms, copied out of a state vector.
@@ -886,6 +937,13 @@ impl Drive {
                 terms = TermStates::of(&plant.layout, y0);
             },
         )?;
+        let exp = (plant.scheme == DriveScheme::Exponential).then(|| {
+            let t = &plant.tol;
+            let atol = (0..t.n)
+                .map(|i| t.fixed[i] + t.range.0 * t.per_m[i])
+                .collect();
+            ExpScheme::new(&plant.layout, plant.rtol, atol, plant.base_moved.clone())
+        });
         Ok(Drive {
             sensors: SensorState::new(plant.sensors, plant.seed, &plant.start_sensors),
             plant,
@@ -898,6 +956,7 @@ impl Drive {
             tol,
             terms,
             period: PeriodReport::default(),
+            exp,
         })
     }
 
@@ -936,7 +995,20 @@ impl Drive {
         });
         let tol = plant.tol.adapts().then_some((&plant.tol, &mut self.tol));
         let (truth, integrals, terms) = with_sized!(&mut self.integ, it => {
-            let (y1, period) = advance(it, &layout, set, &mut self.integrals0, span, tol)?;
+            let (y1, period) = match self.exp.as_mut() {
+                None => advance(it, &layout, set, &mut self.integrals0, span, tol, None)?,
+                Some(exp) => advance_exponential(
+                    it,
+                    exp,
+                    &plant.disk,
+                    &layout,
+                    set,
+                    &mut self.integrals0,
+                    span,
+                    tol,
+                    dt,
+                )?,
+            };
             self.period = period;
             let terms = TermStates::of(&layout, y1.as_slice());
             let s = it.system();
@@ -1005,6 +1077,14 @@ impl Drive {
     /// bounded mode, [`DriveOptions::steps_per_period`]).
     pub fn last_period(&self) -> PeriodReport {
         self.period
+    }
+
+    /// What the exponential scheme did so far ([`DriveScheme::Exponential`]; all zero under
+    /// the integrator).
+    pub fn scheme_counts(&self) -> SchemeCounts {
+        self.exp
+            .as_ref()
+            .map_or(SchemeCounts::default(), |e| e.counts)
     }
 
     /// Solver work so far.
@@ -1102,7 +1182,7 @@ fn base_motion(disk: &Arc<Disk>) -> Option<Arc<dyn crate::model::BaseMotion>> {
 }
 
 /// Longest state a drive integrates (`Integ`'s largest size).
-const MAX_STATE: usize = 10;
+pub(crate) const MAX_STATE: usize = 10;
 
 /// How a period's displacement tolerance follows the contact force's slope
 /// ([`DriveOptions::atol_displacement_flight`]).
@@ -1224,6 +1304,7 @@ fn advance<D: Dim>(
     integrals0: &mut (f64, f64),
     span: Span,
     tol: Option<(&TolRule, &mut TolState)>,
+    start: Option<OVector<f64, D>>,
 ) -> Result<(OVector<f64, D>, PeriodReport)>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
@@ -1233,16 +1314,17 @@ where
         it.set_step_floor(Some(floor))?;
     }
     let integrals = [layout.contact_impulse, layout.heat];
-    let grown = integrals
-        .iter()
-        .zip(rebase)
-        .any(|(i, bound)| i.is_some_and(|i| it.state()[i].abs() > bound));
+    let grown = start.is_none()
+        && integrals
+            .iter()
+            .zip(rebase)
+            .any(|(i, bound)| i.is_some_and(|i| it.state()[i].abs() > bound));
     let mut tol = tol;
-    if set.is_some() || grown {
-        let mut y = if it.t() > t0 {
-            it.interpolate(t0)?
-        } else {
-            it.state().clone()
+    if set.is_some() || grown || start.is_some() {
+        let mut y = match start {
+            Some(y) => y,
+            None if it.t() > t0 => it.interpolate(t0)?,
+            None => it.state().clone(),
         };
         if grown {
             for i in integrals.into_iter().flatten() {
@@ -1297,6 +1379,128 @@ where
     Ok((end_state(it, t1)?, ran.report(it)))
 }
 
+/// One period under the exponential scheme ([`DriveScheme::Exponential`]): one exponential
+/// step from the state at `t0` (the scheme's own, or the integrator's when the period before
+/// was the integrator's), or, where it misses the tolerances or the misses before it leave the
+/// period to the integrator, [`advance`] from the same start.
+#[allow(clippy::too_many_arguments)]
+fn advance_exponential<D: Dim>(
+    it: &mut Integrator<'static, D, SliderSystem>,
+    exp: &mut ExpScheme,
+    disk: &Disk,
+    layout: &StateLayout,
+    set: Option<Held<'_>>,
+    integrals0: &mut (f64, f64),
+    span: Span,
+    tol: Option<(&TolRule, &mut TolState)>,
+    dt: f64,
+) -> Result<(OVector<f64, D>, PeriodReport)>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    if exp.skips() {
+        return advance(it, layout, set, integrals0, span, tol, None);
+    }
+    let Span { t0, rebase, .. } = span;
+    // A held command on a flat disk without a dither: nothing moves within the periods, and
+    // the integrator's steps span many of them at the cost of the read-out alone.
+    let still = disk.is_flat()
+        && set.is_none()
+        && !span.settling
+        && it.system().inputs().voltage.ac_amplitude == 0.0;
+    if still {
+        exp.counts.spanned += 1;
+        return match exp.owned.take() {
+            None => advance(it, layout, None, integrals0, span, tol, None),
+            Some(x) => {
+                let mut x0 = OVector::<f64, D>::from_iterator_generic(
+                    D::from_usize(layout.len()),
+                    nalgebra::U1,
+                    x.iter().copied(),
+                );
+                rebase_integrals(layout, rebase, &mut x0, integrals0);
+                advance(it, layout, None, integrals0, span, tol, Some(x0))
+            }
+        };
+    }
+    let owned = exp.owned.take();
+    let from_integrator = owned.is_none();
+    let mut x0 = match owned {
+        Some(x) => OVector::<f64, D>::from_iterator_generic(
+            D::from_usize(layout.len()),
+            nalgebra::U1,
+            x.iter().copied(),
+        ),
+        None if it.t() > t0 => it.interpolate(t0)?,
+        None => it.state().clone(),
+    };
+    if !exp.straight(it.system(), t0, &x0, dt) {
+        let _ = exp.missed::<D>();
+        if from_integrator {
+            // The integrator holds the state: the period as the default drive runs it.
+            return advance(it, layout, set, integrals0, span, tol, None);
+        }
+    } else {
+        if let Some(held) = set {
+            held.apply(it.system_mut());
+        }
+        rebase_integrals(layout, rebase, &mut x0, integrals0);
+        match exp.attempt(it.system(), disk, t0, dt, &x0) {
+            Attempt::Done(x1, err) => {
+                let mut x = [0.0; MAX_STATE];
+                x[..x1.len()].copy_from_slice(x1.as_slice());
+                exp.owned = Some(x);
+                return Ok((
+                    x1,
+                    PeriodReport {
+                        steps: 1,
+                        error_estimate: err,
+                        exponential: true,
+                    },
+                ));
+            }
+            Attempt::Missed => {
+                // The integrator from the same start; its last step ends on the period's end,
+                // so that the restart's first step does not run on over several periods of the
+                // disk's motion.
+                let landed = Span { land: true, ..span };
+                return advance(it, layout, None, integrals0, landed, tol, Some(x0));
+            }
+        }
+    }
+    // The scheme held the state and the contact force is not straight enough: the integrator
+    // from the same start, under the new command.
+    rebase_integrals(layout, rebase, &mut x0, integrals0);
+    if let Some(held) = set {
+        held.apply(it.system_mut());
+    }
+    let landed = Span { land: true, ..span };
+    advance(it, layout, None, integrals0, landed, tol, Some(x0))
+}
+
+/// Sets the period integrals of `x` back to zero once either has grown past its bound (see
+/// [`advance`]).
+fn rebase_integrals<D: Dim>(
+    layout: &StateLayout,
+    rebase: [f64; 2],
+    x: &mut OVector<f64, D>,
+    integrals0: &mut (f64, f64),
+) where
+    DefaultAllocator: Allocator<D>,
+{
+    let integrals = [layout.contact_impulse, layout.heat];
+    if integrals
+        .iter()
+        .zip(rebase)
+        .any(|(i, bound)| i.is_some_and(|i| x[i].abs() > bound))
+    {
+        for i in integrals.into_iter().flatten() {
+            x[i] = 0.0;
+        }
+        *integrals0 = (0.0, 0.0);
+    }
+}
+
 /// What one run over a period saw.
 struct PeriodRun {
     /// The largest contact-force slope at the step ends, when asked for and a step ended.
@@ -1319,6 +1523,7 @@ impl PeriodRun {
             } else {
                 self.error
             },
+            exponential: false,
         }
     }
 }

@@ -1,0 +1,732 @@
+//! The drive's exponential scheme ([`DriveScheme::Exponential`](super::DriveScheme)): each
+//! period one exponential step, or 2 to 16 substeps, with the slider's Jacobian held across
+//! periods and the known periodic forcings (the disk's waviness, an AC dither) taken out exactly
+//! by their particular solutions; the existing integrator for the periods the scheme cannot
+//! answer for.
+//!
+//! The split. With `J` the slider's Jacobian (held), taken at the slow state (the state less
+//! the known forcings' responses, so that it does not swing with the disk's phase), the
+//! forcings that are known functions of time are the disk's motion, `u_d(t) = −r ẅ(t)` on the
+//! accelerations, and the dither's part of the interface force, `u_v(t) = e (V(t)² − mean)`
+//! with `e = ∂f/∂(V²)` there. Each is a sum of sinusoids (the disk's harmonics; `V²` has its
+//! lines at `ω` and `2ω`), so `p′ = J p + u` has the periodic solution
+//! `p(t) = Σ Re(C_k e^{iω_k t})` with `(iω_k − J) C_k = U_k`. The state is integrated as
+//! `z = x − p(t)`: `z′ = f(t, z + p) − p′(t)`, whose remainder `z′ − J z` holds what is left
+//! of the nonlinear forces, the mean voltage and the heater. The disk's `p` is tabulated over
+//! a revolution on the disk's own grid (values and slopes by an inverse FFT, cubic Hermite
+//! between the nodes) for the `J` it was built with; the dither's is summed per evaluation
+//! (two lines).
+//!
+//! The step is [`crate::ode::ExponentialStepper`]'s (ETD2RK) on `z`, at the drive's contact
+//! tolerances, per component. Before it, a check of the contact force's curvature over the
+//! forcings' reach ([`ExpScheme::straight`]) refuses what the estimate cannot see. A period
+//! whose estimate is above 1 is tried again with the Jacobian taken afresh at its start (the
+//! disk's table rebuilt when that moved `J` by more than [`REBUILD_SHIFT`]), then with twice
+//! the substeps, up to [`LEVELS`]; if it still misses, the period is run by the integrator
+//! from the same start, as the default drive runs it, and the following periods too, for a
+//! number that doubles with each consecutive miss, up to [`MAX_SKIP`]. A held command on a
+//! flat disk without a dither is left to the integrator (`src/drive/plant.rs`), whose steps
+//! span many periods there.
+
+use super::disk::{Disk, NODES};
+use super::plant::MAX_STATE;
+use crate::force::Gaps;
+use crate::model::{Inputs, SliderSystem, StateLayout, Voltage};
+use crate::ode::{ExponentialStepper, OdeSystem};
+use nalgebra::{allocator::Allocator, DMatrix, DVector, DefaultAllocator, Dim, OMatrix, OVector};
+use num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// Relative change of the held Jacobian (largest entry change over the largest entry of its
+/// row, the integrals' rows aside) beyond which a refresh also rebuilds the disk's table. The
+/// table's response is off by about this fraction of its size when the held Jacobian has
+/// moved this far from the one it was built with, and that error oscillates at the disk's
+/// frequencies within a period, where the step's estimate cannot see it: 1e-4 of the ~15 pm
+/// the default waviness moves the gap is a sixth of the 0.01 pm displacement tolerance.
+pub(crate) const REBUILD_SHIFT: f64 = 1e-4;
+
+/// Substep levels: a period is `1`, `2`, `4`, `8` or `16` exponential steps.
+pub(crate) const LEVELS: usize = 5;
+
+/// Periods in a row with an estimate below [`CALM_ERROR`] after which the scheme tries half as
+/// many substeps.
+pub(crate) const CALM: usize = 32;
+
+/// See [`CALM`].
+pub(crate) const CALM_ERROR: f64 = 0.25;
+
+/// Most periods run by the integrator after consecutive misses before the exponential step is
+/// tried again.
+pub(crate) const MAX_SKIP: usize = 64;
+
+/// The periodic solution of `p′ = J p + u(t)` for a sum of harmonics, tabulated over a
+/// revolution: values and slopes at the disk's nodes, interpolated by cubic Hermite
+/// polynomials.
+#[derive(Clone, Debug)]
+struct Periodic {
+    n: usize,
+    /// The components with a response (others stay zero).
+    active: Vec<usize>,
+    /// `p` and `p′` at node `i`, component `c`: `[i * n + c]`.
+    values: Vec<f64>,
+    slopes: Vec<f64>,
+}
+
+/// `C` of `(iω − J) C = U`, by the real system `[[−J, −ωI], [ωI, −J]] [C_r; C_i] = [U_r; U_i]`.
+fn response(j: &DMatrix<f64>, w: f64, u: &[Complex64]) -> Option<Vec<Complex64>> {
+    let n = j.nrows();
+    let mut a = DMatrix::<f64>::zeros(2 * n, 2 * n);
+    let mut b = DVector::<f64>::zeros(2 * n);
+    for r in 0..n {
+        for c in 0..n {
+            a[(r, c)] = -j[(r, c)];
+            a[(n + r, n + c)] = -j[(r, c)];
+        }
+        a[(r, n + r)] = -w;
+        a[(n + r, r)] = w;
+        b[r] = u[r].re;
+        b[n + r] = u[r].im;
+    }
+    let x = a.lu().solve(&b)?;
+    Some((0..n).map(|r| Complex64::new(x[r], x[n + r])).collect())
+}
+
+impl Periodic {
+    /// The response to the disk's motion `u = −r ẅ` on the velocities `base` (`(index, r)`):
+    /// each harmonic's `C_k` solved for, then the values and slopes at the nodes summed by an
+    /// inverse fast Fourier transform over the revolution (the nodes are a power of two).
+    fn of_disk(disk: &Disk, j: &DMatrix<f64>, base: &[(usize, f64)]) -> Option<Self> {
+        let n = j.nrows();
+        let zero = Complex64::new(0.0, 0.0);
+        // Per component, the spectrum of p over the orders of the revolution.
+        let mut spectra = vec![vec![zero; NODES]; n];
+        let mut u = vec![zero; n];
+        for h in disk.harmonics() {
+            let w = h.order as f64 * disk.omega();
+            // ẅ = −A ω² sin(ωt + φ) = Re(i A ω² e^{iφ} e^{iωt}).
+            let acc =
+                Complex64::new(0.0, h.amplitude * w * w) * Complex64::from_polar(1.0, h.phase);
+            u.iter_mut().for_each(|x| *x = zero);
+            for &(i, r) in base {
+                u[i] = -r * acc;
+            }
+            let c = response(j, w, &u)?;
+            for (k, ck) in c.iter().enumerate() {
+                spectra[k][h.order as usize % NODES] += ck;
+            }
+        }
+        let active: Vec<usize> = (0..n)
+            .filter(|&k| spectra[k].iter().any(|c| c.norm() > 0.0))
+            .collect();
+        let mut values = vec![0.0; NODES * n];
+        let mut slopes = vec![0.0; NODES * n];
+        let mut buf = vec![zero; NODES];
+        for &k in &active {
+            buf.copy_from_slice(&spectra[k]);
+            inverse_fft(&mut buf);
+            for (i, b) in buf.iter().enumerate() {
+                values[i * n + k] = b.re;
+            }
+            for (m, b) in buf.iter_mut().enumerate() {
+                *b = Complex64::new(0.0, m as f64 * disk.omega()) * spectra[k][m];
+            }
+            inverse_fft(&mut buf);
+            for (i, b) in buf.iter().enumerate() {
+                slopes[i * n + k] = b.re;
+            }
+        }
+        Some(Periodic {
+            n,
+            active,
+            values,
+            slopes,
+        })
+    }
+
+    /// The largest magnitude of component `k` over the revolution.
+    fn largest(&self, k: usize) -> f64 {
+        (0..NODES)
+            .map(|i| self.values[i * self.n + k].abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Adds `p(t)` to `p` and `p′(t)` to `dp`.
+    #[inline]
+    fn add(&self, disk: &Disk, t: f64, p: &mut [f64], dp: &mut [f64]) {
+        let (i, s, hn) = disk.locate(t);
+        let k = (i + 1) % NODES;
+        let n = self.n;
+        let (s2, s3) = (s * s, s * s * s);
+        let (h00, h10, h01, h11) = (
+            2.0 * s3 - 3.0 * s2 + 1.0,
+            s3 - 2.0 * s2 + s,
+            -2.0 * s3 + 3.0 * s2,
+            s3 - s2,
+        );
+        let (d00, d10, d01, d11) = (
+            (6.0 * s2 - 6.0 * s) / hn,
+            3.0 * s2 - 4.0 * s + 1.0,
+            (-6.0 * s2 + 6.0 * s) / hn,
+            3.0 * s2 - 2.0 * s,
+        );
+        for &c in &self.active {
+            let (p0, m0) = (self.values[i * n + c], self.slopes[i * n + c]);
+            let (p1, m1) = (self.values[k * n + c], self.slopes[k * n + c]);
+            p[c] += h00 * p0 + h10 * hn * m0 + h01 * p1 + h11 * hn * m1;
+            dp[c] += d00 * p0 + d10 * m0 + d01 * p1 + d11 * m1;
+        }
+    }
+}
+
+/// `x_i ← Σ_m x_m e^{2πi m i / N}` in place (no `1/N`), `N` a power of two: the iterative
+/// radix-2 Cooley–Tukey transform with its twiddles re-anchored exactly at each stage.
+fn inverse_fft(x: &mut [Complex64]) {
+    let n = x.len();
+    debug_assert!(n.is_power_of_two());
+    let bits = n.trailing_zeros();
+    for i in 0..n {
+        let r = i.reverse_bits() >> (usize::BITS - bits);
+        if r > i {
+            x.swap(i, r);
+        }
+    }
+    let mut len = 2;
+    while len <= n {
+        let half = len / 2;
+        let step = 2.0 * PI / len as f64;
+        for start in (0..n).step_by(len) {
+            for k in 0..half {
+                let w = Complex64::from_polar(1.0, step * k as f64);
+                let (a, b) = (x[start + k], x[start + k + half] * w);
+                x[start + k] = a + b;
+                x[start + k + half] = a - b;
+            }
+        }
+        len *= 2;
+    }
+}
+
+/// The periodic solution for the dither's lines: `V² − mean = 2 V₀ V_a sin ωt − (V_a²/2) cos 2ωt`.
+#[derive(Clone, Debug)]
+struct Dither {
+    voltage: Voltage,
+    w: f64,
+    c1: Vec<Complex64>,
+    c2: Vec<Complex64>,
+}
+
+impl Dither {
+    fn new(voltage: Voltage, j: &DMatrix<f64>, e: &[f64]) -> Option<Self> {
+        let w = 2.0 * PI * voltage.frequency;
+        let v0 = voltage.dc - voltage.contact_potential;
+        let va = voltage.ac_amplitude;
+        // sin ωt = Re(−i e^{iωt}); cos 2ωt = Re(e^{2iωt}).
+        let u1: Vec<Complex64> = e
+            .iter()
+            .map(|&x| Complex64::new(0.0, -2.0 * v0 * va * x))
+            .collect();
+        let u2: Vec<Complex64> = e
+            .iter()
+            .map(|&x| Complex64::new(-0.5 * va * va * x, 0.0))
+            .collect();
+        Some(Dither {
+            voltage,
+            w,
+            c1: response(j, w, &u1)?,
+            c2: response(j, 2.0 * w, &u2)?,
+        })
+    }
+
+    #[inline]
+    fn add(&self, t: f64, p: &mut [f64], dp: &mut [f64]) {
+        let (s, c) = (self.w * t).sin_cos();
+        let e1 = Complex64::new(c, s);
+        let e2 = e1 * e1;
+        for k in 0..p.len() {
+            let (a, b) = (self.c1[k] * e1, self.c2[k] * e2);
+            p[k] += a.re + b.re;
+            dp[k] -= self.w * a.im + 2.0 * self.w * b.im;
+        }
+    }
+}
+
+/// What the exponential scheme did so far ([`crate::drive::Drive::scheme_counts`]).
+///
+/// ```
+/// use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, DriveScheme, Plant};
+/// use hdi_tribology::scene::Scene;
+/// let scene = Scene::paper();
+/// let opts = DriveOptions {
+///     scheme: DriveScheme::Exponential,
+///     disk: DiskSpec::flat(),
+///     ..DriveOptions::default()
+/// };
+/// let mut drive = Plant::new(&scene, &scene_zone(&scene, 0.025)?, 1, opts)?.into_drive()?;
+/// // A command that changes every period, the firmware case.
+/// for k in 0..200 {
+///     let mw = 70.0 + if k % 2 == 0 { 1e-3 } else { -1e-3 };
+///     drive.step(&Command::heater_mw(mw), 50e-6)?;
+/// }
+/// let c = drive.scheme_counts();
+/// // Each period is counted once, by whoever advanced it.
+/// assert_eq!(c.exponential + c.fallbacks + c.skipped + c.spanned, 200);
+/// assert!(c.exponential > 100, "{c:?}");
+/// # Ok::<(), hdi_tribology::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SchemeCounts {
+    /// Periods advanced by one exponential step.
+    pub exponential: u64,
+    /// Periods run by the integrator after the exponential step missed the tolerances there.
+    pub fallbacks: u64,
+    /// Periods run by the integrator without a try, after misses (see the module docs).
+    pub skipped: u64,
+    /// Periods of a command held on a flat disk without a dither, past the four after each
+    /// change: left to the integrator, whose steps span them.
+    pub spanned: u64,
+    /// Refreshes of the held Jacobian.
+    pub refreshes: u64,
+    /// Rebuilds of the disk's response table.
+    pub rebuilds: u64,
+}
+
+/// The state of the exponential scheme of one drive.
+#[derive(Clone, Debug)]
+pub(crate) struct ExpScheme {
+    /// Positions at `0..dofs`; the contact impulse's index.
+    dofs: usize,
+    impulse: Option<usize>,
+    heat: Option<usize>,
+    /// A bound on how far the known forcings move the gaps (m): the sum over the positions of
+    /// their responses' largest magnitude.
+    reach: f64,
+    rtol: f64,
+    atol: Vec<f64>,
+    /// `(index, r)` of the velocities a disk translation moves.
+    base: Vec<(usize, f64)>,
+    /// Steppers of `h / 2^l`, `l < LEVELS`, for the held Jacobian (none before the first
+    /// refresh).
+    steppers: Vec<ExponentialStepper>,
+    /// The level of substeps in use, the level of the last step, and how many calm periods in a
+    /// row it has had (see [`ExpScheme::attempt`]).
+    level: usize,
+    last_level: usize,
+    calm: usize,
+    disk: Option<Periodic>,
+    /// The Jacobian the disk's table was built with.
+    disk_j: Option<DMatrix<f64>>,
+    dither: Option<Dither>,
+    /// The state at the drive's time, when the scheme holds it (the integrator's is stale).
+    pub(crate) owned: Option<[f64; MAX_STATE]>,
+    /// Periods to leave to the integrator, and the next such run's length.
+    skip: usize,
+    backoff: usize,
+    pub(crate) counts: SchemeCounts,
+    /// Work vectors.
+    p: Vec<f64>,
+    dp: Vec<f64>,
+    z0: Vec<f64>,
+    f0: Vec<f64>,
+    z1: Vec<f64>,
+}
+
+/// How one attempt went.
+pub(crate) enum Attempt<D: Dim>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    /// The state at the period's end and the error estimate.
+    Done(OVector<f64, D>, f64),
+    /// Missed the tolerances (the estimate): the integrator runs the period.
+    Missed,
+}
+
+impl ExpScheme {
+    pub(crate) fn new(
+        layout: &StateLayout,
+        rtol: f64,
+        atol: Vec<f64>,
+        base: Vec<(usize, f64)>,
+    ) -> Self {
+        let n = atol.len();
+        ExpScheme {
+            dofs: layout.dofs,
+            impulse: layout.contact_impulse,
+            heat: layout.heat,
+            reach: 0.0,
+            rtol,
+            atol,
+            base,
+            steppers: Vec::new(),
+            level: 0,
+            last_level: 0,
+            calm: 0,
+            disk: None,
+            disk_j: None,
+            dither: None,
+            owned: None,
+            skip: 0,
+            backoff: 0,
+            counts: SchemeCounts::default(),
+            p: vec![0.0; n],
+            dp: vec![0.0; n],
+            z0: vec![0.0; n],
+            f0: vec![0.0; n],
+            z1: vec![0.0; n],
+        }
+    }
+
+    /// Whether the next period is left to the integrator without a try (counted).
+    pub(crate) fn skips(&mut self) -> bool {
+        if self.skip > 0 && self.owned.is_none() {
+            self.skip -= 1;
+            self.counts.skipped += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// The Jacobian at `(t, x − p(t))`, the per-`V²` vector `e` there, and everything built on them
+    /// (the stepper of period `h`, the dither's response; the disk's table when there is none
+    /// or `J` moved by more than [`REBUILD_SHIFT`] from the one it was built with).
+    fn refresh<D: Dim>(
+        &mut self,
+        sys: &SliderSystem,
+        disk: &Disk,
+        t: f64,
+        x: &OVector<f64, D>,
+        h: f64,
+    ) -> bool
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let n = x.len();
+        let dim = x.shape_generic().0;
+        // Linearised about the state less the known forcings' responses (as held so far): the
+        // slow state, whose Jacobian does not swing with the disk's phase.
+        Self::known(disk, &self.disk, &self.dither, t, &mut self.p, &mut self.dp);
+        let slow = OVector::<f64, D>::from_iterator_generic(
+            dim,
+            nalgebra::U1,
+            x.iter().zip(self.p.iter()).map(|(a, b)| a - b),
+        );
+        let mut jd = OMatrix::<f64, D, D>::zeros_generic(dim, dim);
+        OdeSystem::<D>::jacobian(sys, t, &slow, &mut jd);
+        let j = DMatrix::from_iterator(n, n, jd.iter().copied());
+        if j.iter().any(|v| !v.is_finite()) {
+            return false;
+        }
+        self.steppers.clear();
+        for l in 0..LEVELS {
+            let Ok(s) = ExponentialStepper::new(&j, h / (1 << l) as f64) else {
+                return false;
+            };
+            self.steppers.push(s);
+        }
+        self.counts.refreshes += 1;
+        // The integrals' rows (their columns are zero) do not move the other states: a change
+        // there leaves the table's mechanical response as it was.
+        let integral = |r: usize| self.impulse == Some(r) || self.heat == Some(r);
+        let shifted = match &self.disk_j {
+            None => true,
+            Some(jp) => (0..n).filter(|&r| !integral(r)).any(|r| {
+                let scale = (0..n).map(|c| jp[(r, c)].abs()).fold(0.0, f64::max);
+                (0..n).any(|c| (j[(r, c)] - jp[(r, c)]).abs() > REBUILD_SHIFT * scale)
+            }),
+        };
+        if !disk.is_flat() && (self.disk.is_none() || shifted) {
+            self.disk = Periodic::of_disk(disk, &j, &self.base);
+            self.disk_j = Some(j.clone());
+            self.counts.rebuilds += 1;
+            if self.disk.is_none() {
+                return false;
+            }
+        }
+        self.dither = None;
+        let v = sys.inputs().voltage;
+        if v.ac_amplitude != 0.0 && v.frequency > 0.0 {
+            let e = per_volt2(sys, t, &slow);
+            self.dither = Dither::new(v, &j, &e);
+            if self.dither.is_none() {
+                return false;
+            }
+        }
+        self.reach = (0..self.dofs)
+            .map(|k| {
+                let table = self.disk.as_ref().map_or(0.0, |d| d.largest(k));
+                let lines = self
+                    .dither
+                    .as_ref()
+                    .map_or(0.0, |d| d.c1[k].norm() + d.c2[k].norm());
+                table + lines
+            })
+            .sum();
+        true
+    }
+
+    /// Whether the contact force is straight enough over the gaps the known forcings sweep for
+    /// one exponential step: its remainder beyond the held linear part, about
+    /// `½ |F_c″| A²` over the reach `A`, oscillates within the period at the forcings'
+    /// frequencies, where the step's estimate (from the period's ends) cannot see it. Its
+    /// effect on the contact impulse over a period, `h A |F_c′(d − A) − F_c′(d + A)| / 4`, must
+    /// be within the impulse's tolerance.
+    pub(crate) fn straight<D: Dim>(
+        &self,
+        sys: &SliderSystem,
+        t: f64,
+        x: &OVector<f64, D>,
+        h: f64,
+    ) -> bool
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let (Some(i), a) = (self.impulse, self.reach) else {
+            return true;
+        };
+        if a == 0.0 {
+            return true;
+        }
+        let g = sys.gaps(t, x);
+        let forces = sys.model().forces();
+        let slope = |s: f64| {
+            let c = forces.contact(Gaps {
+                bulge: g.bulge + s,
+                pad: g.pad + s,
+            });
+            c.d_bulge + c.d_pad
+        };
+        let bound = 0.25 * h * a * (slope(-a) - slope(a)).abs();
+        bound <= self.atol[i]
+    }
+
+    /// `p(t)` and `p′(t)` of the known forcings into the work vectors.
+    fn known(
+        disk: &Disk,
+        table: &Option<Periodic>,
+        dither: &Option<Dither>,
+        t: f64,
+        p: &mut [f64],
+        dp: &mut [f64],
+    ) {
+        p.iter_mut().for_each(|x| *x = 0.0);
+        dp.iter_mut().for_each(|x| *x = 0.0);
+        if let Some(d) = table {
+            d.add(disk, t, p, dp);
+        }
+        if let Some(d) = dither {
+            d.add(t, p, dp);
+        }
+    }
+
+    /// `2^level` exponential steps over `[t0, t0 + h]` from `x0`: the state at its end and the
+    /// largest error estimate.
+    fn step<D: Dim>(
+        &mut self,
+        sys: &SliderSystem,
+        disk: &Disk,
+        t0: f64,
+        h: f64,
+        x0: &OVector<f64, D>,
+        level: usize,
+    ) -> (OVector<f64, D>, f64)
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let n = x0.len();
+        let dim = x0.shape_generic().0;
+        if level != self.last_level {
+            self.steppers[level].forget();
+            self.last_level = level;
+        }
+        let ExpScheme {
+            rtol,
+            atol,
+            steppers,
+            disk: table,
+            dither,
+            p,
+            dp,
+            z0,
+            f0,
+            z1,
+            ..
+        } = self;
+        let stepper = &mut steppers[level];
+        let m = 1usize << level;
+        let hs = h / m as f64;
+        let (table, dither) = (&*table, &*dither);
+        let mut x = x0.clone();
+        let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
+        let mut err = 0.0f64;
+        for k in 0..m {
+            let ts = t0 + k as f64 * hs;
+            Self::known(disk, table, dither, ts, p, dp);
+            OdeSystem::<D>::rhs(sys, ts, &x, &mut fx);
+            for i in 0..n {
+                z0[i] = x[i] - p[i];
+                f0[i] = fx[i] - dp[i];
+            }
+            let mut pw = [0.0; MAX_STATE];
+            let mut dpw = [0.0; MAX_STATE];
+            let f = |t: f64, z: &[f64], dz: &mut [f64]| {
+                let (pw, dpw) = (&mut pw[..n], &mut dpw[..n]);
+                Self::known(disk, table, dither, t, pw, dpw);
+                let x = OVector::<f64, D>::from_iterator_generic(
+                    dim,
+                    nalgebra::U1,
+                    z.iter().zip(pw.iter()).map(|(a, b)| a + b),
+                );
+                let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
+                OdeSystem::<D>::rhs(sys, t, &x, &mut fx);
+                for i in 0..n {
+                    dz[i] = fx[i] - dpw[i];
+                }
+            };
+            err = err.max(stepper.step(ts, z0, f0, f, (*rtol, atol), z1));
+            let te = if k + 1 == m { t0 + h } else { ts + hs };
+            Self::known(disk, table, dither, te, p, dp);
+            for i in 0..n {
+                x[i] = z1[i] + p[i];
+            }
+        }
+        (x, err)
+    }
+
+    /// Tries one period `[t0, t0 + h]` from `x0`: the stepper as held, then, on a miss, once
+    /// more after a refresh at `(t0, x0)`.
+    pub(crate) fn attempt<D: Dim>(
+        &mut self,
+        sys: &SliderSystem,
+        disk: &Disk,
+        t0: f64,
+        h: f64,
+        x0: &OVector<f64, D>,
+    ) -> Attempt<D>
+    where
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
+    {
+        let stale = match (self.steppers.first(), &self.dither) {
+            (None, _) => true,
+            (Some(s), _) if s.h() != h => true,
+            (_, d) => {
+                let v = sys.inputs().voltage;
+                let want = v.ac_amplitude != 0.0 && v.frequency > 0.0;
+                match d {
+                    Some(d) => !want || d.voltage != v,
+                    None => want,
+                }
+            }
+        };
+        let mut fresh = false;
+        if stale {
+            if !self.refresh(sys, disk, t0, x0, h) {
+                return self.missed();
+            }
+            fresh = true;
+        }
+        let mut level = self.level;
+        let (x1, err) = loop {
+            let (x1, err) = self.step(sys, disk, t0, h, x0, level);
+            if err <= 1.0 {
+                break (x1, err);
+            }
+            if !fresh {
+                if !self.refresh(sys, disk, t0, x0, h) {
+                    return self.missed();
+                }
+                fresh = true;
+            } else if level + 1 < LEVELS {
+                level += 1;
+            } else {
+                break (x1, err);
+            }
+        };
+        if err <= 1.0 && x1.iter().all(|v| v.is_finite()) {
+            self.backoff = 0;
+            self.counts.exponential += 1;
+            // Up at once when the period needed it; down after CALM periods well within the
+            // tolerances.
+            if level != self.level || err > CALM_ERROR {
+                self.calm = 0;
+            } else {
+                self.calm += 1;
+            }
+            self.level = level;
+            if self.calm >= CALM && self.level > 0 {
+                self.level -= 1;
+                self.calm = 0;
+            }
+            Attempt::Done(x1, err)
+        } else {
+            self.missed()
+        }
+    }
+
+    pub(crate) fn missed<D: Dim>(&mut self) -> Attempt<D>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        self.counts.fallbacks += 1;
+        self.backoff = (2 * self.backoff).clamp(1, MAX_SKIP);
+        self.skip = self.backoff;
+        self.owned = None;
+        for s in &mut self.steppers {
+            s.forget();
+        }
+        Attempt::Missed
+    }
+}
+
+/// `∂f/∂(V²)` at `(t, x)`: the right-hand side under `V² = 1` less that under `V² = 0` (the
+/// interface force is affine in `V²`), the other inputs kept.
+fn per_volt2<D: Dim>(sys: &SliderSystem, t: f64, x: &OVector<f64, D>) -> Vec<f64>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let at = |v0: f64| {
+        let mut s = sys.clone();
+        let cp = sys.inputs().voltage.contact_potential;
+        let inputs = Inputs {
+            voltage: Voltage {
+                dc: cp + v0,
+                ac_amplitude: 0.0,
+                frequency: 0.0,
+                contact_potential: cp,
+            },
+            ..sys.inputs().clone()
+        };
+        s.set_inputs(inputs);
+        let mut f = OVector::<f64, D>::zeros_generic(x.shape_generic().0, nalgebra::U1);
+        OdeSystem::<D>::rhs(&s, t, x, &mut f);
+        f
+    };
+    let (one, zero) = (at(1.0), at(0.0));
+    one.iter().zip(zero.iter()).map(|(a, b)| a - b).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The transform against the direct sum.
+    #[test]
+    fn the_fft_is_the_direct_sum() {
+        let n = 64;
+        let x: Vec<Complex64> = (0..n)
+            .map(|m| Complex64::new((m as f64 * 0.37).sin(), (m as f64 * 1.3).cos()))
+            .collect();
+        let mut y = x.clone();
+        inverse_fft(&mut y);
+        for (i, yi) in y.iter().enumerate() {
+            let direct: Complex64 = x
+                .iter()
+                .enumerate()
+                .map(|(m, xm)| {
+                    xm * Complex64::from_polar(1.0, 2.0 * PI * (m * i) as f64 / n as f64)
+                })
+                .sum();
+            assert!((yi - direct).norm() < 1e-12, "{i}");
+        }
+    }
+}
