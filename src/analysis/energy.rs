@@ -3,9 +3,9 @@
 //! audit").
 //!
 //! The lag `τ Ḟ_eff = F(d) − F_eff` drives the slider with `F_eff`, not with the force `F(d)` of
-//! the gaps now. The difference does the power `(F_eff − F) bᵀq̇` on the moving slider
-//! ([`crate::model::LagPowers`]); to first order in `τ` it is `−τ F'(d) ḋ bᵀq̇`, which on the
-//! contact branch (`F' < 0`) feeds energy into every swing. No term of the model supplies that
+//! the gaps now. The difference does the power `(F_eff − F) bᵀq̇ = −τ Ḟ_eff bᵀq̇` on the moving
+//! slider; to first order in `τ` it is `−τ F'(d) ḋ bᵀq̇`, which on the contact branch (`F' < 0`)
+//! feeds energy into every swing. No term of the model supplies that
 //! energy: the audit measures how much the lag creates.
 
 use crate::model::SliderSystem;
