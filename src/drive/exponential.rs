@@ -29,13 +29,16 @@
 //! span many periods there.
 
 use super::disk::{Disk, NODES};
-use super::plant::MAX_STATE;
 use crate::force::Gaps;
 use crate::model::{Inputs, SliderSystem, StateLayout, Voltage};
 use crate::ode::{ExponentialStepper, OdeSystem};
 use nalgebra::{allocator::Allocator, DMatrix, DVector, DefaultAllocator, Dim, OMatrix, OVector};
 use num_complex::Complex64;
 use std::f64::consts::PI;
+
+/// Longest state a drive integrates (the plant's largest sized integrator, and this scheme's
+/// buffers).
+pub(crate) const MAX_STATE: usize = 10;
 
 /// Relative change of the held Jacobian (largest entry change over the largest entry of its
 /// row, the integrals' rows aside) beyond which a refresh also rebuilds the disk's table. The

@@ -1,7 +1,7 @@
 //! The simulated drive: the slider of a scene in a zone, stepped at the controller's rate.
 
 use super::disk::{Disk, DiskSpec};
-use super::exponential::{Attempt, ExpScheme, SchemeCounts};
+use super::exponential::{Attempt, ExpScheme, SchemeCounts, MAX_STATE};
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
 use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
@@ -1180,9 +1180,6 @@ impl Held<'_> {
 fn base_motion(disk: &Arc<Disk>) -> Option<Arc<dyn crate::model::BaseMotion>> {
     (!disk.is_flat()).then(|| disk.clone() as Arc<dyn crate::model::BaseMotion>)
 }
-
-/// Longest state a drive integrates (`Integ`'s largest size).
-pub(crate) const MAX_STATE: usize = 10;
 
 /// How a period's displacement tolerance follows the contact force's slope
 /// ([`DriveOptions::atol_displacement_flight`]).
