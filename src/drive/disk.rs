@@ -214,15 +214,7 @@ impl Disk {
         let (i, s, h) = self.locate(t);
         let (a, b) = (&self.nodes[i], &self.nodes[(i + 1) % NODES]);
         let (p0, m0, p1, m1) = (a[k], a[k + 1] * h, b[k], b[k + 1] * h);
-        let (s2, s3) = (s * s, s * s * s);
-        let value = (2.0 * s3 - 3.0 * s2 + 1.0) * p0
-            + (s3 - 2.0 * s2 + s) * m0
-            + (-2.0 * s3 + 3.0 * s2) * p1
-            + (s3 - s2) * m1;
-        let slope = (6.0 * s2 - 6.0 * s) * p0
-            + (3.0 * s2 - 4.0 * s + 1.0) * m0
-            + (-6.0 * s2 + 6.0 * s) * p1
-            + (3.0 * s2 - 2.0 * s) * m1;
+        let (value, slope) = crate::numerics::cubic_hermite(s, p0, m0, p1, m1);
         (value, slope / h)
     }
 

@@ -159,24 +159,12 @@ impl Periodic {
         let (i, s, hn) = disk.locate(t);
         let k = (i + 1) % NODES;
         let n = self.n;
-        let (s2, s3) = (s * s, s * s * s);
-        let (h00, h10, h01, h11) = (
-            2.0 * s3 - 3.0 * s2 + 1.0,
-            s3 - 2.0 * s2 + s,
-            -2.0 * s3 + 3.0 * s2,
-            s3 - s2,
-        );
-        let (d00, d10, d01, d11) = (
-            (6.0 * s2 - 6.0 * s) / hn,
-            3.0 * s2 - 4.0 * s + 1.0,
-            (-6.0 * s2 + 6.0 * s) / hn,
-            3.0 * s2 - 2.0 * s,
-        );
         for &c in &self.active {
             let (p0, m0) = (self.values[i * n + c], self.slopes[i * n + c]);
             let (p1, m1) = (self.values[k * n + c], self.slopes[k * n + c]);
-            p[c] += h00 * p0 + h10 * hn * m0 + h01 * p1 + h11 * hn * m1;
-            dp[c] += d00 * p0 + d10 * m0 + d01 * p1 + d11 * m1;
+            let (value, slope) = crate::numerics::cubic_hermite(s, p0, hn * m0, p1, hn * m1);
+            p[c] += value;
+            dp[c] += slope / hn;
         }
     }
 }
