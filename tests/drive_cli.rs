@@ -316,6 +316,69 @@ fn hdi_drive_bounded_mode_flags_its_misses() {
     assert!(!never.exists());
 }
 
+/// `--scheme exponential`: the same periods as the default integrator, every true gap within
+/// 0.1 pm of its (the scheme's accuracy against a tight reference is tests/drive_plant.rs's),
+/// the same file from run to run; a scheme that does not exist is a usage error naming the
+/// flag, and nothing is written.
+#[test]
+fn hdi_drive_exponential_scheme_replays_close_to_the_integrator() {
+    let cmds = tmp("changed.csv");
+    let mut text = String::from("time_s,heater_mw,voltage_dc_v\n");
+    for k in 0..80 {
+        let p = 66.0 + if k % 2 == 1 { 0.001 } else { 0.0 };
+        text += &format!("{},{p},0\n", hdi_tribology::units::grid_point(0.0, 5e-5, k));
+    }
+    std::fs::write(&cmds, text).unwrap();
+    let run = |scheme: Option<&str>, out: &std::path::Path| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_hdi"));
+        c.args(["drive", "--paper", "--commands"])
+            .arg(&cmds)
+            .arg("--out")
+            .arg(out);
+        if let Some(s) = scheme {
+            c.args(["--scheme", s]);
+        }
+        c.output().unwrap()
+    };
+    let column = |path: &std::path::Path, name: &str| -> Vec<f64> {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines = text.lines();
+        let i = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .position(|c| c == name)
+            .unwrap();
+        lines
+            .map(|l| l.split(',').nth(i).unwrap().parse().unwrap())
+            .collect()
+    };
+    let (default, exp, again) = (tmp("int.csv"), tmp("exp.csv"), tmp("exp2.csv"));
+    for (scheme, out) in [
+        (None, &default),
+        (Some("exponential"), &exp),
+        (Some("exponential"), &again),
+    ] {
+        let o = run(scheme, out);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    assert_eq!(std::fs::read(&exp).unwrap(), std::fs::read(&again).unwrap());
+    let (a, b) = (column(&default, "true_gap_nm"), column(&exp, "true_gap_nm"));
+    assert_eq!(a.len(), b.len());
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    // The scheme advanced periods itself (not one bit the same), and stayed close.
+    assert!(worst > 0.0 && worst < 1e-4, "worst gap difference {worst} nm");
+    let never = tmp("never-scheme.csv");
+    let o = run(Some("implicit"), &never);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--scheme"));
+    assert!(!never.exists());
+}
+
 /// The sensor file's times come back as typed: the k-th period at 20 kHz ends at k / 20 000 s,
 /// the nearest double to the decimal (`0.00015`, not `0.00015000000000000001`), however long
 /// the run; at 25 kHz likewise.

@@ -23,7 +23,10 @@ class Drive:
     one head; ``MultiDrive`` steps several), and ``steps_per_period`` (the bounded mode for
     firmware in the loop: at most that many Radau5 steps a period, a step at the bound
     accepted whatever its error; ``last_period`` gives the flag; docs/clearance.md, "The
-    bounded mode"). ``flat_disk`` drops the run-out and waviness. ``atol_pm`` (default 0.01) and
+    bounded mode"), and ``scheme`` (``"integrator"``, the default, or ``"exponential"``: one
+    exponential step a period with the Jacobian held, the integrator where it misses, which
+    ``last_period["exponential"]`` tells; docs/clearance.md, "The exponential scheme").
+    ``flat_disk`` drops the run-out and waviness. ``atol_pm`` (default 0.01) and
     ``atol_flight_pm`` (default ``atol_pm``, at least ``atol_pm``) are the integration's
     displacement tolerances near contact and in flight (pm). The same seed gives the same disk
     and the same sensor noise, bit for bit; stepping it with the commands of a command file

@@ -27,7 +27,8 @@ use hdi_tribology::calibration::{
 };
 use hdi_tribology::drive::{
     check_commands, replay_heads_each, sensor_row, spec_zone, Command, CommandRow, DiskSpec, Drive,
-    DriveOptions, MultiDrive, MultiPlant, Plant, Sensors, DEFAULT_RADIUS, SENSOR_COLUMNS,
+    DriveOptions, DriveScheme, MultiDrive, MultiPlant, Plant, Sensors, DEFAULT_RADIUS,
+    SENSOR_COLUMNS,
 };
 use hdi_tribology::fit::{DataSet, FitOptions, FreeParameter};
 use hdi_tribology::force::{Gaps, RelaxingState};
@@ -1617,6 +1618,7 @@ fn plant_of(
     };
     let mut heads_given = false;
     let mut bounded = None;
+    let mut scheme = None;
     if let Some(kw) = settings {
         for (k, v) in kw.iter() {
             let key: String = k.extract()?;
@@ -1627,6 +1629,14 @@ fn plant_of(
                     .extract()
                     .map_err(|_| invalid(&key, "must be a whole number of steps, at least 1"))?;
                 bounded = Some(n);
+                continue;
+            }
+            if key == "scheme" {
+                // `DriveOptions::scheme` by its name; a bad one is named `scheme`.
+                let name: String = v
+                    .extract()
+                    .map_err(|_| invalid(&key, "must be \"integrator\" or \"exponential\""))?;
+                scheme = Some(name.parse::<DriveScheme>().py()?);
                 continue;
             }
             if key == "waviness_orders" {
@@ -1681,6 +1691,9 @@ fn plant_of(
         .py()?;
     if let Some(n) = bounded {
         opts = opts.bounded(n);
+    }
+    if let Some(s) = scheme {
+        opts.scheme = s;
     }
     let radius = spec.radius_m.unwrap_or(DEFAULT_RADIUS);
     let n = spec.heads as usize;

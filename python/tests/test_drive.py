@@ -276,3 +276,21 @@ def test_the_bounded_mode_bounds_the_steps_and_flags_the_misses(paper_scene):
         with pytest.raises(hdi.InvalidInputError) as e:
             hdi.Drive(paper_scene, steps_per_period=bad)
         assert e.value.field == "steps_per_period"
+
+
+def test_the_exponential_scheme_steps_its_own_periods_close_to_the_integrator(paper_scene):
+    # A command changed every period (the case the scheme is for): its periods are its own
+    # (last_period["exponential"]), and the true gap stays within 0.1 pm of the integrator's.
+    exp = hdi.Drive(paper_scene, scheme="exponential")
+    ref = hdi.Drive(paper_scene)
+    own, worst = 0, 0.0
+    for k in range(60):
+        p = 66.0 + (0.001 if k % 2 else 0.0)
+        a, b = exp.step(p), ref.step(p)
+        own += exp.last_period["exponential"]
+        worst = max(worst, abs(a.truth.gap_nm - b.truth.gap_nm))
+    assert own > 30
+    assert 0.0 < worst < 1e-4
+    with pytest.raises(hdi.InvalidInputError) as e:
+        hdi.Drive(paper_scene, scheme="implicit")
+    assert e.value.field == "scheme"

@@ -263,6 +263,42 @@ pub enum DriveScheme {
     Exponential,
 }
 
+impl DriveScheme {
+    /// The scheme's name as the CLI's `--scheme` and Python's `scheme=` take it.
+    pub fn name(self) -> &'static str {
+        match self {
+            DriveScheme::Integrator => "integrator",
+            DriveScheme::Exponential => "exponential",
+        }
+    }
+}
+
+impl std::str::FromStr for DriveScheme {
+    type Err = Error;
+
+    /// `"integrator"` or `"exponential"` (any case); anything else is an error naming `scheme`.
+    ///
+    /// ```
+    /// use hdi_tribology::drive::DriveScheme;
+    /// assert_eq!("Exponential".parse::<DriveScheme>()?, DriveScheme::Exponential);
+    /// assert_eq!(DriveScheme::Integrator.name(), "integrator");
+    /// let e = "implicit".parse::<DriveScheme>().unwrap_err();
+    /// assert!(e.to_string().contains("scheme"), "{e}");
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    fn from_str(s: &str) -> Result<Self> {
+        [DriveScheme::Integrator, DriveScheme::Exponential]
+            .into_iter()
+            .find(|d| d.name().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| {
+                Error::invalid(
+                    "scheme",
+                    format!("must be integrator or exponential, got {s:?}"),
+                )
+            })
+    }
+}
+
 /// Most steps a period may take in the bounded mode ([`DriveOptions::steps_per_period`]).
 pub const MAX_STEPS_PER_PERIOD: usize = 64;
 

@@ -114,6 +114,12 @@ pub struct Args {
           value_parser = clap::value_parser!(u32)
               .range(1..=hdi_tribology::drive::MAX_STEPS_PER_PERIOD as i64))]
     steps_per_period: Option<u32>,
+    /// How each period is advanced: integrator (the adaptive integrator) or exponential (one
+    /// exponential step a period with the Jacobian held, the integrator where it misses; about
+    /// three times faster where the command changes every period; docs/clearance.md, "The
+    /// exponential scheme") [default: integrator].
+    #[arg(long, value_name = "S")]
+    scheme: Option<String>,
 }
 
 /// The drive of the scene's `[drive]` section with the flags over it (each flag checked and
@@ -184,10 +190,19 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )
         // Both are positive numbers by now: what is left is a flag that does not fit the other.
         .map_err(|e| CliError::Usage(e.to_string()))?;
-    let opts = match a.steps_per_period {
+    let mut opts = match a.steps_per_period {
         Some(n) => opts.bounded(n as usize),
         None => opts,
     };
+    if let Some(s) = &a.scheme {
+        opts.scheme = s.parse().map_err(|e| match e {
+            // Named as the flag is written.
+            hdi_tribology::Error::InvalidInput { reason, .. } => {
+                CliError::Usage(hdi_tribology::Error::invalid("--scheme", reason).to_string())
+            }
+            e => CliError::Usage(e.to_string()),
+        })?;
+    }
     let shown = a.commands.display().to_string();
     let file = std::fs::File::open(&a.commands)
         .map_err(|e| CliError::Failed(format!("--commands {shown}: {e}")))?;
