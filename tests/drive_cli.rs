@@ -371,7 +371,10 @@ fn hdi_drive_exponential_scheme_replays_close_to_the_integrator() {
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max);
     // The scheme advanced periods itself (not one bit the same), and stayed close.
-    assert!(worst > 0.0 && worst < 1e-4, "worst gap difference {worst} nm");
+    assert!(
+        worst > 0.0 && worst < 1e-4,
+        "worst gap difference {worst} nm"
+    );
     let never = tmp("never-scheme.csv");
     let o = run(Some("implicit"), &never);
     assert_eq!(o.status.code(), Some(2));
