@@ -35,7 +35,14 @@
 
 // The version of the ABI this header describes: a program built against one version must be
 // run with a library of the same version (check [`hdi_abi_version`] at start-up).
-#define HDI_ABI_VERSION 3
+#define HDI_ABI_VERSION 4
+
+// [`HdiDriveConfig::scheme`]: the adaptive integrator (the default).
+#define HDI_SCHEME_INTEGRATOR 0
+
+// [`HdiDriveConfig::scheme`]: one exponential step a period with the Jacobian held, the
+// integrator where it misses (docs/clearance.md, "The exponential scheme").
+#define HDI_SCHEME_EXPONENTIAL 1
 
 // What a call did. `HDI_STATUS_OK` is 0; every other value is a failure, with its message
 // from [`hdi_last_error`].
@@ -318,6 +325,9 @@ typedef struct HdiDriveConfig {
   // to 64), a step at the bound accepted whatever its error, the error estimate returned by
   // [`hdi_drive_last_period`] as a flag; 0 for adaptive steps (the default).
   uint32_t steps_per_period;
+  // How each period is advanced: [`HDI_SCHEME_INTEGRATOR`] (the default) or
+  // [`HDI_SCHEME_EXPONENTIAL`]; [`HdiPeriod::exponential`] tells which advanced a period.
+  uint32_t scheme;
 } HdiDriveConfig;
 
 // One controller period's command.
@@ -389,6 +399,9 @@ typedef struct HdiPeriod {
   // The largest weighted error estimate of those steps against the tolerances: at most 1
   // under adaptive control; in the bounded mode, above 1 where a step missed them.
   double error_estimate;
+  // Whether one exponential step advanced the period ([`HDI_SCHEME_EXPONENTIAL`]); false
+  // under the integrator, and in a period the exponential scheme left to it.
+  bool exponential;
 } HdiPeriod;
 
 #ifdef __cplusplus

@@ -40,8 +40,8 @@ use hdi_tribology::analysis::{
     Transition,
 };
 use hdi_tribology::drive::{
-    zone_at, Ambient, Command, DiskSpec, DriveOptions, Harmonic, MultiDrive, MultiPlant,
-    SensorSpec, Sensors, DEFAULT_RADIUS,
+    zone_at, Ambient, Command, DiskSpec, DriveOptions, DriveScheme, Harmonic, MultiDrive,
+    MultiPlant, SensorSpec, Sensors, DEFAULT_RADIUS,
 };
 use hdi_tribology::model::{SliderModel, Voltage};
 use hdi_tribology::scene::DriveSpec;
@@ -52,7 +52,13 @@ use std::ffi::{c_char, CStr};
 
 /// The version of the ABI this header describes: a program built against one version must be
 /// run with a library of the same version (check [`hdi_abi_version`] at start-up).
-pub const HDI_ABI_VERSION: u32 = 3;
+pub const HDI_ABI_VERSION: u32 = 4;
+
+/// [`HdiDriveConfig::scheme`]: the adaptive integrator (the default).
+pub const HDI_SCHEME_INTEGRATOR: u32 = 0;
+/// [`HdiDriveConfig::scheme`]: one exponential step a period with the Jacobian held, the
+/// integrator where it misses (docs/clearance.md, "The exponential scheme").
+pub const HDI_SCHEME_EXPONENTIAL: u32 = 1;
 
 /// What a call did. `HDI_STATUS_OK` is 0; every other value is a failure, with its message
 /// from [`hdi_last_error`].
@@ -376,6 +382,9 @@ pub struct HdiDriveConfig {
     /// to 64), a step at the bound accepted whatever its error, the error estimate returned by
     /// [`hdi_drive_last_period`] as a flag; 0 for adaptive steps (the default).
     pub steps_per_period: u32,
+    /// How each period is advanced: [`HDI_SCHEME_INTEGRATOR`] (the default) or
+    /// [`HDI_SCHEME_EXPONENTIAL`]; [`HdiPeriod::exponential`] tells which advanced a period.
+    pub scheme: u32,
 }
 
 /// How the solver advanced a head's last period ([`hdi_drive_last_period`]).
@@ -387,6 +396,9 @@ pub struct HdiPeriod {
     /// The largest weighted error estimate of those steps against the tolerances: at most 1
     /// under adaptive control; in the bounded mode, above 1 where a step missed them.
     pub error_estimate: f64,
+    /// Whether one exponential step advanced the period ([`HDI_SCHEME_EXPONENTIAL`]); false
+    /// under the integrator, and in a period the exponential scheme left to it.
+    pub exponential: bool,
 }
 
 /// Options of the static analyses.
@@ -1108,6 +1120,10 @@ fn config_of(o: &DriveOptions, heads: u32, radius: f64, rpm: Option<f64>) -> Hdi
         contact_force_tolerance_un: to_micro(o.contact_force_tolerance),
         max_step_us: o.max_step.map_or(0.0, to_micro),
         steps_per_period: o.steps_per_period.map_or(0, |n| n as u32),
+        scheme: match o.scheme {
+            DriveScheme::Integrator => HDI_SCHEME_INTEGRATOR,
+            DriveScheme::Exponential => HDI_SCHEME_EXPONENTIAL,
+        },
     }
 }
 
@@ -1401,9 +1417,22 @@ unsafe fn drive_options(scene: &Scene, c: &HdiDriveConfig) -> Result<Built, Fail
         ..lib
     };
     // The plant checks the range (`config_field` names it as the config does).
-    let opts = match c.steps_per_period {
+    let mut opts = match c.steps_per_period {
         0 => opts,
         n => opts.bounded(n as usize),
+    };
+    opts.scheme = match c.scheme {
+        HDI_SCHEME_INTEGRATOR => DriveScheme::Integrator,
+        HDI_SCHEME_EXPONENTIAL => DriveScheme::Exponential,
+        other => {
+            return Err(Failure::invalid(
+                "config.scheme",
+                format!(
+                    "must be HDI_SCHEME_INTEGRATOR ({HDI_SCHEME_INTEGRATOR}) or \
+                     HDI_SCHEME_EXPONENTIAL ({HDI_SCHEME_EXPONENTIAL}), got {other}"
+                ),
+            ))
+        }
     };
     Ok(Built {
         heads: heads as usize,
@@ -1749,6 +1778,7 @@ pub unsafe extern "C" fn hdi_drive_last_period(
         *out = HdiPeriod {
             steps: p.steps as u32,
             error_estimate: p.error_estimate,
+            exponential: p.exponential,
         };
         Ok(())
     })

@@ -4,8 +4,8 @@
 use hdi::*;
 use hdi_tribology::analysis::{self, Protocol};
 use hdi_tribology::drive::{
-    head_seed, spec_zone, zone_at, Ambient, Command, DiskSpec, DriveOptions, Harmonic, MultiPlant,
-    Plant, Sensors,
+    head_seed, spec_zone, zone_at, Ambient, Command, DiskSpec, DriveOptions, DriveScheme, Harmonic,
+    MultiPlant, Plant, Sensors,
 };
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
@@ -674,6 +674,52 @@ fn the_bounded_mode_reports_its_flag() {
     let st = unsafe { hdi_drive_last_period(drive, 1, &mut p) };
     assert_eq!(st, HdiStatus::InvalidInput);
     assert!(last_error().contains("head"), "{}", last_error());
+    ok(unsafe { hdi_drive_free(drive) });
+    ok(unsafe { hdi_scene_free(scene) });
+}
+
+/// The exponential scheme through the C ABI: the same drive as the Rust one with
+/// `DriveScheme::Exponential`, to the bit, each period's scheme in `HdiPeriod::exponential`; a
+/// scheme that does not exist is named.
+#[test]
+fn the_exponential_scheme_is_the_rust_one() {
+    let scene = paper();
+    let mut config = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_drive_config_default(config.as_mut_ptr()) });
+    let mut config: HdiDriveConfig = unsafe { config.assume_init() };
+    assert_eq!(config.scheme, HDI_SCHEME_INTEGRATOR);
+    let mut drive = null_mut();
+    config.scheme = 7;
+    let st = unsafe { hdi_drive_new(scene, &config, 1, &mut drive) };
+    assert_eq!(st, HdiStatus::InvalidInput);
+    assert!(last_error().contains("config.scheme"), "{}", last_error());
+    config.scheme = HDI_SCHEME_EXPONENTIAL;
+    ok(unsafe { hdi_drive_new(scene, &config, 1, &mut drive) });
+    let s = Scene::paper();
+    let opts = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..DriveOptions::default()
+    };
+    let plant = Plant::new(&s, &zone_at(&s, 0.025, None).unwrap(), 1, opts).unwrap();
+    let mut rust = plant.drive().unwrap();
+    let mut own = 0;
+    for k in 0..40 {
+        // A command changed every period: the case the scheme is for.
+        let p = 66.0 + if k % 2 == 1 { 0.001 } else { 0.0 };
+        let cmd = HdiCommand {
+            heater_power_mw: p,
+            ..HdiCommand::default()
+        };
+        let mut out = HdiSensors::default();
+        ok(unsafe { hdi_drive_step(drive, &cmd, 50e-6, &mut out) });
+        let r = rust.step(&Command::heater_mw(p), 50e-6).unwrap();
+        same_sensors(k, &out, &r);
+        let mut q = HdiPeriod::default();
+        ok(unsafe { hdi_drive_last_period(drive, 0, &mut q) });
+        assert_eq!(q.exponential, rust.last_period().exponential);
+        own += usize::from(q.exponential);
+    }
+    assert!(own > 20, "{own} of 40 periods by the exponential scheme");
     ok(unsafe { hdi_drive_free(drive) });
     ok(unsafe { hdi_scene_free(scene) });
 }
