@@ -502,12 +502,6 @@ impl Structure {
         }
     }
 
-    /// The damping matrix `C` as the fixed-size block the hot paths use (zero outside `n × n`).
-    #[inline]
-    pub(crate) fn damping_block(&self) -> DofMatrix {
-        self.damping
-    }
-
     /// The generalised force `e₀ f_heave + b f_bulge − K q − C v`.
     #[inline]
     pub(crate) fn generalised_force(&self, q: &Dofs, v: &Dofs, f_heave: f64, f_bulge: f64) -> Dofs {

@@ -338,13 +338,11 @@ impl SliderSystem {
             return None;
         }
         let st = &self.model.structure;
-        let mut damping = st.damping_block();
-        damping[(0, 0)] += self.model.bearing().damping(y);
         Some(LagAuditParts {
             tau: self.model.interface_lag,
             lagged,
             bulge: st.bulge_vector(),
-            damping,
+            damping: st.damping_with(self.model.bearing().damping(y)),
         })
     }
 
