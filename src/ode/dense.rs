@@ -61,23 +61,12 @@ impl StepPolynomial<'_> {
     /// # Ok::<(), hdi_tribology::ode::OdeError>(())
     /// ```
     pub fn state_at(&self, t: f64, out: &mut [f64]) {
-        let theta = self.theta(t);
-        let n = self.n;
-        out[..n].fill(0.0);
-        for a in self.coeffs.chunks_exact(n.max(1)).rev() {
-            for (o, c) in out[..n].iter_mut().zip(a) {
-                *o = *o * theta + c;
-            }
-        }
-    }
-
-    #[inline]
-    fn theta(&self, t: f64) -> f64 {
-        if self.h != 0.0 {
-            (t - self.t0) / self.h
-        } else {
-            0.0
-        }
+        horner(
+            self.coeffs,
+            self.n,
+            theta(self.t0, self.h, t),
+            &mut out[..self.n],
+        );
     }
 }
 
@@ -124,12 +113,22 @@ impl StepPoly {
     where
         DefaultAllocator: Allocator<D>,
     {
-        let theta = if self.h != 0.0 {
-            (t - self.t0) / self.h
-        } else {
-            0.0
-        };
-        horner(&self.coeffs, self.n, theta, out.as_mut_slice());
+        horner(
+            &self.coeffs,
+            self.n,
+            theta(self.t0, self.h, t),
+            out.as_mut_slice(),
+        );
+    }
+}
+
+/// The fraction `θ = (t − t0)/h` of the step `[t0, t0 + h]` at `t` (0 for an empty step).
+#[inline]
+fn theta(t0: f64, h: f64, t: f64) -> f64 {
+    if h != 0.0 {
+        (t - t0) / h
+    } else {
+        0.0
     }
 }
 
@@ -219,11 +218,7 @@ impl DenseOutput {
         let k = self.t_start.partition_point(|&s| s <= t).saturating_sub(1);
         let lo = self.offset[k];
         let hi = self.offset.get(k + 1).copied().unwrap_or(self.coeffs.len());
-        let theta = if self.h[k] != 0.0 {
-            (t - self.t_start[k]) / self.h[k]
-        } else {
-            0.0
-        };
+        let theta = theta(self.t_start[k], self.h[k], t);
         horner(&self.coeffs[lo..hi], self.n, theta, out.as_mut_slice());
         true
     }
