@@ -633,7 +633,11 @@ impl ExpScheme {
                 break (x1, err);
             }
         };
-        if err <= 1.0 && x1.iter().all(|v| v.is_finite()) {
+        // The step holds the branches of the stateful terms as they were at its start: a
+        // period that ends past a switch is left to the integrator, which stops on it.
+        let switched = (0..OdeSystem::<D>::switches(sys))
+            .any(|i| OdeSystem::<D>::switching(sys, i, t0 + h, &x1) < 0.0);
+        if err <= 1.0 && x1.iter().all(|v| v.is_finite()) && !switched {
             self.backoff = 0;
             self.counts.exponential += 1;
             // Up at once when the period needed it; down after CALM periods well within the

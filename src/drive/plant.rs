@@ -910,7 +910,8 @@ pub struct Drive {
 pub struct PeriodReport {
     /// Steps that ended within the period (0 when one step spans it; in the bounded mode at
     /// most [`DriveOptions::steps_per_period`] + 1, the one more begun in the period before,
-    /// except where Radau5's Newton iteration fails and shortens a step).
+    /// except where Radau5's Newton iteration fails and shortens a step, and one more for each
+    /// switch of a stateful term's branch, where a step ends early).
     pub steps: usize,
     /// The largest weighted error estimate of those steps (of the one spanning the period when
     /// none ended in it), against the drive's tolerances: at most 1 under adaptive control; in

@@ -9,7 +9,7 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-use super::stateful::{RatePartials, StateForce, StatefulTerm, MAX_TERM_STATES};
+use super::stateful::{Branch, RatePartials, StateForce, StatefulTerm, MAX_TERM_STATES};
 use super::{Footprint, ForceEval, Gaps, Scaled};
 use crate::error::{check_non_negative, check_positive};
 use crate::quadrature::{Table, TableOptions};
@@ -123,7 +123,9 @@ impl Pickup {
 /// force is tabulated in `e` once.
 ///
 /// `d*` obeys `ẋ = (d − x)/τ` with `τ = τ_f` while the gap closes below `x` and `τ_h` while it
-/// is above. At rest `d* = d` (the statics): the branch of bridges formed at the gap itself.
+/// is above: two branches split by the sign of `d − d*` ([`StatefulTerm::switching`]), which
+/// the simulations hold over each step and switch at the located root. At rest `d* = d` (the
+/// statics): the branch of bridges formed at the gap itself.
 ///
 /// ```
 /// use std::sync::Arc;
@@ -348,11 +350,11 @@ impl Meniscus {
         }
     }
 
-    fn tau(&self, d: f64, d_star: f64) -> f64 {
-        if d < d_star {
-            self.params.formation_time
-        } else {
-            self.params.healing_time
+    /// The time constant of `d*` on `branch`: healing above the gap's switch, formation below.
+    fn tau(&self, branch: Branch) -> f64 {
+        match branch {
+            Branch::Upper => self.params.healing_time,
+            Branch::Lower => self.params.formation_time,
         }
     }
 }
@@ -372,14 +374,28 @@ impl StatefulTerm for Meniscus {
         }
     }
     fn rates(&self, g: Gaps, x: &[f64], dx: &mut [f64]) {
-        dx[0] = (g.bulge - x[0]) / self.tau(g.bulge, x[0]);
+        self.rates_on(Branch::of(self.switching(g, x)), g, x, dx)
+    }
+    fn rate_partials(&self, g: Gaps, x: &[f64]) -> RatePartials {
+        self.rate_partials_on(Branch::of(self.switching(g, x)), g, x)
+    }
+    /// Two branches, healing and formation.
+    fn switches(&self) -> bool {
+        true
+    }
+    /// `d − d*`: healing where non-negative, formation where the gap is below `d*`.
+    fn switching(&self, g: Gaps, x: &[f64]) -> f64 {
+        g.bulge - x[0]
+    }
+    fn rates_on(&self, branch: Branch, g: Gaps, x: &[f64], dx: &mut [f64]) {
+        dx[0] = (g.bulge - x[0]) / self.tau(branch);
         if let Some(p) = self.params.pickup {
             let (s, _) = self.survival(g.bulge - self.params.mobile_thickness);
             dx[1] = p.rate * s - x[1] / p.loss_time;
         }
     }
-    fn rate_partials(&self, g: Gaps, x: &[f64]) -> RatePartials {
-        let rate = 1.0 / self.tau(g.bulge, x[0]);
+    fn rate_partials_on(&self, branch: Branch, g: Gaps, _x: &[f64]) -> RatePartials {
+        let rate = 1.0 / self.tau(branch);
         let mut p = RatePartials::default();
         p.d_bulge[0] = rate;
         p.d_state[0][0] = -rate;

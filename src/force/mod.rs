@@ -51,5 +51,7 @@ pub use interface::{Breakdown, ForceEval, Gaps, HotForces, HotValues, InterfaceF
 pub use intermolecular::Intermolecular;
 pub use meniscus::{lian_rupture_distance, Meniscus, MeniscusParams, Pickup, Wetting};
 pub use pressure::{lj_zero, Coulomb, LennardJones39, PressureLaw};
-pub use stateful::{RatePartials, RelaxingState, StateForce, StatefulTerm, MAX_TERM_STATES};
+pub use stateful::{
+    Branch, RatePartials, RelaxingState, StateForce, StatefulTerm, MAX_TERM_STATES,
+};
 pub use term::{Coupling, GapReference, InterfaceTerm, TermForce, TermKind};

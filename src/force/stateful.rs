@@ -25,6 +25,50 @@ pub struct RatePartials {
     pub d_state: [[f64; MAX_TERM_STATES]; MAX_TERM_STATES],
 }
 
+/// A branch of a rate law with two ([`StatefulTerm::switching`]): where the switching function
+/// is non-negative (`Upper`) or negative (`Lower`).
+///
+/// ```
+/// use hdi_tribology::force::Branch;
+/// assert_eq!((Branch::of(0.0), Branch::of(-1e-30)), (Branch::Upper, Branch::Lower));
+/// assert_eq!(Branch::of_flag(Branch::Lower.flag()), Branch::Lower);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Branch {
+    /// The switching function is non-negative.
+    Upper,
+    /// The switching function is negative.
+    Lower,
+}
+
+impl Branch {
+    /// The branch where the switching function has the value `s`.
+    pub fn of(s: f64) -> Self {
+        if s < 0.0 {
+            Branch::Lower
+        } else {
+            Branch::Upper
+        }
+    }
+
+    /// The branch as a simulation holds it in its state: +1 (`Upper`) or −1 (`Lower`).
+    pub fn flag(self) -> f64 {
+        match self {
+            Branch::Upper => 1.0,
+            Branch::Lower => -1.0,
+        }
+    }
+
+    /// The branch of a held flag ([`Branch::flag`]).
+    pub fn of_flag(flag: f64) -> Self {
+        if flag < 0.0 {
+            Branch::Lower
+        } else {
+            Branch::Upper
+        }
+    }
+}
+
 /// A term's force (N, positive = away from the disk, acting where the interface force acts) with
 /// its partial derivatives along the gaps and along its own states.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -76,6 +120,28 @@ pub trait StatefulTerm: Debug + Send + Sync {
     /// default (a term that says true and sees the pad gap would get a wrong balance).
     fn rests_on_bulge_gap(&self) -> bool {
         false
+    }
+    /// Whether the rate law has two smooth branches split by the sign of
+    /// [`StatefulTerm::switching`]: false by default. The simulations then hold the branch in
+    /// their state, integrate [`StatefulTerm::rates_on`] over each step and change branch at
+    /// the located root (`ode::OdeSystem::switches`), so no step crosses the law's kink; the
+    /// static analyses read [`StatefulTerm::rates`], which picks the branch by the sign.
+    fn switches(&self) -> bool {
+        false
+    }
+    /// The switching function at gaps `g` and states `x` (its sign picks the branch; a length
+    /// or any other unit). Called only when [`StatefulTerm::switches`] says so.
+    fn switching(&self, _g: Gaps, _x: &[f64]) -> f64 {
+        0.0
+    }
+    /// The rates of `branch`'s law, continued smoothly past the switch; by default
+    /// [`StatefulTerm::rates`].
+    fn rates_on(&self, _branch: Branch, g: Gaps, x: &[f64], dx: &mut [f64]) {
+        self.rates(g, x, dx)
+    }
+    /// The derivatives of [`StatefulTerm::rates_on`]; by default [`StatefulTerm::rate_partials`].
+    fn rate_partials_on(&self, _branch: Branch, g: Gaps, x: &[f64]) -> RatePartials {
+        self.rate_partials(g, x)
     }
 }
 

@@ -426,6 +426,12 @@ impl SliderModel {
         self.stateful.iter().map(|t| t.states()).sum()
     }
 
+    /// The number of stateful terms with two branches ([`StatefulTerm::switches`]): the
+    /// simulations hold one flag for each.
+    pub fn term_branches(&self) -> usize {
+        self.stateful.iter().filter(|t| t.switches()).count()
+    }
+
     /// Masses, springs and dampers, and where the bulge sits.
     pub fn structure(&self) -> &Structure {
         &self.structure

@@ -1,7 +1,7 @@
 //! The slider as an ODE: state layout, right-hand side and analytic Jacobian.
 
 use super::{Dofs, Inputs, QuasiStaticBulge, SliderModel};
-use crate::force::{Gaps, HotValues, MAX_TERM_STATES};
+use crate::force::{Branch, Gaps, HotValues, StatefulTerm, MAX_TERM_STATES};
 use crate::ode::OdeSystem;
 use crate::scene::MAX_DOF;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
@@ -32,6 +32,11 @@ pub struct StateLayout {
     /// The states of the stateful terms, in the order of the model's terms: `n` of them from
     /// index `start`, as `(start, n)`.
     pub term_states: (usize, usize),
+    /// The branches the simulations hold for the stateful terms whose rate law has two
+    /// ([`crate::force::StatefulTerm::switches`]), one flag (+1 or −1,
+    /// [`crate::force::Branch::flag`]) per such term in the order of the terms, as
+    /// `(start, n)`. Their rates are zero: the integrator changes them at the switches.
+    pub branches: (usize, usize),
     /// `Q = ∫ F_c dt` (N s): the running mean of the contact force is `(Q(t) − Q(t − T_w))/T_w`.
     pub contact_impulse: Option<usize>,
     /// `Θ = ∫ ΔT dt` (K s): the time mean of the flash temperature.
@@ -63,11 +68,25 @@ impl StateLayout {
         terms: usize,
         integrals: bool,
     ) -> Self {
+        Self::with_branches(dofs, thermal_lag, interface_lag, (terms, 0), integrals)
+    }
+
+    /// As [`StateLayout::with_term_states`], with `branches` flags after the terms' states
+    /// (`terms` is `(states, branches)`).
+    fn with_branches(
+        dofs: usize,
+        thermal_lag: bool,
+        interface_lag: bool,
+        (terms, branches): (usize, usize),
+        integrals: bool,
+    ) -> Self {
         let mut len = 2 * dofs;
         let delta = next_index(&mut len, thermal_lag);
         let lagged_force = next_index(&mut len, interface_lag);
         let term_states = (len, terms);
         len += terms;
+        let branches = (len, branches);
+        len += branches.1;
         let contact_impulse = next_index(&mut len, integrals);
         let heat = next_index(&mut len, integrals);
         StateLayout {
@@ -75,6 +94,7 @@ impl StateLayout {
             delta,
             lagged_force,
             term_states,
+            branches,
             contact_impulse,
             heat,
             len,
@@ -99,11 +119,11 @@ impl StateLayout {
             Some(_) => 1,
             None => model.structure().dofs(),
         };
-        Self::with_term_states(
+        Self::with_branches(
             dofs,
             model.thermal_lag() > 0.0,
             model.interface_lag() > 0.0,
-            model.term_states(),
+            (model.term_states(), model.term_branches()),
             integrals,
         )
     }
@@ -258,20 +278,21 @@ impl SliderSystem {
         if let Some(i) = self.layout.lagged_force {
             s[i] = rest.interface_force;
         }
-        let (start, n) = self.layout.term_states;
-        if n > 0 {
+        if self.layout.term_states.1 > 0 {
             let g = self
                 .model
                 .gaps_offset(&rest.q, rest.protrusion, self.inputs.clearance_offset);
-            let mut at = start;
-            for term in self.model.stateful_terms() {
+            for (term, at, flag) in self.terms() {
                 let k = term.states();
                 let mut x = [0.0; MAX_TERM_STATES];
                 term.initial(g, &mut x[..k]);
                 for (j, v) in x[..k].iter().enumerate() {
                     s[at + j] = *v;
                 }
-                at += k;
+                // The branch the sign picks at the start.
+                if let Some(i) = flag {
+                    s[i] = Branch::of(term.switching(g, &x[..k])).flag();
+                }
             }
         }
         s
@@ -570,13 +591,40 @@ impl SliderSystem {
         }
     }
 
-    /// Calls `f(term, index of its first state)` for every stateful term.
-    fn for_terms(&self, mut f: impl FnMut(&dyn crate::force::StatefulTerm, usize)) {
-        let mut at = self.layout.term_states.0;
-        for term in self.model.stateful_terms() {
-            f(&**term, at);
+    /// Every stateful term with the index of its first state and of its branch flag (the flag
+    /// only for a term with two branches).
+    fn terms(&self) -> impl Iterator<Item = (&dyn StatefulTerm, usize, Option<usize>)> + '_ {
+        let (mut at, mut flag) = (self.layout.term_states.0, self.layout.branches.0);
+        self.model.stateful_terms().iter().map(move |term| {
+            let held = term.switches().then(|| {
+                flag += 1;
+                flag - 1
+            });
             at += term.states();
+            (&**term as &dyn StatefulTerm, at - term.states(), held)
+        })
+    }
+
+    /// Calls `f(term, index of its first state, index of its branch flag)` for every stateful
+    /// term ([`SliderSystem::terms`]).
+    fn for_terms(&self, mut f: impl FnMut(&dyn StatefulTerm, usize, Option<usize>)) {
+        for (term, at, flag) in self.terms() {
+            f(term, at, flag);
         }
+    }
+
+    /// The term of switch `i` (the `i`-th term with two branches), the index of its first state
+    /// and of its flag.
+    fn switching_term(&self, i: usize) -> Option<(&dyn StatefulTerm, usize, usize)> {
+        let flag = self.layout.branches.0 + i;
+        self.terms()
+            .find(|t| t.2 == Some(flag))
+            .map(|(term, at, _)| (term, at, flag))
+    }
+
+    /// The branch held at flag `flag` of state `s` (the upper one for a term with one law).
+    fn held<S: Index<usize, Output = f64> + ?Sized>(flag: Option<usize>, s: &S) -> Branch {
+        flag.map_or(Branch::Upper, |i| Branch::of_flag(s[i]))
     }
 
     /// The sum of the stateful terms' forces at gaps `g` and state `s` (N), with their rates
@@ -586,12 +634,15 @@ impl SliderSystem {
         DefaultAllocator: Allocator<D>,
     {
         let mut force = 0.0;
-        self.for_terms(|term, at| {
+        self.for_terms(|term, at, flag| {
             let k = term.states();
             let x = &s.as_slice()[at..at + k];
             let mut dx = [0.0; MAX_TERM_STATES];
-            term.rates(g, x, &mut dx[..k]);
+            term.rates_on(Self::held(flag, s), g, x, &mut dx[..k]);
             ds.as_mut_slice()[at..at + k].copy_from_slice(&dx[..k]);
+            if let Some(i) = flag {
+                ds[i] = 0.0;
+            }
             force += term.force(g, x).force.value;
         });
         force
@@ -612,11 +663,11 @@ impl SliderSystem {
             let pad = if c == 0 { d_pad } else { 0.0 };
             d_bulge * b[c] + pad
         };
-        self.for_terms(|term, at| {
+        self.for_terms(|term, at, flag| {
             let k = term.states();
             let x = &s.as_slice()[at..at + k];
             let f = term.force(g, x);
-            let p = term.rate_partials(g, x);
+            let p = term.rate_partials_on(Self::held(flag, s), g, x);
             for r in 0..n {
                 let v = lay.velocity(r);
                 for col in 0..n {
@@ -659,11 +710,11 @@ impl SliderSystem {
         let st = &self.model.structure;
         let lay = self.layout;
         let per_force = st.mass_solve(&st.bulge_vector());
-        self.for_terms(|term, at| {
+        self.for_terms(|term, at, flag| {
             let k = term.states();
             let x = &s.as_slice()[at..at + k];
             let f = term.force(g, x);
-            let p = term.rate_partials(g, x);
+            let p = term.rate_partials_on(Self::held(flag, s), g, x);
             for r in 0..lay.dofs {
                 dfdt[lay.velocity(r)] += per_force[r] * (-f.force.d_bulge * delta_rate);
             }
@@ -678,6 +729,27 @@ impl<D: Dim> OdeSystem<D> for SliderSystem
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+    /// One per stateful term with two branches ([`StatefulTerm::switches`]).
+    fn switches(&self) -> usize {
+        self.layout.branches.1
+    }
+
+    /// The term's switching function times its held flag: non-negative while the held branch
+    /// is the one the sign picks.
+    fn switching(&self, i: usize, t: f64, s: &OVector<f64, D>) -> f64 {
+        let Some((term, at, flag)) = self.switching_term(i) else {
+            return 0.0;
+        };
+        let x = &s.as_slice()[at..at + term.states()];
+        s[flag] * term.switching(self.gaps(t, s), x)
+    }
+
+    /// The other branch.
+    fn switch(&self, i: usize, _t: f64, s: &mut OVector<f64, D>) {
+        let flag = self.layout.branches.0 + i;
+        s[flag] = -s[flag];
+    }
+
     fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
         if let Some(q) = self.model.quasi_static {
             return self.condensed_rhs(&q, t, s, ds);
@@ -837,9 +909,13 @@ impl SliderSystem {
         if let Some(i) = lay.heat {
             atol[i] = heat;
         }
-        self.for_terms(|term, at| {
+        self.for_terms(|term, at, flag| {
             let k = term.states();
             term.tolerances(displacement, &mut atol[at..at + k]);
+            // A flag is ±1 and never integrated: any scale will do.
+            if let Some(i) = flag {
+                atol[i] = 1.0;
+            }
         });
         atol
     }

@@ -103,7 +103,7 @@ where
     loop {
         it.hits.clear();
         let status = it.step_with(events)?;
-        let cut = matches!(status, StepStatus::Acted(_) | StepStatus::Terminated(_));
+        let cut = it.last_cut;
         let t = it.t();
         if let Some(d) = sol.dense.as_mut() {
             d.push(&it.poly);

@@ -177,7 +177,7 @@ pub(crate) fn crossing(d: Direction, g_old: f64, g_new: f64) -> Option<bool> {
 /// the sign has changed), so stopping there never leaves the event undone.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn locate<D: Dim>(
-    ev: &mut Event<'_, D>,
+    mut g: impl FnMut(f64, &OVector<f64, D>) -> f64,
     poly: &StepPoly,
     mut ta: f64,
     mut ga: f64,
@@ -210,7 +210,7 @@ where
             tb - 0.5 * tol.min(0.25 * (tb - ta)),
         );
         poly.eval_into(tm, work);
-        let gm = ev.eval(tm, work);
+        let gm = g(tm, work);
         evals += 1;
         if (gm < 0.0) == (ga < 0.0) && gm != 0.0 {
             ta = tm;

@@ -65,6 +65,15 @@ pub enum StepStatus {
     Terminated(usize),
 }
 
+/// What cut a step short.
+#[derive(Clone, Copy, Debug)]
+enum Cut {
+    /// An event that acts or stops.
+    Event(usize),
+    /// A switch of the system's branch.
+    Switch(usize),
+}
+
 /// The methods of one integration; `Auto` holds an explicit and a stiff one.
 enum Steppers<D: Dim>
 where
@@ -251,6 +260,11 @@ where
     pub(crate) ctx: Ctx<D>,
     events: Vec<Event<'a, D>>,
     g_old: Vec<f64>,
+    /// The system's switching functions at the current point ([`OdeSystem::switches`]).
+    sw_old: Vec<f64>,
+    /// The last step ended on a cut (an acting or terminal event, or a switch of branch)
+    /// short of its interpolant's end.
+    pub(crate) last_cut: bool,
     /// Events located since the last public `step`/`advance_to` began.
     pub(crate) hits: Vec<EventHit<D>>,
     step_hits: Vec<(usize, f64, bool)>,
@@ -349,7 +363,8 @@ where
             rtol: opts.rtol,
             stats: Stats::default(),
             want_stiffness: switching,
-            need_poly: opts.dense,
+            // Switches of branch are located on the interpolant.
+            need_poly: opts.dense || sys.switches() > 0,
         };
         let mut kinks: Vec<f64> = opts.t_stops.clone();
         kinks.sort_by(f64::total_cmp);
@@ -362,6 +377,8 @@ where
             ctx,
             events: Vec::new(),
             g_old: Vec::new(),
+            sw_old: Vec::new(),
+            last_cut: false,
             hits: Vec::new(),
             step_hits: Vec::new(),
             t: t0,
@@ -397,6 +414,7 @@ where
             return_count: 0,
             jac_work: switching.then(|| OMatrix::zeros_generic(rows, rows)),
         };
+        it.init_switches();
         it.restart()?;
         Ok(it)
     }
@@ -420,6 +438,24 @@ where
             self.g_old.push(ev.eval(self.t, &self.y));
         }
         self.ctx.stats.event_evals += events.len();
+        self.init_switches();
+    }
+
+    /// Evaluates the system's switching functions at the current point, first changing the
+    /// branch of any that is negative there (a start, or a system changed through
+    /// `system_mut`, on the wrong branch); the method restarts after such a change.
+    fn init_switches(&mut self) {
+        self.sw_old.clear();
+        for i in 0..self.sys.switches() {
+            let mut g = self.sys.switching(i, self.t, &self.y);
+            if g < 0.0 {
+                self.sys.switch(i, self.t, &mut self.y);
+                self.ctx.stats.branch_switches += 1;
+                self.needs_restart = true;
+                g = self.sys.switching(i, self.t, &self.y);
+            }
+            self.sw_old.push(g);
+        }
     }
 
     /// Restarts the method at the current point (evaluates `f`), and picks an initial step
@@ -834,12 +870,14 @@ where
                 ),
             ));
         }
-        if self.needs_restart {
-            self.restart()?;
-        }
+        // The events first: a changed system may start on another branch, and the method
+        // restarts after that.
         if self.events_stale {
             self.init_events(events);
             self.events_stale = false;
+        }
+        if self.needs_restart {
+            self.restart()?;
         }
         let (kink, stop) = self.next_stop();
         let h_max = self.h_max_opt.min(self.tf - self.t_span0);
@@ -878,9 +916,12 @@ where
 
         let (cut_by, terminal) = self.locate_events(events, t, t_new);
         self.set_next_step(h, err, k, stiff, h_max);
+        self.last_cut = cut_by.is_some();
 
-        if let Some(i) = cut_by {
-            return self.act_on_cut(events, i, terminal);
+        match cut_by {
+            Some(Cut::Event(i)) => return self.act_on_cut(events, i, terminal),
+            Some(Cut::Switch(i)) => return self.switch_on_cut(events, i),
+            None => {}
         }
         if hit_stop && kink == Some(stop) {
             // The right-hand side may have a kink here: no derivative carries over.
@@ -1022,17 +1063,19 @@ where
     }
 
     /// The events' sign changes between the ends of the accepted step `[t, t_new]`, located
-    /// on the interpolant and appended to `self.hits`; the first event that stops or acts cuts
-    /// the step there (later roots are dropped: those of acting events are found again after
-    /// the restart). Sets the time and state to the step's (or the cut's) end, and returns the
-    /// cutting event and whether a terminal one cut.
+    /// on the interpolant and appended to `self.hits`; the first event that stops or acts, or
+    /// the first switch of the system's branch, cuts the step there (later roots are dropped:
+    /// those of acting events and switches are found again after the restart). Sets the time
+    /// and state to the step's (or the cut's) end, and returns the cut and whether a terminal
+    /// event made it.
     #[inline]
     fn locate_events(
         &mut self,
         events: &mut [Event<'_, D>],
         t: f64,
         t_new: f64,
-    ) -> (Option<usize>, bool) {
+    ) -> (Option<Cut>, bool) {
+        let switch = self.locate_switch(t, t_new);
         self.step_hits.clear();
         for (i, ev) in events.iter_mut().enumerate() {
             let g_new = ev.eval(t_new, &self.y_new);
@@ -1059,7 +1102,7 @@ where
             }
             if let Some((ta, ga, tb, gb, rising)) = bracket {
                 let (te, evals) = locate(
-                    ev,
+                    |t, y| ev.eval(t, y),
                     &self.poly,
                     ta,
                     ga,
@@ -1078,7 +1121,8 @@ where
         let mut cut_by = None;
         let mut terminal = false;
         for &(i, te, rising) in &self.step_hits {
-            if let Some(tc) = t_cut {
+            // A switch before an event's root cuts first; the event is found again after it.
+            if let Some(tc) = t_cut.or(switch.map(|(_, ts)| ts)) {
                 if te > tc {
                     break;
                 }
@@ -1093,10 +1137,14 @@ where
             if events[i].is_terminal() || events[i].acts() {
                 if t_cut.is_none() {
                     t_cut = Some(te);
-                    cut_by = Some(i);
+                    cut_by = Some(Cut::Event(i));
                 }
                 terminal |= events[i].is_terminal();
             }
+        }
+        if let (None, Some((j, ts))) = (t_cut, switch) {
+            t_cut = Some(ts);
+            cut_by = Some(Cut::Switch(j));
         }
         let t_reach = t_cut.unwrap_or(t_new);
         if let Some(tc) = t_cut {
@@ -1138,6 +1186,58 @@ where
         self.h = h_next;
         self.err_prev = e;
         self.last_rejected = false;
+    }
+
+    /// The first root in `[t, t_new]` of the system's switching functions, where one falls from
+    /// non-negative at `t` to negative at `t_new`, located on the interpolant: `(switch, time)`.
+    /// Updates the switching functions' values at `t_new`. Only the step's ends are compared:
+    /// a function that dips below zero and back within one step (by less than the step
+    /// resolves) keeps its branch.
+    fn locate_switch(&mut self, t: f64, t_new: f64) -> Option<(usize, f64)> {
+        let mut first: Option<(usize, f64)> = None;
+        for i in 0..self.sw_old.len() {
+            let (ga, gb) = (self.sw_old[i], self.sys.switching(i, t_new, &self.y_new));
+            self.sw_old[i] = gb;
+            if ga >= 0.0 && gb < 0.0 {
+                let sys = &self.sys;
+                let (te, _) = locate(
+                    |t, y| sys.switching(i, t, y),
+                    &self.poly,
+                    t,
+                    ga,
+                    t_new,
+                    gb,
+                    self.event_tol,
+                    &mut self.work,
+                );
+                if first.is_none_or(|(_, tf)| te < tf) {
+                    first = Some((i, te));
+                }
+            }
+        }
+        first
+    }
+
+    /// The step was cut at the root of switch `i`: the system changes branch there and the
+    /// method restarts (the step counts as an ordinary accepted one).
+    fn switch_on_cut(
+        &mut self,
+        events: &mut [Event<'_, D>],
+        i: usize,
+    ) -> Result<StepStatus, OdeError> {
+        self.sys.switch(i, self.t, &mut self.y);
+        self.ctx.stats.branch_switches += 1;
+        check_finite_state(&self.y).map_err(|_| OdeError::NonFinite {
+            t: self.t,
+            what: format!("state set by switch {i} of the system"),
+        })?;
+        self.needs_restart = true;
+        self.init_events(events);
+        Ok(if self.t >= self.tf {
+            StepStatus::ReachedEnd
+        } else {
+            StepStatus::Accepted
+        })
     }
 
     /// The step was cut by event `i`: the actions of every event cut at the same time, in

@@ -31,6 +31,9 @@ pub struct Stats {
     pub stiff_steps: usize,
     /// Event-function evaluations.
     pub event_evals: usize,
+    /// Steps ended on a root of the system's switching functions, where the system changed
+    /// branch ([`OdeSystem::switches`](super::OdeSystem::switches)).
+    pub branch_switches: usize,
 }
 
 impl std::ops::AddAssign<&Stats> for Stats {
@@ -47,6 +50,7 @@ impl std::ops::AddAssign<&Stats> for Stats {
         self.stiffness_switches += s.stiffness_switches;
         self.stiff_steps += s.stiff_steps;
         self.event_evals += s.event_evals;
+        self.branch_switches += s.branch_switches;
     }
 }
 

@@ -93,6 +93,63 @@ where
     ) -> (bool, bool) {
         (self.jacobian(t, y, jac), self.time_derivative(t, y, dfdt))
     }
+
+    /// How many switching functions the system has; none by default.
+    ///
+    /// A right-hand side whose law changes where some function of the state changes sign has a
+    /// kink there, and an adaptive method passes a kink only by cutting its step down and
+    /// building it up again. A system can spare it that: it holds the branch it is on in its
+    /// own state, continues each branch's law smoothly past the switch, and names its switching
+    /// functions here. The integrator then locates each root on the step's interpolant, ends
+    /// the step there, lets the system change branch ([`switch`](OdeSystem::switch)) and
+    /// restarts the method: no step crosses the kink. [`Stats::branch_switches`] counts the
+    /// switches.
+    ///
+    /// A relaxation `ẋ = (u(t) − x)/τ` that follows a rising target with `τ = 0.1` and a
+    /// falling one with `τ = 2`, the branch held in `y[1]` (+1: following, −1: lagging):
+    ///
+    /// ```
+    /// use hdi_tribology::ode::{solve, Method, OdeSystem, Options};
+    /// use nalgebra::{Vector2, U2};
+    /// struct Follower;
+    /// impl OdeSystem<U2> for Follower {
+    ///     fn rhs(&self, t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>) {
+    ///         let tau = if y[1] > 0.0 { 0.1 } else { 2.0 };
+    ///         dy[0] = (t.sin() - y[0]) / tau;
+    ///         dy[1] = 0.0;
+    ///     }
+    ///     fn switches(&self) -> usize {
+    ///         1
+    ///     }
+    ///     // Following while the target is above the state, lagging while it is below.
+    ///     fn switching(&self, _i: usize, t: f64, y: &Vector2<f64>) -> f64 {
+    ///         y[1] * (t.sin() - y[0])
+    ///     }
+    ///     fn switch(&self, _i: usize, _t: f64, y: &mut Vector2<f64>) {
+    ///         y[1] = -y[1];
+    ///     }
+    /// }
+    /// let opts = Options::default().rtol(1e-8).atol(1e-10);
+    /// let sol = solve(&Follower, 0.0, Vector2::new(0.0, 1.0), 20.0, Method::Tsit5, &opts, &mut [])?;
+    /// // The state turns with the target: the branch changes twice per period of sin t.
+    /// assert!(sol.stats.branch_switches >= 5, "{:?}", sol.stats);
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    ///
+    /// [`Stats::branch_switches`]: super::Stats::branch_switches
+    fn switches(&self) -> usize {
+        0
+    }
+
+    /// Switching function `i` at `(t, y)`: non-negative while the branch held in `y` is the
+    /// right one, negative past its switch. Called only for `i < switches()`.
+    fn switching(&self, _i: usize, _t: f64, _y: &OVector<f64, D>) -> f64 {
+        0.0
+    }
+
+    /// Changes the branch of switch `i` held in `y`, at the switch's root `t` (after it, the
+    /// switching function is non-negative again). Called only for `i < switches()`.
+    fn switch(&self, _i: usize, _t: f64, _y: &mut OVector<f64, D>) {}
 }
 
 /// Forwards every method of [`OdeSystem`] through a pointer type.
@@ -133,6 +190,18 @@ macro_rules! forward_system {
                 dfdt: &mut OVector<f64, D>,
             ) -> (bool, bool) {
                 (**self).jacobian_and_time_derivative(t, y, jac, dfdt)
+            }
+            #[inline]
+            fn switches(&self) -> usize {
+                (**self).switches()
+            }
+            #[inline]
+            fn switching(&self, i: usize, t: f64, y: &OVector<f64, D>) -> f64 {
+                (**self).switching(i, t, y)
+            }
+            #[inline]
+            fn switch(&self, i: usize, t: f64, y: &mut OVector<f64, D>) {
+                (**self).switch(i, t, y)
             }
         }
     };
