@@ -394,6 +394,11 @@ impl StatefulTerm for Meniscus {
             dx[1] = p.rate * s - x[1] / p.loss_time;
         }
     }
+    /// `1/τ` of the branch, or the pick-up's loss rate where that is faster.
+    fn fastest_rate_on(&self, branch: Branch) -> Option<f64> {
+        let loss = self.params.pickup.map_or(0.0, |p| 1.0 / p.loss_time);
+        Some((1.0 / self.tau(branch)).max(loss))
+    }
     fn rate_partials_on(&self, branch: Branch, g: Gaps, _x: &[f64]) -> RatePartials {
         let rate = 1.0 / self.tau(branch);
         let mut p = RatePartials::default();

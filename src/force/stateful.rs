@@ -139,6 +139,11 @@ pub trait StatefulTerm: Debug + Send + Sync {
     fn rates_on(&self, _branch: Branch, g: Gaps, x: &[f64], dx: &mut [f64]) {
         self.rates(g, x, dx)
     }
+    /// The fastest rate (1/s) of `branch`'s law, where the term knows it (`None` by default):
+    /// an explicit method starts the branch within its stability bound.
+    fn fastest_rate_on(&self, _branch: Branch) -> Option<f64> {
+        None
+    }
     /// The derivatives of [`StatefulTerm::rates_on`]; by default [`StatefulTerm::rate_partials`].
     fn rate_partials_on(&self, _branch: Branch, g: Gaps, x: &[f64]) -> RatePartials {
         self.rate_partials(g, x)

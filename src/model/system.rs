@@ -744,10 +744,11 @@ where
         s[flag] * term.switching(self.gaps(t, s), x)
     }
 
-    /// The other branch.
-    fn switch(&self, i: usize, _t: f64, s: &mut OVector<f64, D>) {
-        let flag = self.layout.branches.0 + i;
+    /// The other branch, and its fastest rate ([`StatefulTerm::fastest_rate_on`]).
+    fn switch(&self, i: usize, _t: f64, s: &mut OVector<f64, D>) -> Option<f64> {
+        let (term, _, flag) = self.switching_term(i)?;
         s[flag] = -s[flag];
+        term.fastest_rate_on(Branch::of_flag(s[flag]))
     }
 
     fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {

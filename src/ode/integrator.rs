@@ -1225,8 +1225,13 @@ where
         events: &mut [Event<'_, D>],
         i: usize,
     ) -> Result<StepStatus, OdeError> {
-        self.sys.switch(i, self.t, &mut self.y);
+        let rate = self.sys.switch(i, self.t, &mut self.y);
         self.ctx.stats.branch_switches += 1;
+        // An explicit method starts the new branch within its stability bound there.
+        let stepper = self.steppers.get::<S>(self.active);
+        if let Some(rate) = rate.filter(|r| *r > 0.0 && !stepper.is_stiff()) {
+            self.h = self.h.min(stepper.stability_boundary() / rate);
+        }
         check_finite_state(&self.y).map_err(|_| OdeError::NonFinite {
             t: self.t,
             what: format!("state set by switch {i} of the system"),

@@ -125,8 +125,10 @@ where
     ///     fn switching(&self, _i: usize, t: f64, y: &Vector2<f64>) -> f64 {
     ///         y[1] * (t.sin() - y[0])
     ///     }
-    ///     fn switch(&self, _i: usize, _t: f64, y: &mut Vector2<f64>) {
+    ///     fn switch(&self, _i: usize, _t: f64, y: &mut Vector2<f64>) -> Option<f64> {
     ///         y[1] = -y[1];
+    ///         // The fastest rate of the new branch's law, 1/τ.
+    ///         Some(if y[1] > 0.0 { 10.0 } else { 0.5 })
     ///     }
     /// }
     /// let opts = Options::default().rtol(1e-8).atol(1e-10);
@@ -148,8 +150,13 @@ where
     }
 
     /// Changes the branch of switch `i` held in `y`, at the switch's root `t` (after it, the
-    /// switching function is non-negative again). Called only for `i < switches()`.
-    fn switch(&self, _i: usize, _t: f64, _y: &mut OVector<f64, D>) {}
+    /// switching function is non-negative again), and returns the fastest rate (1/s) of the new
+    /// branch's law where the system knows it: an explicit method then starts the branch with
+    /// a step within its stability bound instead of finding that bound by failed steps.
+    /// Called only for `i < switches()`.
+    fn switch(&self, _i: usize, _t: f64, _y: &mut OVector<f64, D>) -> Option<f64> {
+        None
+    }
 }
 
 /// Forwards every method of [`OdeSystem`] through a pointer type.
@@ -200,7 +207,7 @@ macro_rules! forward_system {
                 (**self).switching(i, t, y)
             }
             #[inline]
-            fn switch(&self, i: usize, t: f64, y: &mut OVector<f64, D>) {
+            fn switch(&self, i: usize, t: f64, y: &mut OVector<f64, D>) -> Option<f64> {
                 (**self).switch(i, t, y)
             }
         }
