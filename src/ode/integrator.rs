@@ -1075,7 +1075,11 @@ where
         t: f64,
         t_new: f64,
     ) -> (Option<Cut>, bool) {
-        let switch = self.locate_switch(t, t_new);
+        let switch = if self.sw_old.is_empty() {
+            None
+        } else {
+            self.locate_switch(t, t_new)
+        };
         self.step_hits.clear();
         for (i, ev) in events.iter_mut().enumerate() {
             let g_new = ev.eval(t_new, &self.y_new);
@@ -1193,6 +1197,7 @@ where
     /// Updates the switching functions' values at `t_new`. Only the step's ends are compared:
     /// a function that dips below zero and back within one step (by less than the step
     /// resolves) keeps its branch.
+    #[inline(never)]
     fn locate_switch(&mut self, t: f64, t_new: f64) -> Option<(usize, f64)> {
         let mut first: Option<(usize, f64)> = None;
         for i in 0..self.sw_old.len() {
