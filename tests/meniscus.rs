@@ -540,3 +540,45 @@ fn the_held_branch_integrates_the_law_picked_by_sign() {
         assert!(held.stats.branch_switches >= 10, "{:?}", held.stats);
     }
 }
+
+/// The largest layout a lubricated scene can have: the bulge's two coordinates and velocities,
+/// the thermal and interface lags, `d*` and the head's film, the branch held for `d*`, and the
+/// cycle's two integrals (11 states). A cycle and a drive run on it, and the cycle switches
+/// branch.
+#[test]
+fn the_largest_lubricated_layout_runs() {
+    use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, Plant};
+    use hdi_tribology::model::StateLayout;
+    let mut scene = Scene::from_path(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/paper_bulge.toml"
+    ))
+    .unwrap();
+    scene.heater.thermal_lag_s = 1e-6;
+    scene.slider.interface_lag_s = 1e-8;
+    scene.lubricant = paper_lubricated(true).lubricant;
+    let model = SliderModel::from_scene(&scene).unwrap();
+    let layout = StateLayout::of(&model, true);
+    assert_eq!(
+        (layout.len(), layout.term_states.1, layout.branches.1),
+        (11, 2, 1)
+    );
+    let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
+    let mut opts = CycleOptions::from_scene(&scene).unwrap();
+    opts.solver.max_steps = 1_000_000;
+    let r = simulate_cycle(&model, &programme, &opts).unwrap();
+    assert!(r.touchdown.is_some(), "{:?}", r.stats);
+    assert!(r.stats.branch_switches > 0, "{:?}", r.stats);
+    let opts = DriveOptions {
+        disk: DiskSpec::flat(),
+        ..DriveOptions::default()
+    };
+    let mut drive = Plant::new(&scene, &scene_zone(&scene, 0.025).unwrap(), 1, opts)
+        .unwrap()
+        .into_drive()
+        .unwrap();
+    for _ in 0..20 {
+        drive.step(&Command::heater_mw(70.0), 50e-6).unwrap();
+    }
+    assert_eq!(drive.term_states().len(), 2);
+}

@@ -38,7 +38,7 @@ use std::f64::consts::PI;
 
 /// Longest state a drive integrates (the plant's largest sized integrator, and this scheme's
 /// buffers).
-pub(crate) const MAX_STATE: usize = 10;
+pub(crate) const MAX_STATE: usize = 11;
 
 /// Relative change of the held Jacobian (largest entry change over the largest entry of its
 /// row, the integrals' rows aside) beyond which a refresh also rebuilds the disk's table. The

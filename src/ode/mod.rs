@@ -5,7 +5,9 @@
 //! fixed-size `SVector` stays on the stack, a `DVector` serves larger systems. [`solve`] takes
 //! the system, the time span, a [`Method`] and [`Options`], and returns a [`Solution`] with
 //! saved states, a dense interpolant ([`Solution::sample`]), located [`Event`]s and [`Stats`].
-//! Failures are typed ([`OdeError`]) and say at which `t` and why.
+//! Failures are typed ([`OdeError`]) and say at which `t` and why. A right-hand side whose law
+//! changes branch where a function of the state changes sign names its switching functions
+//! ([`OdeSystem::switches`]): steps end on their roots, so no step crosses the kink.
 //!
 //! The stiff Van der Pol oscillator `y₁' = y₂`, `y₂' = μ(1 − y₁²)y₂ − y₁`, μ = 1000, against
 //! the reference value at t = 2000 of the Test Set for IVP Solvers (Mazzia et al.):

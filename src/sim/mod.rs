@@ -13,7 +13,7 @@ use crate::error::{Error, FailureKind, Result, Stage};
 use crate::model::{Inputs, Rest, SliderModel, SliderSystem};
 use crate::ode::{Integrator, Method, OdeError, Options, SaveAt, Solution};
 use nalgebra::{
-    allocator::Allocator, DefaultAllocator, Dim, DimName, OVector, U10, U4, U5, U6, U7, U8, U9,
+    allocator::Allocator, DefaultAllocator, Dim, DimName, OVector, U10, U11, U4, U5, U6, U7, U8, U9,
 };
 use std::sync::Arc;
 
@@ -136,7 +136,7 @@ impl Problem {
     /// initial state first.
     ///
     /// # Errors
-    /// A layout of another size than 4 to 10 (named by `stage`); the integrator's set-up errors.
+    /// A layout of another size than 4 to 11 (named by `stage`); the integrator's set-up errors.
     pub fn start(
         self,
         stage: Stage,
@@ -160,6 +160,7 @@ impl Problem {
             8 => start!(S8, U8),
             9 => start!(S9, U9),
             10 => start!(S10, U10),
+            11 => start!(S11, U11),
             n => return Err(Self::no_size(stage, n)),
         })
     }
@@ -168,7 +169,7 @@ impl Problem {
         NoFixedSize { stage, states: n }.into()
     }
 
-    /// Runs `job` on a state vector sized at compile time for this problem's layout (4 to 10
+    /// Runs `job` on a state vector sized at compile time for this problem's layout (4 to 11
     /// states), so that a step allocates nothing; `stage` names the analysis in the error for
     /// any other size.
     ///
@@ -183,6 +184,7 @@ impl Problem {
             8 => job.run::<U8>(self),
             9 => job.run::<U9>(self),
             10 => job.run::<U10>(self),
+            11 => job.run::<U11>(self),
             n => Err(Self::no_size(stage, n)),
         }
     }
@@ -221,6 +223,7 @@ pub enum SizedIntegrator {
     S8(Integrator<'static, U8, SliderSystem>),
     S9(Integrator<'static, U9, SliderSystem>),
     S10(Integrator<'static, U10, SliderSystem>),
+    S11(Integrator<'static, U11, SliderSystem>),
 }
 
 /// `with_sized!(integrator, it => body)`: runs `body` with `it` the integrator inside a
@@ -235,6 +238,7 @@ macro_rules! with_sized {
             $crate::sim::SizedIntegrator::S8($it) => $body,
             $crate::sim::SizedIntegrator::S9($it) => $body,
             $crate::sim::SizedIntegrator::S10($it) => $body,
+            $crate::sim::SizedIntegrator::S11($it) => $body,
         }
     };
 }
