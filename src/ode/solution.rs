@@ -32,7 +32,9 @@ pub struct Stats {
     /// Event-function evaluations.
     pub event_evals: usize,
     /// Steps ended on a root of the system's switching functions, where the system changed
-    /// branch ([`OdeSystem::switches`](super::OdeSystem::switches)).
+    /// branch ([`OdeSystem::switches`](super::OdeSystem::switches)); 0 when read from a record
+    /// written without it.
+    #[serde(default)]
     pub branch_switches: usize,
 }
 
