@@ -44,3 +44,19 @@ def test_bad_relaxing_state_names_the_argument():
         m.with_relaxing_state(0.0, 1.0)
     with pytest.raises(hdi.InvalidInputError, match="start"):
         m.with_relaxing_state(1e-4, float("nan"))
+
+
+def test_a_lubricated_cycle_switches_its_branch_and_agrees_with_rust():
+    """The paper scene with 0.3 nm of mobile lubricant: the meniscus's closest approach rides
+    along as a term state, and its healing/formation branch is switched at located roots."""
+    text = hdi.Scene.paper().to_toml() + (
+        "\n[lubricant]\ntotal_thickness_m = 1.3e-9\nbonded_thickness_m = 1.0e-9\n"
+        "surface_tension_n_per_m = 0.024\ncontact_angle_deg = 30.0\nhealing_time_s = 2e-5\n"
+    )
+    c = hdi.simulate_cycle(hdi.Model(hdi.Scene.from_toml(text)))
+    assert c["cycle"].stats["branch_switches"] > 0
+    assert len(c["term_states"]) == 1
+    plain = hdi.simulate_cycle(hdi.Model(hdi.Scene.paper()))
+    assert plain["cycle"].stats["branch_switches"] == 0
+    # Bridges hold the head down: it takes off later (at a lower power) than without them.
+    assert c["takeoff"].power_w < plain["takeoff"].power_w - 1e-3
