@@ -340,13 +340,42 @@ impl Meniscus {
     /// The force with the head's film `t_h` (m) on top of the disk's mobile film, and its partial
     /// derivatives along `d`, `d_star` and `t_h`. With `t_h = 0` it is [`Meniscus::force_at`].
     pub fn force_with_pickup(&self, d: f64, d_star: f64, t_h: f64) -> (f64, f64, f64, f64) {
-        let t = self.params.mobile_thickness + t_h;
-        if d - d_star < self.rupture {
-            let (f, df) = self.at(d_star - t);
+        let (e, held) = self.band_edge(d, d_star, t_h);
+        let (f, df) = self.at(e);
+        if held {
             (f, 0.0, df, -df)
         } else {
-            let (f, df) = self.at(d - t - self.rupture);
             (f, df, 0.0, -df)
+        }
+    }
+
+    /// The value of [`Meniscus::force_with_pickup`] alone (the same number).
+    fn force_value_at(&self, d: f64, d_star: f64, t_h: f64) -> f64 {
+        let e = self.band_edge(d, d_star, t_h).0;
+        match self.table.as_ref().and_then(|t| t.value(e)) {
+            Some(f) => f,
+            None => self.at(e).0,
+        }
+    }
+
+    /// The lowest peak height `e` that carries a bridge at the gap `d` after the closest
+    /// approach `d_star` with the head's film `t_h`, and whether the bridges are those formed
+    /// at `d_star` (true) or those not yet stretched past the rupture distance (false).
+    fn band_edge(&self, d: f64, d_star: f64, t_h: f64) -> (f64, bool) {
+        let t = self.params.mobile_thickness + t_h;
+        if d - d_star < self.rupture {
+            (d_star - t, true)
+        } else {
+            (d - t - self.rupture, false)
+        }
+    }
+
+    /// The head's film `t_h` in the term's states (0 without a pick-up).
+    fn head_film(&self, x: &[f64]) -> f64 {
+        if self.params.pickup.is_some() {
+            x[1]
+        } else {
+            0.0
         }
     }
 
@@ -411,13 +440,12 @@ impl StatefulTerm for Meniscus {
         }
         p
     }
+    fn force_value(&self, g: Gaps, x: &[f64]) -> f64 {
+        self.force_value_at(g.bulge, x[0], self.head_film(x))
+    }
     fn force(&self, g: Gaps, x: &[f64]) -> StateForce {
         let mut d_state = [0.0; MAX_TERM_STATES];
-        let t_h = if self.params.pickup.is_some() {
-            x[1]
-        } else {
-            0.0
-        };
+        let t_h = self.head_film(x);
         let (f, d_bulge, d_star, d_th) = self.force_with_pickup(g.bulge, x[0], t_h);
         d_state[0] = d_star;
         if self.params.pickup.is_some() {

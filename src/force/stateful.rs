@@ -111,6 +111,11 @@ pub trait StatefulTerm: Debug + Send + Sync {
     fn rate_partials(&self, g: Gaps, x: &[f64]) -> RatePartials;
     /// The force at gaps `g` and states `x`, with its derivatives.
     fn force(&self, g: Gaps, x: &[f64]) -> StateForce;
+    /// The value of [`StatefulTerm::force`] alone (the same number), for the right-hand side;
+    /// by default through `force`.
+    fn force_value(&self, g: Gaps, x: &[f64]) -> f64 {
+        self.force(g, x).force.value
+    }
     /// The absolute accuracy each state needs when displacements are integrated to
     /// `displacement` (m).
     fn tolerances(&self, displacement: f64, atol: &mut [f64]);

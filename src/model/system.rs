@@ -643,7 +643,7 @@ impl SliderSystem {
             if let Some(i) = flag {
                 ds[i] = 0.0;
             }
-            force += term.force(g, x).force.value;
+            force += term.force_value(g, x);
         });
         force
     }
