@@ -1,7 +1,7 @@
 //! The simulated drive: the slider of a scene in a zone, stepped at the controller's rate.
 
 use super::disk::{Disk, DiskSpec};
-use super::exponential::{Attempt, ExpScheme, SchemeCounts, MAX_STATE};
+use super::exponential::{state_vector, Attempt, ExpScheme, SchemeCounts, MAX_STATE};
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
 use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
@@ -1392,11 +1392,7 @@ where
             // Too loose for this period: again from its start at the contact tolerance.
             st.atol = rule.range.0;
             rule.apply(st.atol, it)?;
-            let y0 = OVector::<f64, D>::from_iterator_generic(
-                D::from_usize(layout.len()),
-                nalgebra::U1,
-                st.y0.iter().copied(),
-            );
+            let y0 = state_vector::<D>(D::from_usize(layout.len()), |i| st.y0[i]);
             if it.tf() <= t0 {
                 it.set_tf(t1)?;
             }
@@ -1447,11 +1443,7 @@ where
         return match exp.owned.take() {
             None => advance(it, layout, None, integrals0, span, tol, None),
             Some(x) => {
-                let mut x0 = OVector::<f64, D>::from_iterator_generic(
-                    D::from_usize(layout.len()),
-                    nalgebra::U1,
-                    x.iter().copied(),
-                );
+                let mut x0 = state_vector::<D>(D::from_usize(layout.len()), |i| x[i]);
                 rebase_integrals(layout, rebase, &mut x0, integrals0);
                 advance(it, layout, None, integrals0, span, tol, Some(x0))
             }
@@ -1460,11 +1452,7 @@ where
     let owned = exp.owned.take();
     let from_integrator = owned.is_none();
     let mut x0 = match owned {
-        Some(x) => OVector::<f64, D>::from_iterator_generic(
-            D::from_usize(layout.len()),
-            nalgebra::U1,
-            x.iter().copied(),
-        ),
+        Some(x) => state_vector::<D>(D::from_usize(layout.len()), |i| x[i]),
         None if it.t() > t0 => it.interpolate(t0)?,
         None => it.state().clone(),
     };

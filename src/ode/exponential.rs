@@ -3,7 +3,7 @@
 //! ([`ExponentialStepper`]).
 
 use super::OdeError;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 /// The exponential of a square matrix: Padé's [6/6] approximant of `e^{A/2^s}`, squared `s`
 /// times, with `s` the least that brings the 1-norm of `A/2^s` to 1/2 or below (a relative
@@ -160,14 +160,14 @@ pub struct ExponentialStepper {
     h: f64,
     a: DMatrix<f64>,
     /// Work: the exponential Euler state, the right-hand side there, a difference.
-    ya: DVector<f64>,
-    fa: DVector<f64>,
-    d: DVector<f64>,
+    ya: Vec<f64>,
+    fa: Vec<f64>,
+    d: Vec<f64>,
     /// The remainder's change over the previous step, when it ended where the next begins.
-    d_prev: DVector<f64>,
+    d_prev: Vec<f64>,
     have_prev: bool,
-    corr: DVector<f64>,
-    curv: DVector<f64>,
+    corr: Vec<f64>,
+    curv: Vec<f64>,
     /// `φ₁`, `A` and `φ₂` row by row (row-major), for the products.
     rows1: Vec<f64>,
     rows_a: Vec<f64>,
@@ -185,13 +185,13 @@ impl ExponentialStepper {
         Ok(ExponentialStepper {
             h,
             a: a.clone(),
-            ya: DVector::zeros(n),
-            fa: DVector::zeros(n),
-            d: DVector::zeros(n),
-            d_prev: DVector::zeros(n),
+            ya: vec![0.0; n],
+            fa: vec![0.0; n],
+            d: vec![0.0; n],
+            d_prev: vec![0.0; n],
             have_prev: false,
-            corr: DVector::zeros(n),
-            curv: DVector::zeros(n),
+            corr: vec![0.0; n],
+            curv: vec![0.0; n],
             rows1: phi1.transpose().as_slice().to_vec(),
             rows_a: a.transpose().as_slice().to_vec(),
             rows2: phi2.transpose().as_slice().to_vec(),
@@ -304,6 +304,7 @@ impl ExponentialStepper {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::DVector;
 
     /// The exponential of a matrix with known eigenvectors against `V e^{Λ} V⁻¹`.
     #[test]
