@@ -240,7 +240,10 @@ impl ExponentialStepper {
         let n = self.dim();
         assert!(y0.len() == n && f0.len() == n && y1.len() == n && tol.1.len() == n);
         let h = self.h;
-        let dot = |row: &[f64], v: &[f64]| -> f64 { row.iter().zip(v).map(|(a, b)| a * b).sum() };
+        let dot = |row: &[f64], v: &[f64]| -> f64 {
+            let v = &v[..n];
+            row[..n].iter().zip(v).map(|(a, b)| a * b).sum()
+        };
         // a = y0 + h φ1 f0 (rows of the row-major copies).
         for ((a, row), y) in self.ya.iter_mut().zip(self.rows1.chunks_exact(n)).zip(y0) {
             *a = y + h * dot(row, f0);
