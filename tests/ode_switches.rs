@@ -34,9 +34,8 @@ impl OdeSystem<U2> for Kink {
     fn switching(&self, _i: usize, _t: f64, y: &Vector2<f64>) -> f64 {
         y[1] * (1.0 - y[0])
     }
-    fn switch(&self, _i: usize, _t: f64, y: &mut Vector2<f64>) -> Option<f64> {
+    fn switch(&self, _i: usize, _t: f64, y: &mut Vector2<f64>) {
         y[1] = -y[1];
-        None
     }
 }
 

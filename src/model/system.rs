@@ -744,10 +744,15 @@ where
         s[flag] * term.switching(self.gaps(t, s), x)
     }
 
-    /// The other branch, and its fastest rate ([`StatefulTerm::fastest_rate_on`]).
-    fn switch(&self, i: usize, _t: f64, s: &mut OVector<f64, D>) -> Option<f64> {
-        let (term, _, flag) = self.switching_term(i)?;
+    /// The other branch.
+    fn switch(&self, i: usize, _t: f64, s: &mut OVector<f64, D>) {
+        let flag = self.layout.branches.0 + i;
         s[flag] = -s[flag];
+    }
+
+    /// The term's fastest rate on the held branch ([`StatefulTerm::fastest_rate_on`]).
+    fn branch_rate(&self, i: usize, s: &OVector<f64, D>) -> Option<f64> {
+        let (term, _, flag) = self.switching_term(i)?;
         term.fastest_rate_on(Branch::of_flag(s[flag]))
     }
 

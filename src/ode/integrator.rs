@@ -493,6 +493,10 @@ where
             .max(self.h_floor)
             .min(h_max);
             self.h_needs_init = false;
+            // The estimate sees accuracy only: a declared rate bounds an explicit first step.
+            if self.h_init.is_none() {
+                self.within_branch_rates();
+            }
         }
         Ok(())
     }
@@ -1223,6 +1227,21 @@ where
         first
     }
 
+    /// Shortens the coming step of an explicit method to its stability bound for the fastest
+    /// rate the system declares of the branches it holds ([`OdeSystem::branch_rate`]).
+    fn within_branch_rates(&mut self) {
+        let stepper = self.steppers.get::<S>(self.active);
+        if stepper.is_stiff() {
+            return;
+        }
+        let boundary = stepper.stability_boundary();
+        for i in 0..self.sys.switches() {
+            if let Some(rate) = self.sys.branch_rate(i, &self.y).filter(|r| *r > 0.0) {
+                self.h = self.h.min(boundary / rate);
+            }
+        }
+    }
+
     /// The step was cut at the root of switch `i`: the system changes branch there and the
     /// method restarts (the step counts as an ordinary accepted one).
     fn switch_on_cut(
@@ -1230,13 +1249,9 @@ where
         events: &mut [Event<'_, D>],
         i: usize,
     ) -> Result<StepStatus, OdeError> {
-        let rate = self.sys.switch(i, self.t, &mut self.y);
+        self.sys.switch(i, self.t, &mut self.y);
         self.ctx.stats.branch_switches += 1;
-        // An explicit method starts the new branch within its stability bound there.
-        let stepper = self.steppers.get::<S>(self.active);
-        if let Some(rate) = rate.filter(|r| *r > 0.0 && !stepper.is_stiff()) {
-            self.h = self.h.min(stepper.stability_boundary() / rate);
-        }
+        self.within_branch_rates();
         check_finite_state(&self.y).map_err(|_| OdeError::NonFinite {
             t: self.t,
             what: format!("state set by switch {i} of the system"),

@@ -125,9 +125,11 @@ where
     ///     fn switching(&self, _i: usize, t: f64, y: &Vector2<f64>) -> f64 {
     ///         y[1] * (t.sin() - y[0])
     ///     }
-    ///     fn switch(&self, _i: usize, _t: f64, y: &mut Vector2<f64>) -> Option<f64> {
+    ///     fn switch(&self, _i: usize, _t: f64, y: &mut Vector2<f64>) {
     ///         y[1] = -y[1];
-    ///         // The fastest rate of the new branch's law, 1/τ.
+    ///     }
+    ///     // The rate of the held branch's law, 1/τ.
+    ///     fn branch_rate(&self, _i: usize, y: &Vector2<f64>) -> Option<f64> {
     ///         Some(if y[1] > 0.0 { 10.0 } else { 0.5 })
     ///     }
     /// }
@@ -150,11 +152,14 @@ where
     }
 
     /// Changes the branch of switch `i` held in `y`, at the switch's root `t` (after it, the
-    /// switching function is non-negative again), and returns the fastest rate (1/s) of the new
-    /// branch's law where the system knows it: an explicit method then starts the branch with
-    /// a step within its stability bound instead of finding that bound by failed steps.
-    /// Called only for `i < switches()`.
-    fn switch(&self, _i: usize, _t: f64, _y: &mut OVector<f64, D>) -> Option<f64> {
+    /// switching function is non-negative again). Called only for `i < switches()`.
+    fn switch(&self, _i: usize, _t: f64, _y: &mut OVector<f64, D>) {}
+
+    /// The fastest rate (1/s) of the law on the branch of switch `i` held in `y`, where the
+    /// system knows it (`None` by default). An explicit method starts a branch, at the start of
+    /// the integration and after each switch, with a step within its stability bound for that
+    /// rate, instead of finding the bound by failed steps. Called only for `i < switches()`.
+    fn branch_rate(&self, _i: usize, _y: &OVector<f64, D>) -> Option<f64> {
         None
     }
 }
@@ -207,8 +212,12 @@ macro_rules! forward_system {
                 (**self).switching(i, t, y)
             }
             #[inline]
-            fn switch(&self, i: usize, t: f64, y: &mut OVector<f64, D>) -> Option<f64> {
+            fn switch(&self, i: usize, t: f64, y: &mut OVector<f64, D>) {
                 (**self).switch(i, t, y)
+            }
+            #[inline]
+            fn branch_rate(&self, i: usize, y: &OVector<f64, D>) -> Option<f64> {
+                (**self).branch_rate(i, y)
             }
         }
     };
