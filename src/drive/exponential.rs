@@ -305,9 +305,11 @@ pub(crate) struct ExpScheme {
     atol: Vec<f64>,
     /// `(index, r)` of the velocities a disk translation moves.
     base: Vec<(usize, f64)>,
-    /// Steppers of `h / 2^l`, `l < LEVELS`, for the held Jacobian (none before the first
-    /// refresh).
-    steppers: Vec<ExponentialStepper>,
+    /// The held Jacobian and the period it is held for (none before the first refresh).
+    held: Option<(DMatrix<f64>, f64)>,
+    /// Steppers of `h / 2^l`, `l < LEVELS`, for the held Jacobian, each built when its level is
+    /// first used (its φ-functions are most of a refresh's cost).
+    steppers: Vec<Option<ExponentialStepper>>,
     /// The level of substeps in use, the level of the last step, and how many calm periods in a
     /// row it has had (see [`ExpScheme::attempt`]).
     level: usize,
@@ -358,6 +360,7 @@ impl ExpScheme {
             rtol,
             atol,
             base,
+            held: None,
             steppers: Vec::new(),
             level: 0,
             last_level: 0,
@@ -388,6 +391,21 @@ impl ExpScheme {
         }
     }
 
+    /// Builds the stepper of `level` for the held Jacobian if it is not built yet; whether there
+    /// is one.
+    fn stepper(&mut self, level: usize) -> bool {
+        if self.steppers[level].is_none() {
+            let Some((j, h)) = &self.held else {
+                return false;
+            };
+            match ExponentialStepper::new(j, h / (1 << level) as f64) {
+                Ok(s) => self.steppers[level] = Some(s),
+                Err(_) => return false,
+            }
+        }
+        true
+    }
+
     /// The Jacobian at `(t, x − p(t))`, the per-`V²` vector `e` there, and everything built on them
     /// (the stepper of period `h`, the dither's response; the disk's table when there is none
     /// or `J` moved by more than [`REBUILD_SHIFT`] from the one it was built with).
@@ -415,11 +433,10 @@ impl ExpScheme {
             return false;
         }
         self.steppers.clear();
-        for l in 0..LEVELS {
-            let Ok(s) = ExponentialStepper::new(&j, h / (1 << l) as f64) else {
-                return false;
-            };
-            self.steppers.push(s);
+        self.steppers.resize(LEVELS, None);
+        self.held = Some((j.clone(), h));
+        if !self.stepper(0) {
+            return false;
         }
         self.counts.refreshes += 1;
         // The integrals' rows (their columns are zero) do not move the other states: a change
@@ -532,8 +549,12 @@ impl ExpScheme {
     {
         let n = x0.len();
         let dim = x0.shape_generic().0;
+        // A level that cannot be built misses (an infinite estimate).
+        self.stepper(level);
         if level != self.last_level {
-            self.steppers[level].forget();
+            self.steppers[level]
+                .as_mut()
+                .map(ExponentialStepper::forget);
             self.last_level = level;
         }
         let ExpScheme {
@@ -549,38 +570,57 @@ impl ExpScheme {
             z1,
             ..
         } = self;
-        let stepper = &mut steppers[level];
+        let Some(stepper) = steppers[level].as_mut() else {
+            return (x0.clone(), f64::INFINITY);
+        };
         let m = 1usize << level;
         let hs = h / m as f64;
         let (table, dither) = (&*table, &*dither);
+        // Without a known forcing `p` is zero and `z` is `x`: the sums with it are skipped.
+        let forced = table.is_some() || dither.is_some();
         let mut x = x0.clone();
         let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
         let mut err = 0.0f64;
         for k in 0..m {
             let ts = t0 + k as f64 * hs;
-            Self::known(disk, table, dither, ts, p, dp);
             OdeSystem::<D>::rhs(sys, ts, &x, &mut fx);
-            for i in 0..n {
-                z0[i] = x[i] - p[i];
-                f0[i] = fx[i] - dp[i];
+            if forced {
+                Self::known(disk, table, dither, ts, p, dp);
+                for i in 0..n {
+                    z0[i] = x[i] - p[i];
+                    f0[i] = fx[i] - dp[i];
+                }
+            } else {
+                z0.copy_from_slice(x.as_slice());
+                f0.copy_from_slice(fx.as_slice());
             }
             let mut pw = [0.0; MAX_STATE];
             let mut dpw = [0.0; MAX_STATE];
             let f = |t: f64, z: &[f64], dz: &mut [f64]| {
+                let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
+                if !forced {
+                    let x = state_vector::<D>(dim, |i| z[i]);
+                    OdeSystem::<D>::rhs(sys, t, &x, &mut fx);
+                    dz.copy_from_slice(fx.as_slice());
+                    return;
+                }
                 let (pw, dpw) = (&mut pw[..n], &mut dpw[..n]);
                 Self::known(disk, table, dither, t, pw, dpw);
                 let x = state_vector::<D>(dim, |i| z[i] + pw[i]);
-                let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
                 OdeSystem::<D>::rhs(sys, t, &x, &mut fx);
                 for i in 0..n {
                     dz[i] = fx[i] - dpw[i];
                 }
             };
             err = err.max(stepper.step(ts, z0, f0, f, (*rtol, atol), z1));
-            let te = if k + 1 == m { t0 + h } else { ts + hs };
-            Self::known(disk, table, dither, te, p, dp);
-            for i in 0..n {
-                x[i] = z1[i] + p[i];
+            if forced {
+                let te = if k + 1 == m { t0 + h } else { ts + hs };
+                Self::known(disk, table, dither, te, p, dp);
+                for i in 0..n {
+                    x[i] = z1[i] + p[i];
+                }
+            } else {
+                x.as_mut_slice().copy_from_slice(z1);
             }
         }
         (x, err)
@@ -599,9 +639,9 @@ impl ExpScheme {
     where
         DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {
-        let stale = match (self.steppers.first(), &self.dither) {
+        let stale = match (&self.held, &self.dither) {
             (None, _) => true,
-            (Some(s), _) if s.h() != h => true,
+            (Some((_, held)), _) if *held != h => true,
             (_, d) => {
                 let v = sys.inputs().voltage;
                 let want = v.ac_amplitude != 0.0 && v.frequency > 0.0;
@@ -668,7 +708,7 @@ impl ExpScheme {
         self.backoff = (2 * self.backoff).clamp(1, MAX_SKIP);
         self.skip = self.backoff;
         self.owned = None;
-        for s in &mut self.steppers {
+        for s in self.steppers.iter_mut().flatten() {
             s.forget();
         }
         Attempt::Missed
