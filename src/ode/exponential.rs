@@ -253,8 +253,9 @@ impl ExponentialStepper {
     }
 
     /// [`step`](ExponentialStepper::step)'s body for a dimension `n` checked by it.
+    /// Indexed loops: with `n` a constant they unroll.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
     fn step_of(
         &mut self,
         n: usize,
