@@ -262,6 +262,10 @@ fn bad_lubricant_parameters_are_named_with_their_unit() {
             ),
             "lubricant.surface_tension_n_per_m: must be finite and > 0, got 0.0",
         ),
+        (
+            format!("total_thickness_nm = 1.5\nbonded_thickness_nm = 0.5\n{ok}formation_time_us = -0.1\n"),
+            "lubricant.formation_time_us: must be finite and >= 0, got -0.1 µs",
+        ),
     ];
     for (text, want) in cases {
         let err = Scene::from_toml_str(&with(&text)).unwrap_err();
@@ -279,6 +283,13 @@ fn bad_lubricant_parameters_are_named_with_their_unit() {
     assert!((l.healing_time_s - 1e-5).abs() < 1e-20);
     let model = SliderModel::from_scene(&s).unwrap();
     assert_eq!(model.term_states(), 1);
+    // bridges that form at once: τ_f = 0 is accepted
+    let s = Scene::from_toml_str(&with(&format!(
+        "total_thickness_nm = 1.5\nbonded_thickness_nm = 0.5\n{ok}formation_time_s = 0\n"
+    )))
+    .unwrap();
+    assert_eq!(s.lubricant.as_ref().unwrap().formation_time_s, 0.0);
+    assert_eq!(SliderModel::from_scene(&s).unwrap().term_states(), 1);
     // the head's pick-up: both fields or neither, each > 0; with both, a second state
     let lub = "total_thickness_nm = 1.5\nbonded_thickness_nm = 0.5\n";
     for (extra, want) in [
@@ -581,4 +592,77 @@ fn the_largest_lubricated_layout_runs() {
         drive.step(&Command::heater_mw(70.0), 50e-6).unwrap();
     }
     assert_eq!(drive.term_states().len(), 2);
+}
+
+/// Bridges that form at once (`τ_f = 0`) are the limit of a formation time going to zero: at
+/// 0 V and 0.6 V touchdown and take-off of τ_f = 10 ns and 100 ns differ from those of
+/// instant formation in proportion to τ_f (a first-order approach, the lag `τ_f ḋ` of `d*`),
+/// 10 ns within 0.2 µW. Instant formation switches branch where the gap stops closing, and its
+/// formation branch is not stiff: the cycle at 0.6 V takes fewer steps on the stiff method.
+#[test]
+fn instant_formation_is_the_limit_of_a_vanishing_formation_time() {
+    let scene = Scene::paper();
+    let c = scene.contact.as_ref().unwrap();
+    let term = |tau_f: f64| {
+        let mut p = params(0.3e-9, 30f64.to_radians(), Wetting::Disk, None);
+        p.formation_time = tau_f;
+        Meniscus::new(
+            p,
+            c.asperity_radius_m,
+            c.asperity_density_per_m2,
+            scene.peaks().unwrap(),
+            c.footprint,
+        )
+        .unwrap()
+        .tabulated(scene.table_range(), &Default::default())
+        .unwrap()
+    };
+    let plain = SliderModel::from_scene(&scene).unwrap();
+    let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
+    let opts = CycleOptions::from_scene(&scene).unwrap();
+    let power = |d: Option<hdi_tribology::analysis::cycle::Detection>| d.unwrap().power;
+    for v_ac in [0.0, 0.6] {
+        let base = plain.with_ac_amplitude(v_ac);
+        let run = |tau_f: f64| {
+            simulate_cycle(
+                &base.with_stateful_term(term(tau_f)).unwrap(),
+                &programme,
+                &opts,
+            )
+            .unwrap()
+        };
+        let (at_once, r10, r100) = (run(0.0), run(1e-8), run(1e-7));
+        println!(
+            "{v_ac} V: at once {:?}\n  10 ns {:?}\n  100 ns {:?}",
+            at_once.stats, r10.stats, r100.stats
+        );
+        assert!(at_once.stats.branch_switches >= 10, "{:?}", at_once.stats);
+        let mut moved = false;
+        for pick in [
+            |r: &hdi_tribology::analysis::cycle::CycleResult| r.touchdown,
+            |r: &hdi_tribology::analysis::cycle::CycleResult| r.takeoff,
+        ] {
+            let p0 = power(pick(&at_once));
+            let (d10, d100) = (power(pick(&r10)) - p0, power(pick(&r100)) - p0);
+            println!("{v_ac} V: {p0} W; 10 ns {d10:e} W, 100 ns {d100:e} W");
+            assert!(d10.abs() <= 2e-7, "{v_ac} V: 10 ns moved {d10:e} W");
+            // In proportion to τ_f: 10 ns moves the power a tenth as far as 100 ns, within half
+            // of that and the tolerance's 10 nW.
+            let expected = d100 / 10.0;
+            assert!(
+                (d10 - expected).abs() <= 0.5 * expected.abs() + 1e-8,
+                "{v_ac} V: 10 ns {d10:e} W against a tenth of 100 ns {expected:e} W"
+            );
+            moved |= d100.abs() > 1e-7;
+        }
+        if v_ac > 0.0 {
+            assert!(moved, "τ_f should matter with the dither");
+            assert!(
+                at_once.stats.stiff_steps < r100.stats.stiff_steps,
+                "{:?} against {:?}",
+                at_once.stats,
+                r100.stats
+            );
+        }
+    }
 }

@@ -75,7 +75,8 @@ pub struct MeniscusParams {
     pub rupture_distance: Option<f64>,
     /// Healing time τ_h (s, > 0): the closest approach relaxes towards the gap with it.
     pub healing_time: f64,
-    /// Formation time τ_f (s, > 0): the closest approach follows a closing gap with it.
+    /// Formation time τ_f (s, ≥ 0): the closest approach follows a closing gap with it; 0 for
+    /// bridges that form at once (the closest approach is the gap while it closes).
     pub formation_time: f64,
     /// The head's pick-up of lubricant (a second state); `None`: no pick-up, one state.
     pub pickup: Option<Pickup>,
@@ -187,7 +188,7 @@ impl Meniscus {
             check_non_negative("rupture_distance_m", s)?;
         }
         check_positive("healing_time_s", params.healing_time)?;
-        check_positive("formation_time_s", params.formation_time)?;
+        check_non_negative("formation_time_s", params.formation_time)?;
         if let Some(p) = params.pickup {
             check_positive("pickup_rate_m_per_s", p.rate)?;
             check_positive("pickup_loss_time_s", p.loss_time)?;
@@ -379,6 +380,17 @@ impl Meniscus {
         }
     }
 
+    /// Whether bridges form at once (`τ_f = 0`): on the formation branch `d*` is the gap itself,
+    /// and the branch ends where the gap stops closing.
+    fn instant(&self) -> bool {
+        self.params.formation_time == 0.0
+    }
+
+    /// Whether `branch` is the formation branch of instant bridges.
+    fn forming_at_once(&self, branch: Branch) -> bool {
+        branch == Branch::Lower && self.instant()
+    }
+
     /// The time constant of `d*` on `branch`: healing above the gap's switch, formation below.
     fn tau(&self, branch: Branch) -> f64 {
         match branch {
@@ -416,8 +428,14 @@ impl StatefulTerm for Meniscus {
     fn switching(&self, g: Gaps, x: &[f64]) -> f64 {
         g.bulge - x[0]
     }
+    /// Formation at once holds `d*` where the branch began (the force reads the gap) and sets it
+    /// to the gap where the gap stops closing ([`StatefulTerm::enter`]).
     fn rates_on(&self, branch: Branch, g: Gaps, x: &[f64], dx: &mut [f64]) {
-        dx[0] = (g.bulge - x[0]) / self.tau(branch);
+        dx[0] = if self.forming_at_once(branch) {
+            0.0
+        } else {
+            (g.bulge - x[0]) / self.tau(branch)
+        };
         if let Some(p) = self.params.pickup {
             let (s, _) = self.survival(g.bulge - self.params.mobile_thickness);
             dx[1] = p.rate * s - x[1] / p.loss_time;
@@ -425,11 +443,18 @@ impl StatefulTerm for Meniscus {
     }
     /// `1/τ` of the branch, or the pick-up's loss rate where that is faster.
     fn fastest_rate_on(&self, branch: Branch) -> Option<f64> {
-        let loss = self.params.pickup.map_or(0.0, |p| 1.0 / p.loss_time);
-        Some((1.0 / self.tau(branch)).max(loss))
+        let loss = self.params.pickup.map(|p| 1.0 / p.loss_time);
+        if self.forming_at_once(branch) {
+            return loss;
+        }
+        Some((1.0 / self.tau(branch)).max(loss.unwrap_or(0.0)))
     }
     fn rate_partials_on(&self, branch: Branch, g: Gaps, _x: &[f64]) -> RatePartials {
-        let rate = 1.0 / self.tau(branch);
+        let rate = if self.forming_at_once(branch) {
+            0.0
+        } else {
+            1.0 / self.tau(branch)
+        };
         let mut p = RatePartials::default();
         p.d_bulge[0] = rate;
         p.d_state[0][0] = -rate;
@@ -442,6 +467,47 @@ impl StatefulTerm for Meniscus {
     }
     fn force_value(&self, g: Gaps, x: &[f64]) -> f64 {
         self.force_value_at(g.bulge, x[0], self.head_film(x))
+    }
+    /// While bridges form at once: the gap's rate (the branch ends where it stops closing).
+    fn switching_on(&self, branch: Branch, g: Gaps, rate: Gaps, x: &[f64]) -> f64 {
+        if self.forming_at_once(branch) {
+            rate.bulge
+        } else {
+            self.switching(g, x)
+        }
+    }
+    /// While bridges form at once the closest approach is the gap: `F(d − t_m − t_h)`.
+    fn force_on(&self, branch: Branch, g: Gaps, x: &[f64]) -> StateForce {
+        if !self.forming_at_once(branch) {
+            return self.force(g, x);
+        }
+        let t_h = self.head_film(x);
+        let (f, df) = self.at(g.bulge - self.params.mobile_thickness - t_h);
+        let mut d_state = [0.0; MAX_TERM_STATES];
+        if self.params.pickup.is_some() {
+            d_state[1] = -df;
+        }
+        StateForce {
+            force: ForceEval {
+                value: f,
+                d_bulge: df,
+                d_pad: 0.0,
+            },
+            d_state,
+        }
+    }
+    fn force_value_on(&self, branch: Branch, g: Gaps, x: &[f64]) -> f64 {
+        if self.forming_at_once(branch) {
+            self.force_value_at(g.bulge, g.bulge, self.head_film(x))
+        } else {
+            self.force_value(g, x)
+        }
+    }
+    /// Leaving the formation at once, where the gap stops closing: `d*` is the gap there.
+    fn enter(&self, branch: Branch, g: Gaps, x: &mut [f64]) {
+        if branch == Branch::Upper && self.instant() {
+            x[0] = g.bulge;
+        }
     }
     fn force(&self, g: Gaps, x: &[f64]) -> StateForce {
         let mut d_state = [0.0; MAX_TERM_STATES];

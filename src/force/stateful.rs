@@ -153,6 +153,25 @@ pub trait StatefulTerm: Debug + Send + Sync {
     fn rate_partials_on(&self, _branch: Branch, g: Gaps, x: &[f64]) -> RatePartials {
         self.rate_partials(g, x)
     }
+    /// The switching function the simulations watch while they hold `branch`, at gaps `g`
+    /// changing at the rates `rate` (m/s); by default [`StatefulTerm::switching`]. Its sign
+    /// picks the branch as that of `switching` does: a branch may end on a condition of its own
+    /// (a gap that stops closing), not only on the sign of `switching`.
+    fn switching_on(&self, _branch: Branch, g: Gaps, _rate: Gaps, x: &[f64]) -> f64 {
+        self.switching(g, x)
+    }
+    /// The force while the simulations hold `branch`; by default [`StatefulTerm::force`].
+    fn force_on(&self, _branch: Branch, g: Gaps, x: &[f64]) -> StateForce {
+        self.force(g, x)
+    }
+    /// The value of [`StatefulTerm::force_on`] alone (the same number); by default
+    /// [`StatefulTerm::force_value`].
+    fn force_value_on(&self, _branch: Branch, g: Gaps, x: &[f64]) -> f64 {
+        self.force_value(g, x)
+    }
+    /// Called when a simulation switches into `branch` at gaps `g`: the term may set its states
+    /// there (nothing by default). The force must be continuous across the switch.
+    fn enter(&self, _branch: Branch, _g: Gaps, _x: &mut [f64]) {}
 }
 
 /// One first-order state that relaxes towards a target proportional to the bulge gap,

@@ -404,7 +404,7 @@ impl SliderSystem {
         let m = &*self.model;
         let lay = self.layout;
         if let Some(i) = lay.delta {
-            ds[i] = (m.protrusion(self.inputs.heater.power(t)) - s[i]) / m.thermal_lag;
+            ds[i] = self.protrusion_rate(t, s);
         }
         if let Some(i) = lay.lagged_force {
             ds[i] = (hot.interface - s[i]) / m.interface_lag;
@@ -414,6 +414,26 @@ impl SliderSystem {
         }
         if let Some(i) = lay.heat {
             ds[i] = m.friction.flash_temperature(hot.contact, hot.area);
+        }
+    }
+
+    /// The protrusion's rate (m/s) at time `t` and state `s`: the thermal lag's, or the
+    /// programme's where the protrusion follows it at once.
+    fn protrusion_rate<S: Index<usize, Output = f64> + ?Sized>(&self, t: f64, s: &S) -> f64 {
+        let m = &*self.model;
+        match self.layout.delta {
+            Some(i) => (m.protrusion(self.inputs.heater.power(t)) - s[i]) / m.thermal_lag,
+            None => self.power_and_protrusion_rates(t).1,
+        }
+    }
+
+    /// The rates of the gaps (m/s) at time `t` and state `s`, of a model without a quasi-static
+    /// bulge (which takes no stateful terms): the bulge gap's `b·q̇ − δ̇`, the pad gap's `ẏ`.
+    fn gap_rates<S: Index<usize, Output = f64> + ?Sized>(&self, t: f64, s: &S) -> Gaps {
+        let v = self.velocities(s);
+        Gaps {
+            bulge: self.model.structure.bulge_displacement(&v) - self.protrusion_rate(t, s),
+            pad: v[0],
         }
     }
 
@@ -643,7 +663,7 @@ impl SliderSystem {
             if let Some(i) = flag {
                 ds[i] = 0.0;
             }
-            force += term.force_value(g, x);
+            force += term.force_value_on(Self::held(flag, s), g, x);
         });
         force
     }
@@ -666,8 +686,9 @@ impl SliderSystem {
         self.for_terms(|term, at, flag| {
             let k = term.states();
             let x = &s.as_slice()[at..at + k];
-            let f = term.force(g, x);
-            let p = term.rate_partials_on(Self::held(flag, s), g, x);
+            let branch = Self::held(flag, s);
+            let f = term.force_on(branch, g, x);
+            let p = term.rate_partials_on(branch, g, x);
             for r in 0..n {
                 let v = lay.velocity(r);
                 for col in 0..n {
@@ -713,8 +734,9 @@ impl SliderSystem {
         self.for_terms(|term, at, flag| {
             let k = term.states();
             let x = &s.as_slice()[at..at + k];
-            let f = term.force(g, x);
-            let p = term.rate_partials_on(Self::held(flag, s), g, x);
+            let branch = Self::held(flag, s);
+            let f = term.force_on(branch, g, x);
+            let p = term.rate_partials_on(branch, g, x);
             for r in 0..lay.dofs {
                 dfdt[lay.velocity(r)] += per_force[r] * (-f.force.d_bulge * delta_rate);
             }
@@ -741,13 +763,23 @@ where
             return 0.0;
         };
         let x = &s.as_slice()[at..at + term.states()];
-        s[flag] * term.switching(self.gaps(t, s), x)
+        let (g, rate) = (self.gaps(t, s), self.gap_rates(t, s));
+        s[flag] * term.switching_on(Self::held(Some(flag), s), g, rate, x)
     }
 
-    /// The other branch.
-    fn switch(&self, i: usize, _t: f64, s: &mut OVector<f64, D>) {
-        let flag = self.layout.branches.0 + i;
+    /// The other branch, entered ([`StatefulTerm::enter`]).
+    fn switch(&self, i: usize, t: f64, s: &mut OVector<f64, D>) {
+        let Some((term, at, flag)) = self.switching_term(i) else {
+            return;
+        };
         s[flag] = -s[flag];
+        let g = self.gaps(t, s);
+        let k = term.states();
+        term.enter(
+            Self::held(Some(flag), s),
+            g,
+            &mut s.as_mut_slice()[at..at + k],
+        );
     }
 
     /// The term's fastest rate on the held branch ([`StatefulTerm::fastest_rate_on`]).

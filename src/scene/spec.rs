@@ -147,7 +147,8 @@ pub struct LubricantSpec {
     pub wetting: WettingSpec,
     /// Healing time τ_h (s, > 0): how fast the bridges formed at the closest approach drain.
     pub healing_time_s: f64,
-    /// Formation time τ_f (s, > 0), default 1e-7 s: how fast bridges form as the gap closes.
+    /// Formation time τ_f (s, ≥ 0), default 1e-7 s: how fast bridges form as the gap closes;
+    /// 0 for bridges that form at once (the limit τ_f → 0, without its stiff branch).
     #[serde(default = "default_formation_time")]
     pub formation_time_s: f64,
     /// Rupture distance `s_r` (m, ≥ 0); default the Lian law `(1 + θ/2) V^{1/3}` with the bridge

@@ -258,7 +258,7 @@ impl Scene {
             ));
         }
         check_positive("lubricant.healing_time_s", l.healing_time_s)?;
-        check_positive("lubricant.formation_time_s", l.formation_time_s)?;
+        check_non_negative("lubricant.formation_time_s", l.formation_time_s)?;
         if let Some(s) = l.rupture_distance_m {
             check_non_negative("lubricant.rupture_distance_m", s)?;
         }
