@@ -469,9 +469,9 @@ impl StatefulTerm for Meniscus {
         self.force_value_at(g.bulge, x[0], self.head_film(x))
     }
     /// While bridges form at once: the gap's rate (the branch ends where it stops closing).
-    fn switching_on(&self, branch: Branch, g: Gaps, rate: Gaps, x: &[f64]) -> f64 {
+    fn switching_on(&self, branch: Branch, g: Gaps, rate: &dyn Fn() -> Gaps, x: &[f64]) -> f64 {
         if self.forming_at_once(branch) {
-            rate.bulge
+            rate().bulge
         } else {
             self.switching(g, x)
         }
@@ -497,11 +497,12 @@ impl StatefulTerm for Meniscus {
         }
     }
     fn force_value_on(&self, branch: Branch, g: Gaps, x: &[f64]) -> f64 {
-        if self.forming_at_once(branch) {
-            self.force_value_at(g.bulge, g.bulge, self.head_film(x))
+        let d_star = if self.forming_at_once(branch) {
+            g.bulge
         } else {
-            self.force_value(g, x)
-        }
+            x[0]
+        };
+        self.force_value_at(g.bulge, d_star, self.head_film(x))
     }
     /// Leaving the formation at once, where the gap stops closing: `d*` is the gap there.
     fn enter(&self, branch: Branch, g: Gaps, x: &mut [f64]) {

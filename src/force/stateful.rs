@@ -154,10 +154,11 @@ pub trait StatefulTerm: Debug + Send + Sync {
         self.rate_partials(g, x)
     }
     /// The switching function the simulations watch while they hold `branch`, at gaps `g`
-    /// changing at the rates `rate` (m/s); by default [`StatefulTerm::switching`]. Its sign
-    /// picks the branch as that of `switching` does: a branch may end on a condition of its own
-    /// (a gap that stops closing), not only on the sign of `switching`.
-    fn switching_on(&self, _branch: Branch, g: Gaps, _rate: Gaps, x: &[f64]) -> f64 {
+    /// whose rates (m/s) `rate()` gives (computed when called); by default
+    /// [`StatefulTerm::switching`]. Its sign picks the branch as that of `switching` does: a
+    /// branch may end on a condition of its own (a gap that stops closing), not only on the
+    /// sign of `switching`.
+    fn switching_on(&self, _branch: Branch, g: Gaps, _rate: &dyn Fn() -> Gaps, x: &[f64]) -> f64 {
         self.switching(g, x)
     }
     /// The force while the simulations hold `branch`; by default [`StatefulTerm::force`].

@@ -658,12 +658,13 @@ impl SliderSystem {
             let k = term.states();
             let x = &s.as_slice()[at..at + k];
             let mut dx = [0.0; MAX_TERM_STATES];
-            term.rates_on(Self::held(flag, s), g, x, &mut dx[..k]);
+            let branch = Self::held(flag, s);
+            term.rates_on(branch, g, x, &mut dx[..k]);
             ds.as_mut_slice()[at..at + k].copy_from_slice(&dx[..k]);
             if let Some(i) = flag {
                 ds[i] = 0.0;
             }
-            force += term.force_value_on(Self::held(flag, s), g, x);
+            force += term.force_value_on(branch, g, x);
         });
         force
     }
@@ -763,8 +764,8 @@ where
             return 0.0;
         };
         let x = &s.as_slice()[at..at + term.states()];
-        let (g, rate) = (self.gaps(t, s), self.gap_rates(t, s));
-        s[flag] * term.switching_on(Self::held(Some(flag), s), g, rate, x)
+        let rate = || self.gap_rates(t, s);
+        s[flag] * term.switching_on(Self::held(Some(flag), s), self.gaps(t, s), &rate, x)
     }
 
     /// The other branch, entered ([`StatefulTerm::enter`]).
