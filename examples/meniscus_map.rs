@@ -17,7 +17,8 @@
 //! `out/meniscus/{thickness,healing}.csv` and `.svg` (three heat maps each, converged points
 //! coloured, others grey), and prints the CPU time of each map and of one cycle with and without
 //! menisci (median of seven). `--maps thickness` picks one (`--maps none`: the timing alone); `--out DIR` writes elsewhere; without `--grid` a 4 × 4
-//! grid runs.
+//! grid runs. `--formation-us T` sets the formation time where it is not the axis (default
+//! 0.1 µs; 0: bridges that form at once).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -86,11 +87,12 @@ impl Axis {
             Axis::Formation => ((1e-8, 1e-3), 1e6),
         }
     }
-    fn params(self, value: f64) -> MeniscusParams {
+    /// The lubricant at `value` of the axis, formed in `formation` (s) where that is not it.
+    fn params(self, value: f64, formation: f64) -> MeniscusParams {
         let (t_m, tau_h, s_r, tau_f) = match self {
-            Axis::Thickness => (value, HEALING_S, None, FORMATION_S),
-            Axis::Healing => (MOBILE_M, value, None, FORMATION_S),
-            Axis::Rupture => (MOBILE_M, HEALING_S, Some(value), FORMATION_S),
+            Axis::Thickness => (value, HEALING_S, None, formation),
+            Axis::Healing => (MOBILE_M, value, None, formation),
+            Axis::Rupture => (MOBILE_M, HEALING_S, Some(value), formation),
             Axis::Formation => (MOBILE_M, HEALING_S, None, value),
         };
         MeniscusParams {
@@ -130,10 +132,12 @@ struct Setup {
     plain: SliderModel,
     programme: HeaterProgramme,
     opts: CycleOptions,
+    /// The formation time where it is not the axis (s).
+    formation: f64,
 }
 
 impl Setup {
-    fn new() -> Res<Self> {
+    fn new(formation: f64) -> Res<Self> {
         let scene = Scene::paper();
         let mut opts = CycleOptions::from_scene(&scene)?;
         opts.solver.max_steps = MAX_STEPS;
@@ -143,6 +147,7 @@ impl Setup {
             programme: HeaterProgramme::fixed_from_scene(&scene)?,
             opts,
             scene,
+            formation,
         })
     }
 
@@ -402,7 +407,7 @@ fn run_map(setup: &Setup, axis: Axis, n: usize, out: &Path) -> Res<()> {
     let points: Vec<Point> = jobs
         .par_iter()
         .map(|&(x, va)| match x {
-            Some(x) => setup.run(Some(axis.params(x)), x, va),
+            Some(x) => setup.run(Some(axis.params(x, setup.formation)), x, va),
             None => setup.run(None, f64::NAN, va),
         })
         .collect();
@@ -445,7 +450,7 @@ fn timing(setup: &Setup, reps: usize) -> Res<()> {
     };
     for va in [0.0, 0.6] {
         let plain = setup.model(None, va)?;
-        let with = setup.model(Some(Axis::Thickness.params(MOBILE_M)), va)?;
+        let with = setup.model(Some(Axis::Thickness.params(MOBILE_M, setup.formation)), va)?;
         let (a, b) = (time(&plain)?, time(&with)?);
         let (ra, rb) = (setup.cycle(&plain, false)?, setup.cycle(&with, false)?);
         let statics = |m: &SliderModel| -> Res<f64> {
@@ -488,11 +493,21 @@ fn main() -> Res<()> {
     let mut n = 4;
     let mut out = PathBuf::from("out/meniscus");
     let mut maps = vec![Axis::Thickness, Axis::Healing];
+    let mut formation = FORMATION_S;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--grid" => n = args.next().ok_or("--grid needs a number")?.parse()?,
             "--out" => out = args.next().ok_or("--out needs a directory")?.into(),
+            "--formation-us" => {
+                let us: f64 = args.next().ok_or("--formation-us needs a time")?.parse()?;
+                if !(us.is_finite() && us >= 0.0) {
+                    return Err(
+                        format!("--formation-us must be finite and >= 0, got {us} µs").into(),
+                    );
+                }
+                formation = us * 1e-6;
+            }
             "--maps" => {
                 maps = args
                     .next()
@@ -515,7 +530,7 @@ fn main() -> Res<()> {
         return Err(format!("--grid must lie in [2, 64], got {n}").into());
     }
     std::fs::create_dir_all(&out)?;
-    let setup = Setup::new()?;
+    let setup = Setup::new(formation)?;
     timing(&setup, 7)?;
     for axis in maps {
         run_map(&setup, axis, n, &out)?;
@@ -532,7 +547,7 @@ mod tests {
     #[test]
     fn a_small_map_runs_and_writes_its_files() -> Res<()> {
         let dir = tempfile::tempdir()?;
-        let setup = Setup::new()?;
+        let setup = Setup::new(FORMATION_S)?;
         run_map(&setup, Axis::Thickness, 2, dir.path())?;
         let csv = std::fs::read_to_string(dir.path().join("thickness.csv"))?;
         assert_eq!(csv.lines().count(), 1 + 2 * 3);

@@ -60,3 +60,20 @@ def test_a_lubricated_cycle_switches_its_branch_and_agrees_with_rust():
     assert plain["cycle"].stats["branch_switches"] == 0
     # Bridges hold the head down: it takes off later (at a lower power) than without them.
     assert c["takeoff"].power_w < plain["takeoff"].power_w - 1e-3
+
+
+def test_bridges_that_form_at_once_are_the_limit_of_a_short_formation_time():
+    """`formation_time_s = 0`: bridges form at once. Touchdown and take-off agree with those of
+    a 10 ns formation time within 0.2 µW, and a negative formation time names its field."""
+    lub = (
+        "\n[lubricant]\ntotal_thickness_m = 1.3e-9\nbonded_thickness_m = 1.0e-9\n"
+        "surface_tension_n_per_m = 0.024\ncontact_angle_deg = 30.0\nhealing_time_s = 2e-5\n"
+    )
+    base = hdi.Scene.paper().to_toml() + lub
+    at_once = hdi.simulate_cycle(hdi.Model(hdi.Scene.from_toml(base + "formation_time_s = 0\n")))
+    short = hdi.simulate_cycle(hdi.Model(hdi.Scene.from_toml(base + "formation_time_s = 1e-8\n")))
+    assert at_once["cycle"].stats["branch_switches"] > 0
+    for key in ("touchdown", "takeoff"):
+        assert abs(at_once[key].power_w - short[key].power_w) < 2e-7
+    with pytest.raises(hdi.InvalidInputError, match="lubricant.formation_time_s"):
+        hdi.Scene.from_toml(base + "formation_time_s = -1e-8\n")
