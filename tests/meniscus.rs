@@ -471,6 +471,24 @@ fn paper_lubricated(pickup: bool) -> Scene {
     scene
 }
 
+/// Menisci of 0.3 nm of mobile lubricant at 30° (τ_h = 10 µs) on the paper scene's peaks and footprint,
+/// tabulated, forming in `tau_f` (s).
+fn on_the_paper_scene(scene: &Scene, tau_f: f64) -> Meniscus {
+    let c = scene.contact.as_ref().unwrap();
+    let mut p = params(0.3e-9, 30f64.to_radians(), Wetting::Disk, None);
+    p.formation_time = tau_f;
+    Meniscus::new(
+        p,
+        c.asperity_radius_m,
+        c.asperity_density_per_m2,
+        scene.peaks().unwrap(),
+        c.footprint,
+    )
+    .unwrap()
+    .tabulated(scene.table_range(), &Default::default())
+    .unwrap()
+}
+
 /// The meniscus with its branch picked by the sign of `d − d*` at every evaluation: what the
 /// term was before the simulations held its branch (the kink left to the step control).
 #[derive(Debug)]
@@ -507,17 +525,7 @@ impl StatefulTerm for BySign {
 #[test]
 fn the_held_branch_integrates_the_law_picked_by_sign() {
     let scene = Scene::paper();
-    let c = scene.contact.as_ref().unwrap();
-    let m = Meniscus::new(
-        params(0.3e-9, 30f64.to_radians(), Wetting::Disk, None),
-        c.asperity_radius_m,
-        c.asperity_density_per_m2,
-        scene.peaks().unwrap(),
-        c.footprint,
-    )
-    .unwrap()
-    .tabulated(scene.table_range(), &Default::default())
-    .unwrap();
+    let m = on_the_paper_scene(&scene, 1e-7);
     assert!(m.switches() && !BySign(m.clone()).switches());
     let plain = SliderModel::from_scene(&scene).unwrap();
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
@@ -602,21 +610,7 @@ fn the_largest_lubricated_layout_runs() {
 #[test]
 fn instant_formation_is_the_limit_of_a_vanishing_formation_time() {
     let scene = Scene::paper();
-    let c = scene.contact.as_ref().unwrap();
-    let term = |tau_f: f64| {
-        let mut p = params(0.3e-9, 30f64.to_radians(), Wetting::Disk, None);
-        p.formation_time = tau_f;
-        Meniscus::new(
-            p,
-            c.asperity_radius_m,
-            c.asperity_density_per_m2,
-            scene.peaks().unwrap(),
-            c.footprint,
-        )
-        .unwrap()
-        .tabulated(scene.table_range(), &Default::default())
-        .unwrap()
-    };
+    let term = |tau_f: f64| on_the_paper_scene(&scene, tau_f);
     let plain = SliderModel::from_scene(&scene).unwrap();
     let programme = HeaterProgramme::fixed_from_scene(&scene).unwrap();
     let opts = CycleOptions::from_scene(&scene).unwrap();
