@@ -471,8 +471,8 @@ fn paper_lubricated(pickup: bool) -> Scene {
     scene
 }
 
-/// Menisci of 0.3 nm of mobile lubricant at 30° (τ_h = 10 µs) on the paper scene's peaks and footprint,
-/// tabulated, forming in `tau_f` (s).
+/// Menisci of 0.3 nm of mobile lubricant at 30° (τ_h = 10 µs) on the paper scene's peaks and
+/// footprint, tabulated, forming in `tau_f` (s).
 fn on_the_paper_scene(scene: &Scene, tau_f: f64) -> Meniscus {
     let c = scene.contact.as_ref().unwrap();
     let mut p = params(0.3e-9, 30f64.to_radians(), Wetting::Disk, None);
