@@ -128,6 +128,12 @@ impl Pickup {
 /// the simulations hold over each step and switch at the located root. At rest `d* = d` (the
 /// statics): the branch of bridges formed at the gap itself.
 ///
+/// With `τ_f = 0` bridges form at once: on the formation branch the force reads the gap
+/// ([`StatefulTerm::force_on`]), `d*` is held, the branch ends where the gap stops closing
+/// ([`StatefulTerm::switching_on`]) and `d*` is set to the gap there ([`StatefulTerm::enter`]).
+/// That law needs the branch held, as every simulation holds it: by the sign alone
+/// ([`StatefulTerm::rates`]) `d*` would not follow a closing gap.
+///
 /// ```
 /// use std::sync::Arc;
 /// use hdi_tribology::force::{Footprint, Gaps, Meniscus, MeniscusParams, StatefulTerm, Wetting};
