@@ -582,4 +582,76 @@ mod tests {
             }
         }
     }
+
+    /// Formation at once: on the formation branch the force is that of bridges at the gap, its
+    /// slope along the gap is the derivative of that value (a central difference), and entering
+    /// the healing branch sets `d*` to the gap with the force unchanged; a rate that does not
+    /// move `d*`, and a switching function that is the gap's rate.
+    #[test]
+    fn formation_at_once_reads_the_gap_and_hands_over_continuously() {
+        let p = MeniscusParams {
+            surface_tension: 0.025,
+            contact_angle: 0.3,
+            wetting: Wetting::Disk,
+            mobile_thickness: 1e-9,
+            rupture_distance: None,
+            healing_time: 1e-5,
+            formation_time: 0.0,
+            pickup: Some(Pickup {
+                rate: 1e-5,
+                loss_time: 5e-5,
+            }),
+        };
+        let peaks = Arc::new(Gaussian::new(0.0, 0.7e-9).unwrap());
+        let m = Meniscus::new(p, 1e-7, 1.5e14, peaks, Footprint::Flat { area_m2: 1e-12 })
+            .unwrap()
+            .tabulated((-4e-9, 3e-8), &TableOptions::default())
+            .unwrap();
+        let (d, t_h) = (0.6e-9, 0.1e-9);
+        // d* from an earlier, higher point of the closing gap
+        let x = [1.5e-9, t_h];
+        let g = Gaps::same(d);
+        let f = m.force_on(Branch::Lower, g, &x);
+        let value = m.force_value_on(Branch::Lower, g, &x);
+        assert_eq!(f.force.value, value);
+        assert_eq!(value, m.force_with_pickup(d, d, t_h).0);
+        let h = 1e-13;
+        let at = |d: f64| m.force_value_on(Branch::Lower, Gaps::same(d), &x);
+        let slope = (at(d + h) - at(d - h)) / (2.0 * h);
+        assert!(
+            (f.force.d_bulge - slope).abs() <= 1e-6 * slope.abs(),
+            "{} against {slope}",
+            f.force.d_bulge
+        );
+        assert_eq!(f.d_state[0], 0.0);
+        let mut dx = [1.0, 0.0];
+        m.rates_on(Branch::Lower, g, &x, &mut dx);
+        assert_eq!(dx[0], 0.0);
+        let rate = || Gaps::same(-2e-4);
+        assert_eq!(m.switching_on(Branch::Lower, g, &rate, &x), -2e-4);
+        assert_eq!(m.fastest_rate_on(Branch::Lower), Some(1.0 / 5e-5));
+        let mut y = x;
+        m.enter(Branch::Upper, g, &mut y);
+        assert_eq!(y, [d, t_h]);
+        assert_eq!(m.force_value_on(Branch::Upper, g, &y), value);
+        // entering formation changes nothing; a formation time above zero keeps its law
+        m.enter(Branch::Lower, g, &mut y);
+        assert_eq!(y, [d, t_h]);
+        let slow = Meniscus::new(
+            MeniscusParams {
+                formation_time: 1e-7,
+                ..p
+            },
+            1e-7,
+            1.5e14,
+            Arc::new(Gaussian::new(0.0, 0.7e-9).unwrap()),
+            Footprint::Flat { area_m2: 1e-12 },
+        )
+        .unwrap();
+        assert_eq!(
+            slow.force_value_on(Branch::Lower, g, &x),
+            slow.force_value(g, &x)
+        );
+        assert_eq!(slow.switching_on(Branch::Lower, g, &rate, &x), d - x[0]);
+    }
 }
