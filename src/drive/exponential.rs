@@ -552,9 +552,9 @@ impl ExpScheme {
         // A level that cannot be built misses (an infinite estimate).
         self.stepper(level);
         if level != self.last_level {
-            self.steppers[level]
-                .as_mut()
-                .map(ExponentialStepper::forget);
+            if let Some(s) = self.steppers[level].as_mut() {
+                s.forget();
+            }
             self.last_level = level;
         }
         let ExpScheme {

@@ -487,16 +487,17 @@ impl StatefulTerm for Meniscus {
         if !self.forming_at_once(branch) {
             return self.force(g, x);
         }
-        let t_h = self.head_film(x);
-        let (f, df) = self.at(g.bulge - self.params.mobile_thickness - t_h);
+        // `d* = d`: the slope along the gap is the sum of the two partials.
+        let (f, d_bulge, d_star, d_th) =
+            self.force_with_pickup(g.bulge, g.bulge, self.head_film(x));
         let mut d_state = [0.0; MAX_TERM_STATES];
         if self.params.pickup.is_some() {
-            d_state[1] = -df;
+            d_state[1] = d_th;
         }
         StateForce {
             force: ForceEval {
                 value: f,
-                d_bulge: df,
+                d_bulge: d_bulge + d_star,
                 d_pad: 0.0,
             },
             d_state,
