@@ -24,9 +24,9 @@
 //! disk's table rebuilt when that moved `J` by more than [`REBUILD_SHIFT`]), then with twice
 //! the substeps, up to [`LEVELS`]; if it still misses, the period is run by the integrator
 //! from the same start, as the default drive runs it, and the following periods too, for a
-//! number that doubles with each consecutive miss, up to [`MAX_SKIP`]. A held command on a
-//! flat disk without a dither is left to the integrator (`src/drive/plant.rs`), whose steps
-//! span many periods there.
+//! number that doubles with each consecutive miss, up to [`MAX_SKIP`] ([`MAX_SKIP_DITHER`] with
+//! a dither). A held command on a flat disk without a dither is left to the integrator
+//! (`src/drive/plant.rs`), whose steps span many periods there.
 
 use super::disk::{Disk, NODES};
 use crate::force::Gaps;
@@ -71,6 +71,12 @@ pub(crate) const CALM_ERROR: f64 = 0.25;
 /// Most periods run by the integrator after consecutive misses before the exponential step is
 /// tried again.
 pub(crate) const MAX_SKIP: usize = 64;
+
+/// [`MAX_SKIP`] with a dither. Its attempts miss at every level in every case measured
+/// (docs/benchmarks.md), and each costs a refresh at every level, with the disk's table rebuilt
+/// on a wavy disk: about 4 ms, the integrator's time for some 200 periods. After 64 periods
+/// that left the dither case at 3× the default's cost per period.
+pub(crate) const MAX_SKIP_DITHER: usize = 4096;
 
 /// The periodic solution of `p′ = J p + u(t)` for a sum of harmonics, tabulated over a
 /// revolution: values and slopes at the disk's nodes, interpolated by cubic Hermite
@@ -180,10 +186,16 @@ impl Periodic {
 }
 
 /// `x_i ← Σ_m x_m e^{2πi m i / N}` in place (no `1/N`), `N` a power of two: the iterative
-/// radix-2 Cooley–Tukey transform with its twiddles re-anchored exactly at each stage.
+/// radix-2 Cooley–Tukey transform with its twiddles re-anchored exactly at each stage. The
+/// twiddles `e^{2πi m/N}`, `m < N/2`, are computed once: stage `len` takes every `N/len`-th,
+/// whose angle `(2π/N)(k N/len)` is `(2π/len) k` to the bit (the factors are powers of two).
 fn inverse_fft(x: &mut [Complex64]) {
     let n = x.len();
     debug_assert!(n.is_power_of_two());
+    let step = 2.0 * PI / n as f64;
+    let twiddles: Vec<Complex64> = (0..n / 2)
+        .map(|m| Complex64::from_polar(1.0, step * m as f64))
+        .collect();
     let bits = n.trailing_zeros();
     for i in 0..n {
         let r = i.reverse_bits() >> (usize::BITS - bits);
@@ -194,10 +206,10 @@ fn inverse_fft(x: &mut [Complex64]) {
     let mut len = 2;
     while len <= n {
         let half = len / 2;
-        let step = 2.0 * PI / len as f64;
+        let stride = n / len;
         for start in (0..n).step_by(len) {
             for k in 0..half {
-                let w = Complex64::from_polar(1.0, step * k as f64);
+                let w = twiddles[k * stride];
                 let (a, b) = (x[start + k], x[start + k + half] * w);
                 x[start + k] = a + b;
                 x[start + k + half] = a - b;
@@ -705,7 +717,12 @@ impl ExpScheme {
         DefaultAllocator: Allocator<D>,
     {
         self.counts.fallbacks += 1;
-        self.backoff = (2 * self.backoff).clamp(1, MAX_SKIP);
+        let most = if self.dither.is_some() {
+            MAX_SKIP_DITHER
+        } else {
+            MAX_SKIP
+        };
+        self.backoff = (2 * self.backoff).clamp(1, most);
         self.skip = self.backoff;
         self.owned = None;
         for s in self.steppers.iter_mut().flatten() {
