@@ -553,9 +553,9 @@ mod tests {
     use super::*;
     use crate::surface::Gaussian;
 
-    #[test]
-    fn the_table_agrees_with_direct_evaluation() {
-        let p = MeniscusParams {
+    /// 1 nm of mobile lubricant at 0.3 rad, τ_h = 10 µs, τ_f = 0.1 µs, no pick-up.
+    fn sample() -> MeniscusParams {
+        MeniscusParams {
             surface_tension: 0.025,
             contact_angle: 0.3,
             wetting: Wetting::Disk,
@@ -564,7 +564,12 @@ mod tests {
             healing_time: 1e-5,
             formation_time: 1e-7,
             pickup: None,
-        };
+        }
+    }
+
+    #[test]
+    fn the_table_agrees_with_direct_evaluation() {
+        let p = sample();
         let peaks = Arc::new(Gaussian::new(0.0, 0.7e-9).unwrap());
         for footprint in Footprint::samples() {
             let m = Meniscus::new(p, 1e-7, 1.5e14, peaks.clone(), footprint).unwrap();
@@ -591,17 +596,12 @@ mod tests {
     #[test]
     fn formation_at_once_reads_the_gap_and_hands_over_continuously() {
         let p = MeniscusParams {
-            surface_tension: 0.025,
-            contact_angle: 0.3,
-            wetting: Wetting::Disk,
-            mobile_thickness: 1e-9,
-            rupture_distance: None,
-            healing_time: 1e-5,
             formation_time: 0.0,
             pickup: Some(Pickup {
                 rate: 1e-5,
                 loss_time: 5e-5,
             }),
+            ..sample()
         };
         let peaks = Arc::new(Gaussian::new(0.0, 0.7e-9).unwrap());
         let m = Meniscus::new(p, 1e-7, 1.5e14, peaks, Footprint::Flat { area_m2: 1e-12 })
