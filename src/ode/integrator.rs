@@ -29,15 +29,36 @@ const MAX_CONSECUTIVE_FAILURES: usize = 12;
 /// Stiffness switching (`Auto`), in the spirit of LSODA. Every `CHECK_INTERVAL` explicit
 /// steps (or when the explicit method's own indicator fires) the spectral radius ρ of the
 /// Jacobian is estimated; an explicit step with `h·ρ` above `STIFF_FRACTION` of the stability
-/// boundary is limited by stability, not accuracy. Two such checks in a row switch to the
-/// stiff method; it switches back after `STEPS_TO_RETURN` steps with `h·ρ` below
-/// `RETURN_FRACTION` of the boundary (accuracy would limit an explicit step more than
-/// stability). The gap between the fractions prevents ping-pong.
+/// boundary `b` may be limited by stability. Two such checks in a row switch to the stiff
+/// method.
+///
+/// A stiff step pays for itself when it is more than `COST_RATIO` times as long as the
+/// explicit step before the switch. While it does, the stiff method switches back after
+/// `STEPS_TO_RETURN` steps in a row with `h·ρ` below `RETURN_FRACTION` of the boundary (the
+/// stiffness has gone). While it does not, the explicit method would cost less as soon as
+/// its step could be as long: `h·ρ` below `COST_RETURN_FRACTION` of the boundary, the same
+/// number of steps in a row. A stiff run most of whose steps did not pay gained nothing (the
+/// step was held by accuracy, not stability: a forcing such as an AC voltage, resolved by
+/// both methods alike); the next `backoff` stiffness checks are then skipped, a number that
+/// doubles with each such run in a row up to `MAX_BACKOFF` and is cleared by a run that
+/// gained. Without the backoff the two tests would hand over back and forth, since an
+/// explicit step held by accuracy there has `h·ρ` above `STIFF_FRACTION·b` too.
 const CHECK_INTERVAL: usize = 25;
 const STIFF_FRACTION: f64 = 0.6;
 const STIFF_CHECKS_TO_SWITCH: usize = 2;
+/// Cost of a stiff step over an explicit one: Rodas5P's step (six stages, a Jacobian and a
+/// factorisation) against Tsit5's six stages on the paper cycle, 1.40 µs against 0.75 µs
+/// (docs/benchmarks.md, "Auto weighs the cost").
+const COST_RATIO: f64 = 2.0;
 const RETURN_FRACTION: f64 = 0.3;
+/// `STIFF_FRACTION·COST_RATIO` with a margin of 1.5: the explicit step would be as long as the
+/// stiff one.
+const COST_RETURN_FRACTION: f64 = 0.8;
 const STEPS_TO_RETURN: usize = 5;
+/// Fewest steps of a stiff run before it may hand back for its cost (see above).
+const TRIAL_STEPS: usize = 25;
+/// Most stiffness checks skipped after stiff runs that gained nothing (see above).
+const MAX_BACKOFF: usize = 64;
 
 /// An accepted trial step: its size, error norm, the method's error order, whether the
 /// method is stiff and whether the step ends on the stop time.
@@ -156,6 +177,12 @@ where
             }
             Method::Auto => Steppers::Auto(Tsit5::new(y0), Box::new(Rodas5P::new(y0))),
         }
+    }
+
+    /// Whether `Auto` weighs the cost of its stiff steps: for the pair whose costs were measured
+    /// (Tsit5 and Rodas5P, see `COST_RATIO`); with Radau5 or DOP853 it weighs stability alone.
+    fn weighs_cost(&self) -> bool {
+        matches!(self, Steppers::Auto(..))
     }
 
     fn count(&self) -> usize {
@@ -308,6 +335,14 @@ where
     stiff_count: usize,
     since_check: usize,
     return_count: usize,
+    /// Steps of the current stiff run, and those of them that paid for themselves (see
+    /// `COST_RATIO`).
+    stiff_run: (usize, usize),
+    /// The explicit step before the switch to the stiff method.
+    h_explicit: f64,
+    /// Stiffness checks to skip, and the number the next run that gains nothing sets.
+    skip_checks: usize,
+    backoff: usize,
     jac_work: Option<OMatrix<f64, D, D>>,
 }
 
@@ -412,6 +447,10 @@ where
             stiff_count: 0,
             since_check: 0,
             return_count: 0,
+            stiff_run: (0, 0),
+            h_explicit: 0.0,
+            skip_checks: 0,
+            backoff: 0,
             jac_work: switching.then(|| OMatrix::zeros_generic(rows, rows)),
         };
         it.init_switches();
@@ -1348,7 +1387,10 @@ where
                 .get::<S>(self.active)
                 .stiffness()
                 .is_some_and(|h_rho| h_rho > boundary);
-            if flagged || self.since_check >= CHECK_INTERVAL {
+            if (flagged || self.since_check >= CHECK_INTERVAL) && self.skip_checks > 0 {
+                self.since_check = 0;
+                self.skip_checks -= 1;
+            } else if flagged || self.since_check >= CHECK_INTERVAL {
                 self.since_check = 0;
                 let f0 = self.steppers.get::<S>(self.active).f0();
                 let rho = estimate_radius(
@@ -1370,7 +1412,13 @@ where
         } else {
             // The stiff method may hold only a lower bound of ρ: a bound that already keeps
             // the step stiff settles the test; otherwise the test takes the estimate itself.
-            let below = |rho: f64| h_acc * rho < RETURN_FRACTION * boundary;
+            let pays = !self.steppers.weighs_cost() || h_acc > COST_RATIO * self.h_explicit;
+            let fraction = if pays {
+                RETURN_FRACTION
+            } else {
+                COST_RETURN_FRACTION
+            };
+            let below = |rho: f64| h_acc * rho < fraction * boundary;
             let stepper = self.steppers.get::<S>(self.active);
             match stepper.stiffness() {
                 Some(rho) if below(rho) && stepper.stiffness_exact().is_some_and(below) => {
@@ -1378,9 +1426,22 @@ where
                 }
                 _ => self.return_count = 0,
             }
-            self.return_count >= STEPS_TO_RETURN
+            self.stiff_run.0 += 1;
+            self.stiff_run.1 += usize::from(pays);
+            self.return_count >= STEPS_TO_RETURN && (pays || self.stiff_run.0 >= TRIAL_STEPS)
         };
+        if switch && stiff {
+            let (steps, gained) = self.stiff_run;
+            if 2 * gained > steps {
+                self.backoff = 0;
+            } else {
+                self.backoff = (2 * self.backoff).clamp(1, MAX_BACKOFF);
+                self.skip_checks = self.backoff;
+            }
+        }
         if switch {
+            self.stiff_run = (0, 0);
+            self.h_explicit = h_acc;
             self.active = (self.active + 1) % self.steppers.count();
             self.ctx.stats.stiffness_switches += 1;
             self.stiff_count = 0;

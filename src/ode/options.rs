@@ -32,7 +32,10 @@ pub enum Method {
     /// switching both ways. The explicit method is DOP853 for `rtol` below 1e-8 and Tsit5 from
     /// 1e-8 on; the stiff method is Radau5 for `rtol` below 1e-6 and Rodas5P from 1e-6 on (by
     /// the measured work–precision of each pair; the tolerance at the start decides). When
-    /// Rodas5P refuses a step for its rounding floor, Auto goes on with Radau5.
+    /// Rodas5P refuses a step for its rounding floor, Auto goes on with Radau5. With Tsit5 and
+    /// Rodas5P it also weighs the cost: a stiff run whose steps are no longer than twice the
+    /// explicit step before it (the steps held by accuracy, as under an AC forcing) hands back
+    /// once an explicit step could be as long, and the next tries wait longer.
     Auto,
 }
 
