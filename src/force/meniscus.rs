@@ -475,11 +475,17 @@ impl StatefulTerm for Meniscus {
         self.force_value_at(g.bulge, x[0], self.head_film(x))
     }
     /// While bridges form at once: the gap's rate (the branch ends where it stops closing).
-    fn switching_on(&self, branch: Branch, g: Gaps, rate: &dyn Fn() -> Gaps, x: &[f64]) -> f64 {
+    fn switching_on(
+        &self,
+        branch: Branch,
+        gaps: &dyn Fn() -> Gaps,
+        rate: &dyn Fn() -> Gaps,
+        x: &[f64],
+    ) -> f64 {
         if self.forming_at_once(branch) {
             rate().bulge
         } else {
-            self.switching(g, x)
+            self.switching(gaps(), x)
         }
     }
     /// While bridges form at once the closest approach is the gap: `F(d − t_m − t_h)`.
@@ -629,7 +635,7 @@ mod tests {
         m.rates_on(Branch::Lower, g, &x, &mut dx);
         assert_eq!(dx[0], 0.0);
         let rate = || Gaps::same(-2e-4);
-        assert_eq!(m.switching_on(Branch::Lower, g, &rate, &x), -2e-4);
+        assert_eq!(m.switching_on(Branch::Lower, &|| g, &rate, &x), -2e-4);
         assert_eq!(m.fastest_rate_on(Branch::Lower), Some(1.0 / 5e-5));
         let mut y = x;
         m.enter(Branch::Upper, g, &mut y);
@@ -653,6 +659,6 @@ mod tests {
             slow.force_value_on(Branch::Lower, g, &x),
             slow.force_value(g, &x)
         );
-        assert_eq!(slow.switching_on(Branch::Lower, g, &rate, &x), d - x[0]);
+        assert_eq!(slow.switching_on(Branch::Lower, &|| g, &rate, &x), d - x[0]);
     }
 }

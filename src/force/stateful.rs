@@ -153,13 +153,19 @@ pub trait StatefulTerm: Debug + Send + Sync {
     fn rate_partials_on(&self, _branch: Branch, g: Gaps, x: &[f64]) -> RatePartials {
         self.rate_partials(g, x)
     }
-    /// The switching function the simulations watch while they hold `branch`, at gaps `g`
-    /// whose rates (m/s) `rate()` gives (computed when called); by default
-    /// [`StatefulTerm::switching`]. Its sign picks the branch as that of `switching` does: a
-    /// branch may end on a condition of its own (a gap that stops closing), not only on the
-    /// sign of `switching`.
-    fn switching_on(&self, _branch: Branch, g: Gaps, _rate: &dyn Fn() -> Gaps, x: &[f64]) -> f64 {
-        self.switching(g, x)
+    /// The switching function the simulations watch while they hold `branch`, at the gaps
+    /// `gaps()` and their rates (m/s) `rate()` (each computed when called: a term asks for what
+    /// it reads); by default [`StatefulTerm::switching`]. Its sign picks the branch as that of
+    /// `switching` does: a branch may end on a condition of its own (a gap that stops closing),
+    /// not only on the sign of `switching`.
+    fn switching_on(
+        &self,
+        _branch: Branch,
+        gaps: &dyn Fn() -> Gaps,
+        _rate: &dyn Fn() -> Gaps,
+        x: &[f64],
+    ) -> f64 {
+        self.switching(gaps(), x)
     }
     /// The force while the simulations hold `branch`; by default [`StatefulTerm::force`].
     fn force_on(&self, _branch: Branch, g: Gaps, x: &[f64]) -> StateForce {

@@ -764,8 +764,9 @@ where
             return 0.0;
         };
         let x = &s.as_slice()[at..at + term.states()];
+        let gaps = || self.gaps(t, s);
         let rate = || self.gap_rates(t, s);
-        s[flag] * term.switching_on(Self::held(Some(flag), s), self.gaps(t, s), &rate, x)
+        s[flag] * term.switching_on(Self::held(Some(flag), s), &gaps, &rate, x)
     }
 
     /// The other branch, entered ([`StatefulTerm::enter`]).

@@ -1387,9 +1387,12 @@ where
                 .get::<S>(self.active)
                 .stiffness()
                 .is_some_and(|h_rho| h_rho > boundary);
-            if (flagged || self.since_check >= CHECK_INTERVAL) && self.skip_checks > 0 {
-                self.since_check = 0;
-                self.skip_checks -= 1;
+            if self.skip_checks > 0 {
+                // A backoff counts the periodic checks; the indicator is not heard meanwhile.
+                if self.since_check >= CHECK_INTERVAL {
+                    self.since_check = 0;
+                    self.skip_checks -= 1;
+                }
             } else if flagged || self.since_check >= CHECK_INTERVAL {
                 self.since_check = 0;
                 let f0 = self.steppers.get::<S>(self.active).f0();
@@ -1420,8 +1423,13 @@ where
             };
             let below = |rho: f64| h_acc * rho < fraction * boundary;
             let stepper = self.steppers.get::<S>(self.active);
+            // A run that does not pay may hand back only after its trial: the estimate is
+            // taken from the steps that could end it on.
+            let tested = pays || self.stiff_run.0 + STEPS_TO_RETURN >= TRIAL_STEPS;
             match stepper.stiffness() {
-                Some(rho) if below(rho) && stepper.stiffness_exact().is_some_and(below) => {
+                Some(rho)
+                    if tested && below(rho) && stepper.stiffness_exact().is_some_and(below) =>
+                {
                     self.return_count += 1;
                 }
                 _ => self.return_count = 0,
