@@ -37,12 +37,14 @@ const MAX_CONSECUTIVE_FAILURES: usize = 12;
 /// `STEPS_TO_RETURN` steps in a row with `h·ρ` below `RETURN_FRACTION` of the boundary (the
 /// stiffness has gone). While it does not, the explicit method would cost less as soon as
 /// its step could be as long: `h·ρ` below `COST_RETURN_FRACTION` of the boundary, the same
-/// number of steps in a row. A stiff run most of whose steps did not pay gained nothing (the
-/// step was held by accuracy, not stability: a forcing such as an AC voltage, resolved by
-/// both methods alike); the next `backoff` stiffness checks are then skipped, a number that
-/// doubles with each such run in a row up to `MAX_BACKOFF` and is cleared by a run that
-/// gained. Without the backoff the two tests would hand over back and forth, since an
-/// explicit step held by accuracy there has `h·ρ` above `STIFF_FRACTION·b` too.
+/// number of steps in a row, after a trial of at least `TRIAL_STEPS` steps. A stiff run most
+/// of whose steps did not pay gained nothing (the step was held by accuracy, not stability:
+/// a forcing such as an AC voltage, resolved by both methods alike); the next `backoff`
+/// periodic stiffness checks are then skipped (the explicit method's indicator is not heard
+/// meanwhile), a number that doubles with each such run in a row up to `MAX_BACKOFF` and is
+/// cleared by a run that gained. Without the backoff the two tests would hand over back and
+/// forth, since an explicit step held by accuracy there has `h·ρ` above `STIFF_FRACTION·b`
+/// too. Only `Auto`'s pair of Tsit5 and Rodas5P weighs the cost (`Steppers::weighs_cost`).
 const CHECK_INTERVAL: usize = 25;
 const STIFF_FRACTION: f64 = 0.6;
 const STIFF_CHECKS_TO_SWITCH: usize = 2;
