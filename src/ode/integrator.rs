@@ -1451,7 +1451,9 @@ where
         }
         if switch {
             self.stiff_run = (0, 0);
-            self.h_explicit = h_acc;
+            if !stiff {
+                self.h_explicit = h_acc;
+            }
             self.active = (self.active + 1) % self.steppers.count();
             self.ctx.stats.stiffness_switches += 1;
             self.stiff_count = 0;
