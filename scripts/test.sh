@@ -8,6 +8,9 @@ cd "$(dirname "$0")/.."
 root=$PWD
 # One build directory for the crate and its Python package.
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/target}"
+# No incremental caches unless asked for (CARGO_INCREMENTAL=1): on a fresh machine they are
+# gigabytes of disk that no later build reads.
+export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 
 cargo test --all-features
 # The numbers the docs quote against the code (docs/architecture.md, "Numbers in the docs"):
