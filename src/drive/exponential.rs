@@ -340,6 +340,10 @@ pub(crate) struct ExpScheme {
     /// Work vectors.
     p: Vec<f64>,
     dp: Vec<f64>,
+    /// The time (its bits) whose known forcings `p`, `dp` hold, as the forcings are now: a
+    /// period that starts where the one before ended reads them instead of computing them
+    /// again (the same numbers).
+    known_at: Option<u64>,
     z0: Vec<f64>,
     f0: Vec<f64>,
     z1: Vec<f64>,
@@ -386,6 +390,7 @@ impl ExpScheme {
             counts: SchemeCounts::default(),
             p: vec![0.0; n],
             dp: vec![0.0; n],
+            known_at: None,
             z0: vec![0.0; n],
             f0: vec![0.0; n],
             z1: vec![0.0; n],
@@ -437,6 +442,8 @@ impl ExpScheme {
         // Linearised about the state less the known forcings' responses (as held so far): the
         // slow state, whose Jacobian does not swing with the disk's phase.
         Self::known(disk, &self.disk, &self.dither, t, &mut self.p, &mut self.dp);
+        // The table or the dither's lines may change below.
+        self.known_at = None;
         let slow = state_vector::<D>(dim, |i| x[i] - self.p[i]);
         let mut jd = OMatrix::<f64, D, D>::zeros_generic(dim, dim);
         OdeSystem::<D>::jacobian(sys, t, &slow, &mut jd);
@@ -577,6 +584,7 @@ impl ExpScheme {
             dither,
             p,
             dp,
+            known_at,
             z0,
             f0,
             z1,
@@ -597,7 +605,9 @@ impl ExpScheme {
             let ts = t0 + k as f64 * hs;
             OdeSystem::<D>::rhs(sys, ts, &x, &mut fx);
             if forced {
-                Self::known(disk, table, dither, ts, p, dp);
+                if *known_at != Some(ts.to_bits()) {
+                    Self::known(disk, table, dither, ts, p, dp);
+                }
                 for i in 0..n {
                     z0[i] = x[i] - p[i];
                     f0[i] = fx[i] - dp[i];
@@ -637,6 +647,7 @@ impl ExpScheme {
                 } else {
                     Self::known(disk, table, dither, te, p, dp);
                 }
+                *known_at = Some(te.to_bits());
                 for i in 0..n {
                     x[i] = z1[i] + p[i];
                 }
