@@ -45,6 +45,8 @@ const MAX_CONSECUTIVE_FAILURES: usize = 12;
 /// cleared by a run that gained. Without the backoff the two tests would hand over back and
 /// forth, since an explicit step held by accuracy there has `h·ρ` above `STIFF_FRACTION·b`
 /// too. Only `Auto`'s pair of Tsit5 and Rodas5P weighs the cost (`Steppers::weighs_cost`).
+/// That pair also hands back at a switch of the system's branch that ends the stiffness it
+/// switched for ([`Integrator::leave_stiff_branch`]).
 const CHECK_INTERVAL: usize = 25;
 const STIFF_FRACTION: f64 = 0.6;
 const STIFF_CHECKS_TO_SWITCH: usize = 2;
