@@ -45,8 +45,10 @@ const MAX_CONSECUTIVE_FAILURES: usize = 12;
 /// cleared by a run that gained. Without the backoff the two tests would hand over back and
 /// forth, since an explicit step held by accuracy there has `h·ρ` above `STIFF_FRACTION·b`
 /// too. Only `Auto`'s pair of Tsit5 and Rodas5P weighs the cost (`Steppers::weighs_cost`).
-/// That pair also hands back at a switch of the system's branch that ends the stiffness it
-/// switched for ([`Integrator::leave_stiff_branch`]).
+/// That pair also goes stiff at once at a switch into a branch whose declared rate would hold
+/// the explicit step far below the coming one, and hands back at a switch that ends the
+/// stiffness it switched for ([`Integrator::enter_stiff_branch`],
+/// [`Integrator::leave_stiff_branch`]).
 const CHECK_INTERVAL: usize = 25;
 const STIFF_FRACTION: f64 = 0.6;
 const STIFF_CHECKS_TO_SWITCH: usize = 2;
@@ -1285,6 +1287,25 @@ where
         }
     }
 
+    /// After a switch into a branch of the fastest rate `entered`: an explicit method that
+    /// weighs its cost hands over to the stiff one at once when the branch's stability bound
+    /// `b/rate` is less than `1/COST_RATIO` of the coming step, as the stiffness checks would
+    /// after some steps at that bound. The bound is the explicit step the stiff run has to beat
+    /// ([`Integrator::leave_stiff_branch`] hands back where the branch ends).
+    fn enter_stiff_branch(&mut self, entered: Option<f64>) {
+        if !self.steppers.weighs_cost() || self.steppers.get::<S>(self.active).is_stiff() {
+            return;
+        }
+        let Some(rate) = entered.filter(|r| *r > 0.0) else {
+            return;
+        };
+        let bound = self.steppers.get::<S>(0).stability_boundary() / rate;
+        if COST_RATIO * bound < self.h {
+            self.h_explicit = bound;
+            self.change_method();
+        }
+    }
+
     /// After a switch of branch from the fastest rate `left` to `entered`: a stiff method that
     /// weighs its cost hands back to the explicit one when the branch it leaves held the
     /// explicit step at its stability bound (`h·rate` above `STIFF_FRACTION` of the boundary
@@ -1332,7 +1353,9 @@ where
         let left = self.sys.branch_rate(i, &self.y);
         self.sys.switch(i, self.t, &mut self.y);
         self.ctx.stats.branch_switches += 1;
-        self.leave_stiff_branch(left, self.sys.branch_rate(i, &self.y));
+        let entered = self.sys.branch_rate(i, &self.y);
+        self.leave_stiff_branch(left, entered);
+        self.enter_stiff_branch(entered);
         self.within_branch_rates();
         check_finite_state(&self.y).map_err(|_| OdeError::NonFinite {
             t: self.t,
