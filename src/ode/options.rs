@@ -35,7 +35,10 @@ pub enum Method {
     /// Rodas5P refuses a step for its rounding floor, Auto goes on with Radau5. With Tsit5 and
     /// Rodas5P it also weighs the cost: a stiff run whose steps are no longer than twice the
     /// explicit step before it (the steps held by accuracy, as under an AC forcing) hands back
-    /// once an explicit step could be as long, and the next tries wait longer.
+    /// once an explicit step could be as long, and the next tries wait longer. For a system
+    /// with branches ([`crate::ode::OdeSystem::branch_rate`]) that pair also goes stiff at
+    /// once on entering a branch whose declared rate holds the explicit step under half the
+    /// coming one, and hands back where such a branch ends and the stiffness went with it.
     Auto,
 }
 
