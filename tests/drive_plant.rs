@@ -419,3 +419,73 @@ fn the_exponential_scheme_replays_to_the_bit() {
     assert_eq!(ca, cb);
     assert_eq!(a, b);
 }
+
+/// A dither held on a flat disk: once the slider has settled onto the dither's orbit, the
+/// exponential scheme reads the periods from a table of it (`src/drive/orbit.rs`). In flight
+/// (70 mW) and in contact (80 mW), then the programme: every sensor within the same fractions
+/// of its noise of the tight reference, and the gap within one displacement tolerance of the
+/// default drive's own deviation.
+#[test]
+fn the_exponential_scheme_reads_a_held_dither_from_its_orbit() {
+    let flat = DriveOptions {
+        disk: DiskSpec::flat(),
+        ..DriveOptions::default()
+    };
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        ..flat.clone()
+    };
+    let mut held = vec![Command::heater_mw(70.0).with_dither(0.5, 10.5); 150];
+    held.extend(vec![Command::heater_mw(80.0).with_dither(0.5, 10.5); 150]);
+    let (dev, counts) = deviation_after(o, &held);
+    let (default, _) = deviation_after(flat.clone(), &held);
+    let (gap, gap_default) = (
+        dev.gap_flight.max(dev.gap_contact),
+        default.gap_flight.max(default.gap_contact),
+    );
+    assert!(
+        gap < gap_default + flat.atol_displacement,
+        "gap differs by {gap} m (the default by {gap_default} m)"
+    );
+    sensors_within_their_noise(&dev);
+    assert!(counts.orbit > 200 && counts.orbit_tables >= 2, "{counts:?}");
+}
+
+/// The orbit's periods replay to the bit, through command changes that drop the table and
+/// holds that build it again.
+#[test]
+fn a_dither_orbit_replays_to_the_bit() {
+    let scene = Scene::paper();
+    let zone = scene_zone(&scene, 0.025).unwrap();
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        disk: DiskSpec::flat(),
+        ..DriveOptions::default()
+    };
+    let run = || {
+        let mut d = Plant::new(&scene, &zone, 3, o.clone())
+            .unwrap()
+            .into_drive()
+            .unwrap();
+        let mut bits = Vec::new();
+        for k in 0..400 {
+            let mw = if k < 200 { 72.0 } else { 80.0 } + if k % 97 == 0 { 1e-3 } else { 0.0 };
+            let c = Command::heater_mw(mw).with_dither(0.5, 10.5);
+            let s = d.step(&c, DT).unwrap();
+            bits.extend(
+                [
+                    s.contact_resistance_ohm,
+                    s.truth.gap_nm,
+                    s.truth.mean_contact_force_un,
+                ]
+                .map(f64::to_bits),
+            );
+        }
+        (bits, d.scheme_counts())
+    };
+    let (a, ca) = run();
+    let (b, cb) = run();
+    assert!(ca.orbit > 100 && ca.orbit_tables >= 2, "{ca:?}");
+    assert_eq!(ca, cb);
+    assert_eq!(a, b);
+}

@@ -26,9 +26,12 @@
 //! from the same start, as the default drive runs it, and the following periods too, for a
 //! number that doubles with each consecutive miss, up to [`MAX_SKIP`] ([`MAX_SKIP_DITHER`] with
 //! a dither). A held command on a flat disk without a dither is left to the integrator
-//! (`src/drive/plant.rs`), whose steps span many periods there.
+//! (`src/drive/plant.rs`), whose steps span many periods there; with a dither, once the slider
+//! has settled onto the dither's periodic orbit, the periods are read from a table of that
+//! orbit (`src/drive/orbit.rs`).
 
 use super::disk::{Disk, NODES};
+use super::orbit::Orbit;
 use crate::force::Gaps;
 use crate::model::{Inputs, SliderSystem, StateLayout, Voltage};
 use crate::ode::{ExponentialStepper, OdeSystem};
@@ -301,6 +304,13 @@ pub struct SchemeCounts {
     pub refreshes: u64,
     /// Rebuilds of the disk's response table.
     pub rebuilds: u64,
+    /// Periods of a dither held on a flat disk read from its settled orbit's table (see
+    /// `src/drive/orbit.rs`).
+    pub orbit: u64,
+    /// Tables of a dither's orbit built.
+    pub orbit_tables: u64,
+    /// Tries to tabulate a dither's orbit that did not pass their checks.
+    pub orbit_refusals: u64,
 }
 
 /// The state of the exponential scheme of one drive.
@@ -347,6 +357,11 @@ pub(crate) struct ExpScheme {
     z0: Vec<f64>,
     f0: Vec<f64>,
     z1: Vec<f64>,
+    /// The settled orbit of a dither held on a flat disk, periods to wait before the next try
+    /// to tabulate it, and the next such wait.
+    pub(crate) orbit: Option<Orbit>,
+    pub(crate) orbit_wait: usize,
+    pub(crate) orbit_backoff: usize,
 }
 
 /// How one attempt went.
@@ -394,7 +409,20 @@ impl ExpScheme {
             z0: vec![0.0; n],
             f0: vec![0.0; n],
             z1: vec![0.0; n],
+            orbit: None,
+            orbit_wait: 0,
+            orbit_backoff: 0,
         }
+    }
+
+    /// The scheme's per-component absolute tolerances (the drive's contact tolerances).
+    pub(crate) fn atol(&self) -> &[f64] {
+        &self.atol
+    }
+
+    /// The scheme's relative tolerance.
+    pub(crate) fn rtol(&self) -> f64 {
+        self.rtol
     }
 
     /// Whether the next period is left to the integrator without a try (counted).

@@ -35,6 +35,7 @@ mod disk;
 mod error;
 mod exponential;
 mod heads;
+mod orbit;
 mod plant;
 mod replay;
 mod rng;

@@ -2,6 +2,7 @@
 
 use super::disk::{Disk, DiskSpec};
 use super::exponential::{state_vector, Attempt, ExpScheme, SchemeCounts, MAX_STATE};
+use super::orbit::Orbit;
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
 use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
@@ -1422,12 +1423,32 @@ fn advance_exponential<D: Dim>(
     set: Option<Held<'_>>,
     integrals0: &mut (f64, f64),
     span: Span,
-    tol: Option<(&TolRule, &mut TolState)>,
+    mut tol: Option<(&TolRule, &mut TolState)>,
     dt: f64,
 ) -> Result<(OVector<f64, D>, PeriodReport)>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+    if set.is_some() {
+        exp.orbit = None;
+        exp.orbit_wait = 0;
+        exp.orbit_backoff = 0;
+    }
+    let v = it.system().inputs().voltage;
+    // A dither held on a flat disk, past the settling periods and outside the bounded mode
+    // (a try runs two periods of the dither): its settled orbit (`src/drive/orbit.rs`).
+    let orbiting = disk.is_flat()
+        && set.is_none()
+        && !span.settling
+        && span.floor.is_none()
+        && v.ac_amplitude != 0.0
+        && v.frequency > 0.0;
+    if orbiting {
+        let again = tol.as_mut().map(|(rule, st)| (&**rule, &mut **st));
+        if let Some(report) = orbit_period(it, exp, layout, integrals0, span, again, v.frequency)? {
+            return Ok(report);
+        }
+    }
     if exp.skips() {
         return advance(it, layout, set, integrals0, span, tol, None);
     }
@@ -1499,6 +1520,104 @@ where
     let landed = Span { land: true, ..span };
     advance(it, layout, None, integrals0, landed, tol, Some(x0))
 }
+
+/// A period of a dither held on a flat disk: read from the settled orbit's table when there
+/// is one; otherwise, when a try is due, run by the integrator and followed by a try to
+/// tabulate the orbit from its end (the integrator restarted there whatever the outcome, and
+/// the next try put off by a doubling wait after a refusal). `None`: neither, the period is
+/// the exponential scheme's as without a dither.
+fn orbit_period<D: Dim>(
+    it: &mut Integrator<'static, D, SliderSystem>,
+    exp: &mut ExpScheme,
+    layout: &StateLayout,
+    integrals0: &mut (f64, f64),
+    span: Span,
+    tol: Option<(&TolRule, &mut TolState)>,
+    frequency: f64,
+) -> Result<Option<(OVector<f64, D>, PeriodReport)>>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    let Span { t0, t1, rebase, .. } = span;
+    let dim = D::from_usize(layout.len());
+    let start = |exp: &mut ExpScheme, it: &Integrator<'static, D, SliderSystem>| -> Result<_> {
+        Ok(match exp.owned.take() {
+            Some(x) => state_vector::<D>(dim, |i| x[i]),
+            None if it.t() > t0 => it.interpolate(t0)?,
+            None => it.state().clone(),
+        })
+    };
+    if exp.orbit.is_some() {
+        let mut x0 = start(exp, it)?;
+        rebase_integrals(layout, rebase, &mut x0, integrals0);
+        let mut x1 = x0.clone();
+        let mut error = 0.0;
+        if let Some(orbit) = &exp.orbit {
+            orbit.period_end(t0, t1, x0.as_slice(), x1.as_mut_slice());
+            error = orbit.error;
+        }
+        let mut x = [0.0; MAX_STATE];
+        x[..x1.len()].copy_from_slice(x1.as_slice());
+        exp.owned = Some(x);
+        exp.counts.orbit += 1;
+        let report = PeriodReport {
+            steps: 0,
+            error_estimate: error,
+            exponential: true,
+        };
+        return Ok(Some((x1, report)));
+    }
+    if exp.orbit_wait > 0 {
+        exp.orbit_wait -= 1;
+        return Ok(None);
+    }
+    let x0 = match exp.owned {
+        Some(_) => {
+            let mut x0 = start(exp, it)?;
+            rebase_integrals(layout, rebase, &mut x0, integrals0);
+            Some(x0)
+        }
+        None => None,
+    };
+    // The tolerances the integrator runs at, which the checks hold the orbit to.
+    let atol: Vec<f64> = match &tol {
+        Some((rule, st)) => (0..rule.n)
+            .map(|i| rule.fixed[i] + st.atol * rule.per_m[i])
+            .collect(),
+        None => exp.atol().to_vec(),
+    };
+    let landed = Span { land: true, ..span };
+    let (y1, report) = advance(it, layout, None, integrals0, landed, tol, x0)?;
+    let budget = 4 * span.max_steps + 4 * super::orbit::NODES;
+    match Orbit::build(
+        it,
+        layout,
+        t1,
+        y1.clone(),
+        frequency,
+        &atol,
+        exp.rtol(),
+        budget,
+    ) {
+        Ok(o) => {
+            exp.orbit = Some(o);
+            exp.orbit_backoff = 0;
+            exp.counts.orbit_tables += 1;
+        }
+        Err(_) => {
+            exp.orbit_backoff = (2 * exp.orbit_backoff).clamp(ORBIT_WAIT.0, ORBIT_WAIT.1);
+            exp.orbit_wait = exp.orbit_backoff;
+            exp.counts.orbit_refusals += 1;
+        }
+    }
+    // The integrator ran on past the period: back to its end.
+    super::orbit::restart(it, t1, y1.clone(), t1 + HORIZON)?;
+    Ok(Some((y1, report)))
+}
+
+/// The first and the longest wait (periods) before another try to tabulate a dither's orbit
+/// after a refusal.
+const ORBIT_WAIT: (usize, usize) = (8, 4096);
 
 /// Sets the period integrals of `x` back to zero once either has grown past its bound (see
 /// [`advance`]).
