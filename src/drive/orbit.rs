@@ -197,7 +197,7 @@ impl Orbit {
         let mut at = [0.0; MAX_STATE];
         let mut worst = 0.0f64;
         for k in (1..2 * NODES).step_by(2) {
-            orbit.local(0, (k / 2) as usize, 0.5, &mut at[..n]);
+            orbit.local(0, k / 2, 0.5, &mut at[..n]);
             for c in 0..n {
                 let base = if integral(c) { states[c] } else { 0.0 };
                 let truth = states[row(k) + c] - base;
