@@ -4,9 +4,9 @@
 //! tolerance (0.01 pm throughout), with the exponential scheme (`DriveScheme::Exponential`, right
 //! after the default on the same case) and with 1 pm in flight
 //! (`DriveOptions::atol_displacement_flight`). Prints a table; the last column gives the shares
-//! of the timed periods the exponential scheme advanced itself and left to the integrator's
-//! spanning steps (a held command on a flat disk); the rest it left to the integrator after
-//! misses.
+//! of the timed periods the exponential scheme advanced itself, left to the integrator's
+//! spanning steps (a held command on a flat disk) and read from a dither's settled orbit (a
+//! dither held on a flat disk); the rest it left to the integrator after misses.
 //!
 //! `cargo bench --bench drive`. Each case settles 20 ms at its heater power, then times blocks
 //! of 200 periods (10 ms of drive time) for at least 1 s; the table gives the fastest block's
@@ -26,7 +26,7 @@ const BLOCK: usize = 200;
 fn main() {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).expect("zone");
-    println!("| scheme | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period | exponential / spanned periods |");
+    println!("| scheme | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period | exponential / spanned / orbit periods |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let configs = [
         ("0.01 pm", DriveOptions::default()),
@@ -87,7 +87,7 @@ fn main() {
                             d.step(&cmd, DT).expect("settle");
                         }
                         let s0 = d.stats().accepted;
-                        let (e0, sp0) = (d.scheme_counts().exponential, d.scheme_counts().spanned);
+                        let c0 = d.scheme_counts();
                         let t0 = d.time();
                         let mut k = 0usize;
                         let (last, t) = timing::measure(5, 100_000, Duration::from_secs(1), || {
@@ -105,15 +105,17 @@ fn main() {
                         });
                         let periods = (d.time() - t0) / DT;
                         let steps = (d.stats().accepted - s0) as f64 / periods;
-                        let exp_share = (d.scheme_counts().exponential - e0) as f64 / periods;
-                        let spanned = (d.scheme_counts().spanned - sp0) as f64 / periods;
+                        let c1 = d.scheme_counts();
+                        let exp_share = (c1.exponential - c0.exponential) as f64 / periods;
+                        let spanned = (c1.spanned - c0.spanned) as f64 / periods;
+                        let orbit = (c1.orbit - c0.orbit) as f64 / periods;
                         let last = last.expect("ran");
                         // The state the case claims: in contact the true contact force is far above F_th.
                         let in_contact = (last.truth.mean_contact_force_un * 1e-6) > 5e-5;
                         assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
                         let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
                         println!(
-                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} / {:.2} |",
+                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} / {:.2} / {:.2} |",
                     match (dither, alternate) {
                         (Some((a, f)), _) => format!("{a} V, {f:.1} kHz"),
                         (None, true) => "off, ±1 µW every period".to_string(),
@@ -125,7 +127,8 @@ fn main() {
                     DT / cpu,
                     steps,
                     exp_share,
-                    spanned
+                    spanned,
+                    orbit
                 );
                     }
                 }
