@@ -425,6 +425,16 @@ impl ExpScheme {
         self.rtol
     }
 
+    /// The dither switched off: its lines and the wait its misses ran up (up to
+    /// [`MAX_SKIP_DITHER`] periods) are dropped, and the next period is tried.
+    pub(crate) fn dither_off(&mut self) {
+        self.dither = None;
+        self.known_at = None;
+        self.reach = self.reach_of_forcings();
+        self.skip = 0;
+        self.backoff = 0;
+    }
+
     /// Whether the next period is left to the integrator without a try (counted).
     pub(crate) fn skips(&mut self) -> bool {
         if self.skip > 0 && self.owned.is_none() {
@@ -513,7 +523,14 @@ impl ExpScheme {
                 return false;
             }
         }
-        self.reach = (0..self.dofs)
+        self.reach = self.reach_of_forcings();
+        true
+    }
+
+    /// How far the known forcings move the gaps (m): the sum over the positions of their
+    /// responses' largest magnitude.
+    fn reach_of_forcings(&self) -> f64 {
+        (0..self.dofs)
             .map(|k| {
                 let table = self.disk.as_ref().map_or(0.0, |d| d.largest(k));
                 let lines = self
@@ -522,8 +539,7 @@ impl ExpScheme {
                     .map_or(0.0, |d| d.c1[k].norm() + d.c2[k].norm());
                 table + lines
             })
-            .sum();
-        true
+            .sum()
     }
 
     /// Whether the contact force is straight enough over the gaps the known forcings sweep for

@@ -1429,12 +1429,21 @@ fn advance_exponential<D: Dim>(
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
-    if set.is_some() {
+    let v = it.system().inputs().voltage;
+    if let Some(held) = &set {
         exp.orbit = None;
         exp.orbit_wait = 0;
         exp.orbit_backoff = 0;
+        // The dither switched off: the wait its misses ran up says nothing of the periods
+        // without it.
+        let c = held.command;
+        if v.ac_amplitude != 0.0
+            && v.frequency > 0.0
+            && !(c.ac_amplitude_v != 0.0 && c.ac_frequency_khz > 0.0)
+        {
+            exp.dither_off();
+        }
     }
-    let v = it.system().inputs().voltage;
     // A dither held on a flat disk, past the settling periods and outside the bounded mode
     // (a try runs two periods of the dither): its settled orbit (`src/drive/orbit.rs`).
     let orbiting = disk.is_flat()
