@@ -368,6 +368,14 @@ fn the_exponential_scheme_holds_near_the_fold() {
 /// one displacement tolerance of the default drive's own deviation on the same programme.
 #[test]
 fn the_exponential_scheme_on_a_flat_disk() {
+    let counts = exponential_on_a_flat_disk(&[]);
+    assert!(counts.exponential > 0 && counts.spanned > 50, "{counts:?}");
+}
+
+/// The exponential scheme against the tight reference on a flat disk, over `prelude` and the
+/// programme: every sensor within the same fractions of its noise, and the gap within one
+/// displacement tolerance of the default drive's own deviation. Returns the scheme's counts.
+fn exponential_on_a_flat_disk(prelude: &[Command]) -> hdi_tribology::drive::SchemeCounts {
     let flat = DriveOptions {
         disk: DiskSpec::flat(),
         ..DriveOptions::default()
@@ -376,8 +384,8 @@ fn the_exponential_scheme_on_a_flat_disk() {
         scheme: DriveScheme::Exponential,
         ..flat.clone()
     };
-    let (dev, counts) = deviation_after(o, &[]);
-    let (default, _) = deviation_after(flat.clone(), &[]);
+    let (dev, counts) = deviation_after(o, prelude);
+    let (default, _) = deviation_after(flat.clone(), prelude);
     let (gap, gap_default) = (
         dev.gap_flight.max(dev.gap_contact),
         default.gap_flight.max(default.gap_contact),
@@ -387,17 +395,31 @@ fn the_exponential_scheme_on_a_flat_disk() {
         "gap differs by {gap} m (the default by {gap_default} m)"
     );
     sensors_within_their_noise(&dev);
-    assert!(counts.exponential > 0 && counts.spanned > 50, "{counts:?}");
+    counts
 }
 
 /// The exponential scheme's sensor stream is the same from run to run, to the bit, over a
 /// programme that moves between its own steps, the integrator and back.
 #[test]
 fn the_exponential_scheme_replays_to_the_bit() {
+    let counts = replays_to_the_bit(DiskSpec::default(), 300, |k| {
+        Command::heater_mw(if k < 150 { 70.0 } else { 78.0 } + 1e-3 * (k % 2) as f64)
+    });
+    assert!(counts.exponential > 0 && counts.fallbacks > 0, "{counts:?}");
+}
+
+/// Runs the exponential scheme on `disk` twice over `periods` commands `command(k)` and checks
+/// that the sensor streams and the scheme's counts are the same to the bit; returns the counts.
+fn replays_to_the_bit(
+    disk: DiskSpec,
+    periods: usize,
+    command: impl Fn(usize) -> Command,
+) -> hdi_tribology::drive::SchemeCounts {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).unwrap();
     let o = DriveOptions {
         scheme: DriveScheme::Exponential,
+        disk,
         ..DriveOptions::default()
     };
     let run = || {
@@ -406,18 +428,22 @@ fn the_exponential_scheme_replays_to_the_bit() {
             .into_drive()
             .unwrap();
         let mut bits = Vec::new();
-        for k in 0..300 {
-            let mw = if k < 150 { 70.0 } else { 78.0 } + 1e-3 * (k % 2) as f64;
-            let s = d.step(&Command::heater_mw(mw), DT).unwrap();
-            bits.extend([s.contact_resistance_ohm, s.truth.gap_nm].map(f64::to_bits));
+        for k in 0..periods {
+            let s = d.step(&command(k), DT).unwrap();
+            let read = [
+                s.contact_resistance_ohm,
+                s.truth.gap_nm,
+                s.truth.mean_contact_force_un,
+            ];
+            bits.extend(read.map(f64::to_bits));
         }
         (bits, d.scheme_counts())
     };
     let (a, ca) = run();
     let (b, cb) = run();
-    assert!(ca.exponential > 0 && ca.fallbacks > 0, "{ca:?}");
     assert_eq!(ca, cb);
     assert_eq!(a, b);
+    ca
 }
 
 /// A dither held on a flat disk: once the slider has settled onto the dither's orbit, the
@@ -427,27 +453,9 @@ fn the_exponential_scheme_replays_to_the_bit() {
 /// default drive's own deviation; the scheme's own steps resume after the dither.
 #[test]
 fn the_exponential_scheme_reads_a_held_dither_from_its_orbit() {
-    let flat = DriveOptions {
-        disk: DiskSpec::flat(),
-        ..DriveOptions::default()
-    };
-    let o = DriveOptions {
-        scheme: DriveScheme::Exponential,
-        ..flat.clone()
-    };
     let mut held = vec![Command::heater_mw(70.0).with_dither(0.5, 10.5); 150];
     held.extend(vec![Command::heater_mw(80.0).with_dither(0.5, 10.5); 150]);
-    let (dev, counts) = deviation_after(o, &held);
-    let (default, _) = deviation_after(flat.clone(), &held);
-    let (gap, gap_default) = (
-        dev.gap_flight.max(dev.gap_contact),
-        default.gap_flight.max(default.gap_contact),
-    );
-    assert!(
-        gap < gap_default + flat.atol_displacement,
-        "gap differs by {gap} m (the default by {gap_default} m)"
-    );
-    sensors_within_their_noise(&dev);
+    let counts = exponential_on_a_flat_disk(&held);
     // After the dither the scheme takes its own steps again (the wait its misses ran up is
     // dropped when it switches off).
     assert!(
@@ -460,37 +468,9 @@ fn the_exponential_scheme_reads_a_held_dither_from_its_orbit() {
 /// holds that build it again.
 #[test]
 fn a_dither_orbit_replays_to_the_bit() {
-    let scene = Scene::paper();
-    let zone = scene_zone(&scene, 0.025).unwrap();
-    let o = DriveOptions {
-        scheme: DriveScheme::Exponential,
-        disk: DiskSpec::flat(),
-        ..DriveOptions::default()
-    };
-    let run = || {
-        let mut d = Plant::new(&scene, &zone, 3, o.clone())
-            .unwrap()
-            .into_drive()
-            .unwrap();
-        let mut bits = Vec::new();
-        for k in 0..400 {
-            let mw = if k < 200 { 72.0 } else { 80.0 } + if k % 97 == 0 { 1e-3 } else { 0.0 };
-            let c = Command::heater_mw(mw).with_dither(0.5, 10.5);
-            let s = d.step(&c, DT).unwrap();
-            bits.extend(
-                [
-                    s.contact_resistance_ohm,
-                    s.truth.gap_nm,
-                    s.truth.mean_contact_force_un,
-                ]
-                .map(f64::to_bits),
-            );
-        }
-        (bits, d.scheme_counts())
-    };
-    let (a, ca) = run();
-    let (b, cb) = run();
-    assert!(ca.orbit > 100 && ca.orbit_tables >= 2, "{ca:?}");
-    assert_eq!(ca, cb);
-    assert_eq!(a, b);
+    let counts = replays_to_the_bit(DiskSpec::flat(), 400, |k| {
+        let mw = if k < 200 { 72.0 } else { 80.0 } + if k % 97 == 0 { 1e-3 } else { 0.0 };
+        Command::heater_mw(mw).with_dither(0.5, 10.5)
+    });
+    assert!(counts.orbit > 100 && counts.orbit_tables >= 2, "{counts:?}");
 }
