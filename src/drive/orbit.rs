@@ -20,7 +20,6 @@
 //! The integrals are not periodic: their growth per period of `T` is kept with the table, and
 //! a period's change is the table's change within `T` plus whole periods of growth.
 
-use super::exponential::MAX_STATE;
 use crate::model::{SliderSystem, StateLayout};
 use crate::ode::{Integrator, OdeSystem};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
@@ -53,7 +52,7 @@ pub(crate) struct Orbit {
     values: Vec<f64>,
     slopes: Vec<f64>,
     /// The integrals' growth over one period (zero elsewhere).
-    growth: [f64; MAX_STATE],
+    growth: Vec<f64>,
     integrals: [Option<usize>; 2],
     /// The largest of the checks' errors, in units of the tolerances.
     pub(crate) error: f64,
@@ -118,8 +117,8 @@ impl Orbit {
         let start = it.stats().accepted;
         let mut states: Vec<f64> = Vec::with_capacity((2 * NODES + 1) * n);
         let mut slopes: Vec<f64> = Vec::with_capacity((2 * NODES + 1) * n);
-        let mut ends = [[0.0; MAX_STATE]; 3];
-        ends[0][..n].copy_from_slice(x.as_slice());
+        let mut ends = vec![vec![0.0; n]; 3];
+        ends[0].copy_from_slice(x.as_slice());
         let ran = (|| -> Result<(), crate::ode::OdeError> {
             restart(it, t, x, node_time(count))?;
             let mut f = it.state().clone();
@@ -132,7 +131,7 @@ impl Orbit {
                     ));
                 }
                 if k == 2 * NODES {
-                    ends[1][..n].copy_from_slice(it.state().as_slice());
+                    ends[1].copy_from_slice(it.state().as_slice());
                 }
                 if k >= 2 * NODES {
                     let s = it.state();
@@ -141,7 +140,7 @@ impl Orbit {
                     slopes.extend_from_slice(f.as_slice());
                 }
             }
-            ends[2][..n].copy_from_slice(it.state().as_slice());
+            ends[2].copy_from_slice(it.state().as_slice());
             Ok(())
         })();
         if ran.is_err() {
@@ -158,7 +157,7 @@ impl Orbit {
             d2 = d2.max((ends[2][c] - ends[1][c]).abs() / w);
         }
         let r = if d1 > 0.0 { d2 / d1 } else { 0.0 };
-        let mut growth = [0.0; MAX_STATE];
+        let mut growth = vec![0.0; n];
         let mut integral_error = 0.0f64;
         for c in integrals.into_iter().flatten() {
             let (g1, g2) = (ends[1][c] - ends[0][c], ends[2][c] - ends[1][c]);
@@ -194,10 +193,10 @@ impl Orbit {
             integrals,
             error: settled.max(integral_error),
         };
-        let mut at = [0.0; MAX_STATE];
+        let mut at = vec![0.0; n];
         let mut worst = 0.0f64;
         for k in (1..2 * NODES).step_by(2) {
-            orbit.local(0, k / 2, 0.5, &mut at[..n]);
+            orbit.local(0, k / 2, 0.5, &mut at);
             for c in 0..n {
                 let base = if integral(c) { states[c] } else { 0.0 };
                 let truth = states[row(k) + c] - base;
@@ -211,42 +210,45 @@ impl Orbit {
         Ok(orbit)
     }
 
-    /// The state at time `t` into `out`, with the integrals counted from the table's start
-    /// (whole periods of growth included).
-    fn at(&self, t: f64, out: &mut [f64]) -> i64 {
+    /// Period `whole` of the table, interval `k` and the place `θ` in it of time `t`.
+    fn place(&self, t: f64) -> (i64, usize, f64) {
         let s = (t - self.t_ref) / self.period;
         let whole = s.floor();
         let u = (s - whole) * NODES as f64;
         let k = (u as usize).min(NODES - 1);
-        self.local(whole as i64, k, u - k as f64, out);
-        whole as i64
+        (whole as i64, k, u - k as f64)
     }
 
-    /// The state at `θ ∈ [0, 1]` of interval `k` of period `whole` into `out`.
+    /// The state at `θ ∈ [0, 1]` of interval `k` of period `whole` into `out`, the integrals
+    /// counted from the table's start (whole periods of growth included).
     fn local(&self, whole: i64, k: usize, theta: f64, out: &mut [f64]) {
-        let h = self.period / NODES as f64;
-        let n = self.n;
-        for (c, o) in out.iter_mut().enumerate().take(n) {
-            let (i0, i1) = (k * n + c, (k + 1) * n + c);
-            let (v, _) = crate::numerics::cubic_hermite(
-                theta,
-                self.values[i0],
-                h * self.slopes[i0],
-                self.values[i1],
-                h * self.slopes[i1],
-            );
-            *o = v + whole as f64 * self.growth[c];
+        for (c, o) in out.iter_mut().enumerate().take(self.n) {
+            *o = self.component(whole, k, theta, c);
         }
+    }
+
+    /// Component `c` of [`Orbit::local`].
+    fn component(&self, whole: i64, k: usize, theta: f64, c: usize) -> f64 {
+        let h = self.period / NODES as f64;
+        let (i0, i1) = (k * self.n + c, (k + 1) * self.n + c);
+        let (v, _) = crate::numerics::cubic_hermite(
+            theta,
+            self.values[i0],
+            h * self.slopes[i0],
+            self.values[i1],
+            h * self.slopes[i1],
+        );
+        v + whole as f64 * self.growth[c]
     }
 
     /// The state at the end `t1` of a period that starts at `t0` in state `x0`: the orbit's
     /// state at `t1`, the integrals `x0`'s plus their change over `[t0, t1]` on the orbit.
     pub(crate) fn period_end(&self, t0: f64, t1: f64, x0: &[f64], x1: &mut [f64]) {
-        let mut a = [0.0; MAX_STATE];
-        self.at(t0, &mut a[..self.n]);
-        self.at(t1, x1);
+        let (w1, k1, th1) = self.place(t1);
+        self.local(w1, k1, th1, x1);
+        let (w0, k0, th0) = self.place(t0);
         for c in self.integrals.into_iter().flatten() {
-            x1[c] = x0[c] + (x1[c] - a[c]);
+            x1[c] = x0[c] + (x1[c] - self.component(w0, k0, th0, c));
         }
     }
 }
