@@ -313,6 +313,35 @@ pub struct SchemeCounts {
     pub orbit_refusals: u64,
 }
 
+/// A wait that doubles with each miss in a row: the periods left to wait, and the next wait.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Backoff {
+    wait: usize,
+    next: usize,
+}
+
+impl Backoff {
+    /// A miss: wait twice as long as after the last one, within `[least, most]` periods.
+    pub(crate) fn missed(&mut self, least: usize, most: usize) {
+        self.next = (2 * self.next).clamp(least, most);
+        self.wait = self.next;
+    }
+
+    /// A success: the next miss waits the least again.
+    pub(crate) fn succeeded(&mut self) {
+        self.next = 0;
+    }
+
+    /// Whether this period is still waited out (counted off).
+    pub(crate) fn waits(&mut self) -> bool {
+        let waits = self.wait > 0;
+        if waits {
+            self.wait -= 1;
+        }
+        waits
+    }
+}
+
 /// The state of the exponential scheme of one drive.
 #[derive(Clone, Debug)]
 pub(crate) struct ExpScheme {
@@ -343,9 +372,8 @@ pub(crate) struct ExpScheme {
     dither: Option<Dither>,
     /// The state at the drive's time, when the scheme holds it (the integrator's is stale).
     pub(crate) owned: Option<[f64; MAX_STATE]>,
-    /// Periods to leave to the integrator, and the next such run's length.
-    skip: usize,
-    backoff: usize,
+    /// Periods to leave to the integrator after misses.
+    misses: Backoff,
     pub(crate) counts: SchemeCounts,
     /// Work vectors.
     p: Vec<f64>,
@@ -357,11 +385,10 @@ pub(crate) struct ExpScheme {
     z0: Vec<f64>,
     f0: Vec<f64>,
     z1: Vec<f64>,
-    /// The settled orbit of a dither held on a flat disk, periods to wait before the next try
-    /// to tabulate it, and the next such wait.
+    /// The settled orbit of a dither held on a flat disk, and the wait before the next try to
+    /// tabulate it after a refusal.
     pub(crate) orbit: Option<Orbit>,
-    pub(crate) orbit_wait: usize,
-    pub(crate) orbit_backoff: usize,
+    pub(crate) orbit_wait: Backoff,
 }
 
 /// How one attempt went.
@@ -400,8 +427,7 @@ impl ExpScheme {
             disk_j: None,
             dither: None,
             owned: None,
-            skip: 0,
-            backoff: 0,
+            misses: Backoff::default(),
             counts: SchemeCounts::default(),
             p: vec![0.0; n],
             dp: vec![0.0; n],
@@ -410,8 +436,7 @@ impl ExpScheme {
             f0: vec![0.0; n],
             z1: vec![0.0; n],
             orbit: None,
-            orbit_wait: 0,
-            orbit_backoff: 0,
+            orbit_wait: Backoff::default(),
         }
     }
 
@@ -431,14 +456,12 @@ impl ExpScheme {
         self.dither = None;
         self.known_at = None;
         self.reach = self.reach_of_forcings();
-        self.skip = 0;
-        self.backoff = 0;
+        self.misses = Backoff::default();
     }
 
     /// Whether the next period is left to the integrator without a try (counted).
     pub(crate) fn skips(&mut self) -> bool {
-        if self.skip > 0 && self.owned.is_none() {
-            self.skip -= 1;
+        if self.owned.is_none() && self.misses.waits() {
             self.counts.skipped += 1;
             true
         } else {
@@ -756,7 +779,7 @@ impl ExpScheme {
         let switched = (0..OdeSystem::<D>::switches(sys))
             .any(|i| OdeSystem::<D>::switching(sys, i, t0 + h, &x1) < 0.0);
         if err <= 1.0 && x1.iter().all(|v| v.is_finite()) && !switched {
-            self.backoff = 0;
+            self.misses.succeeded();
             self.counts.exponential += 1;
             // Up at once when the period needed it; down after CALM periods well within the
             // tolerances.
@@ -786,8 +809,7 @@ impl ExpScheme {
         } else {
             MAX_SKIP
         };
-        self.backoff = (2 * self.backoff).clamp(1, most);
-        self.skip = self.backoff;
+        self.misses.missed(1, most);
         self.owned = None;
         for s in self.steppers.iter_mut().flatten() {
             s.forget();

@@ -111,7 +111,7 @@ impl Orbit {
         let n = x.len();
         let period = 1.0 / frequency;
         let half = period / (2 * NODES) as f64;
-        // Nodes of the first period (every other one, for its end) and all of the second.
+        // `2 NODES` nodes a period over both periods; the second's are kept.
         let count = 4 * NODES;
         let node_time = |k: usize| t + k as f64 * half;
         let start = it.stats().accepted;
@@ -120,15 +120,20 @@ impl Orbit {
         let mut ends = vec![vec![0.0; n]; 3];
         ends[0].copy_from_slice(x.as_slice());
         let ran = (|| -> Result<(), crate::ode::OdeError> {
-            restart(it, t, x, node_time(count))?;
+            restart(it, t, x, node_time(1))?;
             let mut f = it.state().clone();
             for k in 1..=count {
-                it.advance_to(node_time(k))?;
-                if it.stats().accepted - start > max_steps {
-                    return Err(crate::ode::OdeError::invalid(
-                        "max_steps",
-                        "over the budget",
-                    ));
+                // Step by step onto the node (the end time), the budget counted per step.
+                let node = node_time(k);
+                it.set_tf(node)?;
+                while it.t() < node {
+                    it.step()?;
+                    if it.stats().accepted - start > max_steps {
+                        return Err(crate::ode::OdeError::invalid(
+                            "max_steps",
+                            "over the budget",
+                        ));
+                    }
                 }
                 if k == 2 * NODES {
                     ends[1].copy_from_slice(it.state().as_slice());

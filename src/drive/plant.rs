@@ -1,7 +1,7 @@
 //! The simulated drive: the slider of a scene in a zone, stepped at the controller's rate.
 
 use super::disk::{Disk, DiskSpec};
-use super::exponential::{state_vector, Attempt, ExpScheme, SchemeCounts, MAX_STATE};
+use super::exponential::{state_vector, Attempt, Backoff, ExpScheme, SchemeCounts, MAX_STATE};
 use super::orbit::Orbit;
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
 use super::Zone;
@@ -1201,16 +1201,21 @@ impl Held<'_> {
     fn apply(&self, sys: &mut SliderSystem) {
         let inputs = Inputs {
             heater: Heater::Power(self.command.heater_power()),
-            voltage: Voltage {
-                dc: self.command.dc_voltage_v,
-                ac_amplitude: self.command.ac_amplitude_v,
-                frequency: crate::units::khz(self.command.ac_frequency_khz),
-                contact_potential: self.contact_potential,
-            },
+            voltage: self.voltage(),
             clearance_offset: self.clearance,
             base_motion: sys.inputs().base_motion.clone(),
         };
         sys.set_inputs(inputs);
+    }
+
+    /// The head–disk voltage of the command.
+    fn voltage(&self) -> Voltage {
+        Voltage {
+            dc: self.command.dc_voltage_v,
+            ac_amplitude: self.command.ac_amplitude_v,
+            frequency: crate::units::khz(self.command.ac_frequency_khz),
+            contact_potential: self.contact_potential,
+        }
     }
 }
 
@@ -1432,15 +1437,10 @@ where
     let v = it.system().inputs().voltage;
     if let Some(held) = &set {
         exp.orbit = None;
-        exp.orbit_wait = 0;
-        exp.orbit_backoff = 0;
+        exp.orbit_wait = Backoff::default();
         // The dither switched off: the wait its misses ran up says nothing of the periods
         // without it.
-        let c = held.command;
-        if v.ac_amplitude != 0.0
-            && v.frequency > 0.0
-            && !(c.ac_amplitude_v != 0.0 && c.ac_frequency_khz > 0.0)
-        {
+        if v.is_time_dependent() && !held.voltage().is_time_dependent() {
             exp.dither_off();
         }
     }
@@ -1450,8 +1450,7 @@ where
         && set.is_none()
         && !span.settling
         && span.floor.is_none()
-        && v.ac_amplitude != 0.0
-        && v.frequency > 0.0;
+        && v.is_time_dependent();
     if orbiting {
         let again = tol.as_mut().map(|(rule, st)| (&**rule, &mut **st));
         if let Some(report) = orbit_period(it, exp, layout, integrals0, span, again, v.frequency)? {
@@ -1576,8 +1575,7 @@ where
         };
         return Ok(Some((x1, report)));
     }
-    if exp.orbit_wait > 0 {
-        exp.orbit_wait -= 1;
+    if exp.orbit_wait.waits() {
         return Ok(None);
     }
     let x0 = match exp.owned {
@@ -1610,12 +1608,11 @@ where
     ) {
         Ok(o) => {
             exp.orbit = Some(o);
-            exp.orbit_backoff = 0;
+            exp.orbit_wait.succeeded();
             exp.counts.orbit_tables += 1;
         }
         Err(_) => {
-            exp.orbit_backoff = (2 * exp.orbit_backoff).clamp(ORBIT_WAIT.0, ORBIT_WAIT.1);
-            exp.orbit_wait = exp.orbit_backoff;
+            exp.orbit_wait.missed(ORBIT_WAIT.0, ORBIT_WAIT.1);
             exp.counts.orbit_refusals += 1;
         }
     }
