@@ -478,3 +478,36 @@ fn a_dither_orbit_replays_to_the_bit() {
     });
     assert!(counts.orbit > 100 && counts.orbit_tables >= 2, "{counts:?}");
 }
+
+/// A dither on a flat disk under a heater changed every period (±1 µW, alternating, as a
+/// controller's dither of the heater): the exponential scheme reads the periods from the orbit's
+/// period map linearised in the heater power (`src/drive/orbit_map.rs`). In flight (70 mW) and
+/// in contact (80 mW), then the programme: every sensor within the same fractions of its noise
+/// of the tight reference, and the gap within one displacement tolerance of the default
+/// drive's own deviation.
+#[test]
+fn the_exponential_scheme_maps_a_dither_under_a_changing_heater() {
+    let alternating = |mw: f64| {
+        (0..150).map(move |k| Command::heater_mw(mw + 1e-3 * (k % 2) as f64).with_dither(0.5, 10.5))
+    };
+    let prelude: Vec<Command> = alternating(70.0).chain(alternating(80.0)).collect();
+    let counts = exponential_on_a_flat_disk(&prelude);
+    assert!(
+        counts.orbit_mapped > 200 && counts.orbit_maps >= 2,
+        "{counts:?}"
+    );
+}
+
+/// The map's periods replay to the bit, through a heater that changes every period and a
+/// change beyond the map's offset, which drops the table (then built again).
+#[test]
+fn a_dither_map_replays_to_the_bit() {
+    let counts = replays_to_the_bit(DiskSpec::flat(), 300, |k| {
+        let mw = if k < 150 { 72.0 } else { 74.0 } + 1e-3 * (k % 2) as f64;
+        Command::heater_mw(mw).with_dither(0.5, 10.5)
+    });
+    assert!(
+        counts.orbit_mapped > 100 && counts.orbit_maps >= 2,
+        "{counts:?}"
+    );
+}

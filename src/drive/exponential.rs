@@ -32,6 +32,7 @@
 
 use super::disk::{Disk, NODES};
 use super::orbit::Orbit;
+use super::orbit_map::OrbitMap;
 use crate::force::Gaps;
 use crate::model::{Inputs, SliderSystem, StateLayout, Voltage};
 use crate::ode::{ExponentialStepper, OdeSystem};
@@ -311,6 +312,17 @@ pub struct SchemeCounts {
     pub orbit_tables: u64,
     /// Tries to tabulate a dither's orbit that did not pass their checks.
     pub orbit_refusals: u64,
+    /// Periods of a dither on a flat disk under a heater changed within the trusted offset,
+    /// read from the orbit's linearised period map (see `src/drive/orbit_map.rs`); they are
+    /// also counted in `orbit`.
+    pub orbit_mapped: u64,
+    /// Linearised period maps built.
+    pub orbit_maps: u64,
+    /// Tries to build a linearised period map refused by its test or its interpolation check.
+    pub orbit_map_refusals: u64,
+    /// Periods that left an orbit's table: a heater offset or a deviation outside what the
+    /// map's test covered, or a change the table cannot take.
+    pub orbit_exits: u64,
 }
 
 /// A wait that doubles with each miss in a row: the periods left to wait, and the next wait.
@@ -389,6 +401,11 @@ pub(crate) struct ExpScheme {
     /// tabulate it after a refusal.
     pub(crate) orbit: Option<Orbit>,
     pub(crate) orbit_wait: Backoff,
+    /// The orbit's period map linearised in the heater power, when it passed its test.
+    pub(crate) orbit_map: Option<OrbitMap>,
+    /// Periods since the voltage or the clearance last changed, or the heater by more than
+    /// the map's test covers (the orbit's settling periods).
+    pub(crate) voltage_held: usize,
 }
 
 /// How one attempt went.
@@ -437,6 +454,8 @@ impl ExpScheme {
             z1: vec![0.0; n],
             orbit: None,
             orbit_wait: Backoff::default(),
+            orbit_map: None,
+            voltage_held: 0,
         }
     }
 

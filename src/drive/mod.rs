@@ -36,6 +36,7 @@ mod error;
 mod exponential;
 mod heads;
 mod orbit;
+mod orbit_map;
 mod plant;
 mod replay;
 mod rng;

@@ -92,8 +92,9 @@ where
 impl Orbit {
     /// Runs the integrator from `(t, x)` over two periods of the dither of frequency
     /// `frequency` (Hz) and tabulates the second when it passes the checks (module docs), with
-    /// the per-component absolute tolerances `atol` and relative `rtol`. The integrator is left
-    /// at `t + 2T` whatever the outcome; at most `max_steps` steps are taken.
+    /// the per-component absolute tolerances `atol` and relative `rtol`, after `lead` periods
+    /// of settling. The integrator is left at `t + (lead + 2)T` whatever the outcome; at most
+    /// `max_steps` steps are taken.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn build<D: Dim>(
         it: &mut Integrator<'static, D, SliderSystem>,
@@ -101,6 +102,7 @@ impl Orbit {
         t: f64,
         x: OVector<f64, D>,
         frequency: f64,
+        lead: usize,
         atol: &[f64],
         rtol: f64,
         max_steps: usize,
@@ -110,6 +112,27 @@ impl Orbit {
     {
         let n = x.len();
         let period = 1.0 / frequency;
+        let (t, x) = if lead > 0 {
+            let end = t + lead as f64 * period;
+            let first = it.stats().accepted;
+            let ran = (|| -> Result<(), crate::ode::OdeError> {
+                restart(it, t, x, end)?;
+                while it.t() < end {
+                    it.step()?;
+                    if it.stats().accepted - first > max_steps {
+                        return Err(crate::ode::OdeError::invalid(
+                            "max_steps",
+                            "over the budget",
+                        ));
+                    }
+                }
+                Ok(())
+            })();
+            ran.map_err(|_| Refused::Integrator)?;
+            (end, it.state().clone())
+        } else {
+            (t, x)
+        };
         let half = period / (2 * NODES) as f64;
         // `2 NODES` nodes a period over both periods; the second's are kept.
         let count = 4 * NODES;
@@ -244,6 +267,22 @@ impl Orbit {
             h * self.slopes[i1],
         );
         v + whole as f64 * self.growth[c]
+    }
+
+    /// The time of the table's node 0 (s) and the period of the dither (s).
+    pub(crate) fn timing(&self) -> (f64, f64) {
+        (self.t_ref, self.period)
+    }
+
+    /// The indices of the period integrals in the state.
+    pub(crate) fn integrals(&self) -> [Option<usize>; 2] {
+        self.integrals
+    }
+
+    /// The orbit's state at time `t` into `out`, the integrals counted from the table's start.
+    pub(crate) fn state_at(&self, t: f64, out: &mut [f64]) {
+        let (w, k, th) = self.place(t);
+        self.local(w, k, th, out);
     }
 
     /// The state at the end `t1` of a period that starts at `t0` in state `x0`: the orbit's

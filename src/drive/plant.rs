@@ -3,6 +3,7 @@
 use super::disk::{Disk, DiskSpec};
 use super::exponential::{state_vector, Attempt, Backoff, ExpScheme, SchemeCounts, MAX_STATE};
 use super::orbit::Orbit;
+use super::orbit_map::OrbitMap;
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
 use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
@@ -1188,6 +1189,7 @@ impl PeriodClock {
 }
 
 /// A new command to set in the integrator's system.
+#[derive(Clone, Copy)]
 struct Held<'a> {
     command: &'a Command,
     /// The ambient change of the clearance (m).
@@ -1435,25 +1437,58 @@ where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
     let v = it.system().inputs().voltage;
+    // A change of the heater alone, by no more than the orbit's linearised map can take
+    // (`src/drive/orbit_map.rs`), keeps a dither's orbit, its map and the wait for them.
+    let small = set.as_ref().is_some_and(|held| {
+        let inputs = it.system().inputs();
+        let p = held.command.heater_power();
+        let reach = exp
+            .orbit_map
+            .as_ref()
+            .map_or(MAX_HEATER_OFFSET, |m| m.offset());
+        let from = exp
+            .orbit_map
+            .as_ref()
+            .map_or(inputs.heater.power(span.t0), |m| m.heater());
+        held.voltage() == v
+            && held.clearance == inputs.clearance_offset
+            && (p - from).abs() <= reach
+    });
+    exp.voltage_held = if set.is_some() && !small {
+        0
+    } else {
+        exp.voltage_held + 1
+    };
     if let Some(held) = &set {
-        exp.orbit = None;
-        exp.orbit_wait = Backoff::default();
+        if !small {
+            exp.orbit = None;
+            exp.orbit_map = None;
+            exp.orbit_wait = Backoff::default();
+        } else if exp.orbit_map.is_none() && exp.orbit.take().is_some() {
+            // A table without a map reads held periods only.
+            exp.counts.orbit_exits += 1;
+        }
         // The dither switched off: the wait its misses ran up says nothing of the periods
         // without it.
         if v.is_time_dependent() && !held.voltage().is_time_dependent() {
             exp.dither_off();
         }
     }
-    // A dither held on a flat disk, past the settling periods and outside the bounded mode
-    // (a try runs two periods of the dither): its settled orbit (`src/drive/orbit.rs`).
+    // A dither on a flat disk, past the settling periods and outside the bounded mode (a try
+    // runs two periods of the dither): its settled orbit (`src/drive/orbit.rs`).
     let orbiting = disk.is_flat()
-        && set.is_none()
-        && !span.settling
+        && exp.voltage_held >= SETTLE_PERIODS
         && span.floor.is_none()
         && v.is_time_dependent();
     if orbiting {
         let again = tol.as_mut().map(|(rule, st)| (&**rule, &mut **st));
-        if let Some(report) = orbit_period(it, exp, layout, integrals0, span, again, v.frequency)? {
+        let period = OrbitPeriod {
+            layout,
+            span,
+            dt,
+            frequency: v.frequency,
+        };
+        if let Some(report) = orbit_period(it, exp, set, integrals0, period, again)? {
             return Ok(report);
         }
     }
@@ -1529,23 +1564,43 @@ where
     advance(it, layout, None, integrals0, landed, tol, Some(x0))
 }
 
-/// A period of a dither held on a flat disk: read from the settled orbit's table when there
-/// is one; otherwise, when a try is due, run by the integrator and followed by a try to
-/// tabulate the orbit from its end (the integrator restarted there whatever the outcome, and
-/// the next try put off by a doubling wait after a refusal). `None`: neither, the period is
-/// the exponential scheme's as without a dither.
+/// What [`orbit_period`] needs of the period besides the scheme.
+struct OrbitPeriod<'a> {
+    layout: &'a StateLayout,
+    span: Span,
+    /// The drive's period (s) and the dither's frequency (Hz).
+    dt: f64,
+    frequency: f64,
+}
+
+/// The largest change of the heater (W) that keeps a dither's orbit before its map is built
+/// (the largest offset the map's test tries).
+const MAX_HEATER_OFFSET: f64 = super::orbit_map::TEST_OFFSETS[0];
+
+/// A period of a dither on a flat disk: read from the settled orbit's table when there is one
+/// (through its linearised map when there is one, so that the heater may change within the
+/// map's trusted offset); otherwise, when a try is due, run by the integrator and followed by a
+/// try to tabulate the orbit and its map from its end (the integrator restarted there whatever
+/// the outcome, and the next try put off by a doubling wait after a refusal). A period outside
+/// the map's trusted region drops the table and is the integrator's. `None`: neither, the
+/// period is the exponential scheme's as without a dither.
 fn orbit_period<D: Dim>(
     it: &mut Integrator<'static, D, SliderSystem>,
     exp: &mut ExpScheme,
-    layout: &StateLayout,
+    set: Option<Held<'_>>,
     integrals0: &mut (f64, f64),
-    span: Span,
+    period: OrbitPeriod<'_>,
     tol: Option<(&TolRule, &mut TolState)>,
-    frequency: f64,
 ) -> Result<Option<(OVector<f64, D>, PeriodReport)>>
 where
     DefaultAllocator: Allocator<D> + Allocator<D, D>,
 {
+    let OrbitPeriod {
+        layout,
+        span,
+        dt,
+        frequency,
+    } = period;
     let Span { t0, t1, rebase, .. } = span;
     let dim = D::from_usize(layout.len());
     let start = |exp: &mut ExpScheme, it: &Integrator<'static, D, SliderSystem>| -> Result<_> {
@@ -1555,19 +1610,41 @@ where
             None => it.state().clone(),
         })
     };
+    let landed = Span { land: true, ..span };
     if exp.orbit.is_some() {
         let mut x0 = start(exp, it)?;
         rebase_integrals(layout, rebase, &mut x0, integrals0);
-        let mut x1 = x0.clone();
-        let mut error = 0.0;
-        if let Some(orbit) = &exp.orbit {
-            orbit.period_end(t0, t1, x0.as_slice(), x1.as_mut_slice());
-            error = orbit.error;
+        if let Some(held) = &set {
+            held.apply(it.system_mut());
         }
+        let p = it.system().inputs().heater.power(t0);
+        let mut x1 = x0.clone();
+        let read = match (&exp.orbit, &exp.orbit_map) {
+            (Some(orbit), Some(map)) => map
+                .period_end(orbit, t0, t1, dt, x0.as_slice(), p, x1.as_mut_slice())
+                .then_some(orbit.error.max(map.error)),
+            (Some(orbit), None) if set.is_none() => {
+                orbit.period_end(t0, t1, x0.as_slice(), x1.as_mut_slice());
+                Some(orbit.error)
+            }
+            _ => None,
+        };
+        let Some(error) = read else {
+            // Outside what the table and its map hold: the integrator from the same start.
+            exp.orbit = None;
+            exp.orbit_map = None;
+            exp.orbit_wait.missed(ORBIT_WAIT.0, ORBIT_WAIT.1);
+            exp.counts.orbit_exits += 1;
+            let ran = advance(it, layout, None, integrals0, landed, tol, Some(x0))?;
+            return Ok(Some(ran));
+        };
         let mut x = [0.0; MAX_STATE];
         x[..x1.len()].copy_from_slice(x1.as_slice());
         exp.owned = Some(x);
         exp.counts.orbit += 1;
+        if exp.orbit_map.is_some() {
+            exp.counts.orbit_mapped += 1;
+        }
         let report = PeriodReport {
             steps: 0,
             error_estimate: error,
@@ -1593,8 +1670,8 @@ where
             .collect(),
         None => exp.atol().to_vec(),
     };
-    let landed = Span { land: true, ..span };
-    let (y1, report) = advance(it, layout, None, integrals0, landed, tol, x0)?;
+    let changed = set.is_some();
+    let (y1, report) = advance(it, layout, set, integrals0, landed, tol, x0)?;
     let budget = 4 * span.max_steps + 4 * super::orbit::NODES;
     match Orbit::build(
         it,
@@ -1602,14 +1679,30 @@ where
         t1,
         y1.clone(),
         frequency,
+        if changed { ORBIT_LEAD } else { 0 },
         &atol,
         exp.rtol(),
         budget,
     ) {
         Ok(o) => {
-            exp.orbit = Some(o);
             exp.orbit_wait.succeeded();
             exp.counts.orbit_tables += 1;
+            // The map needs a state without branches or term states, whose laws may switch. A
+            // refused map puts off the next try as a refused table does: under a changing
+            // heater the table alone is dropped at the next period.
+            if layout.term_states.1 == 0 && layout.branches.1 == 0 {
+                match OrbitMap::build(it, &o, dt, &atol, exp.rtol(), budget) {
+                    Ok(m) => {
+                        exp.orbit_map = Some(m);
+                        exp.counts.orbit_maps += 1;
+                    }
+                    Err(_) => {
+                        exp.orbit_wait.missed(ORBIT_WAIT.0, ORBIT_WAIT.1);
+                        exp.counts.orbit_map_refusals += 1;
+                    }
+                }
+            }
+            exp.orbit = Some(o);
         }
         Err(_) => {
             exp.orbit_wait.missed(ORBIT_WAIT.0, ORBIT_WAIT.1);
@@ -1620,6 +1713,11 @@ where
     super::orbit::restart(it, t1, y1.clone(), t1 + HORIZON)?;
     Ok(Some((y1, report)))
 }
+
+/// Periods of the dither a try runs before its two periods when the heater changed in the
+/// period it follows: the slider's slowest mode contracts by about 0.39 a period of the dither
+/// at 10.5 kHz, so a deviation of a few tolerances from the orbit is gone after four.
+const ORBIT_LEAD: usize = 4;
 
 /// The first and the longest wait (periods) before another try to tabulate a dither's orbit
 /// after a refusal.
