@@ -1,12 +1,14 @@
 //! `Drive::step` at a 20 kHz controller rate against real time: in flight (70 mW), in contact
 //! (80 mW) and in a flight clear of the peaks (60 mW), on a flat and on the default wavy disk,
-//! with and without an AC dither, and with a command that changes every period; at the default
+//! with and without an AC dither, and with a command that changes every period, without and
+//! under the dither; at the default
 //! tolerance (0.01 pm throughout), with the exponential scheme (`DriveScheme::Exponential`, right
 //! after the default on the same case) and with 1 pm in flight
 //! (`DriveOptions::atol_displacement_flight`). Prints a table; the last column gives the shares
 //! of the timed periods the exponential scheme advanced itself, left to the integrator's
 //! spanning steps (a held command on a flat disk) and read from a dither's settled orbit (a
-//! dither held on a flat disk); the rest it left to the integrator after misses.
+//! dither on a flat disk, held or under a heater changed within the orbit's linearised map);
+//! the rest it left to the integrator after misses.
 //!
 //! `cargo bench --bench drive`. Each case settles 20 ms at its heater power, then times blocks
 //! of 200 periods (10 ms of drive time) for at least 1 s; the table gives the fastest block's
@@ -61,16 +63,22 @@ fn main() {
             // the highest peaks already touch it: 0.07 µN of contact force).
             for (state, mw) in [("flight", 70.0), ("contact", 80.0), ("clear", 60.0)] {
                 // Held commands, with and without dither; then a command that changes every period
-                // (a heater dithered by ±1 µW, alternating): the worst case, a restart per period.
-                for (dither, alternate) in [(None, false), (Some((0.5, 10.5)), false), (None, true)]
-                {
+                // (a heater dithered by ±1 µW, alternating): the worst case, a restart per period;
+                // then the same under the AC dither.
+                for (dither, alternate) in [
+                    (None, false),
+                    (Some((0.5, 10.5)), false),
+                    (None, true),
+                    (Some((0.5, 10.5)), true),
+                ] {
                     for (atol_name, plant) in &plants {
                         // `DRIVE_BENCH_ONLY=exponential/flat/flight/held` runs the cases whose
                         // label contains the value (a profile of one case).
                         let label = format!(
                             "{atol_name}/{disk_name}/{state}/{}",
                             match (dither, alternate) {
-                                (Some(_), _) => "dither",
+                                (Some(_), false) => "dither",
+                                (Some(_), true) => "dither-changed",
                                 (None, true) => "changed",
                                 (None, false) => "held",
                             }
@@ -117,7 +125,8 @@ fn main() {
                         println!(
                     "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} / {:.2} / {:.2} |",
                     match (dither, alternate) {
-                        (Some((a, f)), _) => format!("{a} V, {f:.1} kHz"),
+                        (Some((a, f)), false) => format!("{a} V, {f:.1} kHz"),
+                        (Some((a, f)), true) => format!("{a} V, {f:.1} kHz, ±1 µW every period"),
                         (None, true) => "off, ±1 µW every period".to_string(),
                         (None, false) => "off".to_string(),
                     },

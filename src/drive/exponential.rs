@@ -403,6 +403,10 @@ pub(crate) struct ExpScheme {
     pub(crate) orbit_wait: Backoff,
     /// The orbit's period map linearised in the heater power, when it passed its test.
     pub(crate) orbit_map: Option<OrbitMap>,
+    /// Whether the last period was read from the orbit's table alone, at the orbit's heater
+    /// power: the state is then the orbit's, and so is the next period's under the same
+    /// command.
+    pub(crate) on_orbit: bool,
     /// Periods since the voltage or the clearance last changed, or the heater by more than
     /// the map's test covers (the orbit's settling periods).
     pub(crate) voltage_held: usize,
@@ -455,6 +459,7 @@ impl ExpScheme {
             orbit: None,
             orbit_wait: Backoff::default(),
             orbit_map: None,
+            on_orbit: false,
             voltage_held: 0,
         }
     }

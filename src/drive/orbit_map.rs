@@ -53,6 +53,13 @@ pub(crate) const TEST_PERIODS: usize = 6;
 /// interpolation at the odd nodes over the trusted region, in units of the tolerances.
 pub(crate) const AGREEMENT: f64 = 0.5;
 
+/// The deviation from the orbit (in units of the tolerances) below which a period at the
+/// orbit's heater power is read from the orbit's table alone, as a held dither's periods are
+/// (whose table is trusted at half a tolerance from the orbit): the deviation a heater change
+/// leaves decays by about 0.39 a period of the dither and would otherwise be carried on for
+/// ever, down to subnormal numbers.
+pub(crate) const ON_ORBIT: f64 = 0.01;
+
 /// The longest drive period the map takes, in periods of the dither.
 const MAX_DITHER_PERIODS: f64 = 64.0;
 
@@ -381,7 +388,9 @@ impl OrbitMap {
     /// The state at the end `t1` of a drive period of `dt` (s) that starts at `t0` in state
     /// `x0` at the heater power `p` (W), into `x1`, the integrals `x0`'s plus their change: when
     /// `dt` is the map's and the heater offset and the deviation at `t0` are within the
-    /// trusted region. `false` (and `x1` not written) otherwise.
+    /// trusted region. `None` (and `x1` not written) otherwise; `Some(false)` when the period
+    /// is the orbit's own: the heater at the orbit's power and the deviation within [`ON_ORBIT`]
+    /// of the tolerances, read from the orbit's table as a held dither is.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn period_end(
         &self,
@@ -392,21 +401,26 @@ impl OrbitMap {
         x0: &[f64],
         p: f64,
         x1: &mut [f64],
-    ) -> bool {
+    ) -> Option<bool> {
         let u = p - self.heater;
         if dt != self.dt || u.abs() > self.offset {
-            return false;
+            return None;
         }
         let mut o0 = [0.0; MAX_STATE];
         orbit.state_at(t0, &mut o0[..self.n]);
-        let far = (0..self.n).filter(|&c| !self.integral[c]).any(|c| {
-            (x0[c] - o0[c]).abs() > self.radius * (self.atol[c] + self.rtol * x0[c].abs())
-        });
-        if far {
-            return false;
+        let deviation = (0..self.n)
+            .filter(|&c| !self.integral[c])
+            .map(|c| (x0[c] - o0[c]).abs() / (self.atol[c] + self.rtol * x0[c].abs()))
+            .fold(0.0f64, f64::max);
+        if deviation > self.radius {
+            return None;
+        }
+        if u == 0.0 && deviation <= ON_ORBIT {
+            orbit.period_end(t0, t1, x0, x1);
+            return Some(false);
         }
         self.propagate(orbit, t0, &o0[..self.n], t1, x0, u, x1);
-        true
+        Some(true)
     }
 
     /// The state at `t1` of a period `[t0, t1]` that starts in `x0`, the orbit's state there

@@ -1620,16 +1620,21 @@ where
         let p = it.system().inputs().heater.power(t0);
         let mut x1 = x0.clone();
         let read = match (&exp.orbit, &exp.orbit_map) {
+            (Some(orbit), _) if set.is_none() && exp.on_orbit => {
+                orbit.period_end(t0, t1, x0.as_slice(), x1.as_mut_slice());
+                Some((orbit.error, false))
+            }
             (Some(orbit), Some(map)) => map
                 .period_end(orbit, t0, t1, dt, x0.as_slice(), p, x1.as_mut_slice())
-                .then_some(orbit.error.max(map.error)),
+                .map(|mapped| (orbit.error.max(map.error), mapped)),
             (Some(orbit), None) if set.is_none() => {
                 orbit.period_end(t0, t1, x0.as_slice(), x1.as_mut_slice());
-                Some(orbit.error)
+                Some((orbit.error, false))
             }
             _ => None,
         };
-        let Some(error) = read else {
+        exp.on_orbit = read.is_some_and(|(_, mapped)| !mapped);
+        let Some((error, mapped)) = read else {
             // Outside what the table and its map hold: the integrator from the same start.
             exp.orbit = None;
             exp.orbit_map = None;
@@ -1642,7 +1647,7 @@ where
         x[..x1.len()].copy_from_slice(x1.as_slice());
         exp.owned = Some(x);
         exp.counts.orbit += 1;
-        if exp.orbit_map.is_some() {
+        if mapped {
             exp.counts.orbit_mapped += 1;
         }
         let report = PeriodReport {
@@ -1703,6 +1708,7 @@ where
                 }
             }
             exp.orbit = Some(o);
+            exp.on_orbit = false;
         }
         Err(_) => {
             exp.orbit_wait.missed(ORBIT_WAIT.0, ORBIT_WAIT.1);
