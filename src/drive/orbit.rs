@@ -89,6 +89,30 @@ where
     }
 }
 
+/// Steps the integrator onto `end` (its end time from here), failing once more than
+/// `max_steps` steps have been accepted since the count stood at `first`.
+pub(crate) fn step_onto<D: Dim>(
+    it: &mut Integrator<'static, D, SliderSystem>,
+    end: f64,
+    first: usize,
+    max_steps: usize,
+) -> Result<(), crate::ode::OdeError>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    it.set_tf(end)?;
+    while it.t() < end {
+        it.step()?;
+        if it.stats().accepted - first > max_steps {
+            return Err(crate::ode::OdeError::invalid(
+                "max_steps",
+                "over the budget",
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Orbit {
     /// Runs the integrator from `(t, x)` over two periods of the dither of frequency
     /// `frequency` (Hz) and tabulates the second when it passes the checks (module docs), with
@@ -115,19 +139,7 @@ impl Orbit {
         let (t, x) = if lead > 0 {
             let end = t + lead as f64 * period;
             let first = it.stats().accepted;
-            let ran = (|| -> Result<(), crate::ode::OdeError> {
-                restart(it, t, x, end)?;
-                while it.t() < end {
-                    it.step()?;
-                    if it.stats().accepted - first > max_steps {
-                        return Err(crate::ode::OdeError::invalid(
-                            "max_steps",
-                            "over the budget",
-                        ));
-                    }
-                }
-                Ok(())
-            })();
+            let ran = restart(it, t, x, end).and_then(|()| step_onto(it, end, first, max_steps));
             ran.map_err(|_| Refused::Integrator)?;
             (end, it.state().clone())
         } else {
@@ -147,17 +159,7 @@ impl Orbit {
             let mut f = it.state().clone();
             for k in 1..=count {
                 // Step by step onto the node (the end time), the budget counted per step.
-                let node = node_time(k);
-                it.set_tf(node)?;
-                while it.t() < node {
-                    it.step()?;
-                    if it.stats().accepted - start > max_steps {
-                        return Err(crate::ode::OdeError::invalid(
-                            "max_steps",
-                            "over the budget",
-                        ));
-                    }
-                }
+                step_onto(it, node_time(k), start, max_steps)?;
                 if k == 2 * NODES {
                     ends[1].copy_from_slice(it.state().as_slice());
                 }

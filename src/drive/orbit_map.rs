@@ -31,7 +31,7 @@
 //! `u`, where the tighter run finds 0.02.
 
 use super::exponential::{state_vector, MAX_STATE};
-use super::orbit::{restart, Orbit, Refused, NODES};
+use super::orbit::{restart, step_onto, Orbit, Refused, NODES};
 use crate::model::{Heater, SliderSystem};
 use crate::numerics::cubic_hermite;
 use crate::ode::{expm, Integrator, OdeSystem, Tolerance};
@@ -310,16 +310,7 @@ impl OrbitMap {
         let (mut worst, mut reach) = (0.0f64, 0.0f64);
         for i in 1..=TEST_PERIODS {
             let (t0, t1) = (t + (i - 1) as f64 * self.dt, t + i as f64 * self.dt);
-            it.set_tf(t1)?;
-            while it.t() < t1 {
-                it.step()?;
-                if it.stats().accepted - start > max_steps {
-                    return Err(crate::ode::OdeError::invalid(
-                        "max_steps",
-                        "over the budget",
-                    ));
-                }
-            }
+            step_onto(it, t1, start, max_steps)?;
             orbit.state_at(t0, &mut o0);
             reach = reach.max(self.propagate(orbit, t0, &o0, t1, &lin, p - self.heater, &mut next));
             let s = it.state();

@@ -1620,17 +1620,14 @@ where
         let p = it.system().inputs().heater.power(t0);
         let mut x1 = x0.clone();
         let read = match (&exp.orbit, &exp.orbit_map) {
-            (Some(orbit), _) if set.is_none() && exp.on_orbit => {
+            // A held command on the orbit, or a table without a map: the table alone.
+            (Some(orbit), map) if set.is_none() && (exp.on_orbit || map.is_none()) => {
                 orbit.period_end(t0, t1, x0.as_slice(), x1.as_mut_slice());
                 Some((orbit.error, false))
             }
             (Some(orbit), Some(map)) => map
                 .period_end(orbit, t0, t1, dt, x0.as_slice(), p, x1.as_mut_slice())
                 .map(|mapped| (orbit.error.max(map.error), mapped)),
-            (Some(orbit), None) if set.is_none() => {
-                orbit.period_end(t0, t1, x0.as_slice(), x1.as_mut_slice());
-                Some((orbit.error, false))
-            }
             _ => None,
         };
         exp.on_orbit = read.is_some_and(|(_, mapped)| !mapped);
