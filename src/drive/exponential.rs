@@ -33,6 +33,7 @@
 use super::disk::{Disk, NODES};
 use super::orbit::Orbit;
 use super::orbit_map::OrbitMap;
+use super::state::{state_vector, MAX_STATE};
 use crate::force::Gaps;
 use crate::model::{Inputs, SliderSystem, StateLayout, Voltage};
 use crate::ode::{ExponentialStepper, OdeSystem};
@@ -40,19 +41,6 @@ use nalgebra::{allocator::Allocator, DMatrix, DVector, DefaultAllocator, Dim, OM
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
-/// A state vector of dimension `dim` with components `value(i)`: an indexed loop, which costs a
-/// tenth of collecting an iterator into a fixed-size vector on the drive's per-period path.
-#[inline]
-pub(crate) fn state_vector<D: Dim>(dim: D, value: impl Fn(usize) -> f64) -> OVector<f64, D>
-where
-    DefaultAllocator: Allocator<D>,
-{
-    OVector::<f64, D>::from_fn_generic(dim, nalgebra::U1, |i, _| value(i))
-}
-
-/// Longest state a drive integrates (the plant's largest sized integrator, and this scheme's
-/// buffers).
-pub(crate) const MAX_STATE: usize = 11;
 
 /// Relative change of the held Jacobian (largest entry change over the largest entry of its
 /// row, the integrals' rows aside) beyond which a refresh also rebuilds the disk's table. The

@@ -42,6 +42,7 @@ mod replay;
 mod rng;
 mod roc;
 mod sensors;
+mod state;
 mod zone;
 
 pub use controller::{

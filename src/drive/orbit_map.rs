@@ -30,7 +30,7 @@
 //! that integrator's error instead: in contact it disagreed by 0.5–1.9 tolerances whatever
 //! `u`, where the tighter run finds 0.02.
 
-use super::exponential::{state_vector, MAX_STATE};
+use super::state::{state_vector, MAX_STATE};
 use super::orbit::{restart, step_onto, Orbit, Refused, NODES};
 use crate::model::{Heater, SliderSystem};
 use crate::numerics::cubic_hermite;

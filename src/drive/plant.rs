@@ -1,7 +1,8 @@
 //! The simulated drive: the slider of a scene in a zone, stepped at the controller's rate.
 
 use super::disk::{Disk, DiskSpec};
-use super::exponential::{state_vector, Attempt, Backoff, ExpScheme, SchemeCounts, MAX_STATE};
+use super::exponential::{Attempt, Backoff, ExpScheme, SchemeCounts};
+use super::state::{state_vector, MAX_STATE};
 use super::orbit::Orbit;
 use super::orbit_map::OrbitMap;
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
