@@ -41,7 +41,6 @@ use nalgebra::{allocator::Allocator, DMatrix, DVector, DefaultAllocator, Dim, OM
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
-
 /// Relative change of the held Jacobian (largest entry change over the largest entry of its
 /// row, the integrals' rows aside) beyond which a refresh also rebuilds the disk's table. The
 /// table's response is off by about this fraction of its size when the held Jacobian has

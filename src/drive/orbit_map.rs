@@ -30,8 +30,8 @@
 //! that integrator's error instead: in contact it disagreed by 0.5–1.9 tolerances whatever
 //! `u`, where the tighter run finds 0.02.
 
-use super::state::{state_vector, MAX_STATE};
 use super::orbit::{restart, step_onto, Orbit, Refused, NODES};
+use super::state::{state_vector, MAX_STATE};
 use crate::model::{Heater, SliderSystem};
 use crate::numerics::cubic_hermite;
 use crate::ode::{expm, Integrator, OdeSystem, Tolerance};

@@ -2,10 +2,10 @@
 
 use super::disk::{Disk, DiskSpec};
 use super::exponential::{Attempt, Backoff, ExpScheme, SchemeCounts};
-use super::state::{state_vector, MAX_STATE};
 use super::orbit::Orbit;
 use super::orbit_map::OrbitMap;
 use super::sensors::{Physical, SensorSpec, SensorState, Sensors, TrueState};
+use super::state::{state_vector, MAX_STATE};
 use super::Zone;
 use crate::analysis::{flying_equilibrium, CycleOptions, ScanGrid};
 use crate::error::{check_finite, check_non_negative, Error, Result};
@@ -1439,22 +1439,24 @@ where
 {
     let v = it.system().inputs().voltage;
     // A change of the heater alone, by no more than the orbit's linearised map can take
-    // (`src/drive/orbit_map.rs`), keeps a dither's orbit, its map and the wait for them.
-    let small = set.as_ref().is_some_and(|held| {
-        let inputs = it.system().inputs();
-        let p = held.command.heater_power();
-        let reach = exp
-            .orbit_map
-            .as_ref()
-            .map_or(MAX_HEATER_OFFSET, |m| m.offset());
-        let from = exp
-            .orbit_map
-            .as_ref()
-            .map_or(inputs.heater.power(span.t0), |m| m.heater());
-        held.voltage() == v
-            && held.clearance == inputs.clearance_offset
-            && (p - from).abs() <= reach
-    });
+    // (`src/drive/orbit_map.rs`), keeps a dither's orbit, its map and the wait for them; not
+    // with stateful terms, which have no map.
+    let small = mappable(layout)
+        && set.as_ref().is_some_and(|held| {
+            let inputs = it.system().inputs();
+            let p = held.command.heater_power();
+            let reach = exp
+                .orbit_map
+                .as_ref()
+                .map_or(MAX_HEATER_OFFSET, |m| m.offset());
+            let from = exp
+                .orbit_map
+                .as_ref()
+                .map_or(inputs.heater.power(span.t0), |m| m.heater());
+            held.voltage() == v
+                && held.clearance == inputs.clearance_offset
+                && (p - from).abs() <= reach
+        });
     exp.voltage_held = if set.is_some() && !small {
         0
     } else {
@@ -1468,6 +1470,7 @@ where
         } else if exp.orbit_map.is_none() && exp.orbit.take().is_some() {
             // A table without a map reads held periods only.
             exp.counts.orbit_exits += 1;
+            exp.orbit_wait.missed(ORBIT_WAIT.0, ORBIT_WAIT.1);
         }
         // The dither switched off: the wait its misses ran up says nothing of the periods
         // without it.
@@ -1572,6 +1575,12 @@ struct OrbitPeriod<'a> {
     /// The drive's period (s) and the dither's frequency (Hz).
     dt: f64,
     frequency: f64,
+}
+
+/// Whether a dither's orbit on this state may have a linearised map: not with the states or
+/// branches of stateful terms, whose laws may switch within a period.
+fn mappable(layout: &StateLayout) -> bool {
+    layout.term_states.1 == 0 && layout.branches.1 == 0
 }
 
 /// The largest change of the heater (W) that keeps a dither's orbit before its map is built
@@ -1690,10 +1699,9 @@ where
         Ok(o) => {
             exp.orbit_wait.succeeded();
             exp.counts.orbit_tables += 1;
-            // The map needs a state without branches or term states, whose laws may switch. A
-            // refused map puts off the next try as a refused table does: under a changing
+            // A refused map puts off the next try as a refused table does: under a changing
             // heater the table alone is dropped at the next period.
-            if layout.term_states.1 == 0 && layout.branches.1 == 0 {
+            if mappable(layout) {
                 match OrbitMap::build(it, &o, dt, &atol, exp.rtol(), budget) {
                     Ok(m) => {
                         exp.orbit_map = Some(m);
