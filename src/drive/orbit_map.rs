@@ -248,29 +248,30 @@ impl OrbitMap {
         // offset by ±u.
         let mut start = vec![0.0; n];
         orbit.state_at(t_ref, &mut start);
-        let tight: Vec<f64> = atol.iter().map(|a| a / TIGHTER).collect();
-        it.set_tolerances(rtol / TIGHTER, Tolerance::PerComponent(tight))
-            .map_err(|_| Refused::Integrator)?;
-        let mut passed = None;
-        for &u in &TEST_OFFSETS {
-            let mut worst = 0.0f64;
-            let mut reach = 0.0f64;
-            for sign in [1.0, -1.0] {
-                let (w, r) = map
-                    .test(it, orbit, t_ref, &start, heater + sign * u, max_steps)
-                    .map_err(|_| Refused::Integrator)?;
-                worst = worst.max(w);
-                reach = reach.max(r);
+        // The integrator's own tolerances, restored after the test whatever its outcome.
+        let (rtol0, atol0) = (it.rtol(), it.atol().to_vec());
+        let tested = (|| -> Result<Option<(f64, f64, f64)>, crate::ode::OdeError> {
+            let tight = atol0.iter().map(|a| a / TIGHTER).collect();
+            it.set_tolerances(rtol0 / TIGHTER, Tolerance::PerComponent(tight))?;
+            for &u in &TEST_OFFSETS {
+                let mut worst = 0.0f64;
+                let mut reach = 0.0f64;
+                for sign in [1.0, -1.0] {
+                    let (w, r) =
+                        map.test(it, orbit, t_ref, &start, heater + sign * u, max_steps)?;
+                    worst = worst.max(w);
+                    reach = reach.max(r);
+                }
+                if worst <= AGREEMENT {
+                    return Ok(Some((u, reach, worst)));
+                }
             }
-            if worst <= AGREEMENT {
-                passed = Some((u, reach, worst));
-                break;
-            }
-        }
+            Ok(None)
+        })();
         set_heater(it, heater);
-        it.set_tolerances(rtol, Tolerance::PerComponent(atol.to_vec()))
+        it.set_tolerances(rtol0, Tolerance::PerComponent(atol0))
             .map_err(|_| Refused::Integrator)?;
-        let Some((offset, radius, worst)) = passed else {
+        let Some((offset, radius, worst)) = tested.map_err(|_| Refused::Integrator)? else {
             return Err(Refused::Unsettled);
         };
         map.offset = offset;

@@ -758,6 +758,29 @@ where
         Ok(())
     }
 
+    /// The tolerances of the following steps: the relative one and the absolute one of each
+    /// component (what [`Integrator::set_tolerances`] set last, or the options').
+    ///
+    /// ```
+    /// use hdi_tribology::nalgebra::Vector1;
+    /// use hdi_tribology::ode::{FnSystem, Integrator, Method, Options, Tolerance};
+    /// let decay = FnSystem::new(|_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>| dy[0] = -y[0]);
+    /// let opts = Options::default().rtol(1e-8).atol(1e-12);
+    /// let mut it = Integrator::new(decay, 0.0, Vector1::new(1.0), 1.0, Method::Tsit5, &opts)?;
+    /// it.set_tolerances(1e-10, Tolerance::Scalar(1e-14))?;
+    /// assert_eq!((it.rtol(), it.atol()), (1e-10, &[1e-14][..]));
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    pub fn rtol(&self) -> f64 {
+        self.ctx.rtol
+    }
+
+    /// The absolute tolerance of each component for the following steps (see
+    /// [`Integrator::rtol`]).
+    pub fn atol(&self) -> &[f64] {
+        self.ctx.atol.as_slice()
+    }
+
     /// Changes the tolerances for the following steps. `Auto` keeps the stiff method chosen
     /// from the tolerance at the start.
     ///
