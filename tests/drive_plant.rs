@@ -511,3 +511,27 @@ fn a_dither_map_replays_to_the_bit() {
         "{counts:?}"
     );
 }
+
+/// A heater ramp under a dither (1 µW a period: out of the orbit's map within a few periods)
+/// does not keep building tables it cannot use: the heater's drift stops the tries, and a table
+/// left before it paid for itself puts off the next one.
+#[test]
+fn a_heater_ramp_under_a_dither_does_not_keep_trying_the_orbit() {
+    let scene = Scene::paper();
+    let zone = scene_zone(&scene, 0.025).unwrap();
+    let o = DriveOptions {
+        scheme: DriveScheme::Exponential,
+        disk: DiskSpec::flat(),
+        ..DriveOptions::default()
+    };
+    let mut d = Plant::new(&scene, &zone, 5, o)
+        .unwrap()
+        .into_drive()
+        .unwrap();
+    for k in 0..600 {
+        let c = Command::heater_mw(70.0 + 1e-3 * k as f64).with_dither(0.5, 10.5);
+        d.step(&c, DT).unwrap();
+    }
+    let c = d.scheme_counts();
+    assert!(c.orbit_tables + c.orbit_refusals <= 4, "{c:?}");
+}

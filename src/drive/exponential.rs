@@ -390,6 +390,13 @@ pub(crate) struct ExpScheme {
     pub(crate) orbit_wait: Backoff,
     /// The orbit's period map linearised in the heater power, when it passed its test.
     pub(crate) orbit_map: Option<OrbitMap>,
+    /// Periods read from the orbit's table since it was built, and whether it was built under
+    /// a changing heater and has not yet served `ORBIT_PAYBACK` of them (see
+    /// `src/drive/plant.rs`).
+    pub(crate) orbit_served: usize,
+    pub(crate) orbit_unpaid: bool,
+    /// The heater's drift per period, averaged (W; see `src/drive/plant.rs`).
+    pub(crate) heater_drift: f64,
     /// Whether the last period was read from the orbit's table alone, at the orbit's heater
     /// power: the state is then the orbit's, and so is the next period's under the same
     /// command.
@@ -447,6 +454,9 @@ impl ExpScheme {
             orbit_wait: Backoff::default(),
             orbit_map: None,
             on_orbit: false,
+            orbit_served: 0,
+            orbit_unpaid: false,
+            heater_drift: 0.0,
             voltage_held: 0,
         }
     }

@@ -1462,11 +1462,31 @@ where
     } else {
         exp.voltage_held + 1
     };
+    // The heater's drift per period, averaged over about `DRIFT_PERIODS` (W).
+    let step = match &set {
+        Some(held) if small => {
+            held.command.heater_power() - it.system().inputs().heater.power(span.t0)
+        }
+        _ => 0.0,
+    };
+    exp.heater_drift = if set.is_some() && !small {
+        0.0
+    } else {
+        exp.heater_drift + (step - exp.heater_drift) / DRIFT_PERIODS
+    };
     if let Some(held) = &set {
         if !small {
+            // A table built under a changing heater that is left before it paid for itself
+            // (a heater ramp) puts off the next try by a doubling wait; any other change
+            // starts afresh.
+            let unpaid = exp.orbit.is_some() && exp.orbit_unpaid;
             exp.orbit = None;
             exp.orbit_map = None;
-            exp.orbit_wait = Backoff::default();
+            if unpaid && held.voltage() == v {
+                exp.orbit_wait.missed(ORBIT_WAIT.0, ORBIT_WAIT.1);
+            } else {
+                exp.orbit_wait = Backoff::default();
+            }
         } else if exp.orbit_map.is_none() && exp.orbit.take().is_some() {
             // A table without a map reads held periods only.
             exp.counts.orbit_exits += 1;
@@ -1654,6 +1674,11 @@ where
         x[..x1.len()].copy_from_slice(x1.as_slice());
         exp.owned = Some(x);
         exp.counts.orbit += 1;
+        exp.orbit_served += 1;
+        if exp.orbit_unpaid && exp.orbit_served >= ORBIT_PAYBACK {
+            exp.orbit_unpaid = false;
+            exp.orbit_wait.succeeded();
+        }
         if mapped {
             exp.counts.orbit_mapped += 1;
         }
@@ -1665,6 +1690,11 @@ where
         return Ok(Some((x1, report)));
     }
     if exp.orbit_wait.waits() {
+        return Ok(None);
+    }
+    // A heater that drifts out of the map's largest offset before a table could pay for
+    // itself: no try.
+    if exp.heater_drift.abs() * ORBIT_PAYBACK as f64 > MAX_HEATER_OFFSET {
         return Ok(None);
     }
     let x0 = match exp.owned {
@@ -1697,7 +1727,13 @@ where
         budget,
     ) {
         Ok(o) => {
-            exp.orbit_wait.succeeded();
+            // Under a changing heater a table counts as a success once it has paid for itself
+            // (`ORBIT_PAYBACK`); a held command's at once.
+            exp.orbit_served = 0;
+            exp.orbit_unpaid = changed;
+            if !changed {
+                exp.orbit_wait.succeeded();
+            }
             exp.counts.orbit_tables += 1;
             // A refused map puts off the next try as a refused table does: under a changing
             // heater the table alone is dropped at the next period.
@@ -1730,6 +1766,17 @@ where
 /// period it follows: the slider's slowest mode contracts by about 0.39 a period of the dither
 /// at 10.5 kHz, so a deviation of a few tolerances from the orbit is gone after four.
 const ORBIT_LEAD: usize = 4;
+
+/// Periods a table built under a changing heater must serve before it counts as a success:
+/// a try that builds the table and its map costs 9–10 ms, the integrator's time for 200–500
+/// periods of a dither. A table left sooner (a heater ramp that leaves the map's offset) puts
+/// off the next try by a doubling wait, so that a ramp costs about the integrator's time and
+/// not a try every few periods (measured: 2–7 times the integrator's time before this wait).
+const ORBIT_PAYBACK: usize = 512;
+
+/// The periods the heater's drift is averaged over (an exponential average): a heater that
+/// alternates by ±1 µW drifts by about 0.008 µW a period on it, a ramp by its rate.
+const DRIFT_PERIODS: f64 = 64.0;
 
 /// The first and the longest wait (periods) before another try to tabulate a dither's orbit
 /// after a refusal.
