@@ -1364,11 +1364,7 @@ where
             .any(|(i, bound)| i.is_some_and(|i| it.state()[i].abs() > bound));
     let mut tol = tol;
     if set.is_some() || grown || start.is_some() {
-        let mut y = match start {
-            Some(y) => y,
-            None if it.t() > t0 => it.interpolate(t0)?,
-            None => it.state().clone(),
-        };
+        let mut y = state_at_start(it, t0, start)?;
         if grown {
             for i in integrals.into_iter().flatten() {
                 y[i] = 0.0;
@@ -1539,11 +1535,9 @@ where
     }
     let owned = exp.owned.take();
     let from_integrator = owned.is_none();
-    let mut x0 = match owned {
-        Some(x) => state_vector::<D>(D::from_usize(layout.len()), |i| x[i]),
-        None if it.t() > t0 => it.interpolate(t0)?,
-        None => it.state().clone(),
-    };
+    let dim = D::from_usize(layout.len());
+    let owned = owned.map(|x| state_vector::<D>(dim, |i| x[i]));
+    let mut x0 = state_at_start(it, t0, owned)?;
     if !exp.straight(it.system(), t0, &x0, dt) {
         let _ = exp.missed::<D>();
         if from_integrator {
@@ -1633,12 +1627,9 @@ where
     } = period;
     let Span { t0, t1, rebase, .. } = span;
     let dim = D::from_usize(layout.len());
-    let start = |exp: &mut ExpScheme, it: &Integrator<'static, D, SliderSystem>| -> Result<_> {
-        Ok(match exp.owned.take() {
-            Some(x) => state_vector::<D>(dim, |i| x[i]),
-            None if it.t() > t0 => it.interpolate(t0)?,
-            None => it.state().clone(),
-        })
+    let start = |exp: &mut ExpScheme, it: &Integrator<'static, D, SliderSystem>| {
+        let owned = exp.owned.take().map(|x| state_vector::<D>(dim, |i| x[i]));
+        state_at_start(it, t0, owned)
     };
     let landed = Span { land: true, ..span };
     if exp.orbit.is_some() {
@@ -1781,6 +1772,23 @@ const DRIFT_PERIODS: f64 = 64.0;
 /// The first and the longest wait (periods) before another try to tabulate a dither's orbit
 /// after a refusal.
 const ORBIT_WAIT: (usize, usize) = (8, 4096);
+
+/// The state at a period's start `t0`: `given`, or else the integrator's, read on the
+/// interpolant of its last step when that step ran past `t0`.
+fn state_at_start<D: Dim>(
+    it: &Integrator<'static, D, SliderSystem>,
+    t0: f64,
+    given: Option<OVector<f64, D>>,
+) -> Result<OVector<f64, D>>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    Ok(match given {
+        Some(y) => y,
+        None if it.t() > t0 => it.interpolate(t0)?,
+        None => it.state().clone(),
+    })
+}
 
 /// Sets the period integrals of `x` back to zero once either has grown past its bound (see
 /// [`advance`]).
