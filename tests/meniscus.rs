@@ -703,6 +703,10 @@ fn auto_hands_back_where_a_stiff_branch_ends() {
             // than 3/5 of the steps stiff (the build before: 23 and 83 %).
             assert!(a.stiffness_switches >= 100, "{a:?}");
             assert!(5 * a.stiff_steps < 3 * a.accepted, "{a:?}");
+            // Each entry into the formation branch starts with the first step the last entry
+            // accepted: fewer than one rejected step in ten stiff ones (the build before
+            // rejected three to five at every entry, 667 in 3 431 stiff steps).
+            assert!(10 * a.rejected < a.stiff_steps, "{a:?}");
         }
     }
 }

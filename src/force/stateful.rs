@@ -179,6 +179,12 @@ pub trait StatefulTerm: Debug + Send + Sync {
     /// Called when a simulation switches into `branch` at gaps `g`: the term may set its states
     /// there (nothing by default). The force must be continuous across the switch.
     fn enter(&self, _branch: Branch, _g: Gaps, _x: &mut [f64]) {}
+    /// [`StatefulTerm::rates_on`] into `dx` and the value of [`StatefulTerm::force_value_on`]
+    /// (the same numbers) in one call, for the right-hand side; by default the two calls.
+    fn rates_and_force_value_on(&self, branch: Branch, g: Gaps, x: &[f64], dx: &mut [f64]) -> f64 {
+        self.rates_on(branch, g, x, dx);
+        self.force_value_on(branch, g, x)
+    }
 }
 
 /// One first-order state that relaxes towards a target proportional to the bulge gap,

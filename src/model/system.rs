@@ -188,9 +188,25 @@ pub struct SliderSystem {
     model: Arc<SliderModel>,
     inputs: Inputs,
     layout: StateLayout,
+    /// Per stateful term: the index of its first state, its number of states and the index of
+    /// its branch flag (for a term with two branches), read once from the layout.
+    slots: Vec<TermSlot>,
+    /// Per switch: the term it belongs to (an index into `slots`).
+    switch_terms: Vec<usize>,
     /// `(velocity index, r_i)` of the coordinates a disk translation moves.
     base: [(usize, f64); MAX_DOF],
     n_base: usize,
+}
+
+/// Where a stateful term sits in the state ([`SliderSystem::terms`]).
+#[derive(Clone, Copy, Debug)]
+struct TermSlot {
+    /// The index of its first state.
+    at: usize,
+    /// Its number of states.
+    k: usize,
+    /// The index of its branch flag, for a term with two branches.
+    flag: Option<usize>,
 }
 
 /// Forces and their derivatives at one state.
@@ -222,10 +238,28 @@ impl SliderSystem {
                 n_base += 1;
             }
         }
+        let (mut at, mut flag) = (layout.term_states.0, layout.branches.0);
+        let mut slots = Vec::with_capacity(model.stateful_terms().len());
+        let mut switch_terms = Vec::new();
+        for (j, term) in model.stateful_terms().iter().enumerate() {
+            let held = term.switches().then(|| {
+                switch_terms.push(j);
+                flag += 1;
+                flag - 1
+            });
+            slots.push(TermSlot {
+                at,
+                k: term.states(),
+                flag: held,
+            });
+            at += term.states();
+        }
         SliderSystem {
             model,
             inputs,
             layout,
+            slots,
+            switch_terms,
             base,
             n_base,
         }
@@ -614,15 +648,11 @@ impl SliderSystem {
     /// Every stateful term with the index of its first state and of its branch flag (the flag
     /// only for a term with two branches).
     fn terms(&self) -> impl Iterator<Item = (&dyn StatefulTerm, usize, Option<usize>)> + '_ {
-        let (mut at, mut flag) = (self.layout.term_states.0, self.layout.branches.0);
-        self.model.stateful_terms().iter().map(move |term| {
-            let held = term.switches().then(|| {
-                flag += 1;
-                flag - 1
-            });
-            at += term.states();
-            (&**term as &dyn StatefulTerm, at - term.states(), held)
-        })
+        self.model
+            .stateful_terms()
+            .iter()
+            .zip(&self.slots)
+            .map(|(term, slot)| (&**term as &dyn StatefulTerm, slot.at, slot.flag))
     }
 
     /// Calls `f(term, index of its first state, index of its branch flag)` for every stateful
@@ -635,11 +665,10 @@ impl SliderSystem {
 
     /// The term of switch `i` (the `i`-th term with two branches), the index of its first state
     /// and of its flag.
-    fn switching_term(&self, i: usize) -> Option<(&dyn StatefulTerm, usize, usize)> {
-        let flag = self.layout.branches.0 + i;
-        self.terms()
-            .find(|t| t.2 == Some(flag))
-            .map(|(term, at, _)| (term, at, flag))
+    fn switching_term(&self, i: usize) -> Option<(&dyn StatefulTerm, TermSlot, usize)> {
+        let j = *self.switch_terms.get(i)?;
+        let slot = self.slots[j];
+        Some((&*self.model.stateful_terms()[j], slot, slot.flag?))
     }
 
     /// The branch held at flag `flag` of state `s` (the upper one for a term with one law).
@@ -654,18 +683,19 @@ impl SliderSystem {
         DefaultAllocator: Allocator<D>,
     {
         let mut force = 0.0;
-        self.for_terms(|term, at, flag| {
-            let k = term.states();
+        for (term, slot) in self.model.stateful_terms().iter().zip(&self.slots) {
+            let TermSlot { at, k, flag } = *slot;
             let x = &s.as_slice()[at..at + k];
             let mut dx = [0.0; MAX_TERM_STATES];
             let branch = Self::held(flag, s);
-            term.rates_on(branch, g, x, &mut dx[..k]);
-            ds.as_mut_slice()[at..at + k].copy_from_slice(&dx[..k]);
+            force += term.rates_and_force_value_on(branch, g, x, &mut dx[..k]);
+            for (j, v) in dx[..k].iter().enumerate() {
+                ds[at + j] = *v;
+            }
             if let Some(i) = flag {
                 ds[i] = 0.0;
             }
-            force += term.force_value_on(branch, g, x);
-        });
+        }
         force
     }
 
@@ -760,10 +790,10 @@ where
     /// The term's switching function times its held flag: non-negative while the held branch
     /// is the one the sign picks.
     fn switching(&self, i: usize, t: f64, s: &OVector<f64, D>) -> f64 {
-        let Some((term, at, flag)) = self.switching_term(i) else {
+        let Some((term, slot, flag)) = self.switching_term(i) else {
             return 0.0;
         };
-        let x = &s.as_slice()[at..at + term.states()];
+        let x = &s.as_slice()[slot.at..slot.at + slot.k];
         let gaps = || self.gaps(t, s);
         let rate = || self.gap_rates(t, s);
         s[flag] * term.switching_on(Self::held(Some(flag), s), &gaps, &rate, x)
@@ -771,16 +801,15 @@ where
 
     /// The other branch, entered ([`StatefulTerm::enter`]).
     fn switch(&self, i: usize, t: f64, s: &mut OVector<f64, D>) {
-        let Some((term, at, flag)) = self.switching_term(i) else {
+        let Some((term, slot, flag)) = self.switching_term(i) else {
             return;
         };
         s[flag] = -s[flag];
         let g = self.gaps(t, s);
-        let k = term.states();
         term.enter(
             Self::held(Some(flag), s),
             g,
-            &mut s.as_mut_slice()[at..at + k],
+            &mut s.as_mut_slice()[slot.at..slot.at + slot.k],
         );
     }
 
