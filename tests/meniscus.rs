@@ -705,7 +705,7 @@ fn auto_hands_back_where_a_stiff_branch_ends() {
             assert!(5 * a.stiff_steps < 3 * a.accepted, "{a:?}");
             // Each entry into the formation branch starts with the first step the last entry
             // accepted: fewer than one rejected step in ten stiff ones (the build before
-            // rejected three to five at every entry, 667 in 3 431 stiff steps).
+            // rejected three to five at every entry: 685 rejected steps here).
             assert!(10 * a.rejected < a.stiff_steps, "{a:?}");
         }
     }
