@@ -819,6 +819,33 @@ where
         term.fastest_rate_on(Branch::of_flag(s[flag]))
     }
 
+    /// The stateful terms' own relaxation on their held branches: each term state's
+    /// `∂ẋ_i/∂x_i` ([`StatefulTerm::rate_partials_on`]); zero for the slider's coordinates.
+    fn stiff_diagonal(&self, t: f64, s: &OVector<f64, D>, lambda: &mut OVector<f64, D>) -> bool {
+        lambda.fill(0.0);
+        if self.layout.term_states.1 == 0 {
+            return false;
+        }
+        let g = self.gaps(t, s);
+        let mut any = false;
+        self.for_terms(|term, at, flag| {
+            let k = term.states();
+            let p = term.rate_partials_on(Self::held(flag, s), g, &s.as_slice()[at..at + k]);
+            for c in 0..k {
+                lambda[at + c] = p.d_state[c][c];
+                any |= p.d_state[c][c] != 0.0;
+            }
+        });
+        any
+    }
+
+    /// The stateful terms' rates alone (the other rows are left as they are).
+    fn stiff_rates(&self, t: f64, s: &OVector<f64, D>, rates: &mut OVector<f64, D>) {
+        if self.layout.term_states.1 > 0 {
+            self.term_rates(self.gaps(t, s), s, rates);
+        }
+    }
+
     fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
         if let Some(q) = self.model.quasi_static {
             return self.condensed_rhs(&q, t, s, ds);

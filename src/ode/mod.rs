@@ -29,6 +29,7 @@
 //! # Ok::<(), hdi_tribology::ode::OdeError>(())
 //! ```
 
+mod ark436;
 mod cancel;
 mod dense;
 mod dop853;

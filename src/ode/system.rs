@@ -171,6 +171,68 @@ where
     fn branch_rate(&self, _i: usize, _y: &OVector<f64, D>) -> Option<f64> {
         None
     }
+
+    /// The stiff rows and their slopes, written into `lambda`: `Λ_i = ∂f_i/∂y_i` (1/s) for a
+    /// stiff row `i`, 0 for the others; `false` (the default) where the system declares none.
+    /// A declared row must be affine in its own state, with that slope, and must not depend on
+    /// the other declared rows (a fast relaxation `ẏ_i = Λ_i (y_i − u)` towards a target `u` of
+    /// the other states).
+    ///
+    /// `Auto` reads it where a switch enters a branch whose [`branch_rate`] would hold its
+    /// explicit step far below the coming one: with a declaration it steps the declared rows
+    /// implicitly and the others explicitly (the additive pair ARK4(3)6L[2]SA of Kennedy and
+    /// Carpenter), at about the cost of an explicit step, instead of handing the branch to its
+    /// stiff method. It is read at each step's start and held over the step.
+    ///
+    /// The relaxation of [`switches`] with a fast branch (`τ = 1e-5`), declared:
+    ///
+    /// ```
+    /// use hdi_tribology::ode::{solve, Method, OdeSystem, Options};
+    /// use nalgebra::{Vector2, U2};
+    /// struct Follower;
+    /// impl OdeSystem<U2> for Follower {
+    ///     fn rhs(&self, t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>) {
+    ///         let tau = if y[1] > 0.0 { 1e-5 } else { 2.0 };
+    ///         dy[0] = (t.sin() - y[0]) / tau;
+    ///         dy[1] = 0.0;
+    ///     }
+    ///     fn switches(&self) -> usize {
+    ///         1
+    ///     }
+    ///     fn switching(&self, _i: usize, t: f64, y: &Vector2<f64>) -> f64 {
+    ///         y[1] * (t.sin() - y[0])
+    ///     }
+    ///     fn switch(&self, _i: usize, _t: f64, y: &mut Vector2<f64>) {
+    ///         y[1] = -y[1];
+    ///     }
+    ///     fn branch_rate(&self, _i: usize, y: &Vector2<f64>) -> Option<f64> {
+    ///         Some(if y[1] > 0.0 { 1e5 } else { 0.5 })
+    ///     }
+    ///     // The fast branch's relaxation is the stiff part: −1/τ on the first state.
+    ///     fn stiff_diagonal(&self, _t: f64, y: &Vector2<f64>, lambda: &mut Vector2<f64>) -> bool {
+    ///         *lambda = Vector2::new(if y[1] > 0.0 { -1e5 } else { 0.0 }, 0.0);
+    ///         y[1] > 0.0
+    ///     }
+    /// }
+    /// let opts = Options::default().rtol(1e-6).atol(1e-9);
+    /// let sol = solve(&Follower, 0.0, Vector2::new(0.0, 1.0), 20.0, Method::Auto, &opts, &mut [])?;
+    /// // No step at the explicit bound of the fast branch (3.3e-5): far fewer than 20/3.3e-5.
+    /// assert!(sol.stats.accepted < 20_000, "{:?}", sol.stats);
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    ///
+    /// [`branch_rate`]: OdeSystem::branch_rate
+    /// [`switches`]: OdeSystem::switches
+    fn stiff_diagonal(&self, _t: f64, _y: &OVector<f64, D>, _lambda: &mut OVector<f64, D>) -> bool {
+        false
+    }
+
+    /// The rates of the rows [`stiff_diagonal`](OdeSystem::stiff_diagonal) declares, at
+    /// `(t, y)`, into `rates` (the other rows may hold anything). By default the whole
+    /// right-hand side; a system whose stiff rows cost less alone says so here.
+    fn stiff_rates(&self, t: f64, y: &OVector<f64, D>, rates: &mut OVector<f64, D>) {
+        self.rhs(t, y, rates)
+    }
 }
 
 /// Forwards every method of [`OdeSystem`] through a pointer type.
@@ -227,6 +289,19 @@ macro_rules! forward_system {
             #[inline]
             fn branch_rate(&self, i: usize, y: &OVector<f64, D>) -> Option<f64> {
                 (**self).branch_rate(i, y)
+            }
+            #[inline]
+            fn stiff_diagonal(
+                &self,
+                t: f64,
+                y: &OVector<f64, D>,
+                lambda: &mut OVector<f64, D>,
+            ) -> bool {
+                (**self).stiff_diagonal(t, y, lambda)
+            }
+            #[inline]
+            fn stiff_rates(&self, t: f64, y: &OVector<f64, D>, rates: &mut OVector<f64, D>) {
+                (**self).stiff_rates(t, y, rates)
             }
         }
     };
