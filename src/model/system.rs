@@ -839,10 +839,17 @@ where
         any
     }
 
-    /// The stateful terms' rates alone (the other rows are left as they are).
+    /// The stateful terms' rates alone, without their forces (the other rows are left as they
+    /// are).
     fn stiff_rates(&self, t: f64, s: &OVector<f64, D>, rates: &mut OVector<f64, D>) {
-        if self.layout.term_states.1 > 0 {
-            self.term_rates(self.gaps(t, s), s, rates);
+        if self.layout.term_states.1 == 0 {
+            return;
+        }
+        let g = self.gaps(t, s);
+        for (term, slot) in self.model.stateful_terms().iter().zip(&self.slots) {
+            let TermSlot { at, k, flag } = *slot;
+            let (x, dx) = (&s.as_slice()[at..at + k], &mut rates.as_mut_slice()[at..at + k]);
+            term.rates_on(Self::held(flag, s), g, x, dx);
         }
     }
 
