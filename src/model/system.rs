@@ -848,7 +848,10 @@ where
         let g = self.gaps(t, s);
         for (term, slot) in self.model.stateful_terms().iter().zip(&self.slots) {
             let TermSlot { at, k, flag } = *slot;
-            let (x, dx) = (&s.as_slice()[at..at + k], &mut rates.as_mut_slice()[at..at + k]);
+            let (x, dx) = (
+                &s.as_slice()[at..at + k],
+                &mut rates.as_mut_slice()[at..at + k],
+            );
             term.rates_on(Self::held(flag, s), g, x, dx);
         }
     }

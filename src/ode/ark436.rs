@@ -1,4 +1,4 @@
-//! The additive Runge–Kutta pair ARK4(3)6L[2]SA of Kennedy and Carpenter (Appl. Numer. Math.
+//! The additive Runge–Kutta pair ARK4(3)6L\[2\]SA of Kennedy and Carpenter (Appl. Numer. Math.
 //! 44 (2003) 139–181, Table 6 of their appendix): an explicit method and an L-stable, stiffly
 //! accurate ESDIRK that share their nodes and weights, order 4 with an embedded order 3, six
 //! stages.
@@ -106,7 +106,7 @@ const BHAT: [f64; S] = [
     61727.0 / 225_920.0,
 ];
 
-/// The ARK4(3)6L[2]SA stepper: `F_j` are the full right-hand sides at the stage inputs `Z_j`,
+/// The ARK4(3)6L\[2\]SA stepper: `F_j` are the full right-hand sides at the stage inputs `Z_j`,
 /// the first of which is the step's start (handed on from the last step's end).
 pub(crate) struct Ark436<D: Dim>
 where

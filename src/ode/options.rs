@@ -41,7 +41,7 @@ pub enum Method {
     /// coming one, and hands back where such a branch ends and the stiffness went with it.
     /// Where the system declares that branch's stiff rows
     /// ([`crate::ode::OdeSystem::stiff_diagonal`]) and the rest is not stiff, it steps the
-    /// branch with the additive pair ARK4(3)6L[2]SA instead (those rows implicit, by a
+    /// branch with the additive pair ARK4(3)6L\[2\]SA instead (those rows implicit, by a
     /// division each; the others explicit), back to Tsit5 where the branch ends.
     Auto,
 }

@@ -180,7 +180,7 @@ where
     ///
     /// `Auto` reads it where a switch enters a branch whose [`branch_rate`] would hold its
     /// explicit step far below the coming one: with a declaration it steps the declared rows
-    /// implicitly and the others explicitly (the additive pair ARK4(3)6L[2]SA of Kennedy and
+    /// implicitly and the others explicitly (the additive pair ARK4(3)6L\[2\]SA of Kennedy and
     /// Carpenter), at about the cost of an explicit step, instead of handing the branch to its
     /// stiff method. It is read at each step's start and held over the step.
     ///
