@@ -552,6 +552,11 @@ impl StatefulTerm for Meniscus {
     fn rests_on_bulge_gap(&self) -> bool {
         true
     }
+    /// `ḋ* = (d − d*)/τ` (τ_h or τ_f by branch; 0 while bridges form at once) and
+    /// `ṫ_h = r_p S(d − t_m) − t_h/τ_p`.
+    fn rates_diagonal_affine(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

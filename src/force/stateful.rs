@@ -126,6 +126,15 @@ pub trait StatefulTerm: Debug + Send + Sync {
     fn rests_on_bulge_gap(&self) -> bool {
         false
     }
+    /// Whether every rate of the term, on each branch, is affine in the term's state of its own
+    /// row, with a slope constant on the branch (the diagonal of
+    /// [`StatefulTerm::rate_partials_on`]), and free of the term's other states:
+    /// `ẋ_i = a_i(d) + b_i x_i`. The simulations may then step the term's states implicitly, row
+    /// by row, where a branch is fast (`ode::OdeSystem::stiff_diagonal`). False by default (a
+    /// term that says true and is not would be integrated wrongly).
+    fn rates_diagonal_affine(&self) -> bool {
+        false
+    }
     /// Whether the rate law has two smooth branches split by the sign of
     /// [`StatefulTerm::switching`]: false by default. The simulations then hold the branch in
     /// their state, integrate [`StatefulTerm::rates_on`] over each step and change branch at
@@ -282,6 +291,10 @@ impl StatefulTerm for RelaxingState {
     }
     /// The equilibrium `a d` and the force `k x` see the bulge gap alone.
     fn rests_on_bulge_gap(&self) -> bool {
+        true
+    }
+    /// `ẋ = (a d − x)/τ`.
+    fn rates_diagonal_affine(&self) -> bool {
         true
     }
     fn force(&self, _g: Gaps, x: &[f64]) -> StateForce {

@@ -820,7 +820,9 @@ where
     }
 
     /// The stateful terms' own relaxation on their held branches: each term state's
-    /// `∂ẋ_i/∂x_i` ([`StatefulTerm::rate_partials_on`]); zero for the slider's coordinates.
+    /// `∂ẋ_i/∂x_i` ([`StatefulTerm::rate_partials_on`]), for the terms whose rates are affine
+    /// in their own states row by row ([`StatefulTerm::rates_diagonal_affine`]); zero for the
+    /// slider's coordinates and the other terms.
     fn stiff_diagonal(&self, t: f64, s: &OVector<f64, D>, lambda: &mut OVector<f64, D>) -> bool {
         lambda.fill(0.0);
         if self.layout.term_states.1 == 0 {
@@ -829,6 +831,9 @@ where
         let g = self.gaps(t, s);
         let mut any = false;
         self.for_terms(|term, at, flag| {
+            if !term.rates_diagonal_affine() {
+                return;
+            }
             let k = term.states();
             let p = term.rate_partials_on(Self::held(flag, s), g, &s.as_slice()[at..at + k]);
             for c in 0..k {
