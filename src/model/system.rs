@@ -830,17 +830,17 @@ where
         }
         let g = self.gaps(t, s);
         let mut any = false;
-        self.for_terms(|term, at, flag| {
+        for (term, slot) in self.model.stateful_terms().iter().zip(&self.slots) {
             if !term.rates_diagonal_affine() {
-                return;
+                continue;
             }
-            let k = term.states();
+            let TermSlot { at, k, flag } = *slot;
             let p = term.rate_partials_on(Self::held(flag, s), g, &s.as_slice()[at..at + k]);
             for c in 0..k {
                 lambda[at + c] = p.d_state[c][c];
                 any |= p.d_state[c][c] != 0.0;
             }
-        });
+        }
         any
     }
 

@@ -159,7 +159,8 @@ where
 
     fn attempt(&mut self, sys: &Sys, step: Step<'_, D>, ctx: &mut Ctx<D>) -> Trial {
         let Step { t, h, y, y_new } = step;
-        if !sys.stiff_diagonal(t, y, &mut self.lambda) {
+        let declared = sys.stiff_diagonal(t, y, &mut self.lambda);
+        if !declared {
             self.lambda.fill(0.0);
         }
         let n = y.len();
@@ -180,11 +181,13 @@ where
                 zs[i] = y[i] + h * sum;
             }
             // The stiff rows: `Z = R + hγ f(Z)` with `f` affine in the row's own state.
-            sys.stiff_rates(t + C[s] * h, zs, &mut self.rates);
-            for i in 0..n {
-                let l = self.lambda[i];
-                if l != 0.0 {
-                    zs[i] += h * GAMMA * self.rates[i] / (1.0 - h * GAMMA * l);
+            if declared {
+                sys.stiff_rates(t + C[s] * h, zs, &mut self.rates);
+                for i in 0..n {
+                    let l = self.lambda[i];
+                    if l != 0.0 {
+                        zs[i] += h * GAMMA * self.rates[i] / (1.0 - h * GAMMA * l);
+                    }
                 }
             }
             let (_, fr) = self.f.split_at_mut(s);

@@ -1382,12 +1382,7 @@ where
         let accepted = self.ctx.stats.accepted;
         let imex = self.imex_left_at.is_none_or(|a| accepted > a + 1)
             && self.sys.stiff_diagonal(self.t, &self.y, &mut self.lambda)
-            && {
-                let mut f0 = self.y.clone();
-                self.sys.rhs(self.t, &self.y, &mut f0);
-                self.ctx.stats.rhs_evals += 1;
-                first * self.explicit_part_radius(&f0) < STIFF_FRACTION * boundary
-            };
+            && { first * self.radius_here(true) < STIFF_FRACTION * boundary };
         self.h = first;
         self.h_explicit = bound;
         self.use_method(if imex { IMEX } else { 1 });
@@ -1422,19 +1417,7 @@ where
         if !held {
             return;
         }
-        let mut f0 = self.y.clone();
-        self.sys.rhs(self.t, &self.y, &mut f0);
-        self.ctx.stats.rhs_evals += 1;
-        let rho = estimate_radius(
-            &self.sys,
-            self.t,
-            &self.y,
-            &f0,
-            &mut self.jac_work,
-            &mut self.work,
-            &mut self.ctx,
-        );
-        if self.h * rho < STIFF_FRACTION * boundary {
+        if self.h * self.radius_here(false) < STIFF_FRACTION * boundary {
             self.change_method();
         }
     }
@@ -1556,23 +1539,14 @@ where
                 }
             } else if flagged || self.since_check >= CHECK_INTERVAL {
                 self.since_check = 0;
-                let rho = if self.active == IMEX {
-                    // The stiff rows are the pair's implicit part: the rest limits its step.
-                    let f0 = self.steppers.get::<S>(IMEX).f0().clone();
+                // While the additive pair runs, its implicit rows are left out: the rest
+                // limits its step.
+                let imex = self.active == IMEX;
+                if imex {
                     self.sys.stiff_diagonal(self.t, &self.y, &mut self.lambda);
-                    self.explicit_part_radius(&f0)
-                } else {
-                    let f0 = self.steppers.get::<S>(self.active).f0();
-                    estimate_radius(
-                        &self.sys,
-                        self.t,
-                        &self.y,
-                        f0,
-                        &mut self.jac_work,
-                        &mut self.work,
-                        &mut self.ctx,
-                    )
-                };
+                }
+                let f0 = self.steppers.get::<S>(self.active).f0().clone();
+                let rho = self.radius_at(&f0, imex);
                 if h_acc * rho > STIFF_FRACTION * boundary {
                     self.stiff_count += 1;
                 } else {
@@ -1637,10 +1611,12 @@ where
         self.use_method(usize::from(self.active != 1));
     }
 
-    /// The spectral radius of the Jacobian at the current point without the rows and columns
-    /// the system declares stiff (`self.lambda`, as [`OdeSystem::stiff_diagonal`] last wrote
-    /// it): what limits the additive pair's explicit part. `f0` is `f` at the current point.
-    fn explicit_part_radius(&mut self, f0: &OVector<f64, D>) -> f64 {
+    /// Spectral radius of the Jacobian at the current point, where `f0` is `f`, for the
+    /// stiffness checks (∞ when the Jacobian is not finite, which sends the integration to the
+    /// stiff method). With `without_stiff_rows`, the rows and columns the system declares stiff
+    /// (`self.lambda`, as [`OdeSystem::stiff_diagonal`] last wrote it) are left out: what limits
+    /// the additive pair's explicit part.
+    fn radius_at(&mut self, f0: &OVector<f64, D>, without_stiff_rows: bool) -> f64 {
         let Some(jac) = self.jac_work.as_mut() else {
             return 0.0;
         };
@@ -1655,13 +1631,24 @@ where
         ) {
             return f64::INFINITY;
         }
-        for i in 0..self.y.len() {
-            if self.lambda[i] != 0.0 {
-                jac.row_mut(i).fill(0.0);
-                jac.column_mut(i).fill(0.0);
+        if without_stiff_rows {
+            for i in 0..self.y.len() {
+                if self.lambda[i] != 0.0 {
+                    jac.row_mut(i).fill(0.0);
+                    jac.column_mut(i).fill(0.0);
+                }
             }
         }
         spectral_radius(jac, &self.y)
+    }
+
+    /// [`Integrator::radius_at`] with `f` evaluated at the current point (after a switch, where
+    /// the method has not restarted yet).
+    fn radius_here(&mut self, without_stiff_rows: bool) -> f64 {
+        let mut f0 = self.y.clone();
+        self.sys.rhs(self.t, &self.y, &mut f0);
+        self.ctx.stats.rhs_evals += 1;
+        self.radius_at(&f0, without_stiff_rows)
     }
 
     /// Hands over to method `m` of `Auto`; it restarts from the current state.
@@ -1773,29 +1760,5 @@ where
         h
     } else {
         h0
-    }
-}
-
-/// Spectral radius of the Jacobian at `(t, y)` for the stiffness check (∞ when the Jacobian is
-/// not finite, which sends the integration to the stiff method).
-fn estimate_radius<D: Dim, S: OdeSystem<D> + ?Sized>(
-    sys: &S,
-    t: f64,
-    y: &OVector<f64, D>,
-    f0: &OVector<f64, D>,
-    jac: &mut Option<OMatrix<f64, D, D>>,
-    work: &mut OVector<f64, D>,
-    ctx: &mut Ctx<D>,
-) -> f64
-where
-    DefaultAllocator: Allocator<D> + Allocator<D, D>,
-{
-    let Some(jac) = jac.as_mut() else {
-        return 0.0;
-    };
-    if eval_jacobian(sys, t, y, f0, jac, work, ctx) {
-        spectral_radius(jac, y)
-    } else {
-        f64::INFINITY
     }
 }
