@@ -21,7 +21,7 @@
 //! and the filtered one 0.32–0.80 times (the test below). The filtered estimate thus errs on the
 //! short side, by up to a factor of 3, on a row whose local errors the stiff decay damps rather
 //! than accumulates. On the meniscus's formation branch the raw estimate of the closest
-//! approach held the steps (8 575 at 0.6 V); filtered, the paper cycle takes 7 618, with
+//! approach held the steps (8 575 at 0.6 V); filtered, the paper cycle takes 7 622, with
 //! touchdown and take-off as close to a hundredfold tighter run as before (docs/benchmarks.md,
 //! "The formation branch on an additive pair").
 //!
