@@ -724,13 +724,25 @@ where
         self.end = t_end;
     }
 
-    /// `Q(t)` on the interpolants; `None` outside the integrated range.
-    fn impulse(&self, t: f64) -> Option<f64> {
+    /// `Q(t)` on the interpolants (`None` outside the integrated range), with the search for
+    /// the step that holds `t` starting at step `from`, which is then set to it: a cursor for
+    /// times read in increasing order (`from` must not be past that step; 0 always works).
+    fn impulse_after(&self, t: f64, from: &mut usize) -> Option<f64> {
         let first = self.steps.first()?.0;
         if !(t >= first && t <= self.end) {
             return None;
         }
-        let k = self.steps.partition_point(|s| s.0 <= t).saturating_sub(1);
+        // The last step that starts at or before `t`: a few steps on from `from` by a walk,
+        // beyond them by bisection.
+        let rest = &self.steps[*from..];
+        let walked = rest.iter().take(4).skip(1).take_while(|s| s.0 <= t).count();
+        let k = *from
+            + if walked < 3 {
+                walked
+            } else {
+                rest.partition_point(|s| s.0 <= t).saturating_sub(1)
+            };
+        *from = k;
         let (t0, h, lo) = self.steps[k];
         let hi = self.steps.get(k + 1).map_or(self.coeffs.len(), |s| s.2);
         let theta = if h != 0.0 { (t - t0) / h } else { 0.0 };
@@ -767,8 +779,18 @@ where
 {
     /// Running mean of the contact force at `t ≥ T_w`.
     fn indicator(&self, t: f64) -> f64 {
+        self.indicator_after(t, &mut [0, 0])
+    }
+
+    /// [`Detecting::indicator`] with cursors for `Q(t)` and `Q(t − T_w)` (see
+    /// [`Record::impulse_after`]).
+    fn indicator_after(&self, t: f64, from: &mut [usize; 2]) -> f64 {
         let w = self.detector.window;
-        match (self.rec.impulse(t), self.rec.impulse(t - w)) {
+        let [now, before] = from;
+        match (
+            self.rec.impulse_after(t, now),
+            self.rec.impulse_after(t - w, before),
+        ) {
             (Some(a), Some(b)) => (a - b) / w,
             _ => f64::NAN,
         }
@@ -785,39 +807,59 @@ where
         if a > b {
             return Ok(None);
         }
-        // Step times in (a, b) and in (a − T_w, b − T_w), the latter shifted by T_w.
+        // Step times in (a, b) and in (a − T_w, b − T_w), the latter shifted by T_w, merged in
+        // increasing order without repeats, between `a` and `b`.
         let times = &self.rec.times;
         let inside = |lo: f64, hi: f64| {
             let i = times.partition_point(|&t| t <= lo);
             let j = times.partition_point(|&t| t < hi);
             &times[i..j.max(i)]
         };
-        let mut samples: Vec<f64> = inside(a, b)
+        let within = |t: &f64| *t > a && *t < b;
+        let mut own = inside(a, b).iter().copied().filter(within).peekable();
+        let mut shifted = inside(a - w, b - w)
             .iter()
-            .copied()
-            .chain(inside(a - w, b - w).iter().map(|&t| t + w))
-            .filter(|&t| t > a && t < b)
-            .collect();
-        samples.push(a);
-        samples.push(b);
-        samples.sort_by(f64::total_cmp);
-        samples.dedup();
-        let hit = |x: f64| {
-            let v = self.indicator(x);
+            .map(|&t| t + w)
+            .filter(within)
+            .peekable();
+        let mut merged = std::iter::from_fn(|| match (own.peek(), shifted.peek()) {
+            (Some(x), Some(y)) if x.total_cmp(y).is_gt() => shifted.next(),
+            (Some(_), _) => own.next(),
+            _ => shifted.next(),
+        });
+        let mut last = a;
+        let mut next = || {
+            for t in merged.by_ref() {
+                if t != last {
+                    last = t;
+                    return Some(t);
+                }
+            }
+            (last != b).then(|| {
+                last = b;
+                b
+            })
+        };
+        // The indicator is read at increasing times: its look-ups go on from the last.
+        let mut from = [0, 0];
+        let mut hit = |x: f64| {
+            let v = self.indicator_after(x, &mut from);
             if rising {
                 v >= th
             } else {
                 v < th
             }
         };
-        if hit(samples[0]) {
-            return Ok(Some(samples[0]));
+        if hit(a) {
+            return Ok(Some(a));
         }
-        for pair in samples.windows(2) {
-            if hit(pair[1]) {
-                let t = brent(|x| self.indicator(x) - th, pair[0], pair[1], 1e-12 * w)?;
+        let mut prev = a;
+        while let Some(t) = next() {
+            if hit(t) {
+                let t = brent(|x| self.indicator(x) - th, prev, t, 1e-12 * w)?;
                 return Ok(Some(t));
             }
+            prev = t;
         }
         Ok(None)
     }
@@ -1185,4 +1227,46 @@ where
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Vector1, U1};
+
+    /// Reading `Q` at increasing times with one cursor gives the same bits as a fresh search
+    /// at every time: inside steps, on their starts and ends, twice at one time, and across
+    /// runs of steps longer than the cursor's walk.
+    #[test]
+    fn the_cursor_reads_the_impulse_a_fresh_search_reads() {
+        let mut rec = Record::<U1>::new(0.0, &Vector1::new(0.0), 0, false);
+        let mut t = 0.0;
+        for k in 0..40 {
+            let h = 0.1 + 0.05 * f64::from(k % 7);
+            let c = [
+                f64::from(k),
+                1.0 + 0.1 * f64::from(k),
+                -0.3,
+                0.02 * f64::from(k),
+            ];
+            rec.push_step(t, h, 1, &c, t + h);
+            t += h;
+        }
+        let end = t;
+        let mut times: Vec<f64> = (0..=400).map(|i| end * f64::from(i) / 400.0).collect();
+        times.extend(rec.steps.iter().map(|s| s.0));
+        times.extend(rec.steps.iter().map(|s| s.0 + s.1));
+        times.push(end + 1.0);
+        times.sort_by(f64::total_cmp);
+        // Steps of the cursor over more than its walk: every eighth time only.
+        for stride in [1, 8] {
+            let mut from = 0;
+            for &t in times.iter().step_by(stride) {
+                let fresh = rec.impulse_after(t, &mut 0);
+                let cursor = rec.impulse_after(t, &mut from);
+                assert_eq!(fresh.map(f64::to_bits), cursor.map(f64::to_bits), "t = {t}");
+                assert_eq!(cursor.is_some(), t <= end, "t = {t}");
+            }
+        }
+    }
 }
