@@ -801,6 +801,18 @@ where
     /// The indicator is smooth between step times and step times shifted by `T_w`; it is sampled
     /// there and the crossing is refined by root finding on the dense output.
     fn first_crossing(&self, a: f64, b: f64, rising: bool) -> Result<Option<f64>> {
+        self.first_crossing_after(a, b, rising, &mut [0, 0])
+    }
+
+    /// [`Detecting::first_crossing`] with cursors for the look-ups of `Q` (see
+    /// [`Record::impulse_after`]), for a caller that searches window after window.
+    fn first_crossing_after(
+        &self,
+        a: f64,
+        b: f64,
+        rising: bool,
+        from: &mut [usize; 2],
+    ) -> Result<Option<f64>> {
         let w = self.detector.window;
         let th = self.detector.contact_threshold;
         let a = a.max(w);
@@ -841,9 +853,8 @@ where
             })
         };
         // The indicator is read at increasing times: its look-ups go on from the last.
-        let mut from = [0, 0];
         let mut hit = |x: f64| {
-            let v = self.indicator_after(x, &mut from);
+            let v = self.indicator_after(x, from);
             if rising {
                 v >= th
             } else {
@@ -882,6 +893,8 @@ struct Watch {
     checked: f64,
     /// The touchdown time, once seen.
     found: Option<f64>,
+    /// The look-ups' cursors, carried from window to window.
+    cursors: [usize; 2],
 }
 
 impl<D: DimName> Observer for Recorder<D>
@@ -903,7 +916,7 @@ where
             rec: &self.rec,
             detector: w.detector,
         }
-        .first_crossing(w.checked, t, true)?;
+        .first_crossing_after(w.checked, t, true, &mut w.cursors)?;
         w.checked = t;
         w.found = found;
         Ok(if found.is_some() {
@@ -1034,6 +1047,7 @@ where
                 detector: det,
                 checked: t0,
                 found: None,
+                cursors: [0, 0],
             });
             sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
             let Some(t_td) = recorder.watch.take().and_then(|w| w.found) else {
