@@ -844,14 +844,17 @@ where
         any
     }
 
-    /// The stateful terms' rates alone, without their forces (the other rows are left as they
-    /// are).
+    /// The rates of the terms [`OdeSystem::stiff_diagonal`] declares, without their forces (the
+    /// other rows are left as they are).
     fn stiff_rates(&self, t: f64, s: &OVector<f64, D>, rates: &mut OVector<f64, D>) {
         if self.layout.term_states.1 == 0 {
             return;
         }
         let g = self.gaps(t, s);
         for (term, slot) in self.model.stateful_terms().iter().zip(&self.slots) {
+            if !term.rates_diagonal_affine() {
+                continue;
+            }
             let TermSlot { at, k, flag } = *slot;
             let (x, dx) = (
                 &s.as_slice()[at..at + k],
