@@ -70,7 +70,7 @@ use std::time::{Duration, SystemTime};
 use crate::{Error, Result};
 
 /// The version of the entry layout and payload; entries of another version are stale.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 /// Most entries a cache keeps by default.
 pub const DEFAULT_MAX_ENTRIES: usize = 64;
 /// Most bytes a cache keeps by default (256 MiB); an entry larger than the bound is not stored.

@@ -1,9 +1,15 @@
 //! One table holding the hot-path sums on a shared grid (the static, per-V² and contact forces,
 //! and the real contact area), so that an evaluation costs a single index computation and two
 //! node reads, and the values alone (an ODE's right-hand side) skip the slopes.
+//!
+//! Two kinds: smooth sums are tabulated afresh on equal panels to their tolerance
+//! ([`Fused::build`]); sums with kinks (a contact onset at each peak of a few-peak scene) are
+//! split at the kinks like their separate tables, and on each stretch the shared grid is the
+//! union of the separate tables' grids, so that every function's piecewise cubic is the
+//! separate table's own, to rounding ([`Fused::from_tables`]).
 
 use crate::cache::codec::{malformed, Reader, Writer};
-use crate::quadrature::{hermite_bounds, Span};
+use crate::quadrature::{hermite_bounds, Span, Table};
 use crate::Result;
 
 /// Panels of equal width; each holds a uniform grid refined until every function agrees with its
@@ -22,12 +28,25 @@ struct Panel {
     n: usize,
 }
 
+/// A stretch between two cuts (or the whole range): `count` panels of equal width from panel
+/// `first`.
+#[derive(Clone, Copy, Debug)]
+struct Segment {
+    lo: f64,
+    inv_panel: f64,
+    first: usize,
+    count: usize,
+}
+
 /// Values and slopes of `N` functions at each node.
 #[derive(Clone, Debug)]
 pub(crate) struct Fused<const N: usize> {
     lo: f64,
     hi: f64,
-    inv_panel: f64,
+    /// Interior cuts, ascending: segment `k` covers `[cuts[k-1], cuts[k])` (right-continuous, as
+    /// the separate tables).
+    cuts: Vec<f64>,
+    segments: Vec<Segment>,
     panels: Vec<Panel>,
     nodes: Vec<[(f64, f64); N]>,
 }
@@ -132,7 +151,104 @@ impl<const N: usize> Fused<N> {
         Some(Fused {
             lo,
             hi,
-            inv_panel: 1.0 / width,
+            cuts: Vec::new(),
+            segments: vec![Segment {
+                lo,
+                inv_panel: 1.0 / width,
+                first: 0,
+                count: PANELS,
+            }],
+            panels,
+            nodes,
+        })
+    }
+
+    /// The `N` functions whose separate tables are `parts` (function `k`'s tables on the
+    /// segments between `lo`, the `cuts` and `hi`; `None` for a function that is zero) on one
+    /// grid per segment: the union of the separate tables' grids there. Each separate table's
+    /// nodes are nodes of the union, and a cubic is its own Hermite interpolant, so the fused
+    /// look-up gives each function's separate look-up to rounding. `None` when a table does
+    /// not cover its segment, a value is not finite or the node budget is exceeded.
+    pub(crate) fn from_tables(
+        lo: f64,
+        hi: f64,
+        cuts: &[f64],
+        parts: [Option<&[Table]>; N],
+    ) -> Option<Self> {
+        let count = cuts.len() + 1;
+        if parts.iter().all(Option::is_none) || parts.iter().flatten().any(|p| p.len() != count) {
+            return None;
+        }
+        let mut edges = Vec::with_capacity(count + 1);
+        edges.push(lo);
+        edges.extend_from_slice(cuts);
+        edges.push(hi);
+        let (mut segments, mut panels, mut nodes) = (Vec::new(), Vec::new(), Vec::new());
+        for (s, w) in edges.windows(2).enumerate() {
+            let (a, b) = (w[0], w[1]);
+            let tables: Vec<&Table> = parts.iter().flatten().map(|p| &p[s]).collect();
+            if tables.iter().any(|t| t.range() != (a, b)) {
+                return None;
+            }
+            // Cells of the finest index grid among the tables (powers of two, so each table's
+            // cell holds a whole number of these).
+            let cells = tables.iter().map(|t| t.cell_count()).max()?;
+            segments.push(Segment {
+                lo: a,
+                inv_panel: cells as f64 / (b - a),
+                first: panels.len(),
+                count: cells,
+            });
+            let edge = |c: usize| {
+                if c == cells {
+                    b
+                } else {
+                    a + (b - a) * c as f64 / cells as f64
+                }
+            };
+            for c in 0..cells {
+                let (ca, cb) = (edge(c), edge(c + 1));
+                // The finest spacing of any table here; its intervals per cell are a power of two.
+                let n = tables
+                    .iter()
+                    .map(|t| {
+                        let h = t.cell_spacing(c / (cells / t.cell_count()));
+                        ((cb - ca) / h).round().max(1.0) as usize
+                    })
+                    .max()?
+                    .next_power_of_two();
+                let h = (cb - ca) / n as f64;
+                panels.push(Panel {
+                    a: ca,
+                    h,
+                    inv_h: 1.0 / h,
+                    start: nodes.len(),
+                    n,
+                });
+                for i in 0..=n {
+                    let x = if i == n { cb } else { ca + i as f64 * h };
+                    let mut node = [(0.0, 0.0); N];
+                    for (k, p) in parts.iter().enumerate() {
+                        if let Some(p) = p {
+                            let (v, m) = p[s].eval(x)?;
+                            if !(v.is_finite() && m.is_finite()) {
+                                return None;
+                            }
+                            node[k] = (v, m);
+                        }
+                    }
+                    nodes.push(node);
+                }
+                if nodes.len() > MAX_NODES {
+                    return None;
+                }
+            }
+        }
+        Some(Fused {
+            lo,
+            hi,
+            cuts: cuts.to_vec(),
+            segments,
             panels,
             nodes,
         })
@@ -145,18 +261,29 @@ impl<const N: usize> Fused<N> {
         if !(d >= self.lo && d <= self.hi) {
             return None;
         }
-        let pan = &self.panels[self.panel_index(d)];
+        let pan = &self.panels[self.panel_index(self.segment(d), d)];
         let s = (d - pan.a) * pan.inv_h;
         let j = interval_index(pan, s);
         let k = pan.start + j;
         Some((&self.nodes[k], &self.nodes[k + 1], s - j as f64, pan.h))
     }
 
-    /// The panel of `d` (inside the range). `d` is inside the range, so the index is small and
-    /// non-negative up to rounding: clamped in floating point, the conversion is one instruction.
+    /// The segment holding `d` (inside the range): right-continuous at the cuts.
     #[inline]
-    fn panel_index(&self, d: f64) -> usize {
-        ((d - self.lo) * self.inv_panel).min((PANELS - 1) as f64) as u32 as usize
+    fn segment(&self, d: f64) -> &Segment {
+        if self.cuts.is_empty() {
+            &self.segments[0]
+        } else {
+            &self.segments[self.cuts.partition_point(|&c| c <= d)]
+        }
+    }
+
+    /// The panel of `d` in its segment `seg`. `d` is inside the segment, so the index is small
+    /// and non-negative up to rounding: clamped in floating point, the conversion is one
+    /// instruction.
+    #[inline]
+    fn panel_index(&self, seg: &Segment, d: f64) -> usize {
+        seg.first + ((d - seg.lo) * seg.inv_panel).min((seg.count - 1) as f64) as u32 as usize
     }
 
     /// The `N` (value, slope) pairs at `d`, or `None` outside the range.
@@ -185,9 +312,13 @@ impl<const N: usize> Fused<N> {
         if !(a >= self.lo && b <= self.hi && a <= b) {
             return None;
         }
-        // The same intervals as `locate` gives the points of [a, b].
+        // The same intervals as `locate` gives the points of [a, b]; the panels are in order
+        // along the range, across the segments.
         let interval = |p: &Panel, d: f64| interval_index(p, (d - p.a) * p.inv_h);
-        let (first, last) = (self.panel_index(a), self.panel_index(b));
+        let (first, last) = (
+            self.panel_index(self.segment(a), a),
+            self.panel_index(self.segment(b), b),
+        );
         let mut out: Option<[(Span, Span); K]> = None;
         for (i, p) in self.panels[first..=last].iter().enumerate() {
             let j0 = if i == 0 { interval(p, a) } else { 0 };
@@ -229,7 +360,14 @@ impl<const N: usize> Fused<N> {
     pub(crate) fn encode(&self, w: &mut Writer) {
         w.f64(self.lo);
         w.f64(self.hi);
-        w.f64(self.inv_panel);
+        w.f64s(&self.cuts);
+        w.usize(self.segments.len());
+        for s in &self.segments {
+            w.f64(s.lo);
+            w.f64(s.inv_panel);
+            w.usize(s.first);
+            w.usize(s.count);
+        }
         w.usize(self.panels.len());
         for p in &self.panels {
             w.f64(p.a);
@@ -249,13 +387,43 @@ impl<const N: usize> Fused<N> {
 
     /// A table written by [`Fused::encode`], checked so that every look-up stays inside it.
     pub(crate) fn decode(r: &mut Reader<'_>) -> Result<Self> {
-        let (lo, hi, inv_panel) = (r.finite()?, r.finite()?, r.finite()?);
-        if !(lo < hi && inv_panel > 0.0) {
+        let (lo, hi) = (r.finite()?, r.finite()?);
+        if !(lo < hi) {
             return Err(malformed(format!("a fused table on [{lo:e}, {hi:e}]")));
         }
+        let cuts = r.finite_f64s()?;
+        if !cuts.windows(2).all(|w| w[0] < w[1]) || cuts.iter().any(|&c| !(c > lo && c < hi)) {
+            return Err(malformed("a fused table's cuts".to_string()));
+        }
+        let nseg = r.count(32)?;
+        if nseg != cuts.len() + 1 {
+            return Err(malformed(format!(
+                "a fused table of {nseg} segments between {} cuts",
+                cuts.len()
+            )));
+        }
+        let segments = (0..nseg)
+            .map(|_| {
+                Ok(Segment {
+                    lo: r.finite()?,
+                    inv_panel: r.finite()?,
+                    first: r.usize()?,
+                    count: r.usize()?,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
         let count = r.count(40)?;
-        if count != PANELS {
-            return Err(malformed(format!("a fused table of {count} panels")));
+        // A look-up reads panels first..first + count of its segment.
+        for s in &segments {
+            if !(s.inv_panel > 0.0)
+                || s.count == 0
+                || s.first.checked_add(s.count).is_none_or(|e| e > count)
+            {
+                return Err(malformed(format!(
+                    "a fused segment of panels {}+{}, {count} panels",
+                    s.first, s.count
+                )));
+            }
         }
         let panels = (0..count)
             .map(|_| {
@@ -289,7 +457,8 @@ impl<const N: usize> Fused<N> {
         Ok(Fused {
             lo,
             hi,
-            inv_panel,
+            cuts,
+            segments,
             panels,
             nodes,
         })
@@ -299,6 +468,7 @@ impl<const N: usize> Fused<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cache::codec::{Reader, Writer};
     use crate::quadrature::TableOptions;
 
     #[test]
@@ -334,6 +504,127 @@ mod tests {
             assert_eq!(all.map(|p| p.0), values);
         }
         assert!(t.values(-0.1).is_none());
+    }
+
+    /// Three functions with Hertz-like onsets `(z − x)^{3/2}` at two of the cuts, tabulated
+    /// separately per segment as the interface tables are, and fused on the union grid.
+    fn kinked() -> (Vec<Vec<Table>>, Fused<3>, Vec<f64>) {
+        let cuts = vec![0.9, 1.7];
+        let onset = |x: f64, z: f64, c: f64| {
+            let u = (z - x).max(0.0);
+            (c * u.powf(1.5), -1.5 * c * u.sqrt())
+        };
+        let fs: [&dyn Fn(f64) -> (f64, f64); 3] = [
+            &|x| {
+                let (a, da) = onset(x, 0.9, 2.0);
+                let (b, db) = onset(x, 1.7, 0.5);
+                (a + b + (-x).exp(), da + db - (-x).exp())
+            },
+            &|x| ((3.0 * x).sin() * 1e-3, 3e-3 * (3.0 * x).cos()),
+            &|x| onset(x, 1.7, 1e-6),
+        ];
+        let mut edges = vec![0.0];
+        edges.extend(&cuts);
+        edges.push(3.0);
+        let opts = TableOptions::default();
+        let tables: Vec<Vec<Table>> = fs
+            .iter()
+            .map(|f| {
+                edges
+                    .windows(2)
+                    .map(|w| Table::build(|x| Ok(f(x)), w[0], w[1], &opts).unwrap())
+                    .collect()
+            })
+            .collect();
+        let parts = std::array::from_fn(|k| Some(tables[k].as_slice()));
+        let fused = Fused::from_tables(0.0, 3.0, &cuts, parts).unwrap();
+        (tables, fused, cuts)
+    }
+
+    #[test]
+    fn a_fused_kinked_table_gives_each_separate_look_up_to_rounding() {
+        let (tables, fused, cuts) = kinked();
+        let segment = |x: f64| cuts.partition_point(|&c| c <= x);
+        let mut xs: Vec<f64> = (0..=3000).map(|i| 3.0 * i as f64 / 3000.0).collect();
+        // the cuts themselves and their neighbours, where the segment changes
+        for &c in &cuts {
+            xs.extend([c, c.next_down(), c.next_up(), c - 1e-9, c + 1e-9]);
+        }
+        let (mut worst_v, mut worst_s) = (0.0f64, 0.0f64);
+        for &x in &xs {
+            let got = fused.eval(x).unwrap();
+            assert_eq!(
+                got.map(|p| p.0),
+                fused.values(x).unwrap(),
+                "values alone at {x}"
+            );
+            for (k, t) in tables.iter().enumerate() {
+                let (v, s) = t[segment(x)].eval(x).unwrap();
+                // Relative to the function's scale on the segment (a cubic's rounding).
+                let (scale, slope_scale) = (0..=20).fold((0.0f64, 0.0f64), |(a, b), i| {
+                    let seg = &t[segment(x)];
+                    let (lo, hi) = seg.range();
+                    let (v, s) = seg.eval(lo + (hi - lo) * i as f64 / 20.0).unwrap();
+                    (a.max(v.abs()), b.max(s.abs()))
+                });
+                worst_v = worst_v.max((got[k].0 - v).abs() / scale);
+                worst_s = worst_s.max((got[k].1 - s).abs() / slope_scale);
+            }
+        }
+        // The separate tables meet 1e-9; the fused one reproduces their cubics, not just
+        // their tolerance.
+        assert!(worst_v < 1e-13, "values off by {worst_v:e} of their scale");
+        assert!(worst_s < 1e-10, "slopes off by {worst_s:e} of their scale");
+        assert!(fused.eval(3.1).is_none() && fused.eval(-0.1).is_none());
+        // A missing table is refused, and so is one that does not cover its segment.
+        let parts = [Some(&tables[0][..1]), Some(&tables[1][..]), None];
+        assert!(Fused::from_tables(0.0, 3.0, &cuts, parts).is_none());
+        let parts = [Some(&tables[0][..]), None, None];
+        assert!(Fused::<3>::from_tables(0.0, 3.0, &[0.8, 1.7], parts).is_none());
+    }
+
+    #[test]
+    fn a_fused_kinked_table_reads_back_from_its_encoding_to_the_bit() {
+        let (_, fused, _) = kinked();
+        let mut w = Writer::new();
+        fused.encode(&mut w);
+        let bytes = w.into_bytes();
+        let back = Fused::<3>::decode(&mut Reader::new(&bytes)).unwrap();
+        for i in 0..=1000 {
+            let x = 3.0 * i as f64 / 1000.0;
+            let (a, b) = (fused.eval(x).unwrap(), back.eval(x).unwrap());
+            assert!(a
+                .iter()
+                .zip(&b)
+                .all(|(p, q)| p.0.to_bits() == q.0.to_bits() && p.1.to_bits() == q.1.to_bits()));
+        }
+        // A segment pointing past the panels is refused.
+        let mut cut = bytes.clone();
+        cut.truncate(bytes.len() / 2);
+        assert!(Fused::<3>::decode(&mut Reader::new(&cut)).is_err());
+    }
+
+    #[test]
+    fn bounds_hold_every_look_up_of_a_kinked_stretch() {
+        let (_, t, _) = kinked();
+        let mut x = 0.123_f64;
+        for _ in 0..200 {
+            let a = 3.0 * ((x * 7.77) % 1.0);
+            let b = (a + 3.0 * (x % 1.0).powi(3)).min(3.0);
+            x = (x + 0.618_033_988_749_895) % 1.0 + 0.01;
+            let bounds: [(Span, Span); 3] = t.bounds(a, b).unwrap();
+            let mut ds: Vec<f64> = (0..=50).map(|i| a + (b - a) * i as f64 / 50.0).collect();
+            ds.push(b);
+            ds.extend([0.9, 1.7].into_iter().filter(|&c| a <= c && c <= b));
+            for d in ds.into_iter().filter(|&d| a <= d && d <= b) {
+                let got = t.eval(d).unwrap();
+                for k in 0..3 {
+                    let (v, s) = bounds[k];
+                    assert!(v.lo <= got[k].0 && got[k].0 <= v.hi, "{k} value at {d}");
+                    assert!(s.lo <= got[k].1 && got[k].1 <= s.hi, "{k} slope at {d}");
+                }
+            }
+        }
     }
 
     #[test]

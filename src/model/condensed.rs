@@ -115,6 +115,11 @@ impl QuasiStaticBulge {
                 hi = hi.min(d);
             }
             let newton = if stiff > 0.0 { d - g / stiff } else { f64::NAN };
+            // A Newton step below the resolution of `d` is converged, even though `d` is now
+            // an end of the bracket (which would otherwise send the next point off to bisect).
+            if (newton - d).abs() <= SETTLED {
+                return Some(at);
+            }
             let next = if newton > lo && newton < hi {
                 newton
             } else if lo.is_finite() && hi.is_finite() {
@@ -333,6 +338,33 @@ mod tests {
             let exact = (4e5 * d_r + a) / (4e5 + s);
             assert!((r - exact).abs() <= 1e-22, "{r} vs {exact}");
         }
+    }
+
+    /// A root that Newton reaches to the last bit from the bracket's upper side is returned
+    /// there, not left to bisect back towards it (which stalled up to 1e-16 m off: an error in
+    /// the gap as large as a Jacobian's difference step).
+    #[test]
+    fn settle_stops_where_newton_no_longer_moves() {
+        let (k, c) = (2e6, 1e14);
+        let q = QuasiStaticBulge::new(1e-13, k, 1e-5);
+        let mut worst = 0.0f64;
+        for i in 0..4000 {
+            // A Hertz-like stiffening force `c u² − a`, u = 2 nm − d, attractive at the rigid
+            // gap, so that Newton brackets the root from above and then closes in from below.
+            let d_r = 0.5e-9 + 0.2e-9 * (i % 400) as f64 / 400.0;
+            let a = 3e-4 + 1e-4 * (i / 400) as f64 / 10.0;
+            let f = |d: f64| {
+                let u = 2e-9 - d;
+                (c * u * u - a, -2.0 * c * u)
+            };
+            let r = q.settle(d_r, |d| (d, f(d).0, f(d).1)).expect("a root");
+            // The root of k (d − d_r) = c u² − a: c u² + k u − e = 0, e = k (2 nm − d_r) + a,
+            // in the form without cancellation.
+            let e = k * (2e-9 - d_r) + a;
+            let exact = 2e-9 - 2.0 * e / (k + (k * k + 4.0 * c * e).sqrt());
+            worst = worst.max((r - exact).abs() / exact);
+        }
+        assert!(worst < 1e-14, "settled {worst:e} off");
     }
 
     /// A slope beyond the spring has no stable root: refused.

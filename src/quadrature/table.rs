@@ -576,6 +576,17 @@ impl Table {
         Some(self.panel(d).h)
     }
 
+    /// Number of index cells (a power of two: the cells of the finest panel width, each inside
+    /// one panel).
+    pub(crate) fn cell_count(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Node spacing of the panel holding index cell `c` (`c < cell_count()`).
+    pub(crate) fn cell_spacing(&self, c: usize) -> f64 {
+        self.cells[c].h
+    }
+
     /// Number of panels of uniform spacing.
     pub fn panels(&self) -> usize {
         self.panel_count
