@@ -388,7 +388,7 @@ impl<const N: usize> Fused<N> {
     /// A table written by [`Fused::encode`], checked so that every look-up stays inside it.
     pub(crate) fn decode(r: &mut Reader<'_>) -> Result<Self> {
         let (lo, hi) = (r.finite()?, r.finite()?);
-        if !(lo < hi) {
+        if lo >= hi {
             return Err(malformed(format!("a fused table on [{lo:e}, {hi:e}]")));
         }
         let cuts = r.finite_f64s()?;
@@ -415,7 +415,7 @@ impl<const N: usize> Fused<N> {
         let count = r.count(40)?;
         // A look-up reads panels first..first + count of its segment.
         for s in &segments {
-            if !(s.inv_panel > 0.0)
+            if s.inv_panel <= 0.0
                 || s.count == 0
                 || s.first.checked_add(s.count).is_none_or(|e| e > count)
             {
