@@ -38,11 +38,15 @@ struct Segment {
     count: usize,
 }
 
-/// Values and slopes of `N` functions at each node.
+/// Values and slopes of `N` functions at each node. `CUT`: split at kinks into segments
+/// ([`Fused::from_tables`]); without, [`PANELS`] equal panels over the whole range
+/// ([`Fused::build`]), whose look-up reads no segment (a constant, not a branch, tells them apart).
 #[derive(Clone, Debug)]
-pub(crate) struct Fused<const N: usize> {
+pub(crate) struct Fused<const N: usize, const CUT: bool = false> {
     lo: f64,
     hi: f64,
+    /// The first segment's `inv_panel` (the only one's, without cuts).
+    inv_panel: f64,
     /// Interior cuts, ascending: segment `k` covers `[cuts[k-1], cuts[k])` (right-continuous, as
     /// the separate tables).
     cuts: Vec<f64>,
@@ -148,21 +152,24 @@ impl<const N: usize> Fused<N> {
                 }
             }
         }
-        Some(Fused {
+        let whole = Segment {
+            lo,
+            inv_panel: 1.0 / width,
+            first: 0,
+            count: PANELS,
+        };
+        Some(Fused::assemble(
             lo,
             hi,
-            cuts: Vec::new(),
-            segments: vec![Segment {
-                lo,
-                inv_panel: 1.0 / width,
-                first: 0,
-                count: PANELS,
-            }],
+            Vec::new(),
+            vec![whole],
             panels,
             nodes,
-        })
+        ))
     }
+}
 
+impl<const N: usize> Fused<N, true> {
     /// The `N` functions whose separate tables are `parts` (function `k`'s tables on the
     /// segments between `lo`, the `cuts` and `hi`; `None` for a function that is zero) on one
     /// grid per segment: the union of the separate tables' grids there. Each separate table's
@@ -244,14 +251,36 @@ impl<const N: usize> Fused<N> {
                 }
             }
         }
-        Some(Fused {
+        Some(Fused::assemble(
             lo,
             hi,
-            cuts: cuts.to_vec(),
+            cuts.to_vec(),
             segments,
             panels,
             nodes,
-        })
+        ))
+    }
+}
+
+impl<const N: usize, const CUT: bool> Fused<N, CUT> {
+    /// The table of its parts.
+    fn assemble(
+        lo: f64,
+        hi: f64,
+        cuts: Vec<f64>,
+        segments: Vec<Segment>,
+        panels: Vec<Panel>,
+        nodes: Vec<[(f64, f64); N]>,
+    ) -> Self {
+        Fused {
+            lo,
+            hi,
+            inv_panel: segments[0].inv_panel,
+            cuts,
+            segments,
+            panels,
+            nodes,
+        }
     }
 
     /// The interval holding `d`: its two end nodes, the local coordinate in it and its width;
@@ -261,7 +290,14 @@ impl<const N: usize> Fused<N> {
         if !(d >= self.lo && d <= self.hi) {
             return None;
         }
-        let pan = &self.panels[self.panel_index(self.segment(d), d)];
+        let p = if CUT {
+            self.panel_index(self.segment(d), d)
+        } else {
+            // The one segment of `PANELS` panels from `lo`: `panel_index` of it, without reading
+            // it.
+            ((d - self.lo) * self.inv_panel).min((PANELS - 1) as f64) as u32 as usize
+        };
+        let pan = &self.panels[p];
         let s = (d - pan.a) * pan.inv_h;
         let j = interval_index(pan, s);
         let k = pan.start + j;
@@ -412,6 +448,12 @@ impl<const N: usize> Fused<N> {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        let whole = |s: &Segment| s.lo == lo && s.first == 0 && s.count == PANELS;
+        if !(CUT || (cuts.is_empty() && whole(&segments[0]))) {
+            return Err(malformed(format!(
+                "a fused table of {nseg} segments where one of {PANELS} panels was expected"
+            )));
+        }
         let count = r.count(40)?;
         // A look-up reads panels first..first + count of its segment.
         for s in &segments {
@@ -454,14 +496,7 @@ impl<const N: usize> Fused<N> {
                 )));
             }
         }
-        Ok(Fused {
-            lo,
-            hi,
-            cuts,
-            segments,
-            panels,
-            nodes,
-        })
+        Ok(Fused::assemble(lo, hi, cuts, segments, panels, nodes))
     }
 }
 
@@ -508,7 +543,7 @@ mod tests {
 
     /// Three functions with Hertz-like onsets `(z − x)^{3/2}` at two of the cuts, tabulated
     /// separately per segment as the interface tables are, and fused on the union grid.
-    fn kinked() -> (Vec<Vec<Table>>, Fused<3>, Vec<f64>) {
+    fn kinked() -> (Vec<Vec<Table>>, Fused<3, true>, Vec<f64>) {
         let cuts = vec![0.9, 1.7];
         let onset = |x: f64, z: f64, c: f64| {
             let u = (z - x).max(0.0);
@@ -580,7 +615,7 @@ mod tests {
         let parts = [Some(&tables[0][..1]), Some(&tables[1][..]), None];
         assert!(Fused::from_tables(0.0, 3.0, &cuts, parts).is_none());
         let parts = [Some(&tables[0][..]), None, None];
-        assert!(Fused::<3>::from_tables(0.0, 3.0, &[0.8, 1.7], parts).is_none());
+        assert!(Fused::<3, true>::from_tables(0.0, 3.0, &[0.8, 1.7], parts).is_none());
     }
 
     #[test]
@@ -589,7 +624,9 @@ mod tests {
         let mut w = Writer::new();
         fused.encode(&mut w);
         let bytes = w.into_bytes();
-        let back = Fused::<3>::decode(&mut Reader::new(&bytes)).unwrap();
+        let back = Fused::<3, true>::decode(&mut Reader::new(&bytes)).unwrap();
+        // A smooth table's reader refuses it: its look-up reads no segment.
+        assert!(Fused::<3>::decode(&mut Reader::new(&bytes)).is_err());
         for i in 0..=1000 {
             let x = 3.0 * i as f64 / 1000.0;
             let (a, b) = (fused.eval(x).unwrap(), back.eval(x).unwrap());
@@ -601,7 +638,7 @@ mod tests {
         // A segment pointing past the panels is refused.
         let mut cut = bytes.clone();
         cut.truncate(bytes.len() / 2);
-        assert!(Fused::<3>::decode(&mut Reader::new(&cut)).is_err());
+        assert!(Fused::<3, true>::decode(&mut Reader::new(&cut)).is_err());
     }
 
     #[test]

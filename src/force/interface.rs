@@ -558,6 +558,9 @@ pub struct InterfaceForces {
     by_kind: KindTables,
     /// Static, per-V² and contact sums and the real contact area on one grid.
     fused: Option<Arc<Fused<4>>>,
+    /// The same, split at the kinks, where the tables on the bulge gap have kinks (never with
+    /// `fused`).
+    kinked: Option<Arc<Fused<4, true>>>,
     /// Whether the fused table's fourth function is the real contact area (else it is zero and
     /// the area comes from its own table).
     fused_area: bool,
@@ -590,6 +593,7 @@ impl InterfaceForces {
             area: hot(merged.area),
             by_kind,
             fused: None,
+            kinked: None,
             fused_area: false,
         };
         me.fuse(opts, &area_opts);
@@ -662,8 +666,37 @@ impl InterfaceForces {
         }
         let parts = std::array::from_fn(|k| tabs[k].as_ref().map(|t| t.segments.as_slice()));
         let (lo, hi) = self.range;
-        self.fused = Fused::from_tables(lo, hi, &cuts, parts).map(Arc::new);
-        self.fused_area = self.fused.is_some() && tabs[3].is_some();
+        self.kinked = Fused::from_tables(lo, hi, &cuts, parts).map(Arc::new);
+        self.fused_area = self.kinked.is_some() && tabs[3].is_some();
+    }
+
+    /// The four values of whichever fused table there is at bulge gap `d`; `None` without one
+    /// or outside it.
+    #[inline(always)]
+    fn fused_values(&self, d: f64) -> Option<[f64; 4]> {
+        match &self.fused {
+            Some(f) => f.values(d),
+            None => self.kinked.as_ref().and_then(|k| k.values(d)),
+        }
+    }
+
+    /// The four (value, slope) pairs of whichever fused table there is at bulge gap `d`.
+    #[inline(always)]
+    fn fused_eval(&self, d: f64) -> Option<[(f64, f64); 4]> {
+        match &self.fused {
+            Some(f) => f.eval(d),
+            None => self.kinked.as_ref().and_then(|k| k.eval(d)),
+        }
+    }
+
+    /// Bounds of the first two of [`Self::fused_eval`] over `[a, b]`: `None` without a fused
+    /// table, `Some(None)` where `[a, b]` leaves it.
+    fn fused_bounds(&self, a: f64, b: f64) -> Option<Option<[(Span, Span); 2]>> {
+        match (&self.fused, &self.kinked) {
+            (Some(f), _) => Some(f.bounds(a, b)),
+            (None, Some(k)) => Some(k.bounds(a, b)),
+            (None, None) => None,
+        }
     }
 
     /// The value of [`InterfaceForces::sum`] alone (the same number).
@@ -738,19 +771,17 @@ impl InterfaceForces {
     /// asked for.
     #[inline]
     fn evaluate_with(&self, g: Gaps, contact: bool, voltage: bool) -> HotForces {
-        if let Some(f) = &self.fused {
-            if let Some([s, v, c, _]) = f.eval(g.bulge) {
-                let e = |(value, d_bulge): (f64, f64)| ForceEval {
-                    value,
-                    d_bulge,
-                    d_pad: 0.0,
-                };
-                return HotForces {
-                    static_part: e(s),
-                    per_volt2: e(v),
-                    contact: non_negative(e(c)),
-                };
-            }
+        if let Some([s, v, c, _]) = self.fused_eval(g.bulge) {
+            let e = |(value, d_bulge): (f64, f64)| ForceEval {
+                value,
+                d_bulge,
+                d_pad: 0.0,
+            };
+            return HotForces {
+                static_part: e(s),
+                per_volt2: e(v),
+                contact: non_negative(e(c)),
+            };
         }
         HotForces {
             static_part: self.static_part(g),
@@ -777,9 +808,9 @@ impl InterfaceForces {
         }
         let zero = (Span::point(0.0), Span::point(0.0));
         let slot = |s: &PerGap| s[0].as_ref().map_or(Some(zero), |t| t.bounds(a, b));
-        let (stat, per_v2) = match &self.fused {
-            Some(f) => {
-                let [s, v] = f.bounds(a, b)?;
+        let (stat, per_v2) = match self.fused_bounds(a, b) {
+            Some(bounds) => {
+                let [s, v] = bounds?;
                 (s, v)
             }
             None if volt2 != 0.0 => (slot(&self.static_part)?, slot(&self.per_volt2)?),
@@ -806,9 +837,10 @@ impl InterfaceForces {
     /// (the flash temperature takes its square root).
     #[inline]
     pub fn real_contact_area(&self, g: Gaps) -> f64 {
-        let fused = match &self.fused {
-            Some(f) if self.fused_area => f.values(g.bulge),
-            _ => None,
+        let fused = if self.fused_area {
+            self.fused_values(g.bulge)
+        } else {
+            None
         };
         match fused {
             Some([_, _, _, a]) => a,
@@ -821,9 +853,10 @@ impl InterfaceForces {
     /// same table: the derivative of the interpolant that the value comes from.
     #[inline]
     pub(crate) fn real_contact_area_with_slope(&self, g: Gaps) -> (f64, f64) {
-        let fused = match &self.fused {
-            Some(f) if self.fused_area => f.eval(g.bulge).map(|[_, _, _, a]| a),
-            _ => None,
+        let fused = if self.fused_area {
+            self.fused_eval(g.bulge).map(|[_, _, _, a]| a)
+        } else {
+            None
         };
         let (a, slope) = fused.unwrap_or_else(|| {
             let e = self.sum(&self.area, g);
@@ -856,7 +889,7 @@ impl InterfaceForces {
     /// ```
     #[inline]
     pub fn values(&self, g: Gaps, volt2: f64) -> HotValues {
-        if let Some([s, v, c, a]) = self.fused.as_ref().and_then(|f| f.values(g.bulge)) {
+        if let Some([s, v, c, a]) = self.fused_values(g.bulge) {
             return HotValues {
                 interface: by_coupling(s, v, volt2),
                 contact: if c < 0.0 { 0.0 } else { c },
@@ -978,6 +1011,10 @@ impl InterfaceForces {
         if let Some(f) = &self.fused {
             f.encode(w);
         }
+        w.bool(self.kinked.is_some());
+        if let Some(k) = &self.kinked {
+            k.encode(w);
+        }
         w.bool(self.fused_area);
     }
 
@@ -1047,6 +1084,11 @@ impl InterfaceForces {
         } else {
             None
         };
+        let kinked = if r.bool()? {
+            Some(Arc::new(Fused::decode(r)?))
+        } else {
+            None
+        };
         let fused_area = r.bool()?;
         // Each table sums terms of the kind, coupling and gap it stands for.
         let fits = |t: &Tabulated, area: bool, f: &dyn Fn(&dyn InterfaceTerm) -> bool| {
@@ -1087,6 +1129,7 @@ impl InterfaceForces {
             area,
             by_kind,
             fused,
+            kinked,
             fused_area,
         })
     }
@@ -1136,6 +1179,6 @@ impl InterfaceForces {
                 n += t.segments.iter().map(Table::len).sum::<usize>();
             }
         }
-        n + self.fused.as_ref().map_or(0, |f| f.len())
+        n + self.fused.as_ref().map_or(0, |f| f.len()) + self.kinked.as_ref().map_or(0, |k| k.len())
     }
 }
