@@ -1141,7 +1141,7 @@ fn fig1_chart<'a>(
             Series::markers("", events)
                 .colour(colour)
                 .marker(Marker::Diamond)
-                .width(7 - 3 * (k as u32 % 2))
+                .width(9 - 4 * (k as u32 % 2))
                 .hollow(),
         );
     }
