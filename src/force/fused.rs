@@ -224,6 +224,10 @@ impl<const N: usize> Fused<N, true> {
                     })
                     .max()?
                     .next_power_of_two();
+                // The budget before the nodes are made, not after.
+                if nodes.len() + n + 1 > MAX_NODES {
+                    return None;
+                }
                 let h = (cb - ca) / n as f64;
                 panels.push(Panel {
                     a: ca,
@@ -245,9 +249,6 @@ impl<const N: usize> Fused<N, true> {
                         }
                     }
                     nodes.push(node);
-                }
-                if nodes.len() > MAX_NODES {
-                    return None;
                 }
             }
         }

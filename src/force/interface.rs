@@ -1089,6 +1089,11 @@ impl InterfaceForces {
         } else {
             None
         };
+        if fused.is_some() && kinked.is_some() {
+            return Err(malformed(
+                "both a smooth and a kinked fused table".to_string(),
+            ));
+        }
         let fused_area = r.bool()?;
         // Each table sums terms of the kind, coupling and gap it stands for.
         let fits = |t: &Tabulated, area: bool, f: &dyn Fn(&dyn InterfaceTerm) -> bool| {

@@ -340,9 +340,9 @@ mod tests {
         }
     }
 
-    /// A root that Newton reaches to the last bit from the bracket's upper side is returned
-    /// there, not left to bisect back towards it (which stalled up to 1e-16 m off: an error in
-    /// the gap as large as a Jacobian's difference step).
+    /// A root that Newton reaches to the last bit while that point is an end of the bracket is
+    /// returned there, not left to bisect away and back (which stalled up to 1e-16 m off: an
+    /// error in the gap as large as a Jacobian's difference step).
     #[test]
     fn settle_stops_where_newton_no_longer_moves() {
         let (k, c) = (2e6, 1e14);
