@@ -5,10 +5,10 @@
 mod problems;
 
 use hdi_tribology::ode::{
-    solve, Direction, Event, FnSystem, Integrator, Method, OdeError, Options, SaveAt, StepStatus,
-    Tolerance,
+    solve, Direction, Event, FnSystem, Integrator, Method, OdeError, OdeSystem, Options, SaveAt,
+    StepStatus, TimeMemo, Tolerance,
 };
-use nalgebra::{Vector1, Vector2};
+use nalgebra::{Vector1, Vector2, U1};
 use std::cell::Cell;
 
 const G: f64 = 9.81;
@@ -266,6 +266,55 @@ fn an_action_may_change_the_systems_parameters() {
         it.state()[0]
     );
     assert_eq!(power.get(), 0.0);
+}
+
+/// `y' = u cos t` with the input `u` read through the memo of the time's values: a system
+/// changed at a time it was already asked at must not be read from the memo.
+struct Held {
+    u: f64,
+}
+
+impl OdeSystem<U1> for Held {
+    fn rhs(&self, t: f64, _y: &Vector1<f64>, dy: &mut Vector1<f64>) {
+        dy[0] = self.u * t.cos();
+    }
+    fn rhs_memo(&self, t: f64, _y: &Vector1<f64>, dy: &mut Vector1<f64>, memo: &mut TimeMemo) {
+        dy[0] = memo.get_or_insert_with(t, |t| [self.u * t.cos(), 0.0, 0.0, 0.0])[0];
+    }
+}
+
+#[test]
+fn a_changed_system_is_not_read_from_the_memo_of_its_old_inputs() {
+    // Fixed steps of 0.25: the last stages of the step that ends at 1 fall on t = 1 exactly,
+    // where the system is then changed and the method restarts.
+    let opts = Options {
+        h_init: Some(0.25),
+        adaptive: false,
+        ..Options::default()
+    };
+    for method in [
+        Method::Rodas5P,
+        Method::Tsit5,
+        Method::Dop853,
+        Method::Radau5,
+    ] {
+        let mut it =
+            Integrator::new(Held { u: 1.0 }, 0.0, Vector1::new(0.0), 2.0, method, &opts).unwrap();
+        it.advance_to(1.0).unwrap();
+        let at_one = *it.state();
+        it.system_mut().u = -3.0;
+        it.advance_to(2.0).unwrap();
+        // The same as a new integrator of the changed system started there.
+        let mut fresh = Integrator::new(Held { u: -3.0 }, 1.0, at_one, 2.0, method, &opts).unwrap();
+        fresh.advance_to(2.0).unwrap();
+        assert_eq!(
+            it.state()[0].to_bits(),
+            fresh.state()[0].to_bits(),
+            "{method:?}: {} against {}",
+            it.state()[0],
+            fresh.state()[0]
+        );
+    }
 }
 
 #[test]

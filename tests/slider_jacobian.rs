@@ -2,11 +2,12 @@
 //! in contact (with the contact-impulse and flash-temperature states), for the rigid slider with
 //! and without lags, and for the few-peak deformable slider: every row, the flash temperature's
 //! included, is the derivative of what the right-hand side reads; the two from one force
-//! evaluation (`jacobian_and_time_derivative`) equal the two alone.
+//! evaluation (`jacobian_and_time_derivative`) equal the two alone; the right-hand side with the
+//! inputs' values of a time kept (`rhs_memo`, what the methods call) is `rhs`'s, to the bit.
 
 use hdi_tribology::heater::Programme;
 use hdi_tribology::model::{Dofs, SliderModel, SliderSystem};
-use hdi_tribology::ode::OdeSystem;
+use hdi_tribology::ode::{OdeSystem, TimeMemo};
 use hdi_tribology::scene::Scene;
 use nalgebra::{DMatrix, DVector, Dyn};
 
@@ -106,6 +107,16 @@ fn check(model: &SliderModel, programme: Programme, t: f64, gap: f64, speed: f64
         (true, true)
     );
     assert_eq!((&j2, &dt2), (&j, &dt));
+    // The inputs' values kept per time: filled at `t`, read again, replaced at another time
+    // (the ramp and the AC move every input), and back.
+    let mut memo = TimeMemo::default();
+    for tm in [t, t, t + 3.7e-6, t] {
+        let (mut want, mut got) = (DVector::zeros(n), DVector::from_element(n, f64::NAN));
+        OdeSystem::<Dyn>::rhs(&sys, tm, &s, &mut want);
+        OdeSystem::<Dyn>::rhs_memo(&sys, tm, &s, &mut got, &mut memo);
+        let bits = |v: &DVector<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&want), "rhs_memo at t = {tm:e}");
+    }
     let (jd, dtd) = differences(&sys, t, &s);
     let heat = lay.heat.expect("integrals on: a heat state");
     assert!(

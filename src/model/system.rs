@@ -2,7 +2,7 @@
 
 use super::{Dofs, Inputs, QuasiStaticBulge, SliderModel};
 use crate::force::{Branch, Gaps, HotValues, StatefulTerm, MAX_TERM_STATES};
-use crate::ode::OdeSystem;
+use crate::ode::{OdeSystem, TimeMemo};
 use crate::scene::MAX_DOF;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 use std::ops::Index;
@@ -356,10 +356,34 @@ impl SliderSystem {
 
     /// Protrusion at time `t` and state `s`.
     pub fn protrusion<S: Index<usize, Output = f64> + ?Sized>(&self, t: f64, s: &S) -> f64 {
+        self.protrusion_given(s, || self.inputs.heater.power(t))
+    }
+
+    /// Protrusion at state `s` under the heater power `power()` (W), asked for only where the
+    /// protrusion follows the power at once.
+    #[inline]
+    fn protrusion_given<S: Index<usize, Output = f64> + ?Sized>(
+        &self,
+        s: &S,
+        power: impl FnOnce() -> f64,
+    ) -> f64 {
         match self.layout.delta {
             Some(i) => s[i],
-            None => self.model.protrusion(self.inputs.heater.power(t)),
+            None => self.model.protrusion(power()),
         }
+    }
+
+    /// What the right-hand side reads of the inputs at time `t`, computed from the time alone:
+    /// the squared voltage (V²), the heater's power (W) and its rate (W/s), and the disk's
+    /// acceleration (m/s², zero without a base motion).
+    fn inputs_at(&self, t: f64) -> [f64; 4] {
+        let (power, rate) = self.inputs.heater.power_and_rate(t);
+        let accel = self
+            .inputs
+            .base_motion
+            .as_ref()
+            .map_or(0.0, |b| b.acceleration_value(t));
+        [self.inputs.voltage.squared(t), power, rate, accel]
     }
 
     /// Gaps at time `t` and state `s`. With a quasi-static bulge, the bulge gap where the bulge
@@ -428,7 +452,7 @@ impl SliderSystem {
     /// first-order lags, and the integrands of the contact impulse and of the heat.
     fn lag_and_integral_rates<D: Dim>(
         &self,
-        t: f64,
+        (power, power_rate): (f64, f64),
         s: &OVector<f64, D>,
         hot: &HotValues,
         ds: &mut OVector<f64, D>,
@@ -438,7 +462,7 @@ impl SliderSystem {
         let m = &*self.model;
         let lay = self.layout;
         if let Some(i) = lay.delta {
-            ds[i] = self.protrusion_rate(t, s);
+            ds[i] = self.protrusion_rate_given(s, power, power_rate);
         }
         if let Some(i) = lay.lagged_force {
             ds[i] = (hot.interface - s[i]) / m.interface_lag;
@@ -454,10 +478,22 @@ impl SliderSystem {
     /// The protrusion's rate (m/s) at time `t` and state `s`: the thermal lag's, or the
     /// programme's where the protrusion follows it at once.
     fn protrusion_rate<S: Index<usize, Output = f64> + ?Sized>(&self, t: f64, s: &S) -> f64 {
+        let (power, rate) = self.inputs.heater.power_and_rate(t);
+        self.protrusion_rate_given(s, power, rate)
+    }
+
+    /// [`Self::protrusion_rate`] under the heater's power (W) and its rate (W/s).
+    #[inline]
+    fn protrusion_rate_given<S: Index<usize, Output = f64> + ?Sized>(
+        &self,
+        s: &S,
+        power: f64,
+        power_rate: f64,
+    ) -> f64 {
         let m = &*self.model;
         match self.layout.delta {
-            Some(i) => (m.protrusion(self.inputs.heater.power(t)) - s[i]) / m.thermal_lag,
-            None => self.power_and_protrusion_rates(t).1,
+            Some(i) => (m.protrusion(power) - s[i]) / m.thermal_lag,
+            None => m.protrusion(power_rate),
         }
     }
 
@@ -865,34 +901,13 @@ where
     }
 
     fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
-        if let Some(q) = self.model.quasi_static {
-            return self.condensed_rhs(&q, t, s, ds);
-        }
-        let m = &*self.model;
-        let st = &m.structure;
-        let lay = self.layout;
-        // The values alone: no slope is needed here.
-        let (q, v) = (self.coordinates(s), self.velocities(s));
-        let delta = self.protrusion(t, s);
-        let g = m.gaps_offset(&q, delta, self.inputs.clearance_offset);
-        let hot = m.hot_values(g, self.inputs.voltage.squared(t));
-        let mut drive = self.interface_drive(s, &hot);
-        if lay.term_states.1 > 0 {
-            drive += self.term_rates(g, s, ds);
-        }
-        let f_ab = m.bearing().force(q[0], v[0]);
-        let a = st.mass_solve(&st.generalised_force(&q, &v, f_ab, drive));
-        for i in 0..lay.dofs {
-            ds[i] = v[i];
-            ds[lay.velocity(i)] = a[i];
-        }
-        self.lag_and_integral_rates(t, s, &hot, ds);
-        if let Some(b) = &self.inputs.base_motion {
-            let a = b.acceleration_value(t);
-            for &(i, r) in &self.base[..self.n_base] {
-                ds[i] -= r * a;
-            }
-        }
+        self.rhs_given(t, s, ds, self.inputs_at(t));
+    }
+
+    #[inline]
+    fn rhs_memo(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>, memo: &mut TimeMemo) {
+        let at = memo.get_or_insert_with(t, |t| self.inputs_at(t));
+        self.rhs_given(t, s, ds, at);
     }
 
     fn jacobian(&self, t: f64, s: &OVector<f64, D>, j: &mut OMatrix<f64, D, D>) -> bool {
@@ -1094,12 +1109,54 @@ impl SliderSystem {
         })
     }
 
+    /// The right-hand side at time `t` and state `s`, with what it reads of the inputs there,
+    /// `at` ([`Self::inputs_at`]).
+    #[inline]
+    fn rhs_given<D: Dim>(
+        &self,
+        t: f64,
+        s: &OVector<f64, D>,
+        ds: &mut OVector<f64, D>,
+        [volt2, power, power_rate, accel]: [f64; 4],
+    ) where
+        DefaultAllocator: Allocator<D>,
+    {
+        if let Some(q) = self.model.quasi_static {
+            return self.condensed_rhs(&q, t, s, ds, [volt2, power, power_rate, accel]);
+        }
+        let m = &*self.model;
+        let st = &m.structure;
+        let lay = self.layout;
+        // The values alone: no slope is needed here.
+        let (q, v) = (self.coordinates(s), self.velocities(s));
+        let delta = self.protrusion_given(s, || power);
+        let g = m.gaps_offset(&q, delta, self.inputs.clearance_offset);
+        let hot = m.hot_values(g, volt2);
+        let mut drive = self.interface_drive(s, &hot);
+        if lay.term_states.1 > 0 {
+            drive += self.term_rates(g, s, ds);
+        }
+        let f_ab = m.bearing().force(q[0], v[0]);
+        let a = st.mass_solve(&st.generalised_force(&q, &v, f_ab, drive));
+        for i in 0..lay.dofs {
+            ds[i] = v[i];
+            ds[lay.velocity(i)] = a[i];
+        }
+        self.lag_and_integral_rates((power, power_rate), s, &hot, ds);
+        if self.inputs.base_motion.is_some() {
+            for &(i, r) in &self.base[..self.n_base] {
+                ds[i] -= r * accel;
+            }
+        }
+    }
+
     fn condensed_rhs<D: Dim>(
         &self,
         q: &QuasiStaticBulge,
         t: f64,
         s: &OVector<f64, D>,
         ds: &mut OVector<f64, D>,
+        [volt2, power, power_rate, accel]: [f64; 4],
     ) where
         DefaultAllocator: Allocator<D>,
     {
@@ -1109,14 +1166,14 @@ impl SliderSystem {
             ds.fill(f64::NAN);
             return;
         };
-        let hot = m.hot_values(g, self.inputs.voltage.squared(t));
+        let hot = m.hot_values(g, volt2);
         let v = s[lay.velocity(0)];
         let drive = self.interface_drive(s, &hot);
         ds[0] = v;
         ds[lay.velocity(0)] = (m.bearing().force(s[0], v) + drive) / m.structure.body_mass();
-        self.lag_and_integral_rates(t, s, &hot, ds);
-        if let Some(motion) = &self.inputs.base_motion {
-            ds[lay.velocity(0)] -= motion.acceleration_value(t);
+        self.lag_and_integral_rates((power, power_rate), s, &hot, ds);
+        if self.inputs.base_motion.is_some() {
+            ds[lay.velocity(0)] -= accel;
         }
     }
 

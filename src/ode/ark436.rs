@@ -264,6 +264,7 @@ where
 mod tests {
     use super::*;
     use crate::ode::solution::Stats;
+    use crate::ode::TimeMemo;
     use nalgebra::{Vector2, U2};
 
     /// `x′ = λ (x − cos t)`, `t′ = 1`: the first row stiff (declared) or not.
@@ -302,6 +303,7 @@ mod tests {
             stats: Stats::default(),
             want_stiffness: false,
             need_poly: false,
+            memo: TimeMemo::default(),
         };
         let mut m = Ark436::new(&y);
         let mut poly = StepPoly::new(2);
@@ -416,6 +418,7 @@ mod tests {
                 stats: Stats::default(),
                 want_stiffness: false,
                 need_poly: false,
+                memo: TimeMemo::default(),
             };
             let mut m = Ark436::new(&y);
             m.restart(&sys, t0, &y, &mut ctx);

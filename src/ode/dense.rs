@@ -108,6 +108,17 @@ impl StepPoly {
         &mut self.coeffs[m * self.n + i]
     }
 
+    /// The coefficient vectors `a_0 … a_deg` (as begun), each of the state's length.
+    pub fn rows_mut<const K: usize>(&mut self) -> [&mut [f64]; K] {
+        let n = self.n;
+        let mut rest = &mut self.coeffs[..K * n];
+        std::array::from_fn(|_| {
+            let (row, tail) = std::mem::take(&mut rest).split_at_mut(n);
+            rest = tail;
+            row
+        })
+    }
+
     /// Evaluates at time `t` (extrapolates outside the step) into `out`.
     pub fn eval_into<D: Dim>(&self, t: f64, out: &mut OVector<f64, D>)
     where

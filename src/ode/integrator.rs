@@ -13,7 +13,7 @@ use super::radau5::Radau5;
 use super::rodas5p::Rodas5P;
 use super::solution::Stats;
 use super::stepper::{all_finite, Ctx, FailKind, Step, Stepper, Trial};
-use super::system::OdeSystem;
+use super::system::{OdeSystem, TimeMemo};
 use super::tsit5::Tsit5;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, OVector};
 
@@ -427,6 +427,7 @@ where
             want_stiffness: switching,
             // Switches of branch are located on the interpolant.
             need_poly: opts.dense || sys.switches() > 0,
+            memo: TimeMemo::default(),
         };
         let mut kinks: Vec<f64> = opts.t_stops.clone();
         kinks.sort_by(f64::total_cmp);
@@ -532,6 +533,9 @@ where
     /// Restarts the method at the current point (evaluates `f`), and picks an initial step
     /// size when none is pending.
     fn restart(&mut self) -> Result<(), OdeError> {
+        // The system may have changed (`system_mut`, an event's action): no kept value of its
+        // inputs carries over.
+        self.ctx.memo.clear();
         let stepper = self.steppers.get::<S>(self.active);
         stepper.restart(&self.sys, self.t, &self.y, &mut self.ctx);
         if !all_finite(stepper.f0()) {

@@ -60,7 +60,7 @@ pub use options::{Method, Options, SaveAt, Tolerance, MIN_RTOL};
 pub use problem::OdeProblem;
 pub use solution::{Solution, Stats};
 pub use system::{
-    complex_step_jacobian, finite_difference_jacobian, FnSystem, NoJacobian, OdeSystem,
+    complex_step_jacobian, finite_difference_jacobian, FnSystem, NoJacobian, OdeSystem, TimeMemo,
 };
 
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};

@@ -388,18 +388,24 @@ where
             return;
         }
         poly.begin(t, h, 4);
-        for i in 0..y.len() {
+        let n = y.len();
+        let ks: [&[f64]; 8] = std::array::from_fn(|j| &self.k[j].as_slice()[..n]);
+        let (y0, y1) = (&y.as_slice()[..n], &y_new.as_slice()[..n]);
+        let [a0, a1, a2, a3, a4] = poly.rows_mut::<5>();
+        for i in 0..n {
+            // w_r = Σ_j H[r][j] k_j, summed in the order of j.
             let mut w = [0.0; 3];
-            for (r, wr) in w.iter_mut().enumerate() {
-                for (j, kj) in self.k.iter().enumerate() {
-                    *wr += H[r][j] * kj[i];
-                }
+            for (j, kj) in ks.iter().enumerate() {
+                let k = kj[i];
+                w[0] += H[0][j] * k;
+                w[1] += H[1][j] * k;
+                w[2] += H[2][j] * k;
             }
-            *poly.at(0, i) = y[i];
-            *poly.at(1, i) = y_new[i] - y[i] + w[0];
-            *poly.at(2, i) = w[1] - w[0];
-            *poly.at(3, i) = w[2] - w[1];
-            *poly.at(4, i) = -w[2];
+            a0[i] = y0[i];
+            a1[i] = y1[i] - y0[i] + w[0];
+            a2[i] = w[1] - w[0];
+            a3[i] = w[2] - w[1];
+            a4[i] = -w[2];
         }
     }
 

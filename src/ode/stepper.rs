@@ -2,7 +2,7 @@
 
 use super::dense::StepPoly;
 use super::solution::Stats;
-use super::system::OdeSystem;
+use super::system::{OdeSystem, TimeMemo};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OVector};
 
 /// Tolerances and counters shared by the loop and the method.
@@ -18,6 +18,9 @@ where
     /// Whether the step interpolant is used (dense output, events, output at given times);
     /// methods whose interpolant costs extra function evaluations skip it otherwise.
     pub need_poly: bool,
+    /// The system's values of the last time its right-hand side was asked for
+    /// ([`OdeSystem::rhs_memo`]).
+    pub memo: TimeMemo,
 }
 
 impl<D: Dim> Ctx<D>
@@ -47,7 +50,7 @@ where
     ) where
         DefaultAllocator: Allocator<D, D>,
     {
-        sys.rhs(t, y, out);
+        sys.rhs_memo(t, y, out, &mut self.memo);
         self.stats.rhs_evals += 1;
     }
 

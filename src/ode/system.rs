@@ -233,6 +233,97 @@ where
     fn stiff_rates(&self, t: f64, y: &OVector<f64, D>, rates: &mut OVector<f64, D>) {
         self.rhs(t, y, rates)
     }
+
+    /// Writes `f(t, y)` into `dydt` as [`rhs`](OdeSystem::rhs) does, with `memo` holding
+    /// values the system computed from the time alone on an earlier call. The methods call
+    /// this one: several of their evaluations share a time (Rodas5P's last three stages and
+    /// the next step's first all fall on `t + h`), and a system whose right-hand side has
+    /// costly parts that depend on `t` alone (a sine, a table look-up) computes them once per
+    /// time ([`TimeMemo::get_or_insert_with`]). The result must be the same, to the bit, as
+    /// `rhs`'s. The integrator empties the memo whenever the method restarts: after the system
+    /// is changed ([`Integrator::system_mut`](crate::ode::Integrator::system_mut)), an event
+    /// acts, a branch switches, or a step ends at a kink. By default `rhs`.
+    ///
+    /// ```
+    /// use hdi_tribology::nalgebra::{Vector1, U1};
+    /// use hdi_tribology::ode::{OdeSystem, TimeMemo};
+    /// /// y' = -y + sin t, with the sine kept per time.
+    /// struct Forced;
+    /// impl Forced {
+    ///     fn rhs_with(&self, sin_t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>) {
+    ///         dy[0] = -y[0] + sin_t;
+    ///     }
+    /// }
+    /// impl OdeSystem<U1> for Forced {
+    ///     fn rhs(&self, t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>) {
+    ///         self.rhs_with(t.sin(), y, dy)
+    ///     }
+    ///     fn rhs_memo(&self, t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>, memo: &mut TimeMemo) {
+    ///         let [sin_t, ..] = memo.get_or_insert_with(t, |t| [t.sin(), 0.0, 0.0, 0.0]);
+    ///         self.rhs_with(sin_t, y, dy)
+    ///     }
+    /// }
+    /// let (mut a, mut b, mut memo) = (Vector1::zeros(), Vector1::zeros(), TimeMemo::default());
+    /// Forced.rhs(0.5, &Vector1::new(1.0), &mut a);
+    /// Forced.rhs_memo(0.5, &Vector1::new(1.0), &mut b, &mut memo);
+    /// Forced.rhs_memo(0.5, &Vector1::new(1.0), &mut b, &mut memo);
+    /// assert_eq!(a, b);
+    /// ```
+    #[inline]
+    fn rhs_memo(
+        &self,
+        t: f64,
+        y: &OVector<f64, D>,
+        dydt: &mut OVector<f64, D>,
+        _memo: &mut TimeMemo,
+    ) {
+        self.rhs(t, y, dydt)
+    }
+}
+
+/// Up to four values a system computed from the time alone, kept for the last time asked (see
+/// [`OdeSystem::rhs_memo`]). Empty at first.
+#[derive(Clone, Copy, Debug)]
+pub struct TimeMemo {
+    /// The time of `values`; NaN when empty (no time equals it).
+    t: f64,
+    values: [f64; 4],
+}
+
+impl Default for TimeMemo {
+    fn default() -> Self {
+        TimeMemo {
+            t: f64::NAN,
+            values: [0.0; 4],
+        }
+    }
+}
+
+impl TimeMemo {
+    /// The values kept for `t`, computed by `f(t)` and kept when the memo holds another time.
+    ///
+    /// ```
+    /// use hdi_tribology::ode::TimeMemo;
+    /// let mut memo = TimeMemo::default();
+    /// let mut calls = 0;
+    /// for _ in 0..3 {
+    ///     memo.get_or_insert_with(2.0, |t| { calls += 1; [t * t, 0.0, 0.0, 0.0] });
+    /// }
+    /// assert_eq!((memo.get_or_insert_with(2.0, |_| [0.0; 4])[0], calls), (4.0, 1));
+    /// ```
+    #[inline]
+    pub fn get_or_insert_with(&mut self, t: f64, f: impl FnOnce(f64) -> [f64; 4]) -> [f64; 4] {
+        if t != self.t {
+            self.values = f(t);
+            self.t = t;
+        }
+        self.values
+    }
+
+    /// Forgets the values (the system they came from changed).
+    pub fn clear(&mut self) {
+        self.t = f64::NAN;
+    }
 }
 
 /// Forwards every method of [`OdeSystem`] through a pointer type.
@@ -302,6 +393,16 @@ macro_rules! forward_system {
             #[inline]
             fn stiff_rates(&self, t: f64, y: &OVector<f64, D>, rates: &mut OVector<f64, D>) {
                 (**self).stiff_rates(t, y, rates)
+            }
+            #[inline]
+            fn rhs_memo(
+                &self,
+                t: f64,
+                y: &OVector<f64, D>,
+                dydt: &mut OVector<f64, D>,
+                memo: &mut TimeMemo,
+            ) {
+                (**self).rhs_memo(t, y, dydt, memo)
             }
         }
     };
