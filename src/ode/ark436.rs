@@ -304,6 +304,7 @@ mod tests {
             want_stiffness: false,
             need_poly: false,
             memo: TimeMemo::default(),
+            stage_memos: [TimeMemo::default(); 3],
         };
         let mut m = Ark436::new(&y);
         let mut poly = StepPoly::new(2);
@@ -419,6 +420,7 @@ mod tests {
                 want_stiffness: false,
                 need_poly: false,
                 memo: TimeMemo::default(),
+                stage_memos: [TimeMemo::default(); 3],
             };
             let mut m = Ark436::new(&y);
             m.restart(&sys, t0, &y, &mut ctx);

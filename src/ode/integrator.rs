@@ -428,6 +428,7 @@ where
             // Switches of branch are located on the interpolant.
             need_poly: opts.dense || sys.switches() > 0,
             memo: TimeMemo::default(),
+            stage_memos: [TimeMemo::default(); 3],
         };
         let mut kinks: Vec<f64> = opts.t_stops.clone();
         kinks.sort_by(f64::total_cmp);
@@ -535,7 +536,7 @@ where
     fn restart(&mut self) -> Result<(), OdeError> {
         // The system may have changed (`system_mut`, an event's action): no kept value of its
         // inputs carries over.
-        self.ctx.memo.clear();
+        self.ctx.clear_memos();
         let stepper = self.steppers.get::<S>(self.active);
         stepper.restart(&self.sys, self.t, &self.y, &mut self.ctx);
         if !all_finite(stepper.f0()) {

@@ -341,7 +341,12 @@ where
             for i in 0..3 {
                 self.tmp.copy_from(y);
                 self.tmp += &self.z[i];
-                sys.rhs(t + k.c[i] * h, &self.tmp, &mut self.f[i]);
+                sys.rhs_memo(
+                    t + k.c[i] * h,
+                    &self.tmp,
+                    &mut self.f[i],
+                    &mut ctx.stage_memos[i],
+                );
             }
             ctx.stats.rhs_evals += 3;
             ctx.stats.newton_iters += 1;

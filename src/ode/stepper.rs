@@ -21,6 +21,9 @@ where
     /// The system's values of the last time its right-hand side was asked for
     /// ([`OdeSystem::rhs_memo`]).
     pub memo: TimeMemo,
+    /// The same for each stage of an implicit method, whose iterations ask again at the
+    /// stages' times.
+    pub stage_memos: [TimeMemo; 3],
 }
 
 impl<D: Dim> Ctx<D>
@@ -52,6 +55,14 @@ where
     {
         sys.rhs_memo(t, y, out, &mut self.memo);
         self.stats.rhs_evals += 1;
+    }
+
+    /// Forgets every kept value of the system's inputs (the system may have changed).
+    pub fn clear_memos(&mut self) {
+        self.memo.clear();
+        for m in &mut self.stage_memos {
+            m.clear();
+        }
     }
 
     /// Weighted RMS norm of a vector relative to the scale of `y`.
