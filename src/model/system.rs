@@ -901,10 +901,9 @@ where
     }
 
     fn rhs(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>) {
-        self.rhs_given(t, s, ds, self.inputs_at(t));
+        self.rhs_memo(t, s, ds, &mut TimeMemo::default());
     }
 
-    #[inline]
     fn rhs_memo(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>, memo: &mut TimeMemo) {
         let at = memo.get_or_insert_with(t, |t| self.inputs_at(t));
         self.rhs_given(t, s, ds, at);

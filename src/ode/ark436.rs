@@ -204,7 +204,7 @@ where
                 }
             }
             let (_, fr) = self.f.split_at_mut(s);
-            sys.rhs(t + C[s] * h, zs, &mut fr[0]);
+            sys.rhs_memo(t + C[s] * h, zs, &mut fr[0], &mut ctx.memo);
         }
         for i in 0..n {
             let (mut sum, mut e) = (0.0, 0.0);
@@ -216,7 +216,8 @@ where
             // A declared row's estimate filtered through its stage solve (module docs).
             self.err[i] = h * e / (1.0 - h * GAMMA * self.lambda[i]);
         }
-        sys.rhs(t + h, y_new, &mut self.f_end);
+        // The last stage and the end share t + h: the system's values of that time are kept.
+        sys.rhs_memo(t + h, y_new, &mut self.f_end, &mut ctx.memo);
         ctx.stats.rhs_evals += S;
         if !all_finite(y_new) || !all_finite(&self.f_end) {
             return Trial::Failed {

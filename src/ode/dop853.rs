@@ -477,11 +477,12 @@ where
         for (s, &cs) in C.iter().enumerate().take(12).skip(1) {
             Self::stage_input(&self.k, s, y, h, &mut self.stage);
             let (_, rest) = self.k.split_at_mut(s);
-            sys.rhs(t + cs * h, &self.stage, &mut rest[0]);
+            sys.rhs_memo(t + cs * h, &self.stage, &mut rest[0], &mut ctx.memo);
         }
         Self::stage_input(&self.k, 12, y, h, y_new);
         let (_, rest) = self.k.split_at_mut(12);
-        sys.rhs(t + h, y_new, &mut rest[0]);
+        // Stages 11 and 12 share t + h: the system's values of that time are kept.
+        sys.rhs_memo(t + h, y_new, &mut rest[0], &mut ctx.memo);
         ctx.stats.rhs_evals += 12;
         if !all_finite(y_new) || !all_finite(&self.k[12]) {
             return Trial::Failed {

@@ -161,11 +161,12 @@ where
                 }
             }
             let ts = if s < 6 { t + C[s] * h } else { t + h };
+            // Stages 5 and 6 share t + h: the system's values of that time are kept.
             if s == 6 {
                 // Stage 6 input (at c = 1) is kept for the stiffness estimate.
-                sys.rhs(ts, y_new, &mut rest[0]);
+                sys.rhs_memo(ts, y_new, &mut rest[0], &mut ctx.memo);
             } else {
-                sys.rhs(ts, &self.stage, &mut rest[0]);
+                sys.rhs_memo(ts, &self.stage, &mut rest[0], &mut ctx.memo);
             }
         }
         ctx.stats.rhs_evals += 6;
