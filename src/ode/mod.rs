@@ -7,7 +7,10 @@
 //! saved states, a dense interpolant ([`Solution::sample`]), located [`Event`]s and [`Stats`].
 //! Failures are typed ([`OdeError`]) and say at which `t` and why. A right-hand side whose law
 //! changes branch where a function of the state changes sign names its switching functions
-//! ([`OdeSystem::switches`]): steps end on their roots, so no step crosses the kink.
+//! ([`OdeSystem::switches`]): steps end on their roots, so no step crosses the kink. A
+//! right-hand side with costly parts that depend on the time alone keeps them per time
+//! ([`OdeSystem::rhs_memo`], [`TimeMemo`]): the methods' evaluations that share a time compute
+//! them once.
 //!
 //! The stiff Van der Pol oscillator `y₁' = y₂`, `y₂' = μ(1 − y₁²)y₂ − y₁`, μ = 1000, against
 //! the reference value at t = 2000 of the Test Set for IVP Solvers (Mazzia et al.):
