@@ -1111,18 +1111,14 @@ impl SliderSystem {
     /// The right-hand side at time `t` and state `s`, with what it reads of the inputs there,
     /// `at` ([`Self::inputs_at`]).
     #[inline]
-    fn rhs_given<D: Dim>(
-        &self,
-        t: f64,
-        s: &OVector<f64, D>,
-        ds: &mut OVector<f64, D>,
-        [volt2, power, power_rate, accel]: [f64; 4],
-    ) where
+    fn rhs_given<D: Dim>(&self, t: f64, s: &OVector<f64, D>, ds: &mut OVector<f64, D>, at: [f64; 4])
+    where
         DefaultAllocator: Allocator<D>,
     {
         if let Some(q) = self.model.quasi_static {
-            return self.condensed_rhs(&q, t, s, ds, [volt2, power, power_rate, accel]);
+            return self.condensed_rhs(&q, t, s, ds, at);
         }
+        let [volt2, power, power_rate, accel] = at;
         let m = &*self.model;
         let st = &m.structure;
         let lay = self.layout;
@@ -1159,8 +1155,8 @@ impl SliderSystem {
     ) where
         DefaultAllocator: Allocator<D>,
     {
-        let m = &*self.model;
         let lay = self.layout;
+        let m = &*self.model;
         let Some(g) = self.settled_gaps(q, t, s) else {
             ds.fill(f64::NAN);
             return;
