@@ -282,18 +282,23 @@ where
 }
 
 /// Up to four values a system computed from the time alone, kept for the last time asked (see
-/// [`OdeSystem::rhs_memo`]). Empty at first.
+/// [`OdeSystem::rhs_memo`]), keyed by the time's bits (so `-0.0` and `0.0` are two times, and a
+/// NaN time is never confused with an empty memo). Empty at first.
 #[derive(Clone, Copy, Debug)]
 pub struct TimeMemo {
-    /// The time of `values`; NaN when empty (no time equals it).
-    t: f64,
+    /// The bits of the time of `values`; [`EMPTY`] when empty (a time with those bits, a NaN,
+    /// is never kept).
+    t: u64,
     values: [f64; 4],
 }
+
+/// The key of an empty [`TimeMemo`].
+const EMPTY: u64 = u64::MAX;
 
 impl Default for TimeMemo {
     fn default() -> Self {
         TimeMemo {
-            t: f64::NAN,
+            t: EMPTY,
             values: [0.0; 4],
         }
     }
@@ -310,19 +315,29 @@ impl TimeMemo {
     ///     memo.get_or_insert_with(2.0, |t| { calls += 1; [t * t, 0.0, 0.0, 0.0] });
     /// }
     /// assert_eq!((memo.get_or_insert_with(2.0, |_| [0.0; 4])[0], calls), (4.0, 1));
+    /// // Another time, even one equal to it as a number, is computed afresh.
+    /// assert_eq!(memo.get_or_insert_with(-0.0, |t| [1.0 / t, 0.0, 0.0, 0.0])[0], f64::NEG_INFINITY);
+    /// assert!(memo.get_or_insert_with(0.0, |t| [1.0 / t, 0.0, 0.0, 0.0])[0] > 0.0);
+    /// memo.clear();
+    /// assert!(memo.get_or_insert_with(f64::NAN, |t| [t; 4])[0].is_nan());
+    /// // Every NaN, whatever its bits, is computed afresh from an empty memo.
+    /// memo.clear();
+    /// let nan = f64::from_bits(u64::MAX);
+    /// assert!(memo.get_or_insert_with(nan, |t| [t; 4])[0].is_nan());
     /// ```
     #[inline]
     pub fn get_or_insert_with(&mut self, t: f64, f: impl FnOnce(f64) -> [f64; 4]) -> [f64; 4] {
-        if t != self.t {
+        let key = t.to_bits();
+        if self.t != key || key == EMPTY {
             self.values = f(t);
-            self.t = t;
+            self.t = key;
         }
         self.values
     }
 
     /// Forgets the values (the system they came from changed).
     pub fn clear(&mut self) {
-        self.t = f64::NAN;
+        self.t = EMPTY;
     }
 }
 
