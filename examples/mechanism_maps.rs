@@ -9,14 +9,19 @@
 //!   c/K_contact (≈ 27 ns) lies inside the plausible lags.
 //!
 //! Every point runs the scene's fixed programme at the scene's tolerance, and where that run
-//! gives touchdown and take-off, once more at a tolerance ten times tighter as a check: a point
-//! counts as converged when touchdown and take-off move by at most 0.05 mW between the two
-//! (`--full-check`: both runs at every point and the tighter one shown, `ac_sweep_refined` with
-//! two runs, as the maps in docs/analyses.md were made). Where the two agree, one more run with the
-//! other stiff method (Radau5, or Rodas5P if the scene asks for Radau5) at the scene's tolerance
-//! must agree with the values shown too, to the same 0.05 mW (`--no-method-check` leaves it
-//! out): with AC the detected take-off can be a whole period of `V²` early or late in both runs
-//! of the tolerance check alike. A cycle that bounces below the force
+//! gives touchdown and take-off, two checks must pass before the point counts as converged, each
+//! to 0.05 mW in touchdown and take-off:
+//! - the method check: the other stiff method (Radau5, or Rodas5P if the scene asks for Radau5)
+//!   at the scene's tolerance must agree with the values shown (`--no-method-check` leaves it
+//!   out). With AC the detected take-off can be a whole period of `V²` early or late in both runs
+//!   of a tolerance check alike;
+//! - the tolerance check: a run at a tolerance ten times tighter.
+//!
+//! The method check runs first, being the cheaper of the two (about half the tighter run), and
+//! the tighter run only where it agrees: where it disagrees the point is unconverged whatever
+//! the tighter run gives. (`--full-check`: the tolerance check at every point and the tighter
+//! run shown, `ac_sweep_refined` with two runs, as the maps in docs/analyses.md were made; the
+//! method check then follows it.) A cycle that bounces below the force
 //! tables at more than twice the even step pace stops there (`CycleOptions::stop_outside_tables`).
 //! The output gives each map's CPU time per status, and for the runaways per cause (also in the
 //! CSV's `cause` column). The heatmaps colour only converged
@@ -75,8 +80,8 @@ impl Bulge {
 struct Checks {
     /// Both runs at every point, the tighter one shown (`--full-check`).
     full: bool,
-    /// A third run with the other stiff method where the first two agree (on unless
-    /// `--no-method-check`).
+    /// A run with the other stiff method at the scene's tolerance, before the tighter one (on
+    /// unless `--no-method-check`).
     method: bool,
     /// The bulge mode condensed to its quasi-static equilibrium where
     /// `QuasiStaticBulge::check` passes (`--quasi-static`).
@@ -351,14 +356,6 @@ impl Setup {
         Ok(m.with_structure(structure).with_ac_amplitude(v_ac))
     }
 
-    /// One map point. The cycle at the scene's tolerance gives the values; a second cycle at a
-    /// tenfold tighter tolerance checks them (converged when touchdown and take-off move by at
-    /// most `POWER_TOL`). Where the first cycle already fails (the slider runs into the disk or
-    /// the stepper gives up) or misses touchdown or take-off, the point is marked as such
-    /// without the check run: no value is shown there, so there is nothing to check.
-    /// `checks.full` runs the check everywhere and reports the tighter run instead (the earlier
-    /// scheme, for comparison); `checks.method` runs one more cycle where the two agree, at the
-    /// scene's tolerance with the other stiff method, which must agree with the values shown.
     /// Where the quasi-static bulge holds at a point (`QuasiStaticBulge::check`), what its reduced
     /// model is made of: the bulge spring, the interface lag and the AC amplitude (the bulge's
     /// mass and damping enter only the check). `None` where it does not hold, or on `rigid`.
@@ -380,6 +377,46 @@ impl Setup {
         }))
     }
 
+    /// The method check: the other stiff method at the scene's tolerance must give touchdown and
+    /// take-off within `POWER_TOL` of `shown`. With AC the detected take-off can be a whole
+    /// period of V² early or late (0.24 mW at 5 mW/ms and 10.5 kHz) in both runs of the
+    /// tolerance check alike, which that check cannot see; another method's error rarely picks
+    /// the same period. A run that fails does not agree. Its accepted steps are added to `steps`.
+    fn method_check_agrees(
+        &self,
+        m: &SliderModel,
+        shown: (Option<f64>, Option<f64>),
+        steps: &mut usize,
+    ) -> bool {
+        let mut o = self.opts;
+        o.keep_series = false;
+        o.solver.method = match o.solver.method {
+            Method::Radau5 => Method::Rodas5P,
+            _ => Method::Radau5,
+        };
+        match simulate_cycle(m, &self.programme, &o) {
+            Ok(other) => {
+                *steps += other.stats.accepted;
+                let moved = |a: Option<f64>, b: Option<f64>| match (a, b) {
+                    (Some(a), Some(b)) => (a - b).abs(),
+                    _ => f64::INFINITY,
+                };
+                moved(shown.0, other.touchdown.map(|d| d.power))
+                    .max(moved(shown.1, other.takeoff.map(|d| d.power)))
+                    <= POWER_TOL
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// One map point. The cycle at the scene's tolerance gives the values; the method check
+    /// (`method_check_agrees`), then a cycle at a tenfold tighter tolerance check them (converged
+    /// when both agree within `POWER_TOL`). Where the first cycle already fails (the slider runs
+    /// into the disk or the stepper gives up) or misses touchdown or take-off, the point is marked
+    /// as such without the checks: no value is shown there, so there is nothing to check.
+    /// `checks.full` runs the tighter cycle everywhere and reports it instead (the earlier
+    /// scheme, for comparison), the method check after it. A check cycle that fails marks the
+    /// point: the tighter one as the cause of a runaway, the method check's as a disagreement.
     fn run(&self, axis: Axis, param: f64, v_ac: f64, checks: Checks, quasi: bool) -> Res<Point> {
         let mut m = self.model(axis, param, v_ac)?;
         if quasi {
@@ -430,12 +467,22 @@ impl Setup {
                 if td.is_none() || to.is_none() {
                     return Ok((first, None));
                 }
+                // Both checks must pass, so the cheaper one runs first: the other method at the
+                // scene's tolerance costs about half the tenfold tighter run (Auto's stiff method
+                // is Radau5 there too), and where it disagrees the tighter run would not change
+                // the verdict.
+                if checks.method {
+                    p.runs += 1;
+                    if !self.method_check_agrees(&m, (td, to), &mut p.steps) {
+                        return Ok((first, Some(false)));
+                    }
+                }
                 let mut o = self.opts;
                 o.keep_series = false;
                 o.solver.rtol *= 0.1;
                 o.solver.atol_displacement *= 0.1;
+                p.runs += 1;
                 let check = simulate_cycle(&m, &self.programme, &o)?;
-                p.runs = 2;
                 p.steps += check.stats.accepted;
                 let (td2, to2) = power(&check);
                 let converged = moved(td, td2).max(moved(to, to2)) <= POWER_TOL;
@@ -453,26 +500,11 @@ impl Setup {
             }
         };
         (p.td, p.to) = power(&r);
-        if converged == Some(true) && checks.method {
-            // The other stiff method at the first run's tolerance must agree with the values
-            // shown too: the detected take-off can be a whole period of V² early or late
-            // (0.24 mW at 5 mW/ms and 10.5 kHz) in both runs of the tolerance check alike,
-            // which that check cannot see; another method's error rarely picks the same period.
-            let mut o = self.opts;
-            o.keep_series = false;
-            o.solver.method = match o.solver.method {
-                Method::Radau5 => Method::Rodas5P,
-                _ => Method::Radau5,
-            };
+        if checks.full && converged == Some(true) && checks.method {
+            // With the full check the values shown are the tighter run's, so the method check
+            // follows it.
             p.runs += 1;
-            converged = Some(match simulate_cycle(&m, &self.programme, &o) {
-                Ok(other) => {
-                    p.steps += other.stats.accepted;
-                    let (td3, to3) = power(&other);
-                    moved(p.td, td3).max(moved(p.to, to3)) <= POWER_TOL
-                }
-                Err(_) => false,
-            });
+            converged = Some(self.method_check_agrees(&m, (p.td, p.to), &mut p.steps));
             p.cpu = thread_cpu_seconds() - cpu0;
         }
         p.status = match (p.td, p.to, converged) {
