@@ -1290,10 +1290,10 @@ mod tests {
             "{td} vs {}",
             stat.power
         );
-        let dir = std::env::temp_dir().join("hdi_mechanism_maps_test");
-        std::fs::create_dir_all(&dir)?;
-        draw_map(&dir.join("m.svg"), &spec, &points, 3)?;
-        assert!(std::fs::metadata(dir.join("m.svg"))?.len() > 1000);
+        let dir = tempfile::tempdir()?;
+        let svg = dir.path().join("m.svg");
+        draw_map(&svg, &spec, &points, 3)?;
+        assert!(std::fs::metadata(&svg)?.len() > 1000);
         Ok(())
     }
 

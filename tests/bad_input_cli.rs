@@ -237,12 +237,12 @@ fn write(dir: &std::path::Path, name: &str, text: &str) -> PathBuf {
 
 #[test]
 fn every_subcommand_rejects_bad_scene_files_on_one_line_naming_the_field() {
-    let dir = std::env::temp_dir().join(format!("hdi-bad-scenes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     for (i, (label, text, field)) in bad_scenes().into_iter().enumerate() {
         // The edit itself must have produced a scene the library rejects.
         assert!(Scene::from_toml_str(&text).is_err(), "{label}: accepted");
-        let path = write(&dir, &format!("bad{i}"), &text);
+        let path = write(dir, &format!("bad{i}"), &text);
         let file = path.to_string_lossy().into_owned();
         for args in [
             vec!["scene", file.as_str()],
@@ -264,15 +264,13 @@ fn every_subcommand_rejects_bad_scene_files_on_one_line_naming_the_field() {
             );
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A scene file larger than any scene (64 MiB) is refused before it is read.
 #[test]
 fn an_oversized_scene_file_is_refused_before_it_is_read() {
-    let dir = std::env::temp_dir().join(format!("hdi-big-scene-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("big.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("big.toml");
     let f = std::fs::File::create(&path).unwrap();
     f.set_len(65 << 20).unwrap(); // sparse: no data written
     let err = Scene::from_path(&path).unwrap_err().to_string();
@@ -289,5 +287,4 @@ fn an_oversized_scene_file_is_refused_before_it_is_read() {
             .count(),
         1
     );
-    std::fs::remove_dir_all(&dir).ok();
 }

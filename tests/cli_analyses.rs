@@ -68,9 +68,8 @@ fn static_answers_for_a_scene_file() {
 
 #[test]
 fn cycle_and_sweep_report_every_key_and_the_csv() {
-    let dir = std::env::temp_dir().join(format!("hdi_cli_cycle_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let csv = dir.join("series.csv");
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("series.csv");
     let v = json(&[
         "cycle",
         "--paper",
@@ -244,12 +243,13 @@ fn calibrate_refuses_contact_at_the_start_power() {
 
 #[test]
 fn printed_paper_scene_reads_back_as_the_paper_scene() {
+    let dir = tempfile::tempdir().unwrap();
     for (flag, ext) in [(None, "toml"), (Some("--json"), "json")] {
         let mut args = vec!["scene", "--paper"];
         args.extend(flag);
         let out = hdi(&args);
         assert!(out.status.success());
-        let path = std::env::temp_dir().join(format!("hdi_cli_scene_{}.{ext}", std::process::id()));
+        let path = dir.path().join(format!("paper.{ext}"));
         std::fs::write(&path, &out.stdout).unwrap();
         assert_eq!(Scene::from_path(&path).unwrap(), Scene::paper());
     }

@@ -3,17 +3,25 @@
 
 use std::process::Command;
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("hdi-drive-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+/// One test's directory of files, removed when the test ends, passed or failed.
+struct Tmp(tempfile::TempDir);
+
+impl Tmp {
+    fn new() -> Self {
+        Tmp(tempfile::tempdir().unwrap())
+    }
+
+    fn path(&self, name: &str) -> std::path::PathBuf {
+        self.0.path().join(name)
+    }
 }
 
 #[test]
 fn hdi_drive_writes_the_sensor_csv() {
-    let cmds = tmp("commands.csv");
+    let t = Tmp::new();
+    let cmds = t.path("commands.csv");
     std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,65,0\n").unwrap();
-    let out = tmp("sensors.csv");
+    let out = t.path("sensors.csv");
     let o = Command::new(env!("CARGO_BIN_EXE_hdi"))
         .args(["drive", "--paper", "--commands"])
         .arg(&cmds)
@@ -34,13 +42,14 @@ fn hdi_drive_writes_the_sensor_csv() {
 
 #[test]
 fn hdi_drive_bad_command_file_writes_nothing() {
-    let cmds = tmp("bad.csv");
+    let t = Tmp::new();
+    let cmds = t.path("bad.csv");
     std::fs::write(
         &cmds,
         "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,-65,0\n",
     )
     .unwrap();
-    let out = tmp("never.csv");
+    let out = t.path("never.csv");
     let o = Command::new(env!("CARGO_BIN_EXE_hdi"))
         .args(["drive", "--paper", "--commands"])
         .arg(&cmds)
@@ -56,7 +65,8 @@ fn hdi_drive_bad_command_file_writes_nothing() {
 
 #[test]
 fn hdi_drive_tolerance_flags_that_do_not_fit_write_nothing() {
-    let cmds = tmp("tol.csv");
+    let t = Tmp::new();
+    let cmds = t.path("tol.csv");
     std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.001,65,0\n").unwrap();
     for (flags, named) in [
         (
@@ -66,7 +76,7 @@ fn hdi_drive_tolerance_flags_that_do_not_fit_write_nothing() {
         (vec!["--atol-pm", "2"], ""),
         (vec!["--atol-pm", "0"], "--atol-pm"),
     ] {
-        let out = tmp("tol-out.csv");
+        let out = t.path("tol-out.csv");
         let _ = std::fs::remove_file(&out);
         let o = Command::new(env!("CARGO_BIN_EXE_hdi"))
             .args(["drive", "--paper", "--commands"])
@@ -100,12 +110,13 @@ fn hdi(args: &[&str]) -> std::process::Output {
 /// byte, and a different one from the default drive.
 #[test]
 fn hdi_drive_flags_and_the_scene_drive_section_agree() {
-    let cmds = tmp("settings_commands.csv");
+    let t = Tmp::new();
+    let cmds = t.path("settings_commands.csv");
     std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,62,0\n0.001,66,0\n").unwrap();
     let scene = hdi_tribology::scene::Scene::paper()
         .to_toml_string()
         .unwrap();
-    let with_drive = tmp("drive_scene.toml");
+    let with_drive = t.path("drive_scene.toml");
     std::fs::write(
         &with_drive,
         format!(
@@ -117,11 +128,11 @@ fn hdi_drive_flags_and_the_scene_drive_section_agree() {
         ),
     )
     .unwrap();
-    let plain = tmp("plain_scene.toml");
+    let plain = t.path("plain_scene.toml");
     std::fs::write(&plain, &scene).unwrap();
     let c = cmds.to_str().unwrap();
     let run = |extra: &[&str], out: &str| {
-        let out = tmp(out);
+        let out = t.path(out);
         let mut args = vec!["drive", "--commands", c, "--out", out.to_str().unwrap()];
         args.extend_from_slice(extra);
         let o = hdi(&args);
@@ -162,7 +173,8 @@ fn hdi_drive_flags_and_the_scene_drive_section_agree() {
 /// scene names the field as written.
 #[test]
 fn hdi_drive_bad_settings_name_the_flag_in_its_unit() {
-    let cmds = tmp("bad_settings_commands.csv");
+    let t = Tmp::new();
+    let cmds = t.path("bad_settings_commands.csv");
     std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,62,0\n0.001,66,0\n").unwrap();
     let c = cmds.to_str().unwrap();
     for (flag, value, unit) in [
@@ -183,7 +195,7 @@ fn hdi_drive_bad_settings_name_the_flag_in_its_unit() {
         ("--heads", "0", ""),
         ("--heads", "2.5", ""),
     ] {
-        let out = tmp("never.csv");
+        let out = t.path("never.csv");
         let o = hdi(&[
             "drive",
             "--paper",
@@ -207,7 +219,7 @@ fn hdi_drive_bad_settings_name_the_flag_in_its_unit() {
     let scene = hdi_tribology::scene::Scene::paper()
         .to_toml_string()
         .unwrap();
-    let bad = tmp("bad_drive_scene.toml");
+    let bad = t.path("bad_drive_scene.toml");
     std::fs::write(
         &bad,
         format!("{scene}\n[drive.sensors]\nreadback_wavelength_nm = -80\n"),
@@ -227,11 +239,12 @@ fn hdi_drive_bad_settings_name_the_flag_in_its_unit() {
 /// byte, and the other heads' surfaces are their own.
 #[test]
 fn hdi_drive_heads_replays_every_head() {
-    let cmds = tmp("heads_commands.csv");
+    let t = Tmp::new();
+    let cmds = t.path("heads_commands.csv");
     std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,62,0\n0.001,66,0\n").unwrap();
     let c = cmds.to_str().unwrap();
     let run = |extra: &[&str], name: &str| {
-        let out = tmp(name);
+        let out = t.path(name);
         let mut args = vec!["drive", "--commands", c, "--out", out.to_str().unwrap()];
         args.extend_from_slice(extra);
         let o = hdi(&args);
@@ -249,7 +262,7 @@ fn hdi_drive_heads_replays_every_head() {
     let scene = hdi_tribology::scene::Scene::paper()
         .to_toml_string()
         .unwrap();
-    let in_scene = tmp("heads_scene.toml");
+    let in_scene = t.path("heads_scene.toml");
     std::fs::write(&in_scene, format!("{scene}\n[drive]\nheads = 3\n")).unwrap();
     let (from_scene, _) = run(&[in_scene.to_str().unwrap()], "three_heads_scene.csv");
     assert_eq!(three, from_scene);
@@ -281,13 +294,14 @@ fn hdi_drive_heads_replays_every_head() {
 /// flag, and nothing is written.
 #[test]
 fn hdi_drive_bounded_mode_flags_its_misses() {
-    let cmds = tmp("dither.csv");
+    let t = Tmp::new();
+    let cmds = t.path("dither.csv");
     std::fs::write(
         &cmds,
         "time_s,heater_mw,voltage_dc_v,voltage_ac_v,ac_frequency_khz\n0,68,0,0.5,10.5\n0.002,68,0,0.5,10.5\n",
     )
     .unwrap();
-    let out = tmp("bounded.csv");
+    let out = t.path("bounded.csv");
     let run = |n: &str, out: &std::path::Path| {
         Command::new(env!("CARGO_BIN_EXE_hdi"))
             .args(["drive", "--paper", "--steps-per-period", n, "--commands"])
@@ -309,7 +323,7 @@ fn hdi_drive_bounded_mode_flags_its_misses() {
         err.contains(&format!("{missed} of 40 periods missed")),
         "{err}"
     );
-    let never = tmp("never-bounded.csv");
+    let never = t.path("never-bounded.csv");
     let o = run("65", &never);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--steps-per-period"));
@@ -322,7 +336,8 @@ fn hdi_drive_bounded_mode_flags_its_misses() {
 /// flag, and nothing is written.
 #[test]
 fn hdi_drive_exponential_scheme_replays_close_to_the_integrator() {
-    let cmds = tmp("changed.csv");
+    let t = Tmp::new();
+    let cmds = t.path("changed.csv");
     let mut text = String::from("time_s,heater_mw,voltage_dc_v\n");
     for k in 0..80 {
         let p = 66.0 + if k % 2 == 1 { 0.001 } else { 0.0 };
@@ -353,7 +368,7 @@ fn hdi_drive_exponential_scheme_replays_close_to_the_integrator() {
             .map(|l| l.split(',').nth(i).unwrap().parse().unwrap())
             .collect()
     };
-    let (default, exp, again) = (tmp("int.csv"), tmp("exp.csv"), tmp("exp2.csv"));
+    let (default, exp, again) = (t.path("int.csv"), t.path("exp.csv"), t.path("exp2.csv"));
     for (scheme, out) in [
         (None, &default),
         (Some("exponential"), &exp),
@@ -375,7 +390,7 @@ fn hdi_drive_exponential_scheme_replays_close_to_the_integrator() {
         worst > 0.0 && worst < 1e-4,
         "worst gap difference {worst} nm"
     );
-    let never = tmp("never-scheme.csv");
+    let never = t.path("never-scheme.csv");
     let o = run(Some("implicit"), &never);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--scheme"));
@@ -387,7 +402,8 @@ fn hdi_drive_exponential_scheme_replays_close_to_the_integrator() {
 /// the run; at 25 kHz likewise.
 #[test]
 fn hdi_drive_times_are_the_decimals_of_the_periods() {
-    let cmds = tmp("times.csv");
+    let t = Tmp::new();
+    let cmds = t.path("times.csv");
     std::fs::write(&cmds, "time_s,heater_mw,voltage_dc_v\n0,60,0\n0.1,60,0\n").unwrap();
     for (rate, hz) in [("20", 20_000.0), ("25", 25_000.0)] {
         let o = Command::new(env!("CARGO_BIN_EXE_hdi"))
