@@ -37,7 +37,7 @@
 //! the row's at `V_ac = 0`. Without `--grid` a 6 × 6 grid runs (a few minutes
 //! for all four maps on two cores; the test runs a 3 × 3 map in seconds).
 
-use hdi_tribology::analysis::cycle::{CycleOptions, CycleResult, HeaterProgramme};
+use hdi_tribology::analysis::cycle::{CycleOptions, HeaterProgramme};
 use hdi_tribology::analysis::{ac_sweep_refined, simulate_cycle, Refinement};
 use hdi_tribology::model::{ForceSlopes, SliderModel, Structure};
 use hdi_tribology::ode::Method;
@@ -49,14 +49,13 @@ use std::f64::consts::PI;
 use std::path::Path;
 use std::time::Instant;
 
+#[path = "common/checks.rs"]
+mod checks;
 #[path = "common/colour.rs"]
 mod colour;
+use checks::POWER_TOL;
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
-
-/// Largest change of `P_TD` and `P_TO` between the run at the scene's rtol and ten times tighter
-/// for a point to count as converged (W).
-const POWER_TOL: f64 = 5e-5;
 
 /// Step limit of one cycle of a map.
 const MAX_STEPS: usize = 300_000;
@@ -377,40 +376,8 @@ impl Setup {
         }))
     }
 
-    /// The method check: the other stiff method at the scene's tolerance must give touchdown and
-    /// take-off within `POWER_TOL` of `shown`. With AC the detected take-off can be a whole
-    /// period of V² early or late (0.24 mW at 5 mW/ms and 10.5 kHz) in both runs of the
-    /// tolerance check alike, which that check cannot see; another method's error rarely picks
-    /// the same period. A run that fails does not agree. Its accepted steps are added to `steps`.
-    fn method_check_agrees(
-        &self,
-        m: &SliderModel,
-        shown: (Option<f64>, Option<f64>),
-        steps: &mut usize,
-    ) -> bool {
-        let mut o = self.opts;
-        o.keep_series = false;
-        o.solver.method = match o.solver.method {
-            Method::Radau5 => Method::Rodas5P,
-            _ => Method::Radau5,
-        };
-        match simulate_cycle(m, &self.programme, &o) {
-            Ok(other) => {
-                *steps += other.stats.accepted;
-                let moved = |a: Option<f64>, b: Option<f64>| match (a, b) {
-                    (Some(a), Some(b)) => (a - b).abs(),
-                    _ => f64::INFINITY,
-                };
-                moved(shown.0, other.touchdown.map(|d| d.power))
-                    .max(moved(shown.1, other.takeoff.map(|d| d.power)))
-                    <= POWER_TOL
-            }
-            Err(_) => false,
-        }
-    }
-
-    /// One map point. The cycle at the scene's tolerance gives the values; the method check
-    /// (`method_check_agrees`), then a cycle at a tenfold tighter tolerance check them (converged
+    /// One map point. The cycle at the scene's tolerance gives the values; the method check,
+    /// then a cycle at a tenfold tighter tolerance check them (`checks::both_checks`: converged
     /// when both agree within `POWER_TOL`). Where the first cycle already fails (the slider runs
     /// into the disk or the stepper gives up) or misses touchdown or take-off, the point is marked
     /// as such without the checks: no value is shown there, so there is nothing to check.
@@ -440,11 +407,6 @@ impl Setup {
                 Model::Full
             },
         };
-        let power = |r: &CycleResult| (r.touchdown.map(|d| d.power), r.takeoff.map(|d| d.power));
-        let moved = |a: Option<f64>, b: Option<f64>| match (a, b) {
-            (Some(a), Some(b)) => (a - b).abs(),
-            _ => f64::INFINITY,
-        };
         let outcome = if checks.full {
             let refine = Refinement {
                 power_tol: POWER_TOL,
@@ -463,29 +425,19 @@ impl Setup {
         } else {
             simulate_cycle(&m, &self.programme, &self.opts).and_then(|first| {
                 p.steps = first.stats.accepted;
-                let (td, to) = power(&first);
-                if td.is_none() || to.is_none() {
+                let shown = checks::powers(&first);
+                if shown.0.is_none() || shown.1.is_none() {
                     return Ok((first, None));
                 }
-                // Both checks must pass, so the cheaper one runs first: the other method at the
-                // scene's tolerance costs about half the tenfold tighter run (Auto's stiff method
-                // is Radau5 there too), and where it disagrees the tighter run would not change
-                // the verdict.
-                if checks.method {
-                    p.runs += 1;
-                    if !self.method_check_agrees(&m, (td, to), &mut p.steps) {
-                        return Ok((first, Some(false)));
-                    }
-                }
-                let mut o = self.opts;
-                o.keep_series = false;
-                o.solver.rtol *= 0.1;
-                o.solver.atol_displacement *= 0.1;
-                p.runs += 1;
-                let check = simulate_cycle(&m, &self.programme, &o)?;
-                p.steps += check.stats.accepted;
-                let (td2, to2) = power(&check);
-                let converged = moved(td, td2).max(moved(to, to2)) <= POWER_TOL;
+                let converged = checks::both_checks(
+                    &m,
+                    &self.programme,
+                    &self.opts,
+                    shown,
+                    checks.method,
+                    &mut p.runs,
+                    &mut p.steps,
+                )?;
                 Ok((first, Some(converged)))
             })
         };
@@ -499,12 +451,18 @@ impl Setup {
                 return Ok(p);
             }
         };
-        (p.td, p.to) = power(&r);
+        (p.td, p.to) = checks::powers(&r);
         if checks.full && converged == Some(true) && checks.method {
             // With the full check the values shown are the tighter run's, so the method check
             // follows it.
             p.runs += 1;
-            converged = Some(self.method_check_agrees(&m, (p.td, p.to), &mut p.steps));
+            converged = Some(checks::method_check(
+                &m,
+                &self.programme,
+                &self.opts,
+                (p.td, p.to),
+                &mut p.steps,
+            ));
             p.cpu = thread_cpu_seconds() - cpu0;
         }
         p.status = match (p.td, p.to, converged) {

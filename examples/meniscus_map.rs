@@ -8,10 +8,11 @@
 //! - `formation`: the formation time τ_f (log scale, 10 ns – 1 ms), at the others below
 //!   (`--maps formation`; not in the default set).
 //!
-//! Every point runs the scene's fixed programme at the scene's tolerance and once more at a
-//! tolerance ten times tighter: a point counts as converged when touchdown and take-off move by
-//! at most 0.05 mW between the two (the standard of `mechanism_maps`). The row without menisci
-//! (the plain paper scene) is run alike and written beside each map.
+//! Every point runs the scene's fixed programme at the scene's tolerance; where that run gives
+//! touchdown and take-off, it counts as converged when the other stiff method (Radau5) at the
+//! same tolerance and then a run at a tolerance ten times tighter both agree with it to 0.05 mW
+//! in touchdown and take-off (the checks of `mechanism_maps`, `common/checks.rs`). The row
+//! without menisci (the plain paper scene) is run alike and written beside each map.
 //!
 //! `cargo run --release --all-features --example meniscus_map -- --grid 12` writes
 //! `out/meniscus/{thickness,healing}.csv` and `.svg` (three heat maps each, converged points
@@ -31,14 +32,14 @@ use hdi_tribology::quadrature::TableOptions;
 use hdi_tribology::scene::Scene;
 use rayon::prelude::*;
 
+#[path = "common/checks.rs"]
+mod checks;
 #[path = "common/colour.rs"]
 mod colour;
 use colour::viridis;
 
 type Res<T> = Result<T, Box<dyn std::error::Error + Send + Sync>>;
 
-/// Largest move of `P_TD` and `P_TO` at a 10× tighter tolerance for a converged point (W).
-const POWER_TOL: f64 = 5e-5;
 /// Step limit of one cycle.
 const MAX_STEPS: usize = 300_000;
 
@@ -173,13 +174,9 @@ impl Setup {
         Ok(base.with_stateful_term(m)?)
     }
 
-    fn cycle(&self, model: &SliderModel, tighter: bool) -> hdi_tribology::Result<CycleResult> {
-        let mut o = self.opts;
-        if tighter {
-            o.solver.rtol *= 0.1;
-            o.solver.atol_displacement *= 0.1;
-        }
-        simulate_cycle(model, &self.programme, &o)
+    /// One cycle of the scene's programme at its settings.
+    fn cycle(&self, model: &SliderModel) -> hdi_tribology::Result<CycleResult> {
+        simulate_cycle(model, &self.programme, &self.opts)
     }
 
     fn run(&self, params: Option<MeniscusParams>, param: f64, v_ac: f64) -> Point {
@@ -195,17 +192,20 @@ impl Setup {
         };
         let outcome = (|| -> Res<()> {
             let model = self.model(params, v_ac)?;
-            let a = self.cycle(&model, false)?;
-            p.td = a.touchdown.map(|d| d.power);
-            p.to = a.takeoff.map(|d| d.power);
+            let first = self.cycle(&model)?;
+            let shown = checks::powers(&first);
+            (p.td, p.to) = shown;
             if p.td.is_some() && p.to.is_some() {
-                let b = self.cycle(&model, true)?;
-                let close = |x: Option<f64>, y: Option<f64>| match (x, y) {
-                    (Some(x), Some(y)) => (x - y).abs() <= POWER_TOL,
-                    _ => false,
-                };
-                p.converged = close(p.td, b.touchdown.map(|d| d.power))
-                    && close(p.to, b.takeoff.map(|d| d.power));
+                let (mut runs, mut steps) = (1, 0);
+                p.converged = checks::both_checks(
+                    &model,
+                    &self.programme,
+                    &self.opts,
+                    shown,
+                    true,
+                    &mut runs,
+                    &mut steps,
+                )?;
             }
             Ok(())
         })();
@@ -285,7 +285,7 @@ fn write_svg(path: &Path, axis: Axis, values: &[f64], v: &[f64], points: &[Point
     let (pw, ph) = (cell_w * v.len() as f64, cell_h * rows as f64);
     let (left, top, gap) = (70.0, 40.0, 70.0);
     let width = left + 3.0 * (pw + gap);
-    let height = top + ph + 70.0;
+    let height = top + ph + 84.0;
     let mut s = format!(
         "<svg xmlns='http://www.w3.org/2000/svg' width='{width}' height='{height}' \
          font-family='sans-serif' font-size='10'>\n<rect width='100%' height='100%' fill='white'/>\n"
@@ -382,10 +382,13 @@ fn write_svg(path: &Path, axis: Axis, values: &[f64], v: &[f64], points: &[Point
     }
     writeln!(
         s,
-        "<text x='4' y='{}'>rows: {}; bottom row: no menisci. Grey: moves &gt; 0.05 mW at 10× \
-         tighter tolerance; light grey: touchdown or take-off not detected (no take-off before the programme returns to 60 mW).</text>",
+        "<text x='4' y='{}'>rows: {}; bottom row: no menisci.</text>\n\
+         <text x='4' y='{}'>Grey: moves &gt; 0.05 mW with Radau5 or at 10× tighter tolerance; \
+         light grey: touchdown or take-off not detected (no take-off before the programme \
+         returns to 60 mW).</text>",
         top + ph + 55.0,
-        axis.label()
+        axis.label(),
+        top + ph + 69.0
     )?;
     s.push_str("</svg>\n");
     std::fs::write(path, s)?;
@@ -442,7 +445,7 @@ fn timing(setup: &Setup, reps: usize) -> Res<()> {
         let mut t: Vec<f64> = (0..reps)
             .map(|_| {
                 let t0 = Instant::now();
-                setup.cycle(m, false).map(|_| t0.elapsed().as_secs_f64())
+                setup.cycle(m).map(|_| t0.elapsed().as_secs_f64())
             })
             .collect::<hdi_tribology::Result<_>>()?;
         t.sort_by(f64::total_cmp);
@@ -452,7 +455,7 @@ fn timing(setup: &Setup, reps: usize) -> Res<()> {
         let plain = setup.model(None, va)?;
         let with = setup.model(Some(Axis::Thickness.params(MOBILE_M, setup.formation)), va)?;
         let (a, b) = (time(&plain)?, time(&with)?);
-        let (ra, rb) = (setup.cycle(&plain, false)?, setup.cycle(&with, false)?);
+        let (ra, rb) = (setup.cycle(&plain)?, setup.cycle(&with)?);
         let statics = |m: &SliderModel| -> Res<f64> {
             let t0 = Instant::now();
             for _ in 0..10 {
@@ -552,7 +555,7 @@ mod tests {
         let csv = std::fs::read_to_string(dir.path().join("thickness.csv"))?;
         assert_eq!(csv.lines().count(), 1 + 2 * 3);
         assert!(std::fs::read_to_string(dir.path().join("thickness.svg"))?.contains("<svg"));
-        let plain = setup.cycle(&setup.plain, false)?;
+        let plain = setup.cycle(&setup.plain)?;
         let row = csv.lines().find(|l| l.starts_with("0,,")).unwrap();
         assert!(row.contains(&fmt_mw(plain.touchdown.map(|d| d.power))));
         Ok(())
