@@ -17,9 +17,9 @@
 //!   of a tolerance check alike;
 //! - the tolerance check: a run at a tolerance ten times tighter.
 //!
-//! The method check runs first, being the cheaper of the two (about half the tighter run), and
-//! the tighter run only where it agrees: where it disagrees the point is unconverged whatever
-//! the tighter run gives. (`--full-check`: the tolerance check at every point and the tighter
+//! The method check runs first and the tighter run only where it agrees: where it disagrees the
+//! point is unconverged whatever the tighter run gives, and the map saves that run (a 100 × 100
+//! `freq` map 13–15 % of its time; docs/benchmarks.md, "The method check first"). (`--full-check`: the tolerance check at every point and the tighter
 //! run shown, `ac_sweep_refined` with two runs, as the maps in docs/analyses.md were made; the
 //! method check then follows it.) A cycle that bounces below the force
 //! tables at more than twice the even step pace stops there (`CycleOptions::stop_outside_tables`).

@@ -7,8 +7,8 @@
 //!   period (docs/analyses.md, "Why a method check");
 //! - the tolerance check: the same settings at a tolerance ten times tighter.
 //!
-//! Both must pass, so [`both_checks`] runs the cheaper method check first and the tighter run
-//! only where it agrees.
+//! Both must pass, so [`both_checks`] runs the method check first and the tighter run only where
+//! it agrees: a point the method check stops saves the tighter run.
 
 use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, CycleResult, HeaterProgramme};
 use hdi_tribology::model::SliderModel;
