@@ -344,6 +344,69 @@ fn the_exponential_scheme_keeps_the_sensors_within_their_noise() {
     assert!(counts.exponential > 0, "{counts:?}");
 }
 
+/// Clear of the peaks on the wavy disk (60 mW, a 3.9 nm gap) under a command changed by ±1 µW
+/// every period, the case of the drive's 100× target: after its first period the exponential
+/// scheme continues each period by the two-step method (one right-hand side a period), and the
+/// gap stays within the contact displacement tolerance (0.01 pm) of the tight reference over
+/// 400 periods, the read-back within a small fraction of its noise.
+#[test]
+fn the_two_step_method_keeps_a_changing_command_clear_of_the_peaks_accurate() {
+    let scene = Scene::paper();
+    let zone = scene_zone(&scene, 0.025).unwrap();
+    let fast = Plant::new(
+        &scene,
+        &zone,
+        5,
+        DriveOptions {
+            scheme: DriveScheme::Exponential,
+            ..DriveOptions::default()
+        },
+    )
+    .unwrap();
+    let tight = Plant::new(
+        &scene,
+        &zone,
+        5,
+        DriveOptions {
+            method: hdi_tribology::ode::Method::Radau5,
+            rtol: 1e-10,
+            atol_displacement: 1e-17,
+            atol_displacement_flight: 1e-17,
+            max_step: Some(DT / 4.0),
+            ..DriveOptions::default()
+        },
+    )
+    .unwrap();
+    let (mut a, mut b) = (fast.drive().unwrap(), tight.drive().unwrap());
+    for _ in 0..200 {
+        let c = Command::heater_mw(60.0);
+        a.step(&c, DT).unwrap();
+        b.step(&c, DT).unwrap();
+    }
+    let c0 = a.scheme_counts();
+    let (mut gap, mut readback) = (0.0f64, 0.0f64);
+    for k in 0..400 {
+        let c = Command::heater_mw(60.0 + if k % 2 == 0 { 1e-3 } else { -1e-3 });
+        let (x, y) = (a.step(&c, DT).unwrap(), b.step(&c, DT).unwrap());
+        gap = gap.max((x.truth.gap_nm - y.truth.gap_nm).abs() * 1e-9);
+        readback = readback.max((x.readback.log_ratio() - y.readback.log_ratio()).abs());
+    }
+    let c1 = a.scheme_counts();
+    let two = c1.two_step - c0.two_step;
+    assert!(two >= 390, "{c0:?} -> {c1:?}");
+    assert!(c1.two_step <= c1.exponential);
+    println!(
+        "two-step periods {two} of 400; worst gap {:.4} pm; read-back log ratio {readback:.2e}",
+        gap * 1e12
+    );
+    assert!(gap < 1e-14, "gap differs by {gap} m");
+    let rb_noise = (2.0f64).sqrt() * SensorSpec::default().readback.noise;
+    assert!(
+        readback < 0.01 * rb_noise,
+        "read-back differs by {readback}"
+    );
+}
+
 /// The near-fold case of docs/clearance.md ("Accuracy"): 600 periods held at 74.3 mW, just
 /// below the touchdown fold, where the disk's waviness snaps the head into contact, then the
 /// programme. The exponential scheme must see the snap (its estimate) and leave it to the

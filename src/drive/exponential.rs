@@ -71,15 +71,18 @@ pub(crate) const MAX_SKIP_DITHER: usize = 4096;
 
 /// The periodic solution of `p′ = J p + u(t)` for a sum of harmonics, tabulated over a
 /// revolution: values and slopes at the disk's nodes, interpolated by cubic Hermite
-/// polynomials.
+/// polynomials, each interval's held in power form for a look-up of five multiply-adds
+/// ([`crate::numerics::cubic_hermite_power`]).
 #[derive(Clone, Debug)]
 struct Periodic {
-    n: usize,
     /// The components with a response (others stay zero).
     active: Vec<usize>,
-    /// `p` and `p′` at node `i`, component `c`: `[i * n + c]`.
-    values: Vec<f64>,
-    slopes: Vec<f64>,
+    /// Interval `i` (from node `i` to the next), active component `j`:
+    /// `[i * active.len() + j]`, the cubic's coefficients in the interval's own coordinate and
+    /// its slope's in time ([`crate::numerics::cubic_hermite_power`]).
+    cubics: Vec<[f64; 7]>,
+    /// The largest magnitude of each component over the revolution (0 where not active).
+    largest: Vec<f64>,
 }
 
 /// `C` of `(iω − J) C = U`, by the real system `[[−J, −ωI], [ωI, −J]] [C_r; C_i] = [U_r; U_i]`.
@@ -128,50 +131,55 @@ impl Periodic {
         let active: Vec<usize> = (0..n)
             .filter(|&k| spectra[k].iter().any(|c| c.norm() > 0.0))
             .collect();
-        let mut values = vec![0.0; NODES * n];
-        let mut slopes = vec![0.0; NODES * n];
+        let na = active.len();
+        let mut cubics = vec![[0.0; 7]; NODES * na];
+        let mut largest = vec![0.0; n];
         let mut buf = vec![zero; NODES];
-        for &k in &active {
+        let mut values = vec![0.0; NODES];
+        // The nodes' spacing in time.
+        let hn = disk.locate(0.0).2;
+        for (j, &k) in active.iter().enumerate() {
             buf.copy_from_slice(&spectra[k]);
             inverse_fft(&mut buf);
-            for (i, b) in buf.iter().enumerate() {
-                values[i * n + k] = b.re;
+            for (v, b) in values.iter_mut().zip(&buf) {
+                *v = b.re;
             }
+            largest[k] = values.iter().fold(0.0, |a: f64, v| a.max(v.abs()));
             for (m, b) in buf.iter_mut().enumerate() {
                 *b = Complex64::new(0.0, m as f64 * disk.omega()) * spectra[k][m];
             }
             inverse_fft(&mut buf);
-            for (i, b) in buf.iter().enumerate() {
-                slopes[i * n + k] = b.re;
+            for i in 0..NODES {
+                let next = (i + 1) % NODES;
+                cubics[i * na + j] = crate::numerics::cubic_hermite_power(
+                    hn,
+                    values[i],
+                    buf[i].re,
+                    values[next],
+                    buf[next].re,
+                );
             }
         }
         Some(Periodic {
-            n,
             active,
-            values,
-            slopes,
+            cubics,
+            largest,
         })
     }
 
     /// The largest magnitude of component `k` over the revolution.
     fn largest(&self, k: usize) -> f64 {
-        (0..NODES)
-            .map(|i| self.values[i * self.n + k].abs())
-            .fold(0.0, f64::max)
+        self.largest[k]
     }
 
     /// Adds `p(t)` to `p` and `p′(t)` to `dp`.
     #[inline]
     fn add(&self, disk: &Disk, t: f64, p: &mut [f64], dp: &mut [f64]) {
-        let (i, s, hn) = disk.locate(t);
-        let k = (i + 1) % NODES;
-        let n = self.n;
-        for &c in &self.active {
-            let (p0, m0) = (self.values[i * n + c], self.slopes[i * n + c]);
-            let (p1, m1) = (self.values[k * n + c], self.slopes[k * n + c]);
-            let (value, slope) = crate::numerics::cubic_hermite(s, p0, hn * m0, p1, hn * m1);
-            p[c] += value;
-            dp[c] += slope / hn;
+        let (i, s, _) = disk.locate(t);
+        let na = self.active.len();
+        for (&c, q) in self.active.iter().zip(&self.cubics[i * na..(i + 1) * na]) {
+            p[c] += q[0] + s * (q[1] + s * (q[2] + s * q[3]));
+            dp[c] += q[4] + s * (q[5] + s * q[6]);
         }
     }
 }
@@ -281,6 +289,9 @@ impl Dither {
 pub struct SchemeCounts {
     /// Periods advanced by one exponential step.
     pub exponential: u64,
+    /// Of those, the periods that continued the one before by the two-step method
+    /// ([`crate::ode::ExponentialStepper::step_two`]), one right-hand side each.
+    pub two_step: u64,
     /// Periods run by the integrator after the exponential step missed the tolerances there.
     pub fallbacks: u64,
     /// Periods run by the integrator without a try, after misses (see the module docs).
@@ -384,6 +395,12 @@ pub(crate) struct ExpScheme {
     z0: Vec<f64>,
     f0: Vec<f64>,
     z1: Vec<f64>,
+    /// Where the last period advanced by one step ended, and its inputs: the next period may
+    /// take the two-step method from there ([`ExpScheme::two_step_from`]).
+    last_end: Option<StepEnd>,
+    /// The end of the last one-step period `step` ran: `z` and, after the two-step method, the
+    /// right-hand side there (for `last_end`, when the period is taken).
+    ended: Option<([f64; MAX_STATE], Option<[f64; MAX_STATE]>)>,
     /// The settled orbit of a dither held on a flat disk, and the wait before the next try to
     /// tabulate it after a refusal.
     pub(crate) orbit: Option<Orbit>,
@@ -404,6 +421,28 @@ pub(crate) struct ExpScheme {
     /// Periods since the voltage or the clearance last changed, or the heater by more than
     /// the map's test covers (the orbit's settling periods).
     pub(crate) voltage_held: usize,
+}
+
+/// The end of a period advanced by one exponential step: its time, its state (and the state
+/// less the known forcings, `z`), the right-hand side of `z` there where the two-step method
+/// evaluated it, and the inputs it ran under (the heater's power, the voltage, the clearance
+/// offset).
+#[derive(Clone, Copy, Debug)]
+struct StepEnd {
+    t: f64,
+    x: [f64; MAX_STATE],
+    z: [f64; MAX_STATE],
+    f: Option<[f64; MAX_STATE]>,
+    heater: f64,
+    voltage: Voltage,
+    clearance: f64,
+}
+
+/// Where a period continues the last one (see [`ExpScheme::continuation`]): its start `z0`,
+/// and `F(t0, z0)` where the last period's end value serves (the heater's change added).
+struct Continuation {
+    z: [f64; MAX_STATE],
+    f: Option<[f64; MAX_STATE]>,
 }
 
 /// How one attempt went.
@@ -450,6 +489,8 @@ impl ExpScheme {
             z0: vec![0.0; n],
             f0: vec![0.0; n],
             z1: vec![0.0; n],
+            last_end: None,
+            ended: None,
             orbit: None,
             orbit_wait: Backoff::default(),
             orbit_map: None,
@@ -640,6 +681,56 @@ impl ExpScheme {
         }
     }
 
+    /// Whether the period from `(t0, x0)` continues the last one, for the two-step method
+    /// ([`ExponentialStepper::step_two`]): one step a period, no dither, a stepper with a step
+    /// before, and the last period advanced by one step ended here, to the bit in the state,
+    /// under the same voltage and clearance. Its start `z` is then the last period's end, and so
+    /// is `F(t0, z)` where the last period evaluated it, with a changed heater power added
+    /// ([`SliderSystem::heater_shift`]; without a thermal lag the power moves the gaps, and
+    /// `F` is evaluated afresh). `None`: the one-step method runs, as after a refresh, a miss
+    /// or a change of level.
+    fn continuation<D: Dim>(
+        &mut self,
+        sys: &SliderSystem,
+        t0: f64,
+        x0: &OVector<f64, D>,
+        h: f64,
+        level: usize,
+    ) -> Option<Continuation>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let end = self.last_end.take()?;
+        let inputs = sys.inputs();
+        let continues = level == 0
+            && self.dither.is_none()
+            && self.steppers[0]
+                .as_ref()
+                .is_some_and(ExponentialStepper::has_previous)
+            && (t0 - end.t).abs() <= 1e-9 * h
+            && end.voltage == inputs.voltage
+            && end.clearance == inputs.clearance_offset
+            && x0
+                .iter()
+                .zip(&end.x)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !continues {
+            return None;
+        }
+        let heater = inputs.heater.power(t0);
+        let f = match end.f {
+            Some(mut f) if heater != end.heater => match sys.heater_shift(x0, end.heater, heater) {
+                Some((i, delta)) => {
+                    f[i] += delta;
+                    Some(f)
+                }
+                None => None,
+            },
+            f => f,
+        };
+        Some(Continuation { z: end.z, f })
+    }
+
     /// `2^level` exponential steps over `[t0, t0 + h]` from `x0`: the state at its end and the
     /// largest error estimate.
     fn step<D: Dim>(
@@ -664,6 +755,7 @@ impl ExpScheme {
             }
             self.last_level = level;
         }
+        let mut cont = self.continuation(sys, t0, x0, h, level);
         let ExpScheme {
             rtol,
             atol,
@@ -676,8 +768,10 @@ impl ExpScheme {
             z0,
             f0,
             z1,
+            ended,
             ..
         } = self;
+        *ended = None;
         let Some(stepper) = steppers[level].as_mut() else {
             return (x0.clone(), f64::INFINITY);
         };
@@ -689,20 +783,37 @@ impl ExpScheme {
         let mut x = x0.clone();
         let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
         let mut err = 0.0f64;
+        // The right-hand side at the end, where the two-step method evaluated it.
+        let mut f1 = [0.0; MAX_STATE];
+        let mut f1_known = false;
         for k in 0..m {
             let ts = t0 + k as f64 * hs;
-            OdeSystem::<D>::rhs(sys, ts, &x, &mut fx);
-            if forced {
-                if *known_at != Some(ts.to_bits()) {
-                    Self::known(disk, table, dither, ts, p, dp);
-                }
-                for i in 0..n {
-                    z0[i] = x[i] - p[i];
-                    f0[i] = fx[i] - dp[i];
-                }
+            let c = if k == 0 { cont.take() } else { None };
+            if let Some(Continuation { z, f: Some(f) }) = &c {
+                // The last period's end, and its right-hand side there.
+                z0.copy_from_slice(&z[..n]);
+                f0.copy_from_slice(&f[..n]);
             } else {
-                z0.copy_from_slice(x.as_slice());
-                f0.copy_from_slice(fx.as_slice());
+                OdeSystem::<D>::rhs(sys, ts, &x, &mut fx);
+                if forced {
+                    if *known_at != Some(ts.to_bits()) {
+                        Self::known(disk, table, dither, ts, p, dp);
+                    }
+                    for i in 0..n {
+                        f0[i] = fx[i] - dp[i];
+                    }
+                } else {
+                    f0.copy_from_slice(fx.as_slice());
+                }
+                match &c {
+                    Some(Continuation { z, .. }) => z0.copy_from_slice(&z[..n]),
+                    None if forced => {
+                        for i in 0..n {
+                            z0[i] = x[i] - p[i];
+                        }
+                    }
+                    None => z0.copy_from_slice(x.as_slice()),
+                }
             }
             let mut pw = [0.0; MAX_STATE];
             let mut dpw = [0.0; MAX_STATE];
@@ -726,7 +837,14 @@ impl ExpScheme {
                     dz[i] = fx[i] - dpw[i];
                 }
             };
-            err = err.max(stepper.step(ts, z0, f0, f, (*rtol, atol), z1));
+            let e = if c.is_some() {
+                f1_known = true;
+                stepper.step_two(ts, z0, f0, f, (*rtol, atol), z1, &mut f1[..n])
+            } else {
+                Some(stepper.step(ts, z0, f0, f, (*rtol, atol), z1))
+            };
+            // `continuation` checked that the stepper has a step before.
+            err = err.max(e.unwrap_or(f64::INFINITY));
             if forced {
                 let te = if k + 1 == m { t0 + h } else { ts + hs };
                 if te.to_bits() == at.to_bits() {
@@ -742,6 +860,11 @@ impl ExpScheme {
             } else {
                 x.as_mut_slice().copy_from_slice(z1);
             }
+        }
+        if m == 1 {
+            let mut z = [0.0; MAX_STATE];
+            z[..n].copy_from_slice(z1);
+            *ended = Some((z, f1_known.then_some(f1)));
         }
         (x, err)
     }
@@ -802,6 +925,21 @@ impl ExpScheme {
         if err <= 1.0 && x1.iter().all(|v| v.is_finite()) && !switched {
             self.misses.succeeded();
             self.counts.exponential += 1;
+            if let (0, Some((z, f))) = (level, self.ended.take()) {
+                self.counts.two_step += u64::from(f.is_some());
+                let inputs = sys.inputs();
+                let mut x = [0.0; MAX_STATE];
+                x[..x1.len()].copy_from_slice(x1.as_slice());
+                self.last_end = Some(StepEnd {
+                    t: t0 + h,
+                    x,
+                    z,
+                    f,
+                    heater: inputs.heater.power(t0),
+                    voltage: inputs.voltage,
+                    clearance: inputs.clearance_offset,
+                });
+            }
             // Up at once when the period needed it; down after CALM periods well within the
             // tolerances.
             if level != self.level || err > CALM_ERROR {

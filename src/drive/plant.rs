@@ -1202,13 +1202,11 @@ struct Held<'a> {
 impl Held<'_> {
     /// The inputs of the command, the disk's motion kept.
     fn apply(&self, sys: &mut SliderSystem) {
-        let inputs = Inputs {
-            heater: Heater::Power(self.command.heater_power()),
-            voltage: self.voltage(),
-            clearance_offset: self.clearance,
-            base_motion: sys.inputs().base_motion.clone(),
-        };
-        sys.set_inputs(inputs);
+        sys.set_command_inputs(
+            Heater::Power(self.command.heater_power()),
+            self.voltage(),
+            self.clearance,
+        );
     }
 
     /// The head–disk voltage of the command.

@@ -281,6 +281,19 @@ impl SliderSystem {
         self.inputs = inputs;
     }
 
+    /// The heater, the voltage and the clearance offset of the inputs replaced, the disk's
+    /// motion kept (without touching its shared handle).
+    pub(crate) fn set_command_inputs(
+        &mut self,
+        heater: super::Heater,
+        voltage: super::Voltage,
+        clearance_offset: f64,
+    ) {
+        self.inputs.heater = heater;
+        self.inputs.voltage = voltage;
+        self.inputs.clearance_offset = clearance_offset;
+    }
+
     /// The model.
     pub fn model(&self) -> &SliderModel {
         &self.model
@@ -495,6 +508,23 @@ impl SliderSystem {
             Some(i) => (m.protrusion(power) - s[i]) / m.thermal_lag,
             None => m.protrusion(power_rate),
         }
+    }
+
+    /// The change of the right-hand side at state `s` when the heater's power moves from `from`
+    /// to `to` (W), the other inputs kept: the protrusion's rate alone changes, where a thermal
+    /// lag makes the protrusion a state (its index and the change; `None` without one, where the
+    /// power moves the gaps at once).
+    pub(crate) fn heater_shift<S: Index<usize, Output = f64> + ?Sized>(
+        &self,
+        s: &S,
+        from: f64,
+        to: f64,
+    ) -> Option<(usize, f64)> {
+        let i = self.layout.delta?;
+        Some((
+            i,
+            self.protrusion_rate_given(s, to, 0.0) - self.protrusion_rate_given(s, from, 0.0),
+        ))
     }
 
     /// The rates of the gaps (m/s) at time `t` and state `s`, of a model without a quasi-static
