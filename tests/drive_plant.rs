@@ -145,6 +145,28 @@ struct Deviation {
     steps: usize,
 }
 
+/// The tight reference of the paper scene's drive at 25 mm on `disk` (seed 5): Radau5 at `rtol`
+/// 1e-10 and 1e-17 m, steps no longer than a quarter period.
+fn tight_reference(disk: DiskSpec) -> Plant {
+    let scene = Scene::paper();
+    let zone = scene_zone(&scene, 0.025).unwrap();
+    Plant::new(
+        &scene,
+        &zone,
+        5,
+        DriveOptions {
+            disk,
+            method: hdi_tribology::ode::Method::Radau5,
+            rtol: 1e-10,
+            atol_displacement: 1e-17,
+            atol_displacement_flight: 1e-17,
+            max_step: Some(DT / 4.0),
+            ..DriveOptions::default()
+        },
+    )
+    .unwrap()
+}
+
 /// Runs `opts` and a tight reference (Radau5 at `rtol` 1e-10 and 1e-17 m, steps no longer than
 /// a quarter period) through one programme on the disk of `opts` (the default wavy disk unless
 /// the test says otherwise): a heater staircase into
@@ -164,21 +186,7 @@ fn deviation_after(
     let zone = scene_zone(&scene, 0.025).unwrap();
     let disk = opts.disk.clone();
     let fast = Plant::new(&scene, &zone, 5, opts).unwrap();
-    let tight = Plant::new(
-        &scene,
-        &zone,
-        5,
-        DriveOptions {
-            disk,
-            method: hdi_tribology::ode::Method::Radau5,
-            rtol: 1e-10,
-            atol_displacement: 1e-17,
-            atol_displacement_flight: 1e-17,
-            max_step: Some(DT / 4.0),
-            ..DriveOptions::default()
-        },
-    )
-    .unwrap();
+    let tight = tight_reference(disk);
     let mut programme: Vec<Command> = prelude.to_vec();
     for mw in [62.0, 68.0, 72.0, 76.0, 78.0, 74.0, 70.0] {
         programme.extend(std::iter::repeat_n(Command::heater_mw(mw), 60));
@@ -363,20 +371,7 @@ fn the_two_step_method_keeps_a_changing_command_clear_of_the_peaks_accurate() {
         },
     )
     .unwrap();
-    let tight = Plant::new(
-        &scene,
-        &zone,
-        5,
-        DriveOptions {
-            method: hdi_tribology::ode::Method::Radau5,
-            rtol: 1e-10,
-            atol_displacement: 1e-17,
-            atol_displacement_flight: 1e-17,
-            max_step: Some(DT / 4.0),
-            ..DriveOptions::default()
-        },
-    )
-    .unwrap();
+    let tight = tight_reference(DiskSpec::default());
     let (mut a, mut b) = (fast.drive().unwrap(), tight.drive().unwrap());
     for _ in 0..200 {
         let c = Command::heater_mw(60.0);

@@ -250,7 +250,8 @@ pub enum DriveScheme {
     #[default]
     Integrator,
     /// One exponential step per period, or 2 to 16 substeps where the period needs them
-    /// (ETD2RK, [`crate::ode::ExponentialStepper`]), with the slider's Jacobian held across
+    /// (ETD2RK, [`crate::ode::ExponentialStepper`]; a period of one step that continues the one
+    /// before by the two-step ETD2, one right-hand side, `step_two`), with the slider's Jacobian held across
     /// periods and refreshed when a period misses the tolerances; the disk's waviness and an
     /// AC dither are taken out by their exact periodic responses to the held linear part. A
     /// period whose error estimate still misses the drive's contact tolerances

@@ -117,7 +117,8 @@ pub fn phi_functions(a: &DMatrix<f64>, h: f64) -> Result<PhiFunctions, OdeError>
 /// Steps of one length `h` of a second-order exponential scheme with a held matrix `A`: the
 /// φ-functions are computed once, each step then costs one right-hand side besides the one at
 /// its start, and three products of an `n × n` matrix with a vector. Nothing is allocated per
-/// step.
+/// step. A step that follows another of the same length may take the two-step method instead
+/// ([`ExponentialStepper::step_two`]), whose one right-hand side is at its end.
 ///
 /// For `y' = F(t, y)` and a matrix `A` near `∂F/∂y` (held over many steps, refreshed by the
 /// caller), one step of length `h` is the exponential time differencing scheme ETD2RK of Cox and
@@ -245,7 +246,7 @@ impl ExponentialStepper {
     ) -> f64 {
         let n = self.dim();
         assert!(y0.len() == n && f0.len() == n && y1.len() == n && tol.1.len() == n);
-        // The same loops with the dimension a constant, for the sizes a slider has: unrolled,
+        // The same loops with the dimension a literal, for the sizes a slider has: unrolled,
         // they cost a third of the loops over a dimension known only at run time (the sums
         // are taken in the same order, so the results are the same to the bit).
         match n {
@@ -323,6 +324,7 @@ impl ExponentialStepper {
         assert!(
             y0.len() == n && f0.len() == n && y1.len() == n && f1.len() == n && tol.1.len() == n
         );
+        // As in `step`.
         Some(match n {
             4 => self.two_of(4, t0, y0, f0, f, tol, y1, f1),
             5 => self.two_of(5, t0, y0, f0, f, tol, y1, f1),
@@ -349,15 +351,7 @@ impl ExponentialStepper {
     ) -> f64 {
         let h = self.h;
         let (y0, f0, y1, f1) = (&y0[..n], &f0[..n], &mut y1[..n], &mut f1[..n]);
-        let dot = |rows: &[f64], i: usize, v: &[f64]| -> f64 {
-            let row = &rows[i * n..i * n + n];
-            let v = &v[..n];
-            let mut s = -0.0;
-            for j in 0..n {
-                s += row[j] * v[j];
-            }
-            s
-        };
+        let dot = |rows: &[f64], i: usize, v: &[f64]| row_dot(n, rows, i, v);
         // y1 = y0 + h φ1 f0 + h φ2 d₋₁ (φ2 d₋₁ kept in `curv`).
         for i in 0..n {
             self.curv[i] = dot(&self.rows2, i, &self.d_prev);
@@ -405,16 +399,7 @@ impl ExponentialStepper {
     ) -> f64 {
         let h = self.h;
         let (y0, f0, y1) = (&y0[..n], &f0[..n], &mut y1[..n]);
-        // Σ_j row_j v_j, summed from −0 in order of j (as `Iterator::sum` does).
-        let dot = |rows: &[f64], i: usize, v: &[f64]| -> f64 {
-            let row = &rows[i * n..i * n + n];
-            let v = &v[..n];
-            let mut s = -0.0;
-            for j in 0..n {
-                s += row[j] * v[j];
-            }
-            s
-        };
+        let dot = |rows: &[f64], i: usize, v: &[f64]| row_dot(n, rows, i, v);
         // a = y0 + h φ1 f0 (rows of the row-major copies).
         for i in 0..n {
             self.ya[i] = y0[i] + h * dot(&self.rows1, i, f0);
@@ -458,6 +443,20 @@ impl ExponentialStepper {
             f64::INFINITY
         }
     }
+}
+
+/// `Σ_j row_j v_j` over row `i` of the row-major `rows` (`n` columns), summed from −0 in order of
+/// `j` (as `Iterator::sum` does).
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+fn row_dot(n: usize, rows: &[f64], i: usize, v: &[f64]) -> f64 {
+    let row = &rows[i * n..i * n + n];
+    let v = &v[..n];
+    let mut s = -0.0;
+    for j in 0..n {
+        s += row[j] * v[j];
+    }
+    s
 }
 
 #[cfg(test)]
