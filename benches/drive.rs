@@ -5,7 +5,8 @@
 //! tolerance (0.01 pm throughout), with the exponential scheme (`DriveScheme::Exponential`, right
 //! after the default on the same case) and with 1 pm in flight
 //! (`DriveOptions::atol_displacement_flight`). Prints a table; the last column gives the shares
-//! of the timed periods the exponential scheme advanced itself, left to the integrator's
+//! of the timed periods the exponential scheme advanced itself (in brackets those that continued
+//! the period before by the two-step method), left to the integrator's
 //! spanning steps (a held command on a flat disk) and read from a dither's settled orbit (a
 //! dither on a flat disk, held or under a heater changed within the orbit's linearised map);
 //! the rest it left to the integrator after misses.
@@ -28,7 +29,7 @@ const BLOCK: usize = 200;
 fn main() {
     let scene = Scene::paper();
     let zone = scene_zone(&scene, 0.025).expect("zone");
-    println!("| scheme | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period | exponential / spanned / orbit periods |");
+    println!("| scheme | disk | state | heater (mW) | dither | wall µs/period | CPU µs/period | × real time (wall) | × real time (CPU) | steps/period | exponential (two-step) / spanned / orbit periods |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let configs = [
         ("0.01 pm", DriveOptions::default()),
@@ -115,6 +116,7 @@ fn main() {
                         let steps = (d.stats().accepted - s0) as f64 / periods;
                         let c1 = d.scheme_counts();
                         let exp_share = (c1.exponential - c0.exponential) as f64 / periods;
+                        let two_share = (c1.two_step - c0.two_step) as f64 / periods;
                         let spanned = (c1.spanned - c0.spanned) as f64 / periods;
                         let orbit = (c1.orbit - c0.orbit) as f64 / periods;
                         let last = last.expect("ran");
@@ -123,7 +125,7 @@ fn main() {
                         assert_eq!(in_contact, state == "contact", "{state} at {mw} mW");
                         let (wall, cpu) = (t.wall / BLOCK as f64, t.cpu / BLOCK as f64);
                         println!(
-                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} / {:.2} / {:.2} |",
+                    "| {atol_name} | {disk_name} | {state} | {mw} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {:.2} | {:.2} ({:.2}) / {:.2} / {:.2} |",
                     match (dither, alternate) {
                         (Some((a, f)), false) => format!("{a} V, {f:.1} kHz"),
                         (Some((a, f)), true) => format!("{a} V, {f:.1} kHz, ±1 µW every period"),
@@ -136,6 +138,7 @@ fn main() {
                     DT / cpu,
                     steps,
                     exp_share,
+                    two_share,
                     spanned,
                     orbit
                 );

@@ -285,6 +285,8 @@ impl Dither {
 /// // Each period is counted once, by whoever advanced it.
 /// assert_eq!(c.exponential + c.fallbacks + c.skipped + c.spanned, 200);
 /// assert!(c.exponential > 100, "{c:?}");
+/// // Most of them continue the period before: one right-hand side each.
+/// assert!(c.two_step > c.exponential / 2 && c.two_step <= c.exponential, "{c:?}");
 /// # Ok::<(), hdi_tribology::Error>(())
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -398,11 +400,18 @@ pub(crate) struct ExpScheme {
     f0: Vec<f64>,
     z1: Vec<f64>,
     /// Where the last period advanced by one step ended, and its inputs: the next period may
-    /// take the two-step method from there ([`ExpScheme::two_step_from`]).
+    /// take the two-step method from there ([`ExpScheme::continuation`]). Its state `x`, `z`
+    /// and, where the two-step method evaluated it, the right-hand side of `z` are in `end_x`,
+    /// `end_z`, `end_f`.
     last_end: Option<StepEnd>,
-    /// The end of the last one-step period `step` ran: `z` and, after the two-step method, the
-    /// right-hand side there (for `last_end`, when the period is taken).
-    ended: Option<([f64; MAX_STATE], Option<[f64; MAX_STATE]>)>,
+    end_x: Vec<f64>,
+    end_z: Vec<f64>,
+    end_f: Vec<f64>,
+    /// The end of the last one-step period `step` ran, for `last_end` when the period is taken:
+    /// whether the right-hand side there is known; `z` and it in `ended_z`, `ended_f`.
+    ended: Option<bool>,
+    ended_z: Vec<f64>,
+    ended_f: Vec<f64>,
     /// The settled orbit of a dither held on a flat disk, and the wait before the next try to
     /// tabulate it after a refusal.
     pub(crate) orbit: Option<Orbit>,
@@ -425,26 +434,17 @@ pub(crate) struct ExpScheme {
     pub(crate) voltage_held: usize,
 }
 
-/// The end of a period advanced by one exponential step: its time, its state (and the state
-/// less the known forcings, `z`), the right-hand side of `z` there where the two-step method
-/// evaluated it, and the inputs it ran under (the heater's power, the voltage, the clearance
+/// The end of a period advanced by one exponential step (its state in `ExpScheme::end_x`,
+/// `end_z`, `end_f`): its time, whether the right-hand side there is known (the two-step method
+/// evaluated it), and the inputs it ran under (the heater's power, the voltage, the clearance
 /// offset).
 #[derive(Clone, Copy, Debug)]
 struct StepEnd {
     t: f64,
-    x: [f64; MAX_STATE],
-    z: [f64; MAX_STATE],
-    f: Option<[f64; MAX_STATE]>,
+    f_known: bool,
     heater: f64,
     voltage: Voltage,
     clearance: f64,
-}
-
-/// Where a period continues the last one (see [`ExpScheme::continuation`]): its start `z0`,
-/// and `F(t0, z0)` where the last period's end value serves (the heater's change added).
-struct Continuation {
-    z: [f64; MAX_STATE],
-    f: Option<[f64; MAX_STATE]>,
 }
 
 /// How one attempt went.
@@ -492,7 +492,12 @@ impl ExpScheme {
             f0: vec![0.0; n],
             z1: vec![0.0; n],
             last_end: None,
+            end_x: vec![0.0; n],
+            end_z: vec![0.0; n],
+            end_f: vec![0.0; n],
             ended: None,
+            ended_z: vec![0.0; n],
+            ended_f: vec![0.0; n],
             orbit: None,
             orbit_wait: Backoff::default(),
             orbit_map: None,
@@ -686,11 +691,11 @@ impl ExpScheme {
     /// Whether the period from `(t0, x0)` continues the last one, for the two-step method
     /// ([`ExponentialStepper::step_two`]): one step a period, no dither, a stepper with a step
     /// before, and the last period advanced by one step ended here, to the bit in the state,
-    /// under the same voltage and clearance. Its start `z` is then the last period's end, and so
-    /// is `F(t0, z)` where the last period evaluated it, with a changed heater power added
-    /// ([`SliderSystem::heater_shift`]; without a thermal lag the power moves the gaps, and
-    /// `F` is evaluated afresh). `None`: the one-step method runs, as after a refresh, a miss
-    /// or a change of level.
+    /// under the same voltage and clearance. Its start `z` is then the last period's end
+    /// (`end_z`), and so is `F(t0, z)` where the last period evaluated it (`end_f`, then
+    /// `Some(true)`), with a changed heater power added ([`SliderSystem::heater_shift`];
+    /// without a thermal lag the power moves the gaps, and `F` is evaluated afresh: `Some(false)`).
+    /// `None`: the one-step method runs, as after a refresh, a miss or a change of level.
     fn continuation<D: Dim>(
         &mut self,
         sys: &SliderSystem,
@@ -698,7 +703,7 @@ impl ExpScheme {
         x0: &OVector<f64, D>,
         h: f64,
         level: usize,
-    ) -> Option<Continuation>
+    ) -> Option<bool>
     where
         DefaultAllocator: Allocator<D>,
     {
@@ -714,23 +719,22 @@ impl ExpScheme {
             && end.clearance == inputs.clearance_offset
             && x0
                 .iter()
-                .zip(&end.x)
+                .zip(&self.end_x)
                 .all(|(a, b)| a.to_bits() == b.to_bits());
         if !continues {
             return None;
         }
         let heater = inputs.heater.power(t0);
-        let f = match end.f {
-            Some(mut f) if heater != end.heater => match sys.heater_shift(x0, end.heater, heater) {
-                Some((i, delta)) => {
-                    f[i] += delta;
-                    Some(f)
-                }
-                None => None,
-            },
-            f => f,
-        };
-        Some(Continuation { z: end.z, f })
+        if !end.f_known || heater == end.heater {
+            return Some(end.f_known);
+        }
+        match sys.heater_shift(x0, end.heater, heater) {
+            Some((i, delta)) => {
+                self.end_f[i] += delta;
+                Some(true)
+            }
+            None => Some(false),
+        }
     }
 
     /// `2^level` exponential steps over `[t0, t0 + h]` from `x0`: the state at its end and the
@@ -770,7 +774,11 @@ impl ExpScheme {
             z0,
             f0,
             z1,
+            end_z,
+            end_f,
             ended,
+            ended_z,
+            ended_f,
             ..
         } = self;
         *ended = None;
@@ -785,16 +793,13 @@ impl ExpScheme {
         let mut x = x0.clone();
         let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
         let mut err = 0.0f64;
-        // The right-hand side at the end, where the two-step method evaluated it.
-        let mut f1 = [0.0; MAX_STATE];
-        let mut f1_known = false;
         for k in 0..m {
             let ts = t0 + k as f64 * hs;
             let c = if k == 0 { cont.take() } else { None };
-            if let Some(Continuation { z, f: Some(f) }) = &c {
+            if c == Some(true) {
                 // The last period's end, and its right-hand side there.
-                z0.copy_from_slice(&z[..n]);
-                f0.copy_from_slice(&f[..n]);
+                z0.copy_from_slice(end_z);
+                f0.copy_from_slice(end_f);
             } else {
                 OdeSystem::<D>::rhs(sys, ts, &x, &mut fx);
                 if forced {
@@ -807,8 +812,8 @@ impl ExpScheme {
                 } else {
                     f0.copy_from_slice(fx.as_slice());
                 }
-                match &c {
-                    Some(Continuation { z, .. }) => z0.copy_from_slice(&z[..n]),
+                match c {
+                    Some(_) => z0.copy_from_slice(end_z),
                     None if forced => {
                         for i in 0..n {
                             z0[i] = x[i] - p[i];
@@ -840,8 +845,8 @@ impl ExpScheme {
                 }
             };
             let e = if c.is_some() {
-                f1_known = true;
-                stepper.step_two(ts, z0, f0, f, (*rtol, atol), z1, &mut f1[..n])
+                *ended = Some(true);
+                stepper.step_two(ts, z0, f0, f, (*rtol, atol), z1, ended_f)
             } else {
                 Some(stepper.step(ts, z0, f0, f, (*rtol, atol), z1))
             };
@@ -864,9 +869,8 @@ impl ExpScheme {
             }
         }
         if m == 1 {
-            let mut z = [0.0; MAX_STATE];
-            z[..n].copy_from_slice(z1);
-            *ended = Some((z, f1_known.then_some(f1)));
+            ended_z.copy_from_slice(z1);
+            ended.get_or_insert(false);
         }
         (x, err)
     }
@@ -927,16 +931,15 @@ impl ExpScheme {
         if err <= 1.0 && x1.iter().all(|v| v.is_finite()) && !switched {
             self.misses.succeeded();
             self.counts.exponential += 1;
-            if let (0, Some((z, f))) = (level, self.ended.take()) {
-                self.counts.two_step += u64::from(f.is_some());
+            if let (0, Some(f_known)) = (level, self.ended.take()) {
+                self.counts.two_step += u64::from(f_known);
                 let inputs = sys.inputs();
-                let mut x = [0.0; MAX_STATE];
-                x[..x1.len()].copy_from_slice(x1.as_slice());
+                self.end_x.copy_from_slice(x1.as_slice());
+                std::mem::swap(&mut self.end_z, &mut self.ended_z);
+                std::mem::swap(&mut self.end_f, &mut self.ended_f);
                 self.last_end = Some(StepEnd {
                     t: t0 + h,
-                    x,
-                    z,
-                    f,
+                    f_known,
                     heater: inputs.heater.power(t0),
                     voltage: inputs.voltage,
                     clearance: inputs.clearance_offset,
