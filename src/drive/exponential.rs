@@ -20,7 +20,8 @@
 //! The step is [`crate::ode::ExponentialStepper`]'s (ETD2RK) on `z`, at the drive's contact
 //! tolerances, per component; a period of one step that continues the one before, to the bit,
 //! under the same inputs but the heater, takes its two-step method instead
-//! ([`ExponentialStepper::step_two`], one right-hand side a period, [`ExpScheme::continuation`]). Before it, a check of the contact force's curvature over the
+//! ([`ExponentialStepper::step_two`], one right-hand side a period,
+//! [`ExpScheme::continuation`]). Before it, a check of the contact force's curvature over the
 //! forcings' reach ([`ExpScheme::straight`]) refuses what the estimate cannot see. A period
 //! whose estimate is above 1 is tried again with the Jacobian taken afresh at its start (the
 //! disk's table rebuilt when that moved `J` by more than [`REBUILD_SHIFT`]), then with twice
