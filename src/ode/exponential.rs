@@ -372,15 +372,10 @@ impl ExponentialStepper {
         for i in 0..n {
             let c = dot(&self.rows2, i, &self.d);
             let e = c.abs().max((c - self.curv[i]).abs());
-            let sc = atol[i] + rtol * y0[i].abs().max(y1[i].abs());
-            err = err.max(h * e / sc);
+            err = err.max(weighted(h * e, atol[i], rtol, y0[i], y1[i]));
         }
         std::mem::swap(&mut self.d, &mut self.d_prev);
-        if err.is_finite() {
-            err
-        } else {
-            f64::INFINITY
-        }
+        finite_or_infinite(err)
     }
 
     /// [`step`](ExponentialStepper::step)'s body for a dimension `n` checked by it.
@@ -432,16 +427,27 @@ impl ExponentialStepper {
             let corr = h * self.corr[i];
             y1[i] = self.ya[i] + corr;
             let e = corr.abs().max(h * self.curv[i].abs());
-            let sc = atol[i] + rtol * y0[i].abs().max(y1[i].abs());
-            err = err.max(e / sc);
+            err = err.max(weighted(e, atol[i], rtol, y0[i], y1[i]));
         }
         std::mem::swap(&mut self.d, &mut self.d_prev);
         self.have_prev = true;
-        if err.is_finite() {
-            err
-        } else {
-            f64::INFINITY
-        }
+        finite_or_infinite(err)
+    }
+}
+
+/// A component's error `e` weighted by `atol + rtol·max(|y0|, |y1|)`: the steps' estimate norm.
+#[inline(always)]
+fn weighted(e: f64, atol: f64, rtol: f64, y0: f64, y1: f64) -> f64 {
+    e / (atol + rtol * y0.abs().max(y1.abs()))
+}
+
+/// The estimate, infinite where it is not finite (a non-finite right-hand side).
+#[inline(always)]
+fn finite_or_infinite(err: f64) -> f64 {
+    if err.is_finite() {
+        err
+    } else {
+        f64::INFINITY
     }
 }
 
