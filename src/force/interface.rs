@@ -832,6 +832,45 @@ impl InterfaceForces {
             .then_some(out)
     }
 
+    /// Per gap (bulge, pad), a stretch `(from, to)` of gaps (m) over which every contact slope
+    /// [`InterfaceForces::contact`] can return on that gap, as the tables give it, rounding
+    /// included, is within `slope` (N/m) in magnitude: `to` is the tables' end, and `from` is
+    /// found by bisection to within a millionth of the tables' range. `(−∞, ∞)` where no
+    /// contact term sits on the gap (its slope is zero); an empty stretch (`from > to`) where
+    /// even the tables' end is too steep. A clamped undershoot (`non_negative`) has zero slope,
+    /// within any bound.
+    pub(crate) fn contact_gentle(&self, slope: f64) -> [(f64, f64); 2] {
+        let (lo, hi) = self.range;
+        let steepest = |t: &Slot, a: f64| {
+            t.bounds(a, hi)
+                .map_or(f64::INFINITY, |(_, s)| s.lo.abs().max(s.hi.abs()))
+        };
+        self.contact.each_ref().map(|slot| {
+            let Some(t) = slot else {
+                return (f64::NEG_INFINITY, f64::INFINITY);
+            };
+            // Not NaN: a NaN bound would compare false and pass.
+            let within = |a: f64| steepest(t, a) <= slope;
+            if !within(hi) {
+                return (f64::INFINITY, f64::NEG_INFINITY);
+            }
+            if within(lo) {
+                return (lo, hi);
+            }
+            // `within(b)` holds and `within(a)` does not.
+            let (mut a, mut b) = (lo, hi);
+            while b - a > 1e-6 * (hi - lo) {
+                let m = 0.5 * (a + b);
+                if within(m) {
+                    b = m;
+                } else {
+                    a = m;
+                }
+            }
+            (b, hi)
+        })
+    }
+
     /// Real contact area, m², never negative: where the area is below the table's absolute
     /// tolerance an interpolation undershoot could make it slightly negative, and an area is not
     /// (the flash temperature takes its square root).
@@ -1185,5 +1224,57 @@ impl InterfaceForces {
             }
         }
         n + self.fused.as_ref().map_or(0, |f| f.len()) + self.kinked.as_ref().map_or(0, |k| k.len())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    /// Every contact slope the look-up returns within a gentle stretch is within its bound,
+    /// on whichever gap the contact term sits; the other gap's stretch is unbounded; and the
+    /// stretch starts near where the slopes actually fall below the bound.
+    #[test]
+    fn a_gentle_stretch_holds_every_slope_within_its_bound() {
+        for gap in [GapReference::Bulge, GapReference::Pad] {
+            let mut scene = Scene::paper();
+            scene.contact.as_mut().unwrap().gap = gap;
+            let forces = scene.build_interface().unwrap();
+            let (lo, hi) = forces.table_range();
+            let k = usize::from(gap == GapReference::Pad);
+            for bound in [1e1, 5e2, 1e4, 1e6] {
+                let stretches = forces.contact_gentle(bound);
+                assert_eq!(
+                    stretches[1 - k],
+                    (f64::NEG_INFINITY, f64::INFINITY),
+                    "{gap:?}"
+                );
+                let (from, to) = stretches[k];
+                assert_eq!(to, hi);
+                assert!(from > lo && from < hi, "{gap:?} {bound}: {from:e}");
+                let slope = |d: f64| {
+                    let c = forces.contact(Gaps { bulge: d, pad: d });
+                    c.d_bulge + c.d_pad
+                };
+                let n = 20_000;
+                let mut steep_last = lo;
+                for j in 0..=n {
+                    let d = lo + (hi - lo) * j as f64 / n as f64;
+                    let s = slope(d).abs();
+                    if d >= from {
+                        assert!(s <= bound, "{gap:?} {bound}: |F′({d:e})| = {s:e}");
+                    }
+                    if s > bound {
+                        steep_last = d;
+                    }
+                }
+                // Conservative, but not by more than a few table intervals' worth.
+                assert!(
+                    from - steep_last < 0.02e-9,
+                    "{gap:?} {bound}: from {from:e}, last steep {steep_last:e}"
+                );
+            }
+        }
     }
 }

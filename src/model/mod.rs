@@ -643,8 +643,18 @@ impl SliderModel {
     /// `f` plus the forces of the stateful terms with their states at equilibrium at `g`, and
     /// the total derivatives along the gaps (through the equilibrium's own slope,
     /// `∂x/∂d = −(∂ẋ/∂x)⁻¹ ∂ẋ/∂d`): what a static analysis sees of a term with memory. `f` as
-    /// it is when the model has no such terms.
-    pub(crate) fn with_stateful(&self, mut f: ForceEval, g: Gaps) -> ForceEval {
+    /// it is when the model has no such terms (at the cost of one check, inline: the drive
+    /// reads the interface force every period).
+    #[inline]
+    pub(crate) fn with_stateful(&self, f: ForceEval, g: Gaps) -> ForceEval {
+        if self.stateful.is_empty() {
+            return f;
+        }
+        self.with_stateful_terms(f, g)
+    }
+
+    /// [`SliderModel::with_stateful`] with stateful terms.
+    fn with_stateful_terms(&self, mut f: ForceEval, g: Gaps) -> ForceEval {
         use crate::force::MAX_TERM_STATES;
         use nalgebra::{SMatrix, SVector};
         for term in self.stateful.iter() {
