@@ -367,11 +367,8 @@ pub(crate) struct ExpScheme {
     /// A bound on how far the known forcings move the gaps (m): the sum over the positions of
     /// their responses' largest magnitude.
     reach: f64,
-    /// The reach and the period (their bits) that `gentle` was found for, and per gap (bulge,
-    /// pad) the stretch over which the contact slope is gentle enough that
-    /// [`ExpScheme::straight`] holds without looking it up
-    /// ([`crate::force::InterfaceForces::contact_gentle`]).
-    gentle: Option<(u64, u64, [(f64, f64); 2])>,
+    /// Where [`ExpScheme::straight`] holds without looking the contact force up.
+    gentle: Option<Gentle>,
     rtol: f64,
     atol: Vec<f64>,
     /// `(index, r)` of the velocities a disk translation moves.
@@ -451,6 +448,16 @@ struct StepEnd {
     heater: f64,
     voltage: Voltage,
     clearance: f64,
+}
+
+/// Per gap (bulge, pad), the stretch over which the contact slope is gentle enough that
+/// [`ExpScheme::straight`] holds without looking it up
+/// ([`crate::force::InterfaceForces::contact_gentle`]), and the reach and period (their bits)
+/// it was found for.
+#[derive(Clone, Copy, Debug)]
+struct Gentle {
+    key: (u64, u64),
+    stretches: [(f64, f64); 2],
 }
 
 /// How one attempt went.
@@ -671,11 +678,11 @@ impl ExpScheme {
         let forces = sys.model().forces();
         let key = (a.to_bits(), h.to_bits());
         let gentle = match self.gentle {
-            Some((ra, rh, g)) if (ra, rh) == key => g,
+            Some(g) if g.key == key => g.stretches,
             _ => {
-                let g = forces.contact_gentle(self.atol[i] / (4.0 * h * a));
-                self.gentle = Some((key.0, key.1, g));
-                g
+                let stretches = forces.contact_gentle(self.atol[i] / (4.0 * h * a));
+                self.gentle = Some(Gentle { key, stretches });
+                stretches
             }
         };
         let g = sys.gaps(t, x);
