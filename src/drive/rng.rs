@@ -1,8 +1,11 @@
 //! The drive's seeded random source: one independent stream per noise source, normal deviates.
 //!
-//! The drive's noise must be the same bit for bit for a seed on every platform and with every
-//! version of the dependencies: the bits come from the crate's own SplitMix64
-//! ([`crate::numerics::rng`]), the normal deviates from the Box–Muller transform.
+//! The drive's noise is the same bit for bit for a seed, run after run and with every version of
+//! the dependencies: the bits come from the crate's own SplitMix64 ([`crate::numerics::rng`]),
+//! the same on every platform, and the normal deviates from the Box–Muller transform. Its
+//! logarithm, sine and cosine are the platform's math library's (its square root is exact
+//! everywhere), so across platforms the deviates are the same where those functions round the
+//! same, and may otherwise differ in their last bits; the tests pin them on one platform only.
 
 use crate::numerics::rng::SplitMix64;
 

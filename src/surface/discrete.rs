@@ -57,7 +57,9 @@ impl Discrete {
     }
 
     /// Draws `n` peak heights from `parent` with a seeded xoshiro256** stream
-    /// (same seed, same ensemble on every platform). Sampling inverts the
+    /// (same seed, same uniform stream on every platform; the heights then pass through
+    /// the family's functions in floating point, whose library calls may round differently
+    /// on another platform). Sampling inverts the
     /// survival function: exactly for families that provide
     /// [`PeakDistribution::inverse_survival`], through a table of
     /// `partial_moment(·, 0)` with absolute accuracy 1e-13 otherwise; discrete
