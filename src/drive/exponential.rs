@@ -450,13 +450,14 @@ struct StepEnd {
     clearance: f64,
 }
 
-/// Per gap (bulge, pad), the stretch over which the contact slope is gentle enough that
-/// [`ExpScheme::straight`] holds without looking it up
-/// ([`crate::force::InterfaceForces::contact_gentle`]), and the reach and period (their bits)
-/// it was found for.
+/// Per gap (bulge, pad), the stretch over which every contact slope is within `slope` (N/m)
+/// ([`crate::force::InterfaceForces::contact_gentle`]). It serves [`ExpScheme::straight`]
+/// for every bound `S` from `slope` up to `4 slope`: a stretch within a tighter bound is within
+/// the looser one, so the verdict does not depend on which was found, and a reach or period
+/// that moves a little (a refresh) does not find it again (about 1 M instructions).
 #[derive(Clone, Copy, Debug)]
 struct Gentle {
-    key: (u64, u64),
+    slope: f64,
     stretches: [(f64, f64); 2],
 }
 
@@ -656,7 +657,8 @@ impl ExpScheme {
     /// be within the impulse's tolerance.
     ///
     /// Where each gap's sweep `[d − A, d + A]` lies in a stretch whose contact slopes are all
-    /// within `S = atol / (4 h A)` (found once per reach and period), the bound is at most
+    /// within `S = atol / (4 h A)` (found for half of that, and kept while the reach and period
+    /// move within a factor of two; [`Gentle`]), the bound is at most
     /// `h A (2S + 2S) / 4 = atol / 4`, and the check holds without the two look-ups: the same
     /// verdict.
     pub(crate) fn straight<D: Dim>(
@@ -676,12 +678,14 @@ impl ExpScheme {
             return true;
         }
         let forces = sys.model().forces();
-        let key = (a.to_bits(), h.to_bits());
+        let budget = self.atol[i] / (4.0 * h * a);
         let gentle = match self.gentle {
-            Some(g) if g.key == key => g.stretches,
+            Some(g) if g.slope <= budget && budget <= 4.0 * g.slope => g.stretches,
             _ => {
-                let stretches = forces.contact_gentle(self.atol[i] / (4.0 * h * a));
-                self.gentle = Some(Gentle { key, stretches });
+                // Found for half the budget: it then serves budgets from half to twice this one.
+                let slope = 0.5 * budget;
+                let stretches = forces.contact_gentle(slope);
+                self.gentle = Some(Gentle { slope, stretches });
                 stretches
             }
         };
