@@ -849,7 +849,7 @@ impl InterfaceForces {
             let Some(t) = slot else {
                 return (f64::NEG_INFINITY, f64::INFINITY);
             };
-            // Not NaN: a NaN bound would compare false and pass.
+            // A NaN bound compares false: not within, the safe side.
             let within = |a: f64| steepest(t, a) <= slope;
             if !within(hi) {
                 return (f64::INFINITY, f64::NEG_INFINITY);
