@@ -21,7 +21,8 @@
 //! tolerances, per component; a period of one step that continues the one before, to the bit,
 //! under the same inputs but the heater, takes its two-step method instead
 //! ([`ExponentialStepper::step_two`], one right-hand side a period,
-//! [`ExpScheme::continuation`]). Before it, a check of the contact force's curvature over the
+//! [`ExpScheme::continuation`]), and so does every substep after a period's first, from the
+//! substep before (one right-hand side a substep). Before it, a check of the contact force's curvature over the
 //! forcings' reach ([`ExpScheme::straight`]) refuses what the estimate cannot see. A period
 //! whose estimate is above 1 is tried again with the Jacobian taken afresh at its start (the
 //! disk's table rebuilt when that moved `J` by more than [`REBUILD_SHIFT`]), then with twice
@@ -829,12 +830,19 @@ impl ExpScheme {
         let mut x = x0.clone();
         let mut fx = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
         let mut err = 0.0f64;
+        // Whether the last substep was the two-step method's: its end and the right-hand side
+        // there are in `z1` and `ended_f`, the next substep's start.
+        let mut inner_known = false;
         for k in 0..m {
             let ts = t0 + k as f64 * hs;
             let c = if k == 0 { cont.take() } else { None };
             // `continuation` took `last_end`: `end_z` and `end_f` are not read again before
             // the next accepted period fills them, and are swapped in rather than copied.
-            if c == Some(true) {
+            if inner_known {
+                // `z1` was read into `x`; `ended_f` is scratch when the period has substeps.
+                std::mem::swap(z0, z1);
+                std::mem::swap(f0, ended_f);
+            } else if c == Some(true) {
                 // The last period's end, and its right-hand side there.
                 std::mem::swap(z0, end_z);
                 std::mem::swap(f0, end_f);
@@ -882,13 +890,19 @@ impl ExpScheme {
                     dz[i] = fx[i] - dpw[i];
                 }
             };
-            let e = if c.is_some() {
-                *ended = Some(true);
+            // The two-step method for a period that continues the last one and for every
+            // substep after a period's first, which continues the substep before.
+            let e = if c.is_some() || k > 0 {
+                if c.is_some() {
+                    *ended = Some(true);
+                }
+                inner_known = true;
                 stepper.step_two(ts, z0, f0, f, (*rtol, atol), z1, ended_f)
             } else {
                 Some(stepper.step(ts, z0, f0, f, (*rtol, atol), z1))
             };
-            // `continuation` checked that the stepper has a step before.
+            // `continuation` checked that the stepper has a step before, and a substep after
+            // the first has the one before it.
             err = err.max(e.unwrap_or(f64::INFINITY));
             if forced {
                 let te = if k + 1 == m { t0 + h } else { ts + hs };
