@@ -22,14 +22,14 @@
 //! under the same inputs but the heater, takes its two-step method instead
 //! ([`ExponentialStepper::step_two`], one right-hand side a period,
 //! [`ExpScheme::continuation`]), and so does every substep after a period's first, from the
-//! substep before (one right-hand side a substep). Before it, a check of the contact force's curvature over the
-//! forcings' reach ([`ExpScheme::straight`]) refuses what the estimate cannot see. A period
-//! whose estimate is above 1 is tried again with the Jacobian taken afresh at its start (the
-//! disk's table rebuilt when that moved `J` by more than [`REBUILD_SHIFT`]), then with twice
-//! the substeps, up to [`LEVELS`]; if it still misses, the period is run by the integrator
-//! from the same start, as the default drive runs it, and the following periods too, for a
-//! number that doubles with each consecutive miss, up to [`MAX_SKIP`] ([`MAX_SKIP_DITHER`] with
-//! a dither). A held command on a flat disk without a dither is left to the integrator
+//! substep before (one right-hand side a substep). Before it, a check of the contact force's
+//! curvature over the forcings' reach ([`ExpScheme::straight`]) refuses what the estimate
+//! cannot see. A period whose estimate is above 1 is tried again with the Jacobian taken
+//! afresh at its start (the disk's table rebuilt when that moved `J` by more than
+//! [`REBUILD_SHIFT`]), then with twice the substeps, up to [`LEVELS`]; if it still misses,
+//! the period is run by the integrator from the same start, as the default drive runs it, and
+//! the following periods too, for a number that doubles with each consecutive miss, up to
+//! [`MAX_SKIP`] ([`MAX_SKIP_DITHER`] with a dither). A held command on a flat disk without a dither is left to the integrator
 //! (`src/drive/plant.rs`), whose steps span many periods there; with a dither, once the slider
 //! has settled onto the dither's periodic orbit, the periods are read from a table of that
 //! orbit (`src/drive/orbit.rs`).
@@ -836,14 +836,14 @@ impl ExpScheme {
         for k in 0..m {
             let ts = t0 + k as f64 * hs;
             let c = if k == 0 { cont.take() } else { None };
-            // `continuation` took `last_end`: `end_z` and `end_f` are not read again before
-            // the next accepted period fills them, and are swapped in rather than copied.
             if inner_known {
                 // `z1` was read into `x`; `ended_f` is scratch when the period has substeps.
                 std::mem::swap(z0, z1);
                 std::mem::swap(f0, ended_f);
             } else if c == Some(true) {
-                // The last period's end, and its right-hand side there.
+                // The last period's end, and its right-hand side there. `continuation` took
+                // `last_end`: `end_z` and `end_f` are not read again before the next accepted
+                // period fills them, and are swapped in rather than copied.
                 std::mem::swap(z0, end_z);
                 std::mem::swap(f0, end_f);
             } else {
