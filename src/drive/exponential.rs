@@ -29,10 +29,10 @@
 //! [`REBUILD_SHIFT`]), then with twice the substeps, up to [`LEVELS`]; if it still misses,
 //! the period is run by the integrator from the same start, as the default drive runs it, and
 //! the following periods too, for a number that doubles with each consecutive miss, up to
-//! [`MAX_SKIP`] ([`MAX_SKIP_DITHER`] with a dither). A held command on a flat disk without a dither is left to the integrator
-//! (`src/drive/plant.rs`), whose steps span many periods there; with a dither, once the slider
-//! has settled onto the dither's periodic orbit, the periods are read from a table of that
-//! orbit (`src/drive/orbit.rs`).
+//! [`MAX_SKIP`] ([`MAX_SKIP_DITHER`] with a dither). A held command on a flat disk without a
+//! dither is left to the integrator (`src/drive/plant.rs`), whose steps span many periods
+//! there; with a dither, once the slider has settled onto the dither's periodic orbit, the
+//! periods are read from a table of that orbit (`src/drive/orbit.rs`).
 
 use super::disk::{Disk, NODES};
 use super::orbit::Orbit;
