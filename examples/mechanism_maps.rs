@@ -22,7 +22,8 @@
 //! `freq` map 13–15 % of its time; docs/benchmarks.md, "The method check first"). (`--full-check`: the tolerance check at every point and the tighter
 //! run shown, `ac_sweep_refined` with two runs, as the maps in docs/analyses.md were made; the
 //! method check then follows it.) A cycle that bounces below the force
-//! tables at more than twice the even step pace stops there (`CycleOptions::stop_outside_tables`).
+//! tables at more than twice the even step pace stops there (`CycleOptions::stop_outside_tables`),
+//! and every run ends at its take-off (`CycleOptions::stop_at_takeoff`: the same powers).
 //! The output gives each map's CPU time per status, and for the runaways per cause (also in the
 //! CSV's `cause` column). The heatmaps colour only converged
 //! points with both detections (and, for `ΔP`, a non-negative value); the others are drawn in
@@ -309,6 +310,9 @@ impl Setup {
         opts.stop_outside_tables = true;
         // The maps show powers, not the lag's energy audit, which would cost a tenth more.
         opts.energy_audit = false;
+        // A point shows the two powers and whether the contact bounces during the hold: its
+        // runs end at the take-off (the same powers to the bit, a tenth fewer steps).
+        opts.stop_at_takeoff = true;
         let base = SliderModel::from_scene(scene)?;
         Ok(Setup {
             slopes: ForceSlopes::of(base.forces()),

@@ -457,6 +457,7 @@ fn cycles_reject_bad_detectors_solvers_and_programmes() {
         keep_series: false,
         stop_outside_tables: false,
         energy_audit: true,
+        stop_at_takeoff: false,
     };
     for x in BAD {
         let mut d = base.detector;

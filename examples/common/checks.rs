@@ -52,6 +52,8 @@ pub fn method_check(
 ) -> bool {
     let mut o = *opts;
     o.keep_series = false;
+    // A check compares the two powers alone: the run ends at its take-off.
+    o.stop_at_takeoff = true;
     o.solver.method = other_stiff_method(o.solver.method);
     match simulate_cycle(model, programme, &o) {
         Ok(other) => {
@@ -74,6 +76,8 @@ pub fn tolerance_check(
 ) -> hdi_tribology::Result<bool> {
     let mut o = *opts;
     o.keep_series = false;
+    // A check compares the two powers alone: the run ends at its take-off.
+    o.stop_at_takeoff = true;
     o.solver.rtol *= 0.1;
     o.solver.atol_displacement *= 0.1;
     let tighter = simulate_cycle(model, programme, &o)?;

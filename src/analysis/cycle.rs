@@ -376,6 +376,31 @@ pub struct CycleOptions {
     /// paper scene at 20 ns and 0.6 V: 1.11× the instructions). On by default
     /// ([`CycleOptions::from_scene`]); without a lag it costs nothing either way.
     pub energy_audit: bool,
+    /// End the run at the step where the detector sees take-off, instead of at the programme's
+    /// end. Touchdown and take-off are those of the whole run to the bit: both are first
+    /// crossings, found on the same steps. What the run covers ends there: the statistics, the
+    /// series, the energy audit and the mean temperature rise (over the time run,
+    /// [`CycleResult::duration`]), and a failure after the take-off (the step pace, the
+    /// slider reaching the disk) is not met. For callers that need the two powers alone, such as
+    /// the checks of a map (a 12 × 12 `freq` or `lag_rigid` map of docs/analyses.md spends about
+    /// a tenth of its steps after the take-off). Off by default ([`CycleOptions::from_scene`]).
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
+    /// use hdi_tribology::{model::SliderModel, scene::Scene};
+    /// let scene = Scene::paper();
+    /// let model = SliderModel::from_scene(&scene)?;
+    /// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
+    /// let mut opts = CycleOptions::from_scene(&scene)?;
+    /// let whole = simulate_cycle(&model, &programme, &opts)?;
+    /// opts.stop_at_takeoff = true;
+    /// let short = simulate_cycle(&model, &programme, &opts)?;
+    /// assert_eq!(short.touchdown, whole.touchdown);
+    /// assert_eq!(short.takeoff, whole.takeoff);
+    /// assert!(short.stats.accepted < whole.stats.accepted);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub stop_at_takeoff: bool,
 }
 
 impl CycleOptions {
@@ -507,7 +532,8 @@ pub struct CycleResult {
     /// Time mean of the flash temperature over the whole programme (K).
     #[serde(rename = "mean_temperature_rise_k")]
     pub mean_temperature_rise: f64,
-    /// Length of the programme (s).
+    /// Length of the programme (s), or of the run up to the take-off where
+    /// [`CycleOptions::stop_at_takeoff`] ended it there.
     #[serde(rename = "duration_s")]
     pub duration: f64,
     /// The programme actually run (for the triggered protocol: as fixed by the detection).
@@ -886,15 +912,57 @@ where
     watch: Option<Watch>,
 }
 
-/// The touchdown watch of the triggered programme.
+/// The detector watched step by step: for touchdown (the triggered programme's ramp up), or for
+/// take-off from a time on ([`CycleOptions::stop_at_takeoff`]).
 struct Watch {
     detector: Detector,
     /// The detector has been checked up to here.
     checked: f64,
-    /// The touchdown time, once seen.
+    /// Whether the crossing watched for is touchdown's (rising) or take-off's.
+    rising: bool,
+    /// After the touchdown watched for, watch on for the take-off from this time on (or from
+    /// the touchdown, if later), as the cycle's search does.
+    then_takeoff_from: Option<f64>,
+    /// The crossing's time, once seen.
     found: Option<f64>,
     /// The look-ups' cursors, carried from window to window.
     cursors: [usize; 2],
+}
+
+impl Watch {
+    /// A watch for touchdown from `t0` on.
+    fn touchdown(detector: Detector, t0: f64) -> Self {
+        Watch {
+            detector,
+            checked: t0,
+            rising: true,
+            then_takeoff_from: None,
+            found: None,
+            cursors: [0, 0],
+        }
+    }
+
+    /// A watch for take-off from `from` on.
+    fn takeoff(detector: Detector, from: f64) -> Self {
+        Watch {
+            rising: false,
+            ..Watch::touchdown(detector, from)
+        }
+    }
+
+    /// A watch for touchdown from `t0` on, then for take-off from `from` or the touchdown,
+    /// whichever is later.
+    fn cycle(detector: Detector, t0: f64, from: f64) -> Self {
+        Watch {
+            then_takeoff_from: Some(from),
+            ..Watch::touchdown(detector, t0)
+        }
+    }
+
+    /// Whether the watch has seen the take-off.
+    fn saw_takeoff(&self) -> bool {
+        !self.rising && self.found.is_some()
+    }
 }
 
 impl<D: DimName> Observer for Recorder<D>
@@ -912,11 +980,28 @@ where
         let Some(w) = self.watch.as_mut() else {
             return Ok(Flow::Continue);
         };
-        let found = Detecting {
+        let detecting = Detecting {
             rec: &self.rec,
             detector: w.detector,
-        }
-        .first_crossing_after(w.checked, t, true, &mut w.cursors)?;
+        };
+        let found = loop {
+            if t <= w.checked {
+                return Ok(Flow::Continue);
+            }
+            let found = detecting.first_crossing_after(w.checked, t, w.rising, &mut w.cursors)?;
+            match (found, w.then_takeoff_from.take()) {
+                // Touchdown seen: on to the take-off, in this step too.
+                (Some(td), Some(from)) => {
+                    w.rising = false;
+                    w.checked = from.max(td);
+                    w.cursors = [0, 0];
+                }
+                (found, then) => {
+                    w.then_takeoff_from = then;
+                    break found;
+                }
+            }
+        };
         w.checked = t;
         w.found = found;
         Ok(if found.is_some() {
@@ -1036,19 +1121,17 @@ where
     let search_from;
     match triggered {
         None => {
-            sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
             final_programme = initial_programme.clone();
             search_from = final_programme.end_of_hold();
+            if opts.stop_at_takeoff {
+                recorder.watch = Some(Watch::cycle(det, t0, search_from));
+            }
+            sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
         }
         Some((start_power, rate, overshoot)) => {
             // Ramp up, watching the detector step by step.
             let chunk = overshoot / rate;
-            recorder.watch = Some(Watch {
-                detector: det,
-                checked: t0,
-                found: None,
-                cursors: [0, 0],
-            });
+            recorder.watch = Some(Watch::touchdown(det, t0));
             sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
             let Some(t_td) = recorder.watch.take().and_then(|w| w.found) else {
                 return Err(CycleError::NoTriggeredTouchdown {
@@ -1087,16 +1170,25 @@ where
             it.system_mut()
                 .set_inputs(model.inputs(final_programme.clone()));
             it.set_tf(t_end).map_err(ode_err)?;
-            sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
             search_from = t_peak;
+            if opts.stop_at_takeoff {
+                recorder.watch = Some(Watch::takeoff(det, search_from));
+            }
+            sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
         }
     }
+    // A take-off watch that saw the take-off ended the run there.
+    let stopped = recorder.watch.as_ref().is_some_and(Watch::saw_takeoff);
 
     let detecting = Detecting {
         rec: &recorder.rec,
         detector: det,
     };
-    let end = final_programme.end_time();
+    let end = if stopped {
+        it.t()
+    } else {
+        final_programme.end_time()
+    };
     let td = detecting.first_crossing(t0, end, true)?;
     let to = match td {
         Some(t) => detecting.first_crossing(search_from.max(t), end, false)?,

@@ -112,6 +112,7 @@ impl CycleOptions {
             keep_series: false,
             stop_outside_tables: false,
             energy_audit: true,
+            stop_at_takeoff: false,
         })
     }
 }
