@@ -723,6 +723,8 @@ where
     coeffs: Vec<f64>,
     /// End of the covered range (the last step may have been cut).
     end: f64,
+    /// `Q` there: the state's, as the next step's interpolant would start from it.
+    end_value: f64,
     states: Option<Vec<OVector<f64, D>>>,
 }
 
@@ -737,22 +739,28 @@ where
             steps: Vec::new(),
             coeffs: Vec::new(),
             end: t0,
+            end_value: y0[q],
             states: keep_states.then(|| vec![y0.clone()]),
         }
     }
 
-    /// Keeps the `Q` part of the last step's interpolant, valid up to `t_end`.
-    /// (`coeffs[m·n + i]` is component `i` of the coefficient of `θ^m` on `[t0, t0 + h]`.)
-    fn push_step(&mut self, t0: f64, h: f64, n: usize, coeffs: &[f64], t_end: f64) {
+    /// Keeps the `Q` part of the last step's interpolant, valid up to `t_end`, where `Q` is
+    /// `q_end`. (`coeffs[m·n + i]` is component `i` of the coefficient of `θ^m` on
+    /// `[t0, t0 + h]`.)
+    fn push_step(&mut self, t0: f64, h: f64, n: usize, coeffs: &[f64], t_end: f64, q_end: f64) {
         self.steps.push((t0, h, self.coeffs.len()));
         self.coeffs
             .extend(coeffs.iter().skip(self.q).step_by(n.max(1)));
         self.end = t_end;
+        self.end_value = q_end;
     }
 
     /// `Q(t)` on the interpolants (`None` outside the integrated range), with the search for
     /// the step that holds `t` starting at step `from`, which is then set to it: a cursor for
     /// times read in increasing order (`from` must not be past that step; 0 always works).
+    /// A step time is read on the step that starts there, whose interpolant starts from the
+    /// state; the end of the range, where no step starts, from the state there too. So a
+    /// record cut short at a step reads every time it covers as the whole record does.
     fn impulse_after(&self, t: f64, from: &mut usize) -> Option<f64> {
         let first = self.steps.first()?.0;
         if !(t >= first && t <= self.end) {
@@ -769,6 +777,9 @@ where
                 rest.partition_point(|s| s.0 <= t).saturating_sub(1)
             };
         *from = k;
+        if t == self.end && k + 1 == self.steps.len() {
+            return Some(self.end_value);
+        }
         let (t0, h, lo) = self.steps[k];
         let hi = self.steps.get(k + 1).map_or(self.coeffs.len(), |s| s.2);
         let theta = if h != 0.0 { (t - t0) / h } else { 0.0 };
@@ -782,6 +793,9 @@ where
 
     /// Drops every step time after `t` (inside the last step).
     fn truncate(&mut self, t: f64) {
+        if let Some(q) = self.impulse_after(t, &mut 0) {
+            self.end_value = q;
+        }
         self.end = t;
         let keep = self.times.partition_point(|&s| s <= t);
         self.times.truncate(keep);
@@ -827,78 +841,106 @@ where
     /// The indicator is smooth between step times and step times shifted by `T_w`; it is sampled
     /// there and the crossing is refined by root finding on the dense output.
     fn first_crossing(&self, a: f64, b: f64, rising: bool) -> Result<Option<f64>> {
-        self.first_crossing_after(a, b, rising, &mut [0, 0])
+        self.scan(&mut Scan::new(a, rising), b)
     }
 
-    /// [`Detecting::first_crossing`] with cursors for the look-ups of `Q` (see
-    /// [`Record::impulse_after`]), for a caller that searches window after window.
-    fn first_crossing_after(
-        &self,
-        a: f64,
-        b: f64,
-        rising: bool,
-        from: &mut [usize; 2],
-    ) -> Result<Option<f64>> {
+    /// Reads the samples of `scan` up to `b` in increasing order, from where it stopped: the
+    /// step times and the step times shifted by `T_w` strictly between its start and `b`,
+    /// without repeats, then `b`. The first sample where the indicator is at or above `F_th`
+    /// (`rising`), or below it, brackets the crossing with the sample before. Reading up to
+    /// `b₁` and then on to `b₂` reads the samples one reading up to `b₂` does when `b₁` is a
+    /// step time (a sample itself), so a scan that goes on step after step finds the crossing
+    /// a search over the whole record finds.
+    fn scan(&self, scan: &mut Scan, b: f64) -> Result<Option<f64>> {
         let w = self.detector.window;
         let th = self.detector.contact_threshold;
-        let a = a.max(w);
-        if a > b {
-            return Ok(None);
-        }
-        // Step times in (a, b) and in (a − T_w, b − T_w), the latter shifted by T_w, merged in
-        // increasing order without repeats, between `a` and `b`.
         let times = &self.rec.times;
-        let inside = |lo: f64, hi: f64| {
-            let i = times.partition_point(|&t| t <= lo);
-            let j = times.partition_point(|&t| t < hi);
-            &times[i..j.max(i)]
-        };
-        let within = |t: &f64| *t > a && *t < b;
-        let mut own = inside(a, b).iter().copied().filter(within).peekable();
-        let mut shifted = inside(a - w, b - w)
-            .iter()
-            .map(|&t| t + w)
-            .filter(within)
-            .peekable();
-        let mut merged = std::iter::from_fn(|| match (own.peek(), shifted.peek()) {
-            (Some(x), Some(y)) if x.total_cmp(y).is_gt() => shifted.next(),
-            (Some(_), _) => own.next(),
-            _ => shifted.next(),
-        });
-        let mut last = a;
-        let mut next = || {
-            for t in merged.by_ref() {
-                if t != last {
-                    last = t;
-                    return Some(t);
-                }
-            }
-            (last != b).then(|| {
-                last = b;
-                b
-            })
-        };
+        let rising = scan.rising;
         // The indicator is read at increasing times: its look-ups go on from the last.
-        let mut hit = |x: f64| {
-            let v = self.indicator_after(x, from);
+        let hit = |x: f64, cursors: &mut [usize; 2]| {
+            let v = self.indicator_after(x, cursors);
             if rising {
                 v >= th
             } else {
                 v < th
             }
         };
-        if hit(a) {
-            return Ok(Some(a));
-        }
-        let mut prev = a;
-        while let Some(t) = next() {
-            if hit(t) {
-                let t = brent(|x| self.indicator(x) - th, prev, t, 1e-12 * w)?;
-                return Ok(Some(t));
+        let crossing = |prev: f64, t: f64| brent(|x| self.indicator(x) - th, prev, t, 1e-12 * w);
+        if !scan.started {
+            let a = scan.last.max(w);
+            if a > b {
+                return Ok(None);
             }
-            prev = t;
+            scan.started = true;
+            scan.last = a;
+            scan.own = times.partition_point(|&t| t <= a);
+            scan.shifted = times.partition_point(|&t| t <= a - w);
+            if hit(a, &mut scan.cursors) {
+                return Ok(Some(a));
+            }
+        }
+        loop {
+            let own = times.get(scan.own).copied().filter(|&t| t < b);
+            let shifted = times.get(scan.shifted).map(|&t| t + w).filter(|&t| t < b);
+            let t = match (own, shifted) {
+                (Some(x), Some(y)) if x > y => {
+                    scan.shifted += 1;
+                    y
+                }
+                (Some(x), _) => {
+                    scan.own += 1;
+                    x
+                }
+                (None, Some(y)) => {
+                    scan.shifted += 1;
+                    y
+                }
+                (None, None) => break,
+            };
+            if t <= scan.last {
+                continue;
+            }
+            if hit(t, &mut scan.cursors) {
+                return crossing(scan.last, t).map(Some);
+            }
+            scan.last = t;
+        }
+        if b > scan.last {
+            if hit(b, &mut scan.cursors) {
+                return crossing(scan.last, b).map(Some);
+            }
+            scan.last = b;
         }
         Ok(None)
+    }
+}
+
+/// Where a search of the detector's indicator stands ([`Detecting::scan`]).
+struct Scan {
+    /// Upward crossing (touchdown) or downward (take-off).
+    rising: bool,
+    /// Whether the first sample, the start, has been read.
+    started: bool,
+    /// The start, then the last sample read.
+    last: f64,
+    /// The next step time to read, and the next to read shifted by `T_w`.
+    own: usize,
+    shifted: usize,
+    /// The look-ups' cursors (see [`Record::impulse_after`]).
+    cursors: [usize; 2],
+}
+
+impl Scan {
+    /// A search from `a` on.
+    fn new(a: f64, rising: bool) -> Self {
+        Scan {
+            rising,
+            started: false,
+            last: a,
+            own: 0,
+            shifted: 0,
+            cursors: [0, 0],
+        }
     }
 }
 
@@ -916,17 +958,15 @@ where
 /// take-off from a time on ([`CycleOptions::stop_at_takeoff`]).
 struct Watch {
     detector: Detector,
-    /// The detector has been checked up to here.
-    checked: f64,
-    /// Whether the crossing watched for is touchdown's (rising) or take-off's.
-    rising: bool,
+    /// The search under way.
+    scan: Scan,
     /// After the touchdown watched for, watch on for the take-off from this time on (or from
     /// the touchdown, if later), as the cycle's search does.
     then_takeoff_from: Option<f64>,
     /// The crossing's time, once seen.
     found: Option<f64>,
-    /// The look-ups' cursors, carried from window to window.
-    cursors: [usize; 2],
+    /// The touchdown, where the watch went on to the take-off after it.
+    touchdown: Option<f64>,
 }
 
 impl Watch {
@@ -934,18 +974,17 @@ impl Watch {
     fn touchdown(detector: Detector, t0: f64) -> Self {
         Watch {
             detector,
-            checked: t0,
-            rising: true,
+            scan: Scan::new(t0, true),
             then_takeoff_from: None,
             found: None,
-            cursors: [0, 0],
+            touchdown: None,
         }
     }
 
     /// A watch for take-off from `from` on.
     fn takeoff(detector: Detector, from: f64) -> Self {
         Watch {
-            rising: false,
+            scan: Scan::new(from, false),
             ..Watch::touchdown(detector, from)
         }
     }
@@ -961,7 +1000,7 @@ impl Watch {
 
     /// Whether the watch has seen the take-off.
     fn saw_takeoff(&self) -> bool {
-        !self.rising && self.found.is_some()
+        !self.scan.rising && self.found.is_some()
     }
 }
 
@@ -972,7 +1011,9 @@ where
     fn accepted(&mut self, step: &StepView<'_>) -> Result<Flow> {
         let p = step.last_step;
         let t = step.t;
-        self.rec.push_step(p.t0, p.h, p.n, p.coeffs, t);
+        let q = self.rec.q;
+        self.rec
+            .push_step(p.t0, p.h, p.n, p.coeffs, t, step.state[q]);
         self.rec.times.push(t);
         if let Some(st) = self.rec.states.as_mut() {
             st.push(OVector::<f64, D>::from_column_slice(step.state));
@@ -985,16 +1026,12 @@ where
             detector: w.detector,
         };
         let found = loop {
-            if t <= w.checked {
-                return Ok(Flow::Continue);
-            }
-            let found = detecting.first_crossing_after(w.checked, t, w.rising, &mut w.cursors)?;
+            let found = detecting.scan(&mut w.scan, t)?;
             match (found, w.then_takeoff_from.take()) {
                 // Touchdown seen: on to the take-off, in this step too.
                 (Some(td), Some(from)) => {
-                    w.rising = false;
-                    w.checked = from.max(td);
-                    w.cursors = [0, 0];
+                    w.touchdown = Some(td);
+                    w.scan = Scan::new(from.max(td), false);
                 }
                 (found, then) => {
                     w.then_takeoff_from = then;
@@ -1002,7 +1039,6 @@ where
                 }
             }
         };
-        w.checked = t;
         w.found = found;
         Ok(if found.is_some() {
             Flow::Stop
@@ -1177,22 +1213,33 @@ where
             sim::run(&mut it, None, &mut (&mut recorder, &mut checks), ode_err)?;
         }
     }
-    // A take-off watch that saw the take-off ended the run there.
-    let stopped = recorder.watch.as_ref().is_some_and(Watch::saw_takeoff);
+    // A take-off watch that saw the take-off ended the run there; what it found of the touchdown
+    // and the take-off is what the search below would find.
+    let watched = recorder
+        .watch
+        .as_ref()
+        .filter(|w| w.saw_takeoff())
+        .map(|w| (w.touchdown, w.found));
 
     let detecting = Detecting {
         rec: &recorder.rec,
         detector: det,
     };
-    let end = if stopped {
+    let end = if watched.is_some() {
         it.t()
     } else {
         final_programme.end_time()
     };
-    let td = detecting.first_crossing(t0, end, true)?;
-    let to = match td {
-        Some(t) => detecting.first_crossing(search_from.max(t), end, false)?,
-        None => None,
+    let (td, to) = match watched {
+        Some((Some(td), to)) => (Some(td), to),
+        _ => {
+            let td = detecting.first_crossing(t0, end, true)?;
+            let to = match td {
+                Some(t) => detecting.first_crossing(search_from.max(t), end, false)?,
+                None => None,
+            };
+            (td, to)
+        }
     };
     let as_detection = |t: f64| Detection {
         time: t,
@@ -1355,7 +1402,7 @@ mod tests {
                 -0.3,
                 0.02 * f64::from(k),
             ];
-            rec.push_step(t, h, 1, &c, t + h);
+            rec.push_step(t, h, 1, &c, t + h, c.iter().sum());
             t += h;
         }
         let end = t;
