@@ -218,6 +218,7 @@ def simulate_cycle(
     rtol: Optional[float] = None,
     atol_nm: Optional[float] = None,
     series: bool = True,
+    stop_at_takeoff: bool = False,
 ) -> Dict[str, Any]:
     """One touchdown/take-off cycle at AC amplitude ``v_ac`` (V; default the scene's), under
     the scene's programme (or the touchdown-triggered protocol). ``rtol`` scales the absolute
@@ -226,7 +227,9 @@ def simulate_cycle(
     ``touchdown``/``takeoff`` (Detection or None) and, with ``series``, float64 arrays per
     accepted step: ``t_s``, ``power_w``, ``d_m``, ``air_bearing_n``, ``intermolecular_n``,
     ``electrostatic_n``, ``contact_n``, ``total_n``, ``temperature_rise_k``, ``indicator_n``
-    (NaN until the detector window has filled), and ``term_states`` with terms of memory."""
+    (NaN until the detector window has filled), and ``term_states`` with terms of memory.
+    ``stop_at_takeoff`` ends the run at the step where the detector sees take-off: the same
+    touchdown and take-off to the bit, the rest over the time run."""
 
 def ac_sweep(
     target: Target,

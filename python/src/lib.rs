@@ -980,9 +980,12 @@ fn at_amplitude(model: &SliderModel, v_ac: Option<f64>) -> PyResult<Option<Slide
 /// (W), `d_m` (m), `air_bearing_n`, `intermolecular_n`, `electrostatic_n`, `contact_n`,
 /// `total_n` (N), `temperature_rise_k` (K), `indicator_n` (N, NaN before the detector window
 /// has filled: an empty field in the CSV), and `term_states` when the model has terms with
-/// memory.
+/// memory. With `stop_at_takeoff=True` the run ends at the step where the detector sees
+/// take-off (`CycleOptions::stop_at_takeoff`): the same touchdown and take-off to the bit, the
+/// rest (steps, series, mean temperature rise, `duration_s`) over the time run.
 #[pyfunction]
-#[pyo3(signature = (target, v_ac = None, *, triggered = false, method = None, rtol = None, atol_nm = None, series = true))]
+#[pyo3(signature = (target, v_ac = None, *, triggered = false, method = None, rtol = None, atol_nm = None, series = true, stop_at_takeoff = false))]
+#[allow(clippy::too_many_arguments)]
 fn simulate_cycle<'py>(
     py: Python<'py>,
     target: &Bound<'py, PyAny>,
@@ -992,9 +995,11 @@ fn simulate_cycle<'py>(
     rtol: Option<f64>,
     atol_nm: Option<f64>,
     series: bool,
+    stop_at_takeoff: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     setup.opts.keep_series = series;
+    setup.opts.stop_at_takeoff = stop_at_takeoff;
     let changed = at_amplitude(&setup.model, v_ac)?;
     let m: &SliderModel = changed.as_ref().unwrap_or(&setup.model);
     let mut r = interruptible(py, || {

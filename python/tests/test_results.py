@@ -71,6 +71,11 @@ def test_cycle_series_and_transitions(paper_model):
     assert math.isnan(r["indicator_n"][0])
     no_series = hdi.simulate_cycle(paper_model, series=False)
     assert "t_s" not in no_series and no_series["cycle"].steps == c.steps
+    # ended at the take-off: the same detections to the bit, on the steps up to it
+    short = hdi.simulate_cycle(paper_model, stop_at_takeoff=True)
+    assert short["touchdown"] == td and short["takeoff"] == to
+    assert short["cycle"].steps < c.steps
+    assert short["t_s"][-1] >= to.time_s and np.array_equal(short["t_s"], r["t_s"][: len(short["t_s"])])
 
 
 def test_static_objects(paper_model):
