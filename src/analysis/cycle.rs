@@ -945,7 +945,7 @@ impl Scan {
 }
 
 /// The recorder of a cycle's run: every accepted step goes into the [`Record`]; with a watch,
-/// the run stops at the step where the detector first sees touchdown.
+/// the run stops at the step where the detector first sees what the watch waits for.
 struct Recorder<D: DimName>
 where
     DefaultAllocator: Allocator<D>,
