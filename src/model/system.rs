@@ -1059,7 +1059,7 @@ impl SliderSystem {
         }
         if let Some(i) = lay.lagged_force {
             let j = st.tangent(m.bearing().stiffness(0.0), 0.0, 0.0);
-            atol[i] = displacement * st.condensed(&j).abs();
+            atol[i] = displacement * st.condensed(&j).abs() * lag_tolerance_factor(m, &w);
         }
         if let Some(i) = lay.contact_impulse {
             atol[i] = impulse;
@@ -1076,6 +1076,33 @@ impl SliderSystem {
             }
         });
         atol
+    }
+}
+
+/// How much looser the lagged force's absolute tolerance is than the force that would move the
+/// slider by the displacement tolerance at rest: `max(1, 1/(ω τ))`, with `τ` the interface lag and
+/// `ω` the fastest of the structure's angular frequencies (`w`).
+///
+/// A local error `e` in the lagged force decays as `e^{−t/τ}`: it acts on the structure as an
+/// impulse `e τ`, which changes a mode's velocity by `e τ / m` and its displacement by about
+/// `e τ / (m ω) = e ω τ / k`. The velocity's tolerance is the displacement's times `ω`, so a
+/// lagged-force error of `k / (ω τ)` times the displacement tolerance moves the velocity and the
+/// displacement by no more than their own tolerances. A lag slower than the mode (`ω τ ≥ 1`)
+/// acts as a static load, `e / k`: the factor is then 1. The fastest mode gives the smallest
+/// factor, so the bound holds for every mode.
+fn lag_tolerance_factor(m: &SliderModel, w: &super::Dofs) -> f64 {
+    let tau = m.interface_lag();
+    let dofs = if m.quasi_static.is_some() {
+        1
+    } else {
+        m.structure.dofs()
+    };
+    let omega = (0..dofs).map(|i| w[i]).fold(0.0f64, f64::max);
+    let wt = omega * tau;
+    if wt > 0.0 && wt < 1.0 {
+        1.0 / wt
+    } else {
+        1.0
     }
 }
 
