@@ -458,6 +458,7 @@ fn cycles_reject_bad_detectors_solvers_and_programmes() {
         stop_outside_tables: false,
         energy_audit: true,
         stop_at_takeoff: false,
+        mean_temperature: true,
     };
     for x in BAD {
         let mut d = base.detector;

@@ -219,6 +219,7 @@ def simulate_cycle(
     atol_nm: Optional[float] = None,
     series: bool = True,
     stop_at_takeoff: bool = False,
+    mean_temperature: bool = True,
 ) -> Dict[str, Any]:
     """One touchdown/take-off cycle at AC amplitude ``v_ac`` (V; default the scene's), under
     the scene's programme (or the touchdown-triggered protocol). ``rtol`` scales the absolute
@@ -229,7 +230,9 @@ def simulate_cycle(
     ``electrostatic_n``, ``contact_n``, ``total_n``, ``temperature_rise_k``, ``indicator_n``
     (NaN until the detector window has filled), and ``term_states`` with terms of memory.
     ``stop_at_takeoff`` ends the run at the step where the detector sees take-off: the same
-    touchdown and take-off to the bit, the rest over the time run."""
+    touchdown and take-off to the bit, the rest over the time run. ``mean_temperature=False``
+    leaves the heat integral out of the state: ``mean_temperature_rise_k`` is None, the powers
+    move within the tolerance."""
 
 def ac_sweep(
     target: Target,

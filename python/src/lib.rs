@@ -982,9 +982,12 @@ fn at_amplitude(model: &SliderModel, v_ac: Option<f64>) -> PyResult<Option<Slide
 /// has filled: an empty field in the CSV), and `term_states` when the model has terms with
 /// memory. With `stop_at_takeoff=True` the run ends at the step where the detector sees
 /// take-off (`CycleOptions::stop_at_takeoff`): the same touchdown and take-off to the bit, the
-/// rest (steps, series, mean temperature rise, `duration_s`) over the time run.
+/// rest (steps, series, mean temperature rise, `duration_s`) over the time run. With
+/// `mean_temperature=False` the heat integral is left out of the state
+/// (`CycleOptions::mean_temperature`): the cycle's `mean_temperature_rise_k` is `None`, and the
+/// powers move within the tolerance.
 #[pyfunction]
-#[pyo3(signature = (target, v_ac = None, *, triggered = false, method = None, rtol = None, atol_nm = None, series = true, stop_at_takeoff = false))]
+#[pyo3(signature = (target, v_ac = None, *, triggered = false, method = None, rtol = None, atol_nm = None, series = true, stop_at_takeoff = false, mean_temperature = true))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_cycle<'py>(
     py: Python<'py>,
@@ -996,10 +999,12 @@ fn simulate_cycle<'py>(
     atol_nm: Option<f64>,
     series: bool,
     stop_at_takeoff: bool,
+    mean_temperature: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut setup = cycle_setup(py, target, triggered, method, rtol, atol_nm)?;
     setup.opts.keep_series = series;
     setup.opts.stop_at_takeoff = stop_at_takeoff;
+    setup.opts.mean_temperature = mean_temperature;
     let changed = at_amplitude(&setup.model, v_ac)?;
     let m: &SliderModel = changed.as_ref().unwrap_or(&setup.model);
     let mut r = interruptible(py, || {

@@ -76,6 +76,11 @@ def test_cycle_series_and_transitions(paper_model):
     assert short["touchdown"] == td and short["takeoff"] == to
     assert short["cycle"].steps < c.steps
     assert short["t_s"][-1] >= to.time_s and np.array_equal(short["t_s"], r["t_s"][: len(short["t_s"])])
+    # without the heat integral: no mean temperature, the powers within the tolerance's power
+    cool = hdi.simulate_cycle(paper_model, series=False, mean_temperature=False)
+    assert c.mean_temperature_rise_k > 0 and cool["cycle"].mean_temperature_rise_k is None
+    assert abs(cool["takeoff"].power_w - to.power_w) < 1e-7
+    assert abs(cool["touchdown"].power_w - td.power_w) < 1e-7
 
 
 def test_static_objects(paper_model):

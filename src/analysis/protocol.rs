@@ -113,6 +113,7 @@ impl CycleOptions {
             stop_outside_tables: false,
             energy_audit: true,
             stop_at_takeoff: false,
+            mean_temperature: true,
         })
     }
 }

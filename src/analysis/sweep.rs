@@ -181,7 +181,8 @@ pub struct RefinedCycle {
     /// when one of them was detected in one run and not in the other.
     #[serde(rename = "power_change_w")]
     pub change: f64,
-    /// Change of the mean flash-temperature rise between the last two runs (K).
+    /// Change of the mean flash-temperature rise between the last two runs (K); NaN, and not
+    /// compared, where [`CycleOptions::mean_temperature`] left the temperature out.
     #[serde(rename = "temperature_change_k")]
     pub temperature_change: f64,
     /// Whether `change ≤ power_tol` and `temperature_change ≤ temperature_tol` held for each of
@@ -255,8 +256,10 @@ pub fn ac_sweep_refined(
             let temperature_change =
                 (next.mean_temperature_rise - last.mean_temperature_rise).abs();
             last = next;
-            agreeing = if change <= refine.power_tol && temperature_change <= refine.temperature_tol
-            {
+            // Without the mean temperature (NaN in both runs) the powers alone decide.
+            let temperature_agrees =
+                !opts.mean_temperature || temperature_change <= refine.temperature_tol;
+            agreeing = if change <= refine.power_tol && temperature_agrees {
                 agreeing + 1
             } else {
                 1

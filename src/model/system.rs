@@ -138,6 +138,23 @@ impl StateLayout {
         self.len
     }
 
+    /// The same layout without the heat integral `Θ` (the last state, when there), for runs that
+    /// do not report the mean flash temperature.
+    ///
+    /// ```
+    /// use hdi_tribology::model::StateLayout;
+    /// let l = StateLayout::new(1, false, true, true).without_heat();
+    /// assert_eq!((l.len(), l.contact_impulse, l.heat), (4, Some(3), None));
+    /// assert_eq!(StateLayout::new(1, false, false, false).without_heat().len(), 2);
+    /// ```
+    pub fn without_heat(mut self) -> Self {
+        if let Some(i) = self.heat.take() {
+            debug_assert_eq!(i + 1, self.len, "the heat integral is the last state");
+            self.len -= 1;
+        }
+        self
+    }
+
     /// Always false: positions and velocities are always there.
     pub fn is_empty(&self) -> bool {
         false
@@ -224,6 +241,14 @@ impl SliderSystem {
     /// states. The model is shared with the system (a copy that shares its tables).
     pub fn new(model: &SliderModel, inputs: Inputs, integrals: bool) -> Self {
         Self::shared(Arc::new(model.clone()), inputs, integrals)
+    }
+
+    /// The same system without the heat integral ([`StateLayout::without_heat`]): the right-hand
+    /// side, the Jacobian and the tolerances then leave out `Θ` and the flash temperature's
+    /// slope it needs.
+    pub fn without_heat(mut self) -> Self {
+        self.layout = self.layout.without_heat();
+        self
     }
 
     /// [`SliderSystem::new`] on a model already shared.

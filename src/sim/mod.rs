@@ -13,7 +13,8 @@ use crate::error::{Error, FailureKind, Result, Stage};
 use crate::model::{Inputs, Rest, SliderModel, SliderSystem};
 use crate::ode::{Integrator, Method, OdeError, Options, SaveAt, Solution};
 use nalgebra::{
-    allocator::Allocator, DefaultAllocator, Dim, DimName, OVector, U10, U11, U4, U5, U6, U7, U8, U9,
+    allocator::Allocator, DefaultAllocator, Dim, DimName, OVector, U10, U11, U3, U4, U5, U6, U7,
+    U8, U9,
 };
 use std::sync::Arc;
 
@@ -169,7 +170,7 @@ impl Problem {
         NoFixedSize { stage, states: n }.into()
     }
 
-    /// Runs `job` on a state vector sized at compile time for this problem's layout (4 to 11
+    /// Runs `job` on a state vector sized at compile time for this problem's layout (3 to 11
     /// states), so that a step allocates nothing; `stage` names the analysis in the error for
     /// any other size.
     ///
@@ -177,6 +178,7 @@ impl Problem {
     /// A layout of another size; the job's own errors.
     pub fn dispatch<J: SizedRun>(self, stage: Stage, job: J) -> Result<J::Output> {
         match self.system.layout().len() {
+            3 => job.run::<U3>(self),
             4 => job.run::<U4>(self),
             5 => job.run::<U5>(self),
             6 => job.run::<U6>(self),
@@ -271,6 +273,13 @@ impl ProblemBuilder {
     /// The system the problem will hold.
     pub fn system(&self) -> &SliderSystem {
         &self.system
+    }
+
+    /// Leaves the heat integral out of the state ([`SliderSystem::without_heat`]). Before
+    /// [`ProblemBuilder::tolerances`], which sets one tolerance per state.
+    pub fn without_heat(mut self) -> Self {
+        self.system = self.system.without_heat();
+        self
     }
 
     /// Relative tolerance.
