@@ -275,9 +275,28 @@ impl ProblemBuilder {
         &self.system
     }
 
-    /// Leaves the heat integral out of the state ([`SliderSystem::without_heat`]). Before
-    /// [`ProblemBuilder::tolerances`], which sets one tolerance per state.
+    /// Leaves the heat integral out of the state ([`SliderSystem::without_heat`]), and its
+    /// tolerance where [`ProblemBuilder::tolerances`] already set one per state.
+    ///
+    /// ```
+    /// use hdi_tribology::{heater::Programme, model::SliderModel, scene::Scene, sim::Problem};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let inputs = model.inputs(Programme::constant(0.06, 1e-3)?);
+    /// let problem = Problem::builder(&model, inputs, true)
+    ///     .tolerances(1e-14, 1e-12, 1e-10)
+    ///     .without_heat()
+    ///     .build()?;
+    /// assert_eq!((problem.system().layout().len(), problem.system().layout().heat), (3, None));
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
     pub fn without_heat(mut self) -> Self {
+        if let (Some(i), crate::ode::Tolerance::PerComponent(atol)) =
+            (self.system.layout().heat, &mut self.options.atol)
+        {
+            if atol.len() == self.system.layout().len() {
+                atol.remove(i);
+            }
+        }
         self.system = self.system.without_heat();
         self
     }
