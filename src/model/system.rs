@@ -1084,7 +1084,9 @@ impl SliderSystem {
         }
         if let Some(i) = lay.lagged_force {
             let j = st.tangent(m.bearing().stiffness(0.0), 0.0, 0.0);
-            atol[i] = displacement * st.condensed(&j).abs() * lag_tolerance_factor(m, &w);
+            // The fastest of the coordinates integrated (the body alone with a quasi-static bulge).
+            let omega = (0..lay.dofs).map(|c| w[c]).fold(0.0f64, f64::max);
+            atol[i] = displacement * st.condensed(&j).abs() * lag_tolerance_factor(m, omega);
         }
         if let Some(i) = lay.contact_impulse {
             atol[i] = impulse;
@@ -1106,7 +1108,7 @@ impl SliderSystem {
 
 /// How much looser the lagged force's absolute tolerance is than the force that would move the
 /// slider by the displacement tolerance at rest: `max(1, 1/(ω τ))`, with `τ` the interface lag and
-/// `ω` the fastest of the structure's angular frequencies (`w`).
+/// `ω` (`omega`) the fastest angular frequency of the coordinates integrated.
 ///
 /// A local error `e` in the lagged force decays as `e^{−t/τ}`: it acts on the structure as an
 /// impulse `e τ`, which changes a mode's velocity by `e τ / m` and its displacement by about
@@ -1115,14 +1117,8 @@ impl SliderSystem {
 /// displacement by no more than their own tolerances. A lag slower than the mode (`ω τ ≥ 1`)
 /// acts as a static load, `e / k`: the factor is then 1. The fastest mode gives the smallest
 /// factor, so the bound holds for every mode.
-fn lag_tolerance_factor(m: &SliderModel, w: &super::Dofs) -> f64 {
+fn lag_tolerance_factor(m: &SliderModel, omega: f64) -> f64 {
     let tau = m.interface_lag();
-    let dofs = if m.quasi_static.is_some() {
-        1
-    } else {
-        m.structure.dofs()
-    };
-    let omega = (0..dofs).map(|i| w[i]).fold(0.0f64, f64::max);
     let wt = omega * tau;
     if wt > 0.0 && wt < 1.0 {
         1.0 / wt
