@@ -15,7 +15,9 @@
 //!   at the scene's tolerance must agree with the values shown (`--no-method-check` leaves it
 //!   out). With AC the detected take-off can be a whole period of `V²` early or late in both runs
 //!   of a tolerance check alike;
-//! - the tolerance check: a run at a tolerance ten times tighter.
+//! - the tolerance check: a run at a tolerance ten times tighter by the method the first run
+//!   took (`CycleResult::method`: Rodas5P where `Auto` started stiff, not the Radau5 that `Auto`
+//!   takes below rtol 1e-6).
 //!
 //! The method check runs first and the tighter run only where it agrees: where it disagrees the
 //! point is unconverged whatever the tighter run gives, and the map saves that run (a 100 × 100
@@ -441,7 +443,7 @@ impl Setup {
                     &m,
                     &self.programme,
                     &self.opts,
-                    shown,
+                    &first,
                     checks.method,
                     &mut p.runs,
                     &mut p.steps,
@@ -468,7 +470,7 @@ impl Setup {
                 &m,
                 &self.programme,
                 &self.opts,
-                (p.td, p.to),
+                ((p.td, p.to), r.method),
                 &mut p.steps,
             ));
             p.cpu = thread_cpu_seconds() - cpu0;

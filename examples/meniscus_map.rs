@@ -201,7 +201,7 @@ impl Setup {
                     &model,
                     &self.programme,
                     &self.opts,
-                    shown,
+                    &first,
                     true,
                     &mut runs,
                     &mut steps,

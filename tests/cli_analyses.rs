@@ -87,6 +87,7 @@ fn cycle_and_sweep_report_every_key_and_the_csv() {
         "hysteresis_w",
         "mean_temperature_rise_k",
         "duration_s",
+        "method",
         "stats",
         "wall_seconds",
         "total_stats",
@@ -96,6 +97,7 @@ fn cycle_and_sweep_report_every_key_and_the_csv() {
     }
     assert_eq!(v["programme"].as_str(), Some("fixed"));
     assert_eq!(v["v_ac_v"].as_f64(), Some(0.6));
+    assert_eq!(v["method"].as_str(), Some("auto"));
     let h = v["hysteresis_w"].as_f64().unwrap();
     let (td, to) = (&v["touchdown"]["power_w"], &v["takeoff"]["power_w"]);
     assert_eq!(h, td.as_f64().unwrap() - to.as_f64().unwrap());

@@ -5,7 +5,11 @@
 //!   take-off can land a whole period of `V²` early or late (0.24 mW at 5 mW/ms and 10.5 kHz)
 //!   in both runs of a tolerance check alike; another method's error rarely picks the same
 //!   period (docs/analyses.md, "Why a method check");
-//! - the tolerance check: the same settings at a tolerance ten times tighter.
+//! - the tolerance check: the same method at a tolerance ten times tighter. The method is the
+//!   one the shown run took ([`CycleResult::method`]): where `Auto` ran Rodas5P from the start
+//!   (a stiff slider), the tighter run is Rodas5P too, not the Radau5 that `Auto` takes below
+//!   rtol 1e-6, so that the check varies the tolerance alone and the method check the method
+//!   alone (docs/benchmarks.md, "The tolerance check holds the method").
 //!
 //! Both must pass, so [`both_checks`] runs the method check first and the tighter run only where
 //! it agrees: a point the method check stops saves the tighter run.
@@ -40,21 +44,21 @@ pub fn other_stiff_method(m: Method) -> Method {
     }
 }
 
-/// The method check of the values `shown`, which a cycle with `opts` gave: whether the other
-/// stiff method at the same tolerance agrees. A run that fails does not agree. Its accepted
-/// steps are added to `steps`.
+/// The method check of the values `shown`, which a cycle with `opts` gave by `method`
+/// ([`CycleResult::method`]): whether the other stiff method at the same tolerance agrees. A run
+/// that fails does not agree. Its accepted steps are added to `steps`.
 pub fn method_check(
     model: &SliderModel,
     programme: &HeaterProgramme,
     opts: &CycleOptions,
-    shown: (Option<f64>, Option<f64>),
+    (shown, method): ((Option<f64>, Option<f64>), Method),
     steps: &mut usize,
 ) -> bool {
     let mut o = *opts;
     o.keep_series = false;
     // A check compares the two powers alone: the run ends at its take-off.
     o.stop_at_takeoff = true;
-    o.solver.method = other_stiff_method(o.solver.method);
+    o.solver.method = other_stiff_method(method);
     match simulate_cycle(model, programme, &o) {
         Ok(other) => {
             *steps += other.stats.accepted;
@@ -64,20 +68,22 @@ pub fn method_check(
     }
 }
 
-/// The tolerance check of the values `shown`: whether a cycle at ten times tighter tolerances
-/// than `opts` agrees. A run that fails is the point's error. Its accepted steps are added to
+/// The tolerance check of the values `shown`, which a cycle with `opts` gave by `method`
+/// ([`CycleResult::method`]): whether a cycle by the same method at ten times tighter
+/// tolerances agrees. A run that fails is the point's error. Its accepted steps are added to
 /// `steps`.
 pub fn tolerance_check(
     model: &SliderModel,
     programme: &HeaterProgramme,
     opts: &CycleOptions,
-    shown: (Option<f64>, Option<f64>),
+    (shown, method): ((Option<f64>, Option<f64>), Method),
     steps: &mut usize,
 ) -> hdi_tribology::Result<bool> {
     let mut o = *opts;
     o.keep_series = false;
     // A check compares the two powers alone: the run ends at its take-off.
     o.stop_at_takeoff = true;
+    o.solver.method = method;
     o.solver.rtol *= 0.1;
     o.solver.atol_displacement *= 0.1;
     let tighter = simulate_cycle(model, programme, &o)?;
@@ -85,18 +91,20 @@ pub fn tolerance_check(
     Ok(agree(shown, powers(&tighter)))
 }
 
-/// Both checks of the values `shown` (the method check only where `method`), the method check
-/// first: whether the point converged. Each run started is counted in `runs`, its accepted
-/// steps in `steps`; the tighter run's failure is the point's error.
+/// Both checks of the values that the cycle `first` (run with `opts`) shows (the method check
+/// only where `method`), the method check first: whether the point converged. Each run started
+/// is counted in `runs`, its accepted steps in `steps`; the tighter run's failure is the point's
+/// error.
 pub fn both_checks(
     model: &SliderModel,
     programme: &HeaterProgramme,
     opts: &CycleOptions,
-    shown: (Option<f64>, Option<f64>),
+    first: &CycleResult,
     method: bool,
     runs: &mut usize,
     steps: &mut usize,
 ) -> hdi_tribology::Result<bool> {
+    let shown = (powers(first), first.method);
     if method {
         *runs += 1;
         if !method_check(model, programme, opts, shown, steps) {
@@ -126,24 +134,63 @@ mod tests {
         assert!(shown.0.is_some() && shown.1.is_some());
         let (mut runs, mut steps) = (1, first.stats.accepted);
         assert!(both_checks(
-            &model, &programme, &opts, shown, true, &mut runs, &mut steps
+            &model, &programme, &opts, &first, true, &mut runs, &mut steps
         )?);
         assert_eq!(runs, 3);
-        let off = (shown.0.map(|p| p + 1e-3), shown.1);
+        let mut off = first.clone();
+        off.touchdown = first.touchdown.map(|mut d| {
+            d.power += 1e-3;
+            d
+        });
         let (mut runs, mut steps) = (1, 0);
         assert!(!both_checks(
-            &model, &programme, &opts, off, true, &mut runs, &mut steps
+            &model, &programme, &opts, &off, true, &mut runs, &mut steps
         )?);
         assert_eq!(runs, 2);
         // Without the method check the tighter run alone decides, and disagrees too.
         let (mut runs, mut steps) = (1, 0);
         assert!(!both_checks(
-            &model, &programme, &opts, off, false, &mut runs, &mut steps
+            &model, &programme, &opts, &off, false, &mut runs, &mut steps
         )?);
         assert_eq!(runs, 2);
         assert!(!agree((shown.0, None), shown));
         assert_eq!(other_stiff_method(Method::Auto), Method::Radau5);
         assert_eq!(other_stiff_method(Method::Radau5), Method::Rodas5P);
+        Ok(())
+    }
+
+    /// Where `Auto` ran Rodas5P from the start (a 10 ns interface lag), the tolerance check runs
+    /// Rodas5P at the tighter tolerance: its steps are those of that run, not those of `Auto`
+    /// there, which would take Radau5.
+    #[test]
+    fn the_tolerance_check_holds_the_method_the_first_run_took() -> hdi_tribology::Result<()> {
+        let scene = Scene::paper();
+        let model = SliderModel::from_scene(&scene)?.with_interface_lag(1e-8);
+        let programme = HeaterProgramme::fixed_from_scene(&scene)?;
+        let mut opts = CycleOptions::from_scene(&scene)?;
+        opts.solver.method = Method::Auto;
+        let first = simulate_cycle(&model, &programme, &opts)?;
+        assert_eq!(first.method, Method::Rodas5P);
+        let mut steps = 0;
+        assert!(tolerance_check(
+            &model,
+            &programme,
+            &opts,
+            (powers(&first), first.method),
+            &mut steps
+        )?);
+        let tighter = |method| {
+            let mut o = opts;
+            o.stop_at_takeoff = true;
+            o.solver.method = method;
+            o.solver.rtol *= 0.1;
+            o.solver.atol_displacement *= 0.1;
+            simulate_cycle(&model, &programme, &o)
+        };
+        let (held, auto) = (tighter(Method::Rodas5P)?, tighter(Method::Auto)?);
+        assert_eq!(auto.method, Method::Radau5);
+        assert_eq!(steps, held.stats.accepted);
+        assert_ne!(steps, auto.stats.accepted);
         Ok(())
     }
 }

@@ -148,3 +148,5 @@ def test_cycle_reports_the_lag_energy_audit_only_with_a_lag(paper_scene, paper_m
     assert 0 < c.lag_work_j < c.damping_work_j
     plain = hdi.simulate_cycle(paper_model, series=False)["cycle"]
     assert "lag_work_j" not in plain and "damping_work_j" not in plain
+    # a 20 ns lag is faster than any explicit step follows: "auto" runs Rodas5P from the start
+    assert (c.method, plain.method) == ("rodas5p", "auto")

@@ -565,6 +565,26 @@ pub struct CycleResult {
     /// The programme actually run (for the triggered protocol: as fixed by the detection).
     #[serde(skip)]
     pub programme: Programme,
+    /// The method the cycle ran with: as asked, except that `Auto` on a slider whose fastest
+    /// rate no explicit step can follow runs its stiff method from the start
+    /// ([`Method::for_problem`]): Rodas5P at `rtol` ≥ 1e-6, Radau5 below. A check that holds
+    /// the method while it tightens the tolerance reads it here.
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
+    /// use hdi_tribology::{model::SliderModel, ode::Method, scene::Scene};
+    /// let scene = Scene::paper();
+    /// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
+    /// let mut opts = CycleOptions::from_scene(&scene)?;
+    /// opts.solver.method = Method::Auto;
+    /// let rigid = SliderModel::from_scene(&scene)?;
+    /// assert_eq!(simulate_cycle(&rigid, &programme, &opts)?.method, Method::Auto);
+    /// // A 10 ns interface lag: 1e8 s⁻¹, which no explicit step follows over the programme.
+    /// let lagged = rigid.with_interface_lag(1e-8);
+    /// assert_eq!(simulate_cycle(&lagged, &programme, &opts)?.method, Method::Rodas5P);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub method: Method,
     /// Solver statistics of the cycle's integration.
     pub stats: Stats,
     /// Wall-clock time of the simulation (s).
@@ -1163,6 +1183,7 @@ where
         .direction(ode::Direction::Falling)
         .terminal(true);
     let end = initial_programme.end_time();
+    let method = problem.method();
     let audit = Audit::of(problem.system(), opts.energy_audit);
     let it = problem
         .integrator(t0, y0.clone(), end)
@@ -1296,6 +1317,7 @@ where
         mean_temperature_rise,
         duration,
         programme: final_programme,
+        method,
         stats: it.stats(),
         wall_seconds: clock.elapsed().as_secs_f64(),
         series,

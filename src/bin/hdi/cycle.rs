@@ -15,10 +15,11 @@ use hdi_tribology::units::{fmt_short, mw as from_mw, shift_decimal};
 /// One touchdown/take-off cycle under the scene's fixed heater programme (or the
 /// touchdown-triggered protocol), JSON, each key with its unit: scene, programme (fixed or
 /// triggered), v_ac_v, touchdown and takeoff ({time_s, power_w} or null), hysteresis_w,
-/// mean_temperature_rise_k, duration_s, stats and wall_seconds (of the run kept), rtol, atol_m,
-/// runs, power_change_w, temperature_change_k, total_stats, total_wall_seconds (over every run),
-/// status and flags (docs/python.md, "Results"); with an interface lag also lag_work_j and
-/// damping_work_j (the lag's energy audit, docs/analyses.md).
+/// mean_temperature_rise_k, duration_s, method (as asked, or the stiff method `auto` ran from
+/// the start), stats and wall_seconds (of the run kept), rtol, atol_m, runs, power_change_w,
+/// temperature_change_k, total_stats, total_wall_seconds (over every run), status and flags
+/// (docs/python.md, "Results"); with an interface lag also lag_work_j and damping_work_j (the
+/// lag's energy audit, docs/analyses.md).
 ///
 /// By default the solver tolerances are tightened tenfold per run until touchdown and take-off
 /// move by at most --refine-mw and the mean temperature rise by at most --refine-k; status is then
