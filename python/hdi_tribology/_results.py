@@ -131,7 +131,7 @@ class Detection(Result):
 class Cycle(Result):
     """One touchdown/take-off cycle, as ``hdi cycle`` prints it: ``scene``, ``programme``,
     ``v_ac_v``, ``touchdown``/``takeoff`` (Detection or None), ``hysteresis_w``,
-    ``mean_temperature_rise_k``, ``duration_s``, ``method`` (``"auto"``, or the stiff method
+    ``mean_temperature_rise_k``, ``duration_s``, ``method`` (as asked, or the stiff method
     ``"auto"`` ran from the start), ``stats``, ``wall_seconds``, ``rtol``,
     ``atol_m``, ``runs``, ``power_change_w``, ``temperature_change_k``, ``total_stats``,
     ``total_wall_seconds``, ``status`` and ``flags``; with an interface lag also ``lag_work_j``
