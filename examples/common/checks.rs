@@ -44,6 +44,25 @@ pub fn other_stiff_method(m: Method) -> Method {
     }
 }
 
+/// The options of a check run by `method`: those of `opts`, without the series, ending at the
+/// take-off (a check compares the two powers alone).
+fn check_options(opts: &CycleOptions, method: Method) -> CycleOptions {
+    let mut o = *opts;
+    o.keep_series = false;
+    o.stop_at_takeoff = true;
+    o.solver.method = method;
+    o
+}
+
+/// The options of the tolerance check's run by `method`: [`check_options`] at ten times tighter
+/// tolerances.
+fn tighter_options(opts: &CycleOptions, method: Method) -> CycleOptions {
+    let mut o = check_options(opts, method);
+    o.solver.rtol *= 0.1;
+    o.solver.atol_displacement *= 0.1;
+    o
+}
+
 /// The method check of the values `shown`, which a cycle with `opts` gave by `method`
 /// ([`CycleResult::method`]): whether the other stiff method at the same tolerance agrees. A run
 /// that fails does not agree. Its accepted steps are added to `steps`.
@@ -54,11 +73,7 @@ pub fn method_check(
     (shown, method): ((Option<f64>, Option<f64>), Method),
     steps: &mut usize,
 ) -> bool {
-    let mut o = *opts;
-    o.keep_series = false;
-    // A check compares the two powers alone: the run ends at its take-off.
-    o.stop_at_takeoff = true;
-    o.solver.method = other_stiff_method(method);
+    let o = check_options(opts, other_stiff_method(method));
     match simulate_cycle(model, programme, &o) {
         Ok(other) => {
             *steps += other.stats.accepted;
@@ -79,14 +94,7 @@ pub fn tolerance_check(
     (shown, method): ((Option<f64>, Option<f64>), Method),
     steps: &mut usize,
 ) -> hdi_tribology::Result<bool> {
-    let mut o = *opts;
-    o.keep_series = false;
-    // A check compares the two powers alone: the run ends at its take-off.
-    o.stop_at_takeoff = true;
-    o.solver.method = method;
-    o.solver.rtol *= 0.1;
-    o.solver.atol_displacement *= 0.1;
-    let tighter = simulate_cycle(model, programme, &o)?;
+    let tighter = simulate_cycle(model, programme, &tighter_options(opts, method))?;
     *steps += tighter.stats.accepted;
     Ok(agree(shown, powers(&tighter)))
 }
@@ -179,14 +187,7 @@ mod tests {
             (powers(&first), first.method),
             &mut steps
         )?);
-        let tighter = |method| {
-            let mut o = opts;
-            o.stop_at_takeoff = true;
-            o.solver.method = method;
-            o.solver.rtol *= 0.1;
-            o.solver.atol_displacement *= 0.1;
-            simulate_cycle(&model, &programme, &o)
-        };
+        let tighter = |method| simulate_cycle(&model, &programme, &tighter_options(&opts, method));
         let (held, auto) = (tighter(Method::Rodas5P)?, tighter(Method::Auto)?);
         assert_eq!(auto.method, Method::Radau5);
         assert_eq!(steps, held.stats.accepted);
