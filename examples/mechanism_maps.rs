@@ -987,8 +987,7 @@ fn check(setup: &Setup, spec: &MapSpec, points: &[Point]) -> Res<()> {
         let mut o = setup.opts;
         o.keep_series = false;
         o.solver.method = Method::Radau5;
-        o.solver.rtol *= 0.01;
-        o.solver.atol_displacement *= 0.01;
+        o.solver = o.solver.with_rtol(o.solver.rtol / 100.0);
         let r = simulate_cycle(&m, &setup.programme, &o);
         let show = |x: Option<f64>| x.map_or("—".to_string(), |x| format!("{:.3}", x * 1e3));
         let (td, to) = match &r {

@@ -157,8 +157,7 @@ fn tightening_the_solver_tolerance_tenfold_changes_little() {
         let m = with_ac(&model, v_ac);
         let a = simulate_cycle(&m, &fixed, &opts).unwrap();
         let mut tight = opts;
-        tight.solver.rtol *= 0.1;
-        tight.solver.atol_displacement *= 0.1;
+        tight.solver = tight.solver.with_rtol(tight.solver.rtol / 10.0);
         let b = simulate_cycle(&m, &fixed, &tight).unwrap();
         // Detected powers move with the trajectory's error (~rtol) amplified by the slope of the
         // indicator; 0.01 mW is 0.2 % of the hysteresis.

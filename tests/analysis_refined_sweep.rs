@@ -32,8 +32,7 @@ fn reference(
     });
     let mut o = *opts;
     o.solver.method = Method::Radau5;
-    o.solver.atol_displacement *= 1e-10 / o.solver.rtol;
-    o.solver.rtol = 1e-10;
+    o.solver = o.solver.with_rtol(1e-10);
     let r = simulate_cycle(&m, programme, &o).unwrap();
     (r.touchdown.unwrap().power, r.takeoff.unwrap().power)
 }
@@ -187,8 +186,7 @@ fn the_mean_temperature_is_refined_too() {
     });
     let mut o = opts;
     o.solver.method = Method::Radau5;
-    o.solver.atol_displacement *= 1e-10 / o.solver.rtol;
-    o.solver.rtol = 1e-10;
+    o.solver = o.solver.with_rtol(1e-10);
     let reference = simulate_cycle(&m, &programme, &o)
         .unwrap()
         .mean_temperature_rise;
@@ -204,8 +202,7 @@ fn the_mean_temperature_is_refined_too() {
     );
     // The tolerance alone at which the powers settle is not enough for the temperature.
     let mut o = opts;
-    o.solver.atol_displacement *= 0.1;
-    o.solver.rtol *= 0.1;
+    o.solver = o.solver.with_rtol(o.solver.rtol / 10.0);
     let loose = simulate_cycle(&m, &programme, &o)
         .unwrap()
         .mean_temperature_rise;

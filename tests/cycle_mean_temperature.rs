@@ -73,8 +73,7 @@ fn leaving_the_mean_temperature_out_keeps_the_accuracy_of_the_powers() {
     for (name, model, programme, opts, bound) in cases() {
         let mut tight = opts;
         tight.solver.method = Method::Radau5;
-        tight.solver.rtol *= 1e-4;
-        tight.solver.atol_displacement *= 1e-4;
+        tight.solver = tight.solver.with_rtol(tight.solver.rtol * 1e-4);
         let reference = simulate_cycle(&model, &programme, &tight).unwrap();
         let with = simulate_cycle(&model, &programme, &opts).unwrap();
         let mut o = opts;

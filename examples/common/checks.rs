@@ -55,11 +55,11 @@ fn check_options(opts: &CycleOptions, method: Method) -> CycleOptions {
 }
 
 /// The options of the tolerance check's run by `method`: [`check_options`] at ten times tighter
-/// tolerances.
+/// tolerances, by the library's one rule for a new rtol (`SolverSettings::with_rtol`, which
+/// scales the displacement tolerance alike).
 fn tighter_options(opts: &CycleOptions, method: Method) -> CycleOptions {
     let mut o = check_options(opts, method);
-    o.solver.rtol *= 0.1;
-    o.solver.atol_displacement *= 0.1;
+    o.solver = o.solver.with_rtol(o.solver.rtol / 10.0);
     o
 }
 
