@@ -5,7 +5,8 @@
 //! sensors stray from a tight reference run, in units of their noise.
 //!
 //! `cargo bench --bench drive_bounded`. Each case settles 20 ms at its heater power, then runs
-//! `PERIODS` periods; the whole case is run `REPEATS` times from the same start (the same work
+//! `PERIODS` periods (the case `snap` settles in flight at 70 mW and is then commanded to
+//! 80 mW: its first periods hold the snap into contact); the whole case is run `REPEATS` times from the same start (the same work
 //! to the bit: the same seed, the same commands), and a period's time is the least of its
 //! repeats: a period the scheduler interrupted in one repeat is not interrupted in all of them,
 //! so what is left is the period's own cost. Times are wall-clock (`Instant`) per period on one
@@ -38,11 +39,15 @@ fn command(mw: f64, kind: &str, k: usize) -> Command {
 /// What one run gives: its sensors, times (s), steps and largest error estimate.
 type Run = (Vec<Sensors>, Vec<f64>, usize, f64);
 
-/// Settles a drive, then runs the case's periods.
-fn run(plant: &Plant, mw: f64, kind: &str) -> Result<Run, hdi_tribology::Error> {
+/// Settles a drive at `settle_mw`, then runs the case's periods at `mw`.
+fn run(
+    plant: &Plant,
+    (settle_mw, mw): (f64, f64),
+    kind: &str,
+) -> Result<Run, hdi_tribology::Error> {
     let mut d: Drive = plant.drive()?;
     for k in 0..SETTLE {
-        d.step(&command(mw, kind, k), DT)?;
+        d.step(&command(settle_mw, kind, k), DT)?;
     }
     let (mut out, mut times) = (Vec::with_capacity(PERIODS), Vec::with_capacity(PERIODS));
     let (s0, mut worst) = (d.stats().accepted, 0.0f64);
@@ -93,8 +98,15 @@ fn main() {
             Plant::new(&scene, &zone, 1, opts).expect("plant")
         };
         let reference = plant(None, true);
-        for (state, mw) in [("flight", 70.0), ("contact", 80.0)] {
+        for (state, mw) in [
+            ("flight", (70.0, 70.0)),
+            ("contact", (80.0, 80.0)),
+            ("snap", (70.0, 80.0)),
+        ] {
             for kind in ["held", "dither", "changed"] {
+                if state == "snap" && kind != "held" {
+                    continue;
+                }
                 // `DRIVE_BOUNDED_CASE=wavy,contact,dither` runs one case only.
                 if let Ok(only) = std::env::var("DRIVE_BOUNDED_CASE") {
                     if only != format!("{disk_name},{state},{kind}") {

@@ -2,7 +2,7 @@
 //! the error estimate as a flag, and what it costs in accuracy against a tight reference.
 
 use hdi_tribology::drive::{
-    scene_zone, Command, DiskSpec, Drive, DriveOptions, Plant, SensorSpec, Sensors,
+    scene_zone, Command, DiskSpec, Drive, DriveError, DriveOptions, Plant, SensorSpec, Sensors,
 };
 use hdi_tribology::ode::Method;
 use hdi_tribology::scene::Scene;
@@ -190,4 +190,39 @@ fn bad_bounds_are_typed_errors() {
             "{e}"
         );
     }
+}
+
+/// The bounded mode reads the interface forces from their tables alone: a trial state outside
+/// them fails its step instead of paying for direct quadrature (in the snap into contact,
+/// Radau5's diverging Newton iterates reach micrometres into the disk, about 0.2 ms an
+/// evaluation). With tables cut off at 0.5 nm, which the snap into contact at 80 mW passes
+/// on its way to 0.68 nm, the adaptive drive runs on with the exact forces there, and the
+/// bounded one stops with an error that names the tables.
+#[test]
+fn the_bounded_mode_reads_the_forces_from_the_tables_alone() {
+    let mut scene = Scene::paper();
+    scene.table.d_min_m = Some(5e-10);
+    let zone = scene_zone(&scene, 0.025).unwrap();
+    let drive = |opts: DriveOptions| Plant::new(&scene, &zone, 3, opts).unwrap().drive().unwrap();
+    let to_contact = |d: &mut Drive| -> Result<Sensors, Error> {
+        let mut last = d.step(&Command::heater_mw(80.0), DT)?;
+        for _ in 1..60 {
+            last = d.step(&Command::heater_mw(80.0), DT)?;
+        }
+        Ok(last)
+    };
+    let adaptive = to_contact(&mut drive(DriveOptions::default())).unwrap();
+    assert!(
+        adaptive.truth.mean_contact_force_un > 1000.0,
+        "{adaptive:?}"
+    );
+    let e = to_contact(&mut drive(bounded(8))).unwrap_err();
+    let Error::Analysis(a) = &e else {
+        panic!("{e:?}")
+    };
+    let Some(DriveError::LeftTheTables { table_low_nm, .. }) = a.downcast_ref() else {
+        panic!("{e}")
+    };
+    assert!((table_low_nm - 0.5).abs() < 1e-9, "{e}");
+    assert!(e.to_string().contains("table.d_min_m"), "{e}");
 }

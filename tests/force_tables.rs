@@ -3,8 +3,8 @@
 use std::sync::Arc;
 
 use hdi_tribology::force::{
-    Coupling, Electrostatic, Footprint, GapReference, Gaps, GreenwoodWilliamson, InterfaceForces,
-    InterfaceTerm, Intermolecular, TermKind,
+    Coupling, Electrostatic, Footprint, GapReference, Gaps, GreenwoodWilliamson, HotForces,
+    InterfaceForces, InterfaceTerm, Intermolecular, OutsideTables, TermKind,
 };
 use hdi_tribology::quadrature::TableOptions;
 use hdi_tribology::scene::Scene;
@@ -316,5 +316,64 @@ fn values_alone_equal_the_values_of_the_full_evaluation() {
                 );
             }
         }
+    }
+}
+
+/// Forces that refuse the exact fallback ([`OutsideTables::Refused`]) are the same numbers
+/// inside the tables, bit for bit, through every hot-path function, and NaN outside them, below
+/// and above (the contact force too, which is clamped at zero only inside): fused tables (the
+/// paper scene), kinked ones (the few-peak scene) and terms on the pad gap.
+#[test]
+fn refused_forces_are_the_tables_inside_and_nan_outside() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes");
+    for name in ["paper.toml", "paper_bulge.toml", "finite_radius.toml"] {
+        let exact = Scene::from_path(format!("{dir}/{name}"))
+            .unwrap()
+            .build_interface()
+            .unwrap();
+        assert_eq!(exact.outside_tables(), OutsideTables::Exact);
+        let refused = exact.clone().with_outside_tables(OutsideTables::Refused);
+        let (lo, hi) = exact.table_range();
+        let bits = |h: HotForces| {
+            [h.static_part, h.per_volt2, h.contact]
+                .map(|e| [e.value, e.d_bulge, e.d_pad].map(f64::to_bits))
+        };
+        for d in points(lo, hi - 2e-9, 300) {
+            let g = Gaps {
+                bulge: d,
+                pad: d + 2e-9,
+            };
+            assert_eq!(
+                bits(refused.evaluate(g)),
+                bits(exact.evaluate(g)),
+                "{name} {d:e}"
+            );
+            let (a, b) = (refused.values(g, 0.36), exact.values(g, 0.36));
+            assert_eq!(
+                [a.interface, a.contact, a.area].map(f64::to_bits),
+                [b.interface, b.contact, b.area].map(f64::to_bits),
+                "{name} {d:e}"
+            );
+            assert_eq!(refused.breakdown(g, 0.36), exact.breakdown(g, 0.36));
+        }
+        for d in [lo - 1e-9, lo - 1e-6, hi + 1e-9, 1e3 * hi] {
+            let g = Gaps::same(d);
+            let (h, v) = (refused.evaluate(g), refused.values(g, 0.36));
+            assert!(
+                h.static_part.value.is_nan() && v.interface.is_nan(),
+                "{name} {d:e}"
+            );
+            assert!(
+                exact.evaluate(g).static_part.value.is_finite(),
+                "{name} {d:e}"
+            );
+            assert!(refused.breakdown(g, 0.36).total.is_nan(), "{name} {d:e}");
+        }
+        // Below the tables, where the contact force is large, the refusal is not clamped away.
+        let below = Gaps::same(lo - 1e-9);
+        assert!(
+            refused.contact(below).value.is_nan() && refused.values(below, 0.0).contact.is_nan()
+        );
+        assert!(exact.contact(below).value > 0.0);
     }
 }

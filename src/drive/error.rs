@@ -37,6 +37,26 @@ pub enum DriveError {
         /// End of the period (s).
         t1_s: f64,
     },
+    /// In the bounded mode ([`DriveOptions::steps_per_period`](super::DriveOptions)), every
+    /// trial step was non-finite down to the smallest step: there the interface forces come
+    /// from their tables alone ([`OutsideTables::Refused`](crate::force::OutsideTables)), so that
+    /// no right-hand side pays for direct quadrature, and the slider's path most likely left
+    /// the tables.
+    #[error(
+        "the bounded mode evaluates the interface forces from their tables alone ({table_low_nm} \
+         to {table_high_nm:.3} nm), and at t = {t_s} s the slider's path left them ({detail}); \
+         extend the tables (table.d_min_m, table.d_max_m) or run without steps_per_period"
+    )]
+    LeftTheTables {
+        /// Where the integrator stopped (s).
+        t_s: f64,
+        /// Low end of the force tables (nm).
+        table_low_nm: f64,
+        /// High end of the force tables (nm).
+        table_high_nm: f64,
+        /// The integrator's own account.
+        detail: String,
+    },
     /// A head of a [`MultiDrive`](super::MultiDrive) failed in an earlier step, after the
     /// heads before it had moved on: the heads no longer share one clock.
     #[error(
@@ -53,4 +73,5 @@ failure_kind!(DriveError, convergence = |e| matches!(e, DriveError::PeriodSteps 
         NotFinished => Stage::DRIVE_CONTROLLER,
         PeriodSteps => Stage::DRIVE,
         HeadsOutOfStep => Stage::DRIVE,
+        LeftTheTables => Stage::DRIVE,
 });

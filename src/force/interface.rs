@@ -101,6 +101,21 @@ pub struct Breakdown {
     pub total: f64,
 }
 
+/// What the interface forces are at separations outside their tables
+/// ([`InterfaceForces::with_outside_tables`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OutsideTables {
+    /// The exact sum of the terms by direct quadrature: correct everywhere, but on the paper
+    /// scene one evaluation below the tables costs about 0.2 ms, some two thousand look-ups.
+    #[default]
+    Exact,
+    /// Not a number. An ODE step whose trial state leaves the tables then fails as non-finite
+    /// and is shortened, so no right-hand side costs more than a look-up; a run whose solution
+    /// itself leaves the tables ends in an error. For runs whose cost per step must be bounded
+    /// (the drive's bounded mode, `DriveOptions::steps_per_period`).
+    Refused,
+}
+
 /// A sum of terms tabulated over one gap, split at the terms' kinks, with exact fallback.
 #[derive(Debug)]
 struct Tabulated {
@@ -241,9 +256,10 @@ impl Tabulated {
         out
     }
 
-    /// Table look-up; outside the range the exact sum; NaN if that fails.
+    /// Table look-up; outside the range the exact sum of `terms` (NaN without them, or if that
+    /// fails).
     #[inline]
-    fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+    fn eval(&self, terms: Exact<'_>, d: f64) -> (f64, f64) {
         match self.lookup(d) {
             Some(v) => v,
             None => fallback(self, terms, d),
@@ -251,11 +267,18 @@ impl Tabulated {
     }
 }
 
-/// The exact sum outside the tables (kept out of line: the hot path stays small).
+/// The terms whose exact sum a look-up outside the tables evaluates; `None` where the forces
+/// refuse to ([`OutsideTables::Refused`]).
+type Exact<'a> = Option<&'a [Box<dyn InterfaceTerm>]>;
+
+/// The exact sum outside the tables, NaN without the terms (kept out of line: the hot path stays
+/// small).
 #[cold]
 #[inline(never)]
-fn fallback(tab: &Tabulated, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
-    tab.exact_one(terms, d).unwrap_or((f64::NAN, f64::NAN))
+fn fallback(tab: &Tabulated, terms: Exact<'_>, d: f64) -> (f64, f64) {
+    terms
+        .and_then(|t| tab.exact_one(t, d).ok())
+        .unwrap_or((f64::NAN, f64::NAN))
 }
 
 /// A table on the hot path: a single-segment table is held by value, saving the pointer chase
@@ -276,7 +299,7 @@ impl Slot {
     }
 
     #[inline]
-    fn eval(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> (f64, f64) {
+    fn eval(&self, terms: Exact<'_>, d: f64) -> (f64, f64) {
         let hit = match &self.single {
             Some(t) => t.eval(d),
             None => self.tab.lookup(d),
@@ -289,7 +312,7 @@ impl Slot {
 
     /// The value of [`Slot::eval`] alone (the same number).
     #[inline]
-    fn value(&self, terms: &[Box<dyn InterfaceTerm>], d: f64) -> f64 {
+    fn value(&self, terms: Exact<'_>, d: f64) -> f64 {
         let hit = match &self.single {
             Some(t) => t.value(d),
             None => self.tab.lookup_value(d),
@@ -528,8 +551,10 @@ impl GapTables {
 /// a kink ([`InterfaceTerm::kinks`]).
 ///
 /// Outside the table range every hot-path function falls back to the exact term evaluation (slow
-/// but correct; nothing is clamped). The hot-path functions are infallible: if that fallback fails
-/// they return NaN, which an ODE solver reports as a non-finite state.
+/// but correct; nothing is clamped), unless the forces refuse it
+/// ([`InterfaceForces::with_outside_tables`]). The hot-path functions are infallible: if that
+/// fallback fails, or is refused, they return NaN, which an ODE solver reports as a non-finite
+/// state.
 ///
 /// ```
 /// use hdi_tribology::force::{Gaps, InterfaceForces};
@@ -564,6 +589,8 @@ pub struct InterfaceForces {
     /// Whether the fused table's fourth function is the real contact area (else it is zero and
     /// the area comes from its own table).
     fused_area: bool,
+    /// The forces outside the tables.
+    outside: OutsideTables,
 }
 
 impl InterfaceForces {
@@ -595,6 +622,7 @@ impl InterfaceForces {
             fused: None,
             kinked: None,
             fused_area: false,
+            outside: OutsideTables::Exact,
         };
         me.fuse(opts, &area_opts);
         Ok(me)
@@ -704,10 +732,10 @@ impl InterfaceForces {
     fn sum_value(&self, slots: &PerGap, g: Gaps) -> f64 {
         let mut v = 0.0;
         if let Some(t) = &slots[0] {
-            v += t.value(&self.terms, g.bulge);
+            v += t.value(self.exact(), g.bulge);
         }
         if let Some(t) = &slots[1] {
-            v += t.value(&self.terms, g.pad);
+            v += t.value(self.exact(), g.pad);
         }
         v
     }
@@ -716,12 +744,12 @@ impl InterfaceForces {
     fn sum(&self, slots: &PerGap, g: Gaps) -> ForceEval {
         let mut e = ForceEval::default();
         if let Some(t) = &slots[0] {
-            let (v, s) = t.eval(&self.terms, g.bulge);
+            let (v, s) = t.eval(self.exact(), g.bulge);
             e.value += v;
             e.d_bulge = s;
         }
         if let Some(t) = &slots[1] {
-            let (v, s) = t.eval(&self.terms, g.pad);
+            let (v, s) = t.eval(self.exact(), g.pad);
             e.value += v;
             e.d_pad = s;
         }
@@ -961,7 +989,7 @@ impl InterfaceForces {
                 GapReference::Bulge => g.bulge,
                 GapReference::Pad => g.pad,
             };
-            let v = t.eval(&self.terms, d).0;
+            let v = t.eval(self.exact(), d).0;
             let x = match coupling {
                 Coupling::Static => v,
                 Coupling::PerVoltSquared => v * volt2,
@@ -1175,6 +1203,7 @@ impl InterfaceForces {
             fused,
             kinked,
             fused_area,
+            outside: OutsideTables::Exact,
         })
     }
 
@@ -1196,6 +1225,40 @@ impl InterfaceForces {
     /// The tabulated range of separations (m).
     pub fn table_range(&self) -> (f64, f64) {
         self.range
+    }
+
+    /// The same forces with `outside` as what they are outside the tables: the exact sum of the
+    /// terms (the default) or NaN ([`OutsideTables`]). Inside the tables nothing changes; the
+    /// tables are shared, not rebuilt.
+    ///
+    /// ```
+    /// use hdi_tribology::force::{Gaps, OutsideTables};
+    /// use hdi_tribology::scene::Scene;
+    /// let exact = Scene::paper().build_interface()?;
+    /// let refused = exact.clone().with_outside_tables(OutsideTables::Refused);
+    /// let (inside, below) = (Gaps::same(1e-9), Gaps::same(exact.table_range().0 - 1e-9));
+    /// assert_eq!(refused.values(inside, 0.25), exact.values(inside, 0.25));
+    /// assert!(exact.contact(below).value > 0.0);
+    /// assert!(refused.contact(below).value.is_nan());
+    /// assert_eq!(refused.outside_tables(), OutsideTables::Refused);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn with_outside_tables(self, outside: OutsideTables) -> Self {
+        InterfaceForces { outside, ..self }
+    }
+
+    /// What the forces are outside the tables ([`InterfaceForces::with_outside_tables`]).
+    pub fn outside_tables(&self) -> OutsideTables {
+        self.outside
+    }
+
+    /// The terms a look-up outside the tables sums exactly, or `None` where it is refused.
+    #[inline]
+    fn exact(&self) -> Exact<'_> {
+        match self.outside {
+            OutsideTables::Exact => Some(&self.terms),
+            OutsideTables::Refused => None,
+        }
     }
 
     /// The terms, in the order given to [`InterfaceForces::build`].

@@ -47,7 +47,9 @@ pub use electrostatic::Electrostatic;
 pub use error::ForceError;
 pub use footprint::{Footprint, Scaled};
 pub(crate) use interface::by_coupling;
-pub use interface::{Breakdown, ForceEval, Gaps, HotForces, HotValues, InterfaceForces};
+pub use interface::{
+    Breakdown, ForceEval, Gaps, HotForces, HotValues, InterfaceForces, OutsideTables,
+};
 pub use intermolecular::Intermolecular;
 pub use meniscus::{lian_rupture_distance, Meniscus, MeniscusParams, Pickup, Wetting};
 pub use pressure::{lj_zero, Coulomb, LennardJones39, PressureLaw};

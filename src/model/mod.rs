@@ -20,7 +20,7 @@ use crate::cache::{CacheReport, TableCache};
 use crate::error::{Error, Result};
 use crate::force::{
     by_coupling, AirBearing, AirBearingModel, Breakdown, ForceEval, Gaps, HotForces, HotValues,
-    InterfaceForces, Meniscus, StatefulTerm,
+    InterfaceForces, Meniscus, OutsideTables, StatefulTerm,
 };
 use crate::heater::Programme;
 use crate::quadrature::Span;
@@ -371,6 +371,25 @@ impl SliderModel {
     pub fn with_interface_lag(&self, tau: f64) -> Self {
         SliderModel {
             interface_lag: tau,
+            ..self.clone()
+        }
+    }
+
+    /// The same model with its interface forces outside their tables as `outside` says
+    /// ([`InterfaceForces::with_outside_tables`]): with [`OutsideTables::Refused`] they are NaN
+    /// there, so that no right-hand side pays for direct quadrature (the drive's bounded mode).
+    ///
+    /// ```no_run
+    /// use hdi_tribology::{force::OutsideTables, model::SliderModel, scene::Scene};
+    /// let model = SliderModel::from_scene(&Scene::paper())?;
+    /// let bounded = model.with_outside_tables(OutsideTables::Refused);
+    /// assert_eq!(bounded.forces().outside_tables(), OutsideTables::Refused);
+    /// assert_eq!(model.forces().outside_tables(), OutsideTables::Exact);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub fn with_outside_tables(&self, outside: OutsideTables) -> Self {
+        SliderModel {
+            forces: Arc::new(self.forces.as_ref().clone().with_outside_tables(outside)),
             ..self.clone()
         }
     }
