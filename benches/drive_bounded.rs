@@ -1,16 +1,16 @@
-//! The drive's cost per period, period by period: the adaptive steps (Rodas5P, the default)
-//! against the bounded mode (`DriveOptions::bounded`, Radau5), in flight and in contact, on a flat and on the default
-//! wavy disk, with a held command, a 0.5 V dither and a command changed every period. Prints
-//! the median, the 99.9th percentile and the largest time of one period, and how far each run's
-//! sensors stray from a tight reference run, in units of their noise.
+//! The drive's cost per period, period by period: the adaptive steps (Rodas5P, the default) against
+//! the bounded mode (`DriveOptions::bounded`, Radau5), in flight and in contact, on a flat and on
+//! the default wavy disk, with a held command, a 0.5 V dither and a command changed every period.
+//! Prints the median, the 99.9th percentile and the largest time of one period, and how far each
+//! run's sensors stray from a tight reference run, in units of their noise.
 //!
 //! `cargo bench --bench drive_bounded`. Each case settles 20 ms at its heater power, then runs
-//! `PERIODS` periods (the case `snap` settles in flight at 70 mW and is then commanded to
-//! 80 mW: its first periods hold the snap into contact); the whole case is run `REPEATS` times from the same start (the same work
-//! to the bit: the same seed, the same commands), and a period's time is the least of its
-//! repeats: a period the scheduler interrupted in one repeat is not interrupted in all of them,
-//! so what is left is the period's own cost. Times are wall-clock (`Instant`) per period on one
-//! thread.
+//! `PERIODS` periods (the case `snap` settles in flight at 70 mW and is then commanded to 80 mW:
+//! its first periods hold the snap into contact); the whole case is run `REPEATS` times from the
+//! same start (the same work to the bit: the same seed, the same commands), and a period's time is
+//! the least of its repeats: a period the scheduler interrupted in one repeat is not interrupted in
+//! all of them, so what is left is the period's own cost. Times are wall-clock (`Instant`) per
+//! period on one thread.
 
 use hdi_tribology::drive::{scene_zone, Command, DiskSpec, Drive, DriveOptions, Plant, Sensors};
 use hdi_tribology::ode::Method;

@@ -43,9 +43,10 @@ pub enum DriveError {
     /// no right-hand side pays for direct quadrature, and the slider's path most likely left
     /// the tables.
     #[error(
-        "the bounded mode evaluates the interface forces from their tables alone ({table_low_nm} \
-         to {table_high_nm:.3} nm), and at t = {t_s} s the slider's path left them ({detail}); \
-         extend the tables (table.d_min_m, table.d_max_m) or run without steps_per_period"
+        "the bounded mode reads the interface forces from their tables alone ({table_low_nm:.3} \
+         to {table_high_nm:.3} nm), and at t = {t_s} s every trial step was non-finite, as where \
+         the slider's path leaves them ({detail}); extend the tables (table.d_min_m, \
+         table.d_max_m) or run without steps_per_period"
     )]
     LeftTheTables {
         /// Where the integrator stopped (s).
