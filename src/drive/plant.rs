@@ -233,7 +233,7 @@ pub struct DriveOptions {
     /// ([`OutsideTables::Refused`]): a trial state outside them fails its step, which is
     /// shortened, instead of paying for direct quadrature, and a path that leaves them ends in
     /// [`DriveError::LeftTheTables`](super::DriveError::LeftTheTables). That keeps the snap's
-    /// periods to about 0.2–0.4 ms at 4 to 32 steps, where the diverging Newton iterates had
+    /// periods to 0.13–0.41 ms at 4 to 32 steps, where the diverging Newton iterates had
     /// cost up to 29 ms.
     pub steps_per_period: Option<usize>,
     /// How each period is advanced: the adaptive integrator (the default) or one exponential
