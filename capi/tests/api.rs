@@ -678,6 +678,41 @@ fn the_bounded_mode_reports_its_flag() {
     ok(unsafe { hdi_scene_free(scene) });
 }
 
+/// A bounded drive whose path leaves the force tables stops with `HDI_STATUS_ANALYSIS` and a
+/// message that names the tables (docs/firmware.md): the paper scene's tables cut off at
+/// 0.5 nm, which the snap into contact at 80 mW passes.
+#[test]
+fn a_bounded_drive_that_leaves_the_tables_says_so() {
+    let mut s = Scene::paper();
+    s.table.d_min_m = Some(5e-10);
+    let text = std::ffi::CString::new(s.to_toml_string().unwrap()).unwrap();
+    let mut scene = null_mut();
+    ok(unsafe { hdi_scene_from_toml(text.as_ptr(), &mut scene) });
+    let mut config = std::mem::MaybeUninit::uninit();
+    ok(unsafe { hdi_drive_config_default(config.as_mut_ptr()) });
+    let mut config: HdiDriveConfig = unsafe { config.assume_init() };
+    config.steps_per_period = 8;
+    let mut drive = null_mut();
+    ok(unsafe { hdi_drive_new(scene, &config, 1, &mut drive) });
+    let cmd = HdiCommand {
+        heater_power_mw: 80.0,
+        ..HdiCommand::default()
+    };
+    let mut status = HdiStatus::Ok;
+    for _ in 0..60 {
+        let mut out = HdiSensors::default();
+        status = unsafe { hdi_drive_step(drive, &cmd, 50e-6, &mut out) };
+        if status != HdiStatus::Ok {
+            break;
+        }
+    }
+    assert_eq!(status, HdiStatus::Analysis, "{}", last_error());
+    let e = last_error();
+    assert!(e.contains("0.500 to") && e.contains("table.d_min_m"), "{e}");
+    ok(unsafe { hdi_drive_free(drive) });
+    ok(unsafe { hdi_scene_free(scene) });
+}
+
 /// The exponential scheme through the C ABI: the same drive as the Rust one with
 /// `DriveScheme::Exponential`, to the bit, each period's scheme in `HdiPeriod::exponential`; a
 /// scheme that does not exist is named.
