@@ -1886,19 +1886,20 @@ where
     };
     let mut slope = Slope(None);
     // In the bounded mode a non-finite trial state is most likely one outside the force tables,
-    // which the forces refuse there (`OutsideTables::Refused`): say so.
-    let range = it.system().model().forces().table_range();
-    let ode_error = |e: OdeError| match e {
-        OdeError::NonFinite { t, what } if span.floor.is_some() => {
-            super::DriveError::LeftTheTables {
-                t_s: t,
-                table_low_nm: crate::units::to_nm(range.0),
-                table_high_nm: crate::units::to_nm(range.1),
-                detail: what,
-            }
-            .into()
+    // which the forces refuse there (`OutsideTables::Refused`): say so, with their range (read
+    // only in that mode).
+    let refused = span
+        .floor
+        .map(|_| it.system().model().forces().table_range());
+    let ode_error = |e: OdeError| match (e, refused) {
+        (OdeError::NonFinite { t, what }, Some(range)) => super::DriveError::LeftTheTables {
+            t_s: t,
+            table_low_nm: crate::units::to_nm(range.0),
+            table_high_nm: crate::units::to_nm(range.1),
+            detail: what,
         }
-        e => Error::from(e),
+        .into(),
+        (e, _) => Error::from(e),
     };
     if slopes {
         crate::sim::run(it, Some(t1), &mut (&mut budget, &mut slope), ode_error)?;
