@@ -4,9 +4,10 @@
 //! examples' tests check the numbers of their own runs; `cargo run --release --example
 //! docs_numbers -- --check --slow` checks all, the fits included.
 
+// `static_numbers` names it `crate::doc_numbers`: the test program re-exports it at its root.
 #[path = "../examples/common/doc_numbers.rs"]
 #[allow(dead_code)]
-mod doc_numbers;
+pub(crate) mod doc_numbers;
 #[path = "../examples/common/static_numbers.rs"]
 mod static_numbers;
 

@@ -224,7 +224,7 @@ fn ac_curve(truth: &Scene, seed: u64, sd_mw: f64) -> DataSet {
 /// The coverage of the AC-only fit's error bars over noise draws: touchdown and take-off at
 /// five AC amplitudes (0–0.8 V) from the paper scene with 0.7 mW (1 %) of noise stated as the
 /// uncertainty; σ, A and η free, starting 10 % off. Slow (one to three minutes per draw):
-/// `cargo test --all-features --test fit_trust -- --ignored --nocapture ac_fit_coverage`
+/// `cargo test --all-features --test fit -- --ignored --nocapture ac_fit_coverage`
 /// (`DRAWS=n` sets the number of draws, 20 by default). The figures are in docs/fit.md.
 #[test]
 #[ignore]

@@ -339,15 +339,16 @@ fn child_writes_the_paper_tables() {
 fn processes_writing_at_once_leave_a_valid_entry() {
     let dir = temp_dir("processes");
     let me = std::env::current_exe().unwrap();
+    // The child's full name in this test program: `<file>::<test>`, this file being a module of
+    // the program (module_path!() starts with the program's own name).
+    let child = match module_path!().split_once("::") {
+        Some((_, file)) => format!("{file}::child_writes_the_paper_tables"),
+        None => "child_writes_the_paper_tables".to_string(),
+    };
     let children: Vec<_> = (0..3)
         .map(|_| {
             Command::new(&me)
-                .args([
-                    "--exact",
-                    "child_writes_the_paper_tables",
-                    "--ignored",
-                    "--test-threads=1",
-                ])
+                .args(["--exact", child.as_str(), "--ignored", "--test-threads=1"])
                 .env("HDI_TEST_CACHE_DIR", dir.path())
                 .stdout(std::process::Stdio::piped())
                 .stderr(std::process::Stdio::piped())
