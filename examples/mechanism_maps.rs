@@ -319,6 +319,10 @@ impl Setup {
         // Nor the mean flash temperature: its integral left out of the state, about 13 % fewer
         // instructions per cycle (the powers move within the tolerance).
         opts.mean_temperature = false;
+        // The bounce flag reads the contact force over the hold alone: the series covers it
+        // (the same values to the bit, a sixth fewer instructions in a point's first run).
+        let hold = (at_top[0], at_top[at_top.len() - 1]);
+        opts.series_window = Some(hold);
         let base = SliderModel::from_scene(scene)?;
         Ok(Setup {
             slopes: ForceSlopes::of(base.forces()),
@@ -327,7 +331,7 @@ impl Setup {
             opts,
             bulge,
             body_mass: scene.slider.mass_kg,
-            hold: (at_top[0], at_top[at_top.len() - 1]),
+            hold,
         })
     }
 

@@ -455,6 +455,7 @@ fn cycles_reject_bad_detectors_solvers_and_programmes() {
         detector: det,
         solver: sol,
         keep_series: false,
+        series_window: None,
         stop_outside_tables: false,
         energy_audit: true,
         stop_at_takeoff: false,
@@ -501,6 +502,16 @@ fn cycles_reject_bad_detectors_solvers_and_programmes() {
         field(simulate_cycle(&model, &programme, &with(base.detector, s))),
         "solver.max_steps"
     );
+    // A series window that ends before it starts, or is not finite.
+    for window in [(2e-3, 1e-3), (f64::NAN, 1e-3), (0.0, f64::INFINITY)] {
+        let mut o = base;
+        o.keep_series = true;
+        o.series_window = Some(window);
+        assert_eq!(
+            field(simulate_cycle(&model, &programme, &o)),
+            "series_window"
+        );
+    }
 }
 
 /// Analyses in heater power need `η > 0`; a heater too weak to reach touchdown fails the

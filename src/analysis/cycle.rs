@@ -335,6 +335,30 @@ pub struct CycleOptions {
     pub solver: SolverSettings,
     /// Keep the time series of forces and spacing (costs memory and some time).
     pub keep_series: bool,
+    /// With [`keep_series`](CycleOptions::keep_series), the series holds only the step times
+    /// within `[start, end]` (s, both included); `None` (the default): every step. Each value
+    /// is the one the whole series has at that time, to the bit; the times outside cost no
+    /// evaluation of the forces, the detector or the heater. For callers that read one stretch,
+    /// such as the mechanism maps' bounce flag over the hold (the series of the whole run took
+    /// about a sixth of a few-peak cycle's instructions).
+    ///
+    /// ```
+    /// use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgramme};
+    /// use hdi_tribology::{model::SliderModel, scene::Scene};
+    /// let scene = Scene::paper();
+    /// let model = SliderModel::from_scene(&scene)?;
+    /// let programme = HeaterProgramme::fixed_from_scene(&scene)?;
+    /// let mut opts = CycleOptions::from_scene(&scene)?;
+    /// opts.keep_series = true;
+    /// let whole = simulate_cycle(&model, &programme, &opts)?.series.unwrap();
+    /// opts.series_window = Some((4e-3, 6e-3));
+    /// let part = simulate_cycle(&model, &programme, &opts)?.series.unwrap();
+    /// let first = whole.t.iter().position(|&t| t >= 4e-3).unwrap();
+    /// assert!(part.t.iter().all(|&t| (4e-3..=6e-3).contains(&t)));
+    /// assert_eq!(part.contact[..], whole.contact[first..first + part.t.len()]);
+    /// # Ok::<(), hdi_tribology::Error>(())
+    /// ```
+    pub series_window: Option<(f64, f64)>,
     /// Stop a cycle whose contact bounces deep in the disk at a pace that would use up the step
     /// budget. At an accepted step whose bulge gap is below the low end of the force tables
     /// ([`InterfaceForces::table_range`](crate::force::InterfaceForces::table_range)), the cycle
@@ -442,6 +466,16 @@ impl CycleOptions {
         }
         if self.solver.max_steps == 0 {
             return Err(Error::invalid("solver.max_steps", "must be at least 1"));
+        }
+        if let Some((start, end)) = self.series_window {
+            if !(start.is_finite() && end.is_finite() && start <= end) {
+                return Err(Error::invalid(
+                    "series_window",
+                    format!(
+                        "must be a finite (start, end) with start <= end, got ({start} s, {end} s)"
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -1304,11 +1338,15 @@ where
     };
     let duration = end - t0;
     let mean_temperature_rise = heat.map_or(f64::NAN, |h| it.state()[h] / duration);
-    let series = recorder
-        .rec
-        .states
-        .as_ref()
-        .map(|states| series_of(it.system(), &recorder.rec.times, states, &detecting));
+    let series = recorder.rec.states.as_ref().map(|states| {
+        series_of(
+            it.system(),
+            &recorder.rec.times,
+            states,
+            &detecting,
+            opts.series_window,
+        )
+    });
     Ok(CycleResult {
         v_ac: model.voltage().ac_amplitude,
         touchdown,
@@ -1399,6 +1437,7 @@ fn series_of<D: DimName>(
     times: &[f64],
     states: &[OVector<f64, D>],
     det: &Detecting<D>,
+    window: Option<(f64, f64)>,
 ) -> TimeSeries
 where
     DefaultAllocator: Allocator<D>,
@@ -1407,7 +1446,8 @@ where
     let mut out = TimeSeries::default();
     let (first, n_terms) = sys.layout().term_states;
     out.term_states = vec![Vec::with_capacity(times.len()); n_terms];
-    for (t, s) in times.iter().zip(states) {
+    let inside = |t: f64| window.is_none_or(|(a, b)| t >= a && t <= b);
+    for (t, s) in times.iter().zip(states).filter(|(t, _)| inside(**t)) {
         let t = *t;
         let g = sys.gaps(t, s);
         let volt2 = sys.inputs().voltage.squared(t);

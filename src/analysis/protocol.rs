@@ -110,6 +110,7 @@ impl CycleOptions {
                 max_steps: scene.solver.max_steps,
             },
             keep_series: false,
+            series_window: None,
             stop_outside_tables: false,
             energy_audit: true,
             stop_at_takeoff: false,

@@ -17,6 +17,8 @@ mod analysis_refined_sweep;
 mod analysis_static;
 #[path = "../cycle_mean_temperature.rs"]
 mod cycle_mean_temperature;
+#[path = "../cycle_series_window.rs"]
+mod cycle_series_window;
 #[path = "../cycle_stop_at_takeoff.rs"]
 mod cycle_stop_at_takeoff;
 #[path = "../docs_numbers.rs"]
