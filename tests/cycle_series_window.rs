@@ -8,6 +8,9 @@ use hdi_tribology::analysis::cycle::{
 use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 
+#[path = "common/scenes.rs"]
+mod scenes;
+
 /// Every field of `s` at the indices `keep`, as bits (NaN indicators compare by their bits).
 fn fields(s: &TimeSeries, keep: &[usize]) -> Vec<Vec<u64>> {
     let mut all = vec![
@@ -85,11 +88,7 @@ fn the_windowed_series_is_the_whole_series_within_the_window() {
 /// series' run), ended at the take-off, the window over the hold.
 #[test]
 fn the_maps_window_over_the_hold_holds_for_a_lagged_few_peak_cycle() {
-    let scene = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let scene = scenes::paper_bulge();
     let model = SliderModel::from_scene(&scene)
         .unwrap()
         .with_interface_lag(1e-8)

@@ -4,6 +4,15 @@
 use hdi_tribology::force::Footprint;
 use hdi_tribology::scene::{ElectrostaticSpec, Scene};
 
+/// The few-peak deformable-slider scene of the mechanism maps, `scenes/paper_bulge.toml`.
+pub fn paper_bulge() -> Scene {
+    Scene::from_path(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/paper_bulge.toml"
+    ))
+    .expect("the repository's scene reads")
+}
+
 /// The paper scene made smooth, with electrostatics alone on the given footprint (no contact, no
 /// intermolecular force, contact potential 0 V): the pull-in closed forms hold for it.
 pub fn electrostatic_only(footprint: Footprint) -> Scene {
