@@ -504,7 +504,8 @@ impl Detection {
     }
 }
 
-/// Time series of one cycle, at every accepted step.
+/// Time series of one cycle, at every accepted step (within
+/// [`CycleOptions::series_window`] where one is set).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct TimeSeries {
     /// Time (s).
