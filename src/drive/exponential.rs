@@ -40,8 +40,11 @@ use super::orbit_map::OrbitMap;
 use super::state::{state_vector, MAX_STATE};
 use crate::force::Gaps;
 use crate::model::{Inputs, SliderSystem, StateLayout, Voltage};
+use crate::ode::lu::Lu;
 use crate::ode::{ExponentialStepper, OdeSystem};
-use nalgebra::{allocator::Allocator, DMatrix, DVector, DefaultAllocator, Dim, OMatrix, OVector};
+use nalgebra::{
+    allocator::Allocator, DMatrix, DVector, DefaultAllocator, Dim, Dyn, OMatrix, OVector,
+};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -52,6 +55,23 @@ use std::f64::consts::PI;
 /// frequencies within a period, where the step's estimate cannot see it: 1e-4 of the ~15 pm
 /// the default waviness moves the gap is a sixth of the 0.01 pm displacement tolerance.
 pub(crate) const REBUILD_SHIFT: f64 = 1e-4;
+
+/// Most passes of the disk table's curvature ([`Periodic`]). Each leaves out of its sweep what
+/// the pass before had not found. On the paper scene, the part left out moves the gap by
+/// 3.5e-13, 1.9e-14, 7.9e-16 and 2.4e-17 m after one to four passes at the jump into contact
+/// (80 mW), and by 4–7e-15, 4–6e-17 and 3–5e-19 m after one to three in flight (70 mW) and in
+/// settled contact; [`ExpScheme::straight`] needs it within about 6e-14 m in contact.
+pub(crate) const CURVATURE_PASSES: usize = 4;
+
+/// The passes end once the part left out moves the gaps by this fraction of the smallest
+/// displacement tolerance or less.
+pub(crate) const ENOUGH_UNSWEPT: f64 = 0.01;
+
+/// Fewest and most periods a table must have lasted before the next one takes the curvature
+/// (its passes cost some 20 000 of the scheme's periods, 10–20 ms). The wait doubles each time a
+/// table with the curvature is replaced sooner than the wait (the state moves, as in a ramp of the
+/// heater), and halves when one lasted.
+pub(crate) const CURVATURE_WAIT: (usize, usize) = (64, 65_536);
 
 /// Substep levels: a period is `1`, `2`, `4`, `8` or `16` exponential steps.
 pub(crate) const LEVELS: usize = 5;
@@ -77,6 +97,14 @@ pub(crate) const MAX_SKIP_DITHER: usize = 4096;
 /// revolution: values and slopes at the disk's nodes, interpolated by cubic Hermite
 /// polynomials, each interval's held in power form for a look-up of five multiply-adds
 /// ([`crate::numerics::cubic_hermite_power`]).
+///
+/// With the curvature ([`Periodic::of_disk`]), `u` also holds what the forces leave beyond `J`
+/// along the disk's sweep: `q(t) = f(x_s + p(t)) − f(x_s) − J p(t)` at the slow state `x_s`
+/// the table is built at. Its lines are those of the sampled `q` over the revolution (a
+/// discrete Fourier transform on the disk's nodes), each answered like a harmonic's; the mean of
+/// `q` stays in the remainder. `p` is the table's own response, so `q` is found by
+/// [`CURVATURE_PASSES`] passes: the first along the response to the disk's motion alone, each
+/// next along the response the pass before found.
 #[derive(Clone, Debug)]
 struct Periodic {
     /// The components with a response (others stay zero).
@@ -87,34 +115,78 @@ struct Periodic {
     cubics: Vec<[f64; 7]>,
     /// The largest magnitude of each component over the revolution (0 where not active).
     largest: Vec<f64>,
+    /// Where the table holds the curvature: the largest magnitude of each component of what
+    /// its last pass changed, the part of the response the sweep of that pass left out.
+    unswept: Option<Vec<f64>>,
+    /// How far the curvature's response moves the gaps (m): the reach of its first pass, 0
+    /// without it.
+    found: f64,
 }
 
-/// `C` of `(iω − J) C = U`, by the real system `[[−J, −ωI], [ωI, −J]] [C_r; C_i] = [U_r; U_i]`.
-fn response(j: &DMatrix<f64>, w: f64, u: &[Complex64]) -> Option<Vec<Complex64>> {
-    let n = j.nrows();
-    let mut a = DMatrix::<f64>::zeros(2 * n, 2 * n);
-    let mut b = DVector::<f64>::zeros(2 * n);
-    for r in 0..n {
-        for c in 0..n {
-            a[(r, c)] = -j[(r, c)];
-            a[(n + r, n + c)] = -j[(r, c)];
+/// What [`Periodic::of_disk`] needs to take the curvature: `q_of(p, q)` writes the forces'
+/// remainder `q` beyond `J` at the offset `p` from the slow state; the passes end once the part
+/// their sweep left out moves the gaps (the positions `0..dofs`) by `enough` (m) or less, or
+/// after [`CURVATURE_PASSES`].
+struct Curvature<'a> {
+    q_of: &'a mut dyn FnMut(&[f64], &mut [f64]),
+    dofs: usize,
+    enough: f64,
+}
+
+/// `C` of `(iω − J) C = U` for one `J` and many `ω`: the complex `n × n` system factored in
+/// place by partial pivoting ([`crate::ode::lu::Lu`]), its storage reused.
+struct Resolvent<'a> {
+    j: &'a DMatrix<f64>,
+    lu: Lu<Complex64, Dyn>,
+    b: DVector<Complex64>,
+}
+
+impl<'a> Resolvent<'a> {
+    fn new(j: &'a DMatrix<f64>) -> Self {
+        let n = j.nrows();
+        Resolvent {
+            j,
+            lu: Lu::new(Dyn(n)),
+            b: DVector::zeros(n),
         }
-        a[(r, n + r)] = -w;
-        a[(n + r, r)] = w;
-        b[r] = u[r].re;
-        b[n + r] = u[r].im;
     }
-    let x = a.lu().solve(&b)?;
-    Some((0..n).map(|r| Complex64::new(x[r], x[n + r])).collect())
+
+    /// `C` of `(iω − J) C = U`; `None` where the system is singular.
+    fn solve(&mut self, w: f64, u: &[Complex64]) -> Option<Vec<Complex64>> {
+        let n = self.j.nrows();
+        for (r, ur) in u.iter().enumerate().take(n) {
+            for c in 0..n {
+                self.lu.m[(r, c)] = Complex64::new(-self.j[(r, c)], if r == c { w } else { 0.0 });
+            }
+            self.b[r] = *ur;
+        }
+        if !self.lu.factor() {
+            return None;
+        }
+        self.lu.solve_mut(&mut self.b);
+        self.b
+            .iter()
+            .all(|c| c.is_finite())
+            .then(|| self.b.iter().copied().collect())
+    }
 }
 
 impl Periodic {
     /// The response to the disk's motion `u = −r ẅ` on the velocities `base` (`(index, r)`):
     /// each harmonic's `C_k` solved for, then the values and slopes at the nodes summed by an
     /// inverse fast Fourier transform over the revolution (the nodes are a power of two).
-    fn of_disk(disk: &Disk, j: &DMatrix<f64>, base: &[(usize, f64)]) -> Option<Self> {
+    ///
+    /// With `curvature` (`q_of(p, q)` writes the forces' remainder `q` beyond `J` at the offset
+    /// `p` from the slow state), the response to that remainder along the disk's sweep too.
+    fn of_disk(
+        disk: &Disk,
+        j: &DMatrix<f64>,
+        base: &[(usize, f64)],
+        curvature: Option<Curvature>,
+    ) -> Option<Self> {
         let n = j.nrows();
         let zero = Complex64::new(0.0, 0.0);
+        let mut solver = Resolvent::new(j);
         // Per component, the spectrum of p over the orders of the revolution.
         let mut spectra = vec![vec![zero; NODES]; n];
         let mut u = vec![zero; n];
@@ -127,9 +199,54 @@ impl Periodic {
             for &(i, r) in base {
                 u[i] = -r * acc;
             }
-            let c = response(j, w, &u)?;
+            let c = solver.solve(w, &u)?;
             for (k, ck) in c.iter().enumerate() {
                 spectra[k][h.order as usize % NODES] += ck;
+            }
+        }
+        let mut unswept = None;
+        let mut found = 0.0;
+        if let Some(Curvature { q_of, dofs, enough }) = curvature {
+            let largest: &mut Vec<f64> = unswept.insert(vec![0.0; n]);
+            let mut buf = vec![zero; NODES];
+            // The sweep at the nodes: the linear response's, then with each pass's change.
+            let mut values = vec![vec![0.0; NODES]; n];
+            for (v, spectrum) in values.iter_mut().zip(&spectra) {
+                if spectrum.iter().any(|c| c.norm() > 0.0) {
+                    buf.copy_from_slice(spectrum);
+                    inverse_fft(&mut buf);
+                    for (x, b) in v.iter_mut().zip(&buf) {
+                        *x = b.re;
+                    }
+                }
+            }
+            let mut response = vec![vec![zero; NODES]; n];
+            for pass in 0..CURVATURE_PASSES {
+                let next = Self::curvature(disk, &mut solver, &values, q_of)?;
+                for (k, (now, was)) in next.iter().zip(response.iter_mut()).enumerate() {
+                    for ((b, x), y) in buf.iter_mut().zip(now).zip(was.iter()) {
+                        *b = x - y;
+                    }
+                    inverse_fft(&mut buf);
+                    largest[k] = 0.0;
+                    for (v, b) in values[k].iter_mut().zip(&buf) {
+                        *v += b.re;
+                        largest[k] = largest[k].max(b.re.abs());
+                    }
+                    was.copy_from_slice(now);
+                }
+                let reach = largest[..dofs].iter().sum::<f64>();
+                if pass == 0 {
+                    found = reach;
+                }
+                if reach <= enough {
+                    break;
+                }
+            }
+            for (s, r) in spectra.iter_mut().zip(&response) {
+                for (a, b) in s.iter_mut().zip(r) {
+                    *a += b;
+                }
             }
         }
         let active: Vec<usize> = (0..n)
@@ -168,7 +285,71 @@ impl Periodic {
             active,
             cubics,
             largest,
+            unswept,
+            found,
         })
+    }
+
+    /// The spectra of the response to the curvature `q_of` along the sweep of the linear
+    /// response `spectra`: `q` at the disk's nodes, its lines by the transform, each line's
+    /// `C` from `solver` (the mean and the Nyquist line left out).
+    fn curvature(
+        disk: &Disk,
+        solver: &mut Resolvent,
+        values: &[Vec<f64>],
+        q_of: &mut dyn FnMut(&[f64], &mut [f64]),
+    ) -> Option<Vec<Vec<Complex64>>> {
+        let n = values.len();
+        let zero = Complex64::new(0.0, 0.0);
+        let mut lines = vec![vec![zero; NODES]; n];
+        let (mut p, mut q) = (vec![0.0; n], vec![0.0; n]);
+        for i in 0..NODES {
+            for (pk, v) in p.iter_mut().zip(values) {
+                *pk = v[i];
+            }
+            q_of(&p, &mut q);
+            if q.iter().any(|x| !x.is_finite()) {
+                return None;
+            }
+            for (l, &qk) in lines.iter_mut().zip(&q) {
+                l[i] = Complex64::new(qk, 0.0);
+            }
+        }
+        // `Q_m = Σ_i q_i e^{−2πi m i/N}`: the inverse transform of the (real) samples,
+        // conjugated; `q(t) = Re Σ_{0<m<N/2} (2 Q_m / N) e^{i m Ω t}` besides the mean and the
+        // Nyquist line.
+        for l in lines.iter_mut() {
+            inverse_fft(l);
+        }
+        let scale = 2.0 / NODES as f64;
+        let mut out = vec![vec![zero; NODES]; n];
+        let mut u = vec![zero; n];
+        for m in 1..NODES / 2 {
+            for (uk, l) in u.iter_mut().zip(&lines) {
+                *uk = l[m].conj() * scale;
+            }
+            if u.iter().all(|c| c.norm() == 0.0) {
+                continue;
+            }
+            let c = solver.solve(m as f64 * disk.omega(), &u)?;
+            for (o, ck) in out.iter_mut().zip(c) {
+                o[m] = ck;
+            }
+        }
+        Some(out)
+    }
+
+    /// How far the part of the response the curvature's last sweep left out moves the gaps
+    /// (m): the sum over the positions `0..dofs` of its largest magnitude.
+    fn unswept_reach(&self, dofs: usize) -> f64 {
+        self.unswept
+            .as_ref()
+            .map_or(0.0, |c| c[..dofs].iter().sum())
+    }
+
+    /// Whether the table holds the curvature.
+    fn is_curved(&self) -> bool {
+        self.unswept.is_some()
     }
 
     /// The largest magnitude of component `k` over the revolution.
@@ -188,17 +369,34 @@ impl Periodic {
     }
 }
 
+/// The larger of the two gaps' distances between `a` and `b` (m).
+fn offset(a: Gaps, b: Gaps) -> f64 {
+    (a.bulge - b.bulge).abs().max((a.pad - b.pad).abs())
+}
+
 /// `x_i ← Σ_m x_m e^{2πi m i / N}` in place (no `1/N`), `N` a power of two: the iterative
 /// radix-2 Cooley–Tukey transform with its twiddles re-anchored exactly at each stage. The
 /// twiddles `e^{2πi m/N}`, `m < N/2`, are computed once: stage `len` takes every `N/len`-th,
 /// whose angle `(2π/N)(k N/len)` is `(2π/len) k` to the bit (the factors are powers of two).
+///
+/// The twiddles of the disk's [`NODES`] are computed once per process.
 fn inverse_fft(x: &mut [Complex64]) {
     let n = x.len();
     debug_assert!(n.is_power_of_two());
-    let step = 2.0 * PI / n as f64;
-    let twiddles: Vec<Complex64> = (0..n / 2)
-        .map(|m| Complex64::from_polar(1.0, step * m as f64))
-        .collect();
+    let of = |n: usize| -> Vec<Complex64> {
+        let step = 2.0 * PI / n as f64;
+        (0..n / 2)
+            .map(|m| Complex64::from_polar(1.0, step * m as f64))
+            .collect()
+    };
+    static NODE_TWIDDLES: std::sync::OnceLock<Vec<Complex64>> = std::sync::OnceLock::new();
+    let own;
+    let twiddles: &[Complex64] = if n == NODES {
+        NODE_TWIDDLES.get_or_init(|| of(NODES))
+    } else {
+        own = of(n);
+        &own
+    };
     let bits = n.trailing_zeros();
     for i in 0..n {
         let r = i.reverse_bits() >> (usize::BITS - bits);
@@ -245,11 +443,12 @@ impl Dither {
             .iter()
             .map(|&x| Complex64::new(-0.5 * va * va * x, 0.0))
             .collect();
+        let mut solver = Resolvent::new(j);
         Some(Dither {
             voltage,
             w,
-            c1: response(j, w, &u1)?,
-            c2: response(j, 2.0 * w, &u2)?,
+            c1: solver.solve(w, &u1)?,
+            c2: solver.solve(2.0 * w, &u2)?,
         })
     }
 
@@ -309,6 +508,9 @@ pub struct SchemeCounts {
     pub refreshes: u64,
     /// Rebuilds of the disk's response table.
     pub rebuilds: u64,
+    /// Of those, the tables that took the forces' curvature along the disk's sweep (see
+    /// docs/clearance.md, "The exponential scheme").
+    pub curved: u64,
     /// Periods of a dither held on a flat disk read from its settled orbit's table (see
     /// `src/drive/orbit.rs`).
     pub orbit: u64,
@@ -387,6 +589,16 @@ pub(crate) struct ExpScheme {
     disk: Option<Periodic>,
     /// The Jacobian the disk's table was built with.
     disk_j: Option<DMatrix<f64>>,
+    /// The gaps of the slow state the disk's table was built at, and the time it was built.
+    table_gaps: Option<Gaps>,
+    built_at: f64,
+    /// Periods a table must have lasted before the next one takes the curvature
+    /// ([`CURVATURE_WAIT`]).
+    curvature_wait: usize,
+    /// Whether the next table should take the curvature: a period needed substeps or missed
+    /// [`ExpScheme::straight`] under a table without it, or the last table's curvature moved
+    /// the gaps by more than its passes' end.
+    curvature_needed: bool,
     dither: Option<Dither>,
     /// The state at the drive's time, when the scheme holds it (the integrator's is stale).
     pub(crate) owned: Option<[f64; MAX_STATE]>,
@@ -497,6 +709,10 @@ impl ExpScheme {
             calm: 0,
             disk: None,
             disk_j: None,
+            table_gaps: None,
+            built_at: f64::NEG_INFINITY,
+            curvature_wait: CURVATURE_WAIT.0,
+            curvature_needed: false,
             dither: None,
             owned: None,
             misses: Backoff::default(),
@@ -614,17 +830,70 @@ impl ExpScheme {
                 (0..n).any(|c| (j[(r, c)] - jp[(r, c)]).abs() > REBUILD_SHIFT * scale)
             }),
         };
-        if !disk.is_flat() && (self.disk.is_none() || shifted) {
-            self.disk = Periodic::of_disk(disk, &j, &self.base);
+        // The curvature is taken with the voltage held: under a dither, `V²` swings within
+        // the period and its product with the disk's sweep is not periodic in the revolution.
+        let v = sys.inputs().voltage;
+        let dithered = v.ac_amplitude != 0.0 && v.frequency > 0.0;
+        let gaps = sys.gaps(t, &slow);
+        let lasted = self.lasted(t, h);
+        let curving = !dithered && lasted && self.curvature_needed;
+        let curved = self.disk.as_ref().is_some_and(Periodic::is_curved);
+        let stale = self.disk.as_ref().is_some_and(|d| {
+            (d.is_curved() && dithered)
+                || (curving
+                    && (!d.is_curved()
+                        || self
+                            .table_gaps
+                            .is_some_and(|r| offset(gaps, r) > d.unswept_reach(self.dofs))))
+        });
+        if !disk.is_flat() && (self.disk.is_none() || shifted || stale) {
+            if curved {
+                self.curvature_wait = if lasted {
+                    (self.curvature_wait / 2).max(CURVATURE_WAIT.0)
+                } else {
+                    (self.curvature_wait * 2).min(CURVATURE_WAIT.1)
+                };
+            }
+            let table = if !curving {
+                Periodic::of_disk(disk, &j, &self.base, None)
+            } else {
+                let dim = slow.shape_generic().0;
+                let mut f_slow = OVector::<f64, D>::zeros_generic(dim, nalgebra::U1);
+                OdeSystem::<D>::rhs(sys, t, &slow, &mut f_slow);
+                let mut fx = f_slow.clone();
+                let mut q_of = |p: &[f64], q: &mut [f64]| {
+                    let x = state_vector::<D>(dim, |i| slow[i] + p[i]);
+                    OdeSystem::<D>::rhs(sys, t, &x, &mut fx);
+                    for (r, qr) in q.iter_mut().enumerate() {
+                        let jp: f64 = p.iter().enumerate().map(|(c, pc)| j[(r, c)] * pc).sum();
+                        *qr = fx[r] - f_slow[r] - jp;
+                    }
+                };
+                let enough = ENOUGH_UNSWEPT * self.min_position_atol();
+                let curvature = Curvature {
+                    q_of: &mut q_of,
+                    dofs: self.dofs,
+                    enough,
+                };
+                Periodic::of_disk(disk, &j, &self.base, Some(curvature))
+            };
+            self.disk = table;
             self.disk_j = Some(j.clone());
+            self.table_gaps = Some(gaps);
+            self.built_at = t;
+            if let Some(d) = self.disk.as_ref().filter(|d| d.is_curved()) {
+                self.counts.curved += 1;
+                // Needed again only where the curvature moves the gaps by more than the passes
+                // leave out at their end, or a sign of need comes anew.
+                self.curvature_needed = d.found > ENOUGH_UNSWEPT * self.min_position_atol();
+            }
             self.counts.rebuilds += 1;
             if self.disk.is_none() {
                 return false;
             }
         }
         self.dither = None;
-        let v = sys.inputs().voltage;
-        if v.ac_amplitude != 0.0 && v.frequency > 0.0 {
+        if dithered {
             let e = per_volt2(sys, t, &slow);
             self.dither = Dither::new(v, &j, &e);
             if self.dither.is_none() {
@@ -633,6 +902,33 @@ impl ExpScheme {
         }
         self.reach = self.reach_of_forcings();
         true
+    }
+
+    /// The smallest of the positions' absolute tolerances (m).
+    fn min_position_atol(&self) -> f64 {
+        self.atol[..self.dofs]
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b))
+    }
+
+    /// Whether the disk's table has lasted [`ExpScheme::curvature_wait`] periods of `h` at `t`.
+    fn lasted(&self, t: f64, h: f64) -> bool {
+        t - self.built_at >= self.curvature_wait as f64 * h
+    }
+
+    /// Whether a refresh at `t` would rebuild the disk's table with the curvature: one without
+    /// it, or one whose slow gaps are off by `off` (m), more than the part its sweep left out
+    /// (see [`ExpScheme::refresh`]).
+    fn wants_curvature(&self, sys: &SliderSystem, t: f64, h: f64, off: f64) -> bool {
+        let v = sys.inputs().voltage;
+        let dithered = v.ac_amplitude != 0.0 && v.frequency > 0.0;
+        !dithered
+            && self.curvature_needed
+            && self.lasted(t, h)
+            && self
+                .disk
+                .as_ref()
+                .is_some_and(|d| !d.is_curved() || off > d.unswept_reach(self.dofs))
     }
 
     /// How far the known forcings move the gaps (m): the sum over the positions of their
@@ -662,15 +958,25 @@ impl ExpScheme {
     /// move within a factor of two; [`Gentle`]), the bound is at most
     /// `h A (2S + 2S) / 4 = atol / 4`, and the check holds without the two look-ups: the same
     /// verdict.
+    ///
+    /// Where the disk's table holds the curvature along the sweep from the slow gaps `d_r` it
+    /// was built at ([`Periodic`]), the remainder left is `(F_c′(d_r + δ(t)) − F_c′(d_r)) D`,
+    /// with `D` the slow gaps' offset from `d_r` plus the reach of the curvature's own response
+    /// (which its sweep leaves out): its impulse over the period is within
+    /// `h D |F_c′(d − A) − F_c′(d + A)|`, and that bound passes the check too. When it misses by
+    /// an offset larger than that reach, and a table built at the slow state here would pass,
+    /// the Jacobian and the table are taken afresh there ([`ExpScheme::refresh`]) and the
+    /// bound checked again.
     pub(crate) fn straight<D: Dim>(
         &mut self,
         sys: &SliderSystem,
+        disk: &Disk,
         t: f64,
         x: &OVector<f64, D>,
         h: f64,
     ) -> bool
     where
-        DefaultAllocator: Allocator<D>,
+        DefaultAllocator: Allocator<D> + Allocator<D, D>,
     {
         let (Some(i), a) = (self.impulse, self.reach) else {
             return true;
@@ -702,8 +1008,61 @@ impl ExpScheme {
             });
             c.d_bulge + c.d_pad
         };
-        let bound = 0.25 * h * a * (slope(-a) - slope(a)).abs();
-        bound <= self.atol[i]
+        let spread = (slope(-a) - slope(a)).abs();
+        let atol = self.atol[i];
+        if 0.25 * h * a * spread <= atol {
+            return true;
+        }
+        let curved = |s: &Self| {
+            s.disk
+                .as_ref()
+                .filter(|d| d.is_curved())
+                .map(|d| d.unswept_reach(s.dofs))
+        };
+        let mut off = f64::INFINITY;
+        if let Some(reach) = curved(self) {
+            off = self.slow_offset(sys, disk, t, x);
+            if h * (off + reach) * spread <= atol {
+                return true;
+            }
+            if 2.0 * h * reach * spread > atol {
+                // A table built here would miss too.
+                return false;
+            }
+        }
+        self.curvature_needed = true;
+        if self.wants_curvature(sys, t, h, off) && self.refresh(sys, disk, t, x, h) {
+            if let Some(reach) = curved(self) {
+                return h * (self.slow_offset(sys, disk, t, x) + reach) * spread <= atol;
+            }
+        }
+        false
+    }
+
+    /// The slow gaps' offset (m) at `(t, x)` from those the disk's table was built at
+    /// ([`offset`]); the known forcings at `t` are left in the work vectors.
+    fn slow_offset<D: Dim>(
+        &mut self,
+        sys: &SliderSystem,
+        disk: &Disk,
+        t: f64,
+        x: &OVector<f64, D>,
+    ) -> f64
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let Some(at) = self.table_gaps else {
+            return f64::INFINITY;
+        };
+        if self.known_at != Some(t.to_bits()) {
+            Self::known(disk, &self.disk, &self.dither, t, &mut self.p, &mut self.dp);
+            self.known_at = Some(t.to_bits());
+        }
+        let mut slow = [0.0; MAX_STATE];
+        for (s, (xi, pi)) in slow.iter_mut().zip(x.iter().zip(&self.p)) {
+            *s = xi - pi;
+        }
+        offset(sys.gaps(t, &slow[..]), at)
     }
 
     /// `p(t)` and `p′(t)` of the known forcings into the work vectors.
@@ -952,7 +1311,10 @@ impl ExpScheme {
                     None => want,
                 }
             }
-        };
+        } || (self.level > 0 && self.wants_curvature(sys, t0, h, 0.0));
+        if self.level > 0 && !self.disk.as_ref().is_some_and(Periodic::is_curved) {
+            self.curvature_needed = true;
+        }
         let mut fresh = false;
         if stale {
             if !self.refresh(sys, disk, t0, x0, h) {
@@ -1085,5 +1447,59 @@ mod tests {
                 .sum();
             assert!((yi - direct).norm() < 1e-12, "{i}");
         }
+    }
+
+    /// The transform on the disk's nodes (its twiddles kept) against the same on a grid of its
+    /// own, at a few outputs, and the resolvent against the residual of the system it solves.
+    #[test]
+    fn the_node_transform_and_the_resolvent() {
+        let x: Vec<Complex64> = (0..NODES)
+            .map(|m| {
+                Complex64::new((m as f64 * 0.37).sin(), (m as f64 * 1.3).cos()) / (1.0 + m as f64)
+            })
+            .collect();
+        for _ in 0..2 {
+            let mut y = x.clone();
+            inverse_fft(&mut y);
+            for i in [0, 1, 77, NODES - 1] {
+                let direct: Complex64 = x
+                    .iter()
+                    .enumerate()
+                    .map(|(m, xm)| {
+                        xm * Complex64::from_polar(
+                            1.0,
+                            2.0 * PI * ((m * i) % NODES) as f64 / NODES as f64,
+                        )
+                    })
+                    .sum();
+                assert!((y[i] - direct).norm() < 1e-11, "{i}: {} vs {direct}", y[i]);
+            }
+        }
+        // A damped oscillator and a lag, as a slider's Jacobian has them.
+        let j = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, -4e10, -2e4, 3e5, 0.0, 0.0, -1e4]);
+        let u = [
+            Complex64::new(1.0, -2.0),
+            Complex64::new(0.5, 3.0),
+            Complex64::new(-1.0, 0.25),
+        ];
+        let mut r = Resolvent::new(&j);
+        for w in [0.0, 1e3, 2e5, 3e6] {
+            let c = r.solve(w, &u).unwrap();
+            for (row, uk) in u.iter().enumerate() {
+                let jc: Complex64 = (0..3).map(|col| c[col] * j[(row, col)]).sum();
+                let residual = Complex64::new(0.0, w) * c[row] - jc - uk;
+                let scale = (0..3)
+                    .map(|col| (c[col] * j[(row, col)]).norm())
+                    .sum::<f64>()
+                    + uk.norm();
+                assert!(
+                    residual.norm() <= 1e-13 * scale,
+                    "ω {w}, row {row}: {residual}"
+                );
+            }
+        }
+        // Singular at ω = 0 when J is.
+        let singular = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 0.0, 0.0]);
+        assert!(Resolvent::new(&singular).solve(0.0, &u[..2]).is_none());
     }
 }

@@ -1551,7 +1551,7 @@ where
     let dim = D::from_usize(layout.len());
     let owned = owned.map(|x| state_vector::<D>(dim, |i| x[i]));
     let mut x0 = state_at_start(it, t0, owned)?;
-    if !exp.straight(it.system(), t0, &x0, dt) {
+    if !exp.straight(it.system(), disk, t0, &x0, dt) {
         let _ = exp.missed::<D>();
         if from_integrator {
             // The integrator holds the state: the period as the default drive runs it.

@@ -42,7 +42,7 @@ mod event;
 mod exponential;
 mod integrator;
 mod jacobian;
-mod lu;
+pub(crate) mod lu;
 mod options;
 mod problem;
 mod radau5;
