@@ -208,33 +208,25 @@ impl Periodic {
         let mut found = 0.0;
         if let Some(Curvature { q_of, dofs, enough }) = curvature {
             let largest: &mut Vec<f64> = unswept.insert(vec![0.0; n]);
-            let mut buf = vec![zero; NODES];
             // The sweep at the nodes: the linear response's, then with each pass's change.
-            let mut values = vec![vec![0.0; NODES]; n];
-            for (v, spectrum) in values.iter_mut().zip(&spectra) {
-                if spectrum.iter().any(|c| c.norm() > 0.0) {
-                    buf.copy_from_slice(spectrum);
-                    inverse_fft(&mut buf);
-                    for (x, b) in v.iter_mut().zip(&buf) {
-                        *x = b.re;
-                    }
-                }
-            }
+            let mut values = real_values(&spectra.iter().map(Vec::as_slice).collect::<Vec<_>>());
             let mut response = vec![vec![zero; NODES]; n];
             for pass in 0..CURVATURE_PASSES {
                 let next = Self::curvature(disk, &mut solver, &values, q_of)?;
-                for (k, (now, was)) in next.iter().zip(response.iter_mut()).enumerate() {
-                    for ((b, x), y) in buf.iter_mut().zip(now).zip(was.iter()) {
-                        *b = x - y;
-                    }
-                    inverse_fft(&mut buf);
+                let changes: Vec<Vec<Complex64>> = next
+                    .iter()
+                    .zip(&response)
+                    .map(|(now, was)| now.iter().zip(was).map(|(x, y)| x - y).collect())
+                    .collect();
+                let changed = real_values(&changes.iter().map(Vec::as_slice).collect::<Vec<_>>());
+                for (k, change) in changed.iter().enumerate() {
                     largest[k] = 0.0;
-                    for (v, b) in values[k].iter_mut().zip(&buf) {
-                        *v += b.re;
-                        largest[k] = largest[k].max(b.re.abs());
+                    for (v, c) in values[k].iter_mut().zip(change) {
+                        *v += c;
+                        largest[k] = largest[k].max(c.abs());
                     }
-                    was.copy_from_slice(now);
                 }
+                response = next;
                 let reach = largest[..dofs].iter().sum::<f64>();
                 if pass == 0 {
                     found = reach;
@@ -255,29 +247,25 @@ impl Periodic {
         let na = active.len();
         let mut cubics = vec![[0.0; 7]; NODES * na];
         let mut largest = vec![0.0; n];
-        let mut buf = vec![zero; NODES];
-        let mut values = vec![0.0; NODES];
         // The nodes' spacing in time.
         let hn = disk.locate(0.0).2;
         for (j, &k) in active.iter().enumerate() {
-            buf.copy_from_slice(&spectra[k]);
-            inverse_fft(&mut buf);
-            for (v, b) in values.iter_mut().zip(&buf) {
-                *v = b.re;
-            }
+            let slopes: Vec<Complex64> = spectra[k]
+                .iter()
+                .enumerate()
+                .map(|(m, c)| Complex64::new(0.0, m as f64 * disk.omega()) * c)
+                .collect();
+            let both = real_values(&[&spectra[k], &slopes]);
+            let (values, slopes) = (&both[0], &both[1]);
             largest[k] = values.iter().fold(0.0, |a: f64, v| a.max(v.abs()));
-            for (m, b) in buf.iter_mut().enumerate() {
-                *b = Complex64::new(0.0, m as f64 * disk.omega()) * spectra[k][m];
-            }
-            inverse_fft(&mut buf);
             for i in 0..NODES {
                 let next = (i + 1) % NODES;
                 cubics[i * na + j] = crate::numerics::cubic_hermite_power(
                     hn,
                     values[i],
-                    buf[i].re,
+                    slopes[i],
                     values[next],
-                    buf[next].re,
+                    slopes[next],
                 );
             }
         }
@@ -301,7 +289,7 @@ impl Periodic {
     ) -> Option<Vec<Vec<Complex64>>> {
         let n = values.len();
         let zero = Complex64::new(0.0, 0.0);
-        let mut lines = vec![vec![zero; NODES]; n];
+        let mut samples = vec![vec![0.0; NODES]; n];
         let (mut p, mut q) = (vec![0.0; n], vec![0.0; n]);
         for i in 0..NODES {
             for (pk, v) in p.iter_mut().zip(values) {
@@ -311,22 +299,18 @@ impl Periodic {
             if q.iter().any(|x| !x.is_finite()) {
                 return None;
             }
-            for (l, &qk) in lines.iter_mut().zip(&q) {
-                l[i] = Complex64::new(qk, 0.0);
+            for (l, &qk) in samples.iter_mut().zip(&q) {
+                l[i] = qk;
             }
         }
-        // `Q_m = Σ_i q_i e^{−2πi m i/N}`: the inverse transform of the (real) samples,
-        // conjugated; `q(t) = Re Σ_{0<m<N/2} (2 Q_m / N) e^{i m Ω t}` besides the mean and the
-        // Nyquist line.
-        for l in lines.iter_mut() {
-            inverse_fft(l);
-        }
+        // `q(t) = Re Σ_{0<m<N/2} (2 Q_m / N) e^{i m Ω t}` besides the mean and the Nyquist line.
+        let lines = real_lines(&samples);
         let scale = 2.0 / NODES as f64;
         let mut out = vec![vec![zero; NODES]; n];
         let mut u = vec![zero; n];
         for m in 1..NODES / 2 {
             for (uk, l) in u.iter_mut().zip(&lines) {
-                *uk = l[m].conj() * scale;
+                *uk = l[m] * scale;
             }
             if u.iter().all(|c| c.norm() == 0.0) {
                 continue;
@@ -374,20 +358,85 @@ fn offset(a: Gaps, b: Gaps) -> f64 {
     (a.bulge - b.bulge).abs().max((a.pad - b.pad).abs())
 }
 
+/// `Re Σ_m s_m e^{2πi m i/N}` at every `i`, for each spectrum `s` of `spectra` (of the same
+/// power-of-two length): two per transform. The real part of a sum is the sum over the
+/// Hermitian part `h_m = (s_m + conj(s_{N−m}))/2`, whose transform is real; two such, `h` and
+/// `g`, are one transform of `h + i g`, whose real and imaginary parts they give.
+fn real_values(spectra: &[&[Complex64]]) -> Vec<Vec<f64>> {
+    let Some(n) = spectra.first().map(|s| s.len()) else {
+        return Vec::new();
+    };
+    let zero = Complex64::new(0.0, 0.0);
+    let i1 = Complex64::new(0.0, 1.0);
+    let mut out = vec![vec![0.0; n]; spectra.len()];
+    let mut buf = vec![zero; n];
+    for (pair, outs) in spectra.chunks(2).zip(out.chunks_mut(2)) {
+        let hermitian = |s: &[Complex64], m: usize| 0.5 * (s[m] + s[(n - m) % n].conj());
+        for (m, b) in buf.iter_mut().enumerate() {
+            *b = hermitian(pair[0], m) + pair.get(1).map_or(zero, |s| i1 * hermitian(s, m));
+        }
+        inverse_fft(&mut buf);
+        for (k, o) in outs.iter_mut().enumerate() {
+            for (x, b) in o.iter_mut().zip(&buf) {
+                *x = if k == 0 { b.re } else { b.im };
+            }
+        }
+    }
+    out
+}
+
+/// `Q_m = Σ_i q_i e^{−2πi m i/N}` for each real sequence `q` of `samples` (of the same
+/// power-of-two length): two per transform. With `W` the transform (`e^{+…}`) of `a + i b`,
+/// `A_m = (W_{N−m} + conj(W_m))/2` and `B_m = (W_{N−m} − conj(W_m))/(2i)`.
+fn real_lines(samples: &[Vec<f64>]) -> Vec<Vec<Complex64>> {
+    let Some(n) = samples.first().map(Vec::len) else {
+        return Vec::new();
+    };
+    let zero = Complex64::new(0.0, 0.0);
+    let mut out = vec![vec![zero; n]; samples.len()];
+    let mut buf = vec![zero; n];
+    for (pair, outs) in samples.chunks(2).zip(out.chunks_mut(2)) {
+        for (i, b) in buf.iter_mut().enumerate() {
+            *b = Complex64::new(pair[0][i], pair.get(1).map_or(0.0, |q| q[i]));
+        }
+        inverse_fft(&mut buf);
+        for (k, o) in outs.iter_mut().enumerate() {
+            for (m, x) in o.iter_mut().enumerate() {
+                let (w, v) = (buf[(n - m) % n], buf[m].conj());
+                *x = if k == 0 {
+                    0.5 * (w + v)
+                } else {
+                    Complex64::new(0.0, -0.5) * (w - v)
+                };
+            }
+        }
+    }
+    out
+}
+
 /// `x_i ← Σ_m x_m e^{2πi m i / N}` in place (no `1/N`), `N` a power of two: the iterative
 /// radix-2 Cooley–Tukey transform with its twiddles re-anchored exactly at each stage. The
 /// twiddles `e^{2πi m/N}`, `m < N/2`, are computed once: stage `len` takes every `N/len`-th,
-/// whose angle `(2π/N)(k N/len)` is `(2π/len) k` to the bit (the factors are powers of two).
+/// whose angle `(2π/N)(k N/len)` is `(2π/len) k` to the bit (the factors are powers of two),
+/// laid out stage by stage so that each stage reads its own in order.
 ///
 /// The twiddles of the disk's [`NODES`] are computed once per process.
 fn inverse_fft(x: &mut [Complex64]) {
     let n = x.len();
     debug_assert!(n.is_power_of_two());
+    // Stage `len` at `half − 1`, `half = len / 2`: `n − 1` twiddles in all.
     let of = |n: usize| -> Vec<Complex64> {
         let step = 2.0 * PI / n as f64;
-        (0..n / 2)
+        let all: Vec<Complex64> = (0..n / 2)
             .map(|m| Complex64::from_polar(1.0, step * m as f64))
-            .collect()
+            .collect();
+        let mut staged = Vec::with_capacity(n);
+        let mut len = 2;
+        while len <= n {
+            staged.extend((0..len / 2).map(|k| all[k * (n / len)]));
+            len *= 2;
+        }
+        staged
     };
     static NODE_TWIDDLES: std::sync::OnceLock<Vec<Complex64>> = std::sync::OnceLock::new();
     let own;
@@ -407,13 +456,13 @@ fn inverse_fft(x: &mut [Complex64]) {
     let mut len = 2;
     while len <= n {
         let half = len / 2;
-        let stride = n / len;
-        for start in (0..n).step_by(len) {
-            for k in 0..half {
-                let w = twiddles[k * stride];
-                let (a, b) = (x[start + k], x[start + k + half] * w);
-                x[start + k] = a + b;
-                x[start + k + half] = a - b;
+        let stage = &twiddles[half - 1..len - 1];
+        for block in x.chunks_exact_mut(len) {
+            let (lo, hi) = block.split_at_mut(half);
+            for ((a, b), w) in lo.iter_mut().zip(hi.iter_mut()).zip(stage) {
+                let (u, v) = (*a, *b * w);
+                *a = u + v;
+                *b = u - v;
             }
         }
         len *= 2;
@@ -1496,6 +1545,45 @@ mod tests {
                     residual.norm() <= 1e-13 * scale,
                     "ω {w}, row {row}: {residual}"
                 );
+            }
+        }
+        // Two real outputs per transform, three inputs (one unpaired), against direct sums.
+        let n = 64;
+        let spectra: Vec<Vec<Complex64>> = (0..3)
+            .map(|k| {
+                (0..n)
+                    .map(|m| {
+                        Complex64::new(
+                            (m as f64 * 0.3 + k as f64).sin(),
+                            (m as f64 * 0.7 - k as f64).cos(),
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        let values = real_values(&spectra.iter().map(Vec::as_slice).collect::<Vec<_>>());
+        let lines = real_lines(&values);
+        for (k, s) in spectra.iter().enumerate() {
+            for (i, value) in values[k].iter().enumerate() {
+                let direct: f64 = s
+                    .iter()
+                    .enumerate()
+                    .map(|(m, c)| {
+                        (c * Complex64::from_polar(1.0, 2.0 * PI * ((m * i) % n) as f64 / n as f64))
+                            .re
+                    })
+                    .sum();
+                assert!((value - direct).abs() < 1e-12, "{k} {i}");
+            }
+            for (m, line) in lines[k].iter().enumerate() {
+                let direct: Complex64 = values[k]
+                    .iter()
+                    .enumerate()
+                    .map(|(i, q)| {
+                        q * Complex64::from_polar(1.0, -2.0 * PI * ((m * i) % n) as f64 / n as f64)
+                    })
+                    .sum();
+                assert!((line - direct).norm() < 1e-11, "{k} {m}");
             }
         }
         // Singular at ω = 0 when J is.
