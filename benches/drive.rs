@@ -15,6 +15,10 @@
 //! of 200 periods (10 ms of drive time) for at least 1 s; the table gives the fastest block's
 //! wall-clock time and the mean CPU time of the thread per period, and the ratio of the period
 //! (50 µs) to each: how many times faster than real time the drive runs on one core.
+//!
+//! Then three programmes on the wavy disk from a fresh drive, each run timed whole, default and
+//! exponential scheme (`ramps`): the heater ramped into contact and back, ramped slowly, and
+//! stepped; here the table rebuilds of the exponential scheme count.
 
 #[path = "../examples/common/timing.rs"]
 mod timing;
@@ -145,6 +149,62 @@ fn main() {
                     }
                 }
             }
+        }
+    }
+    ramps(&scene, &zone, &configs);
+}
+
+/// A heater ramped on the wavy disk, the command changed every period: `60 + 22 sin²(π t / T)`
+/// mW over `T` (into contact and back for `T` = 0.2 s; up to 62 mW over the first 0.2 s for
+/// `T` = 2 s), and a step from 70 to 80 mW held 0.1 s each: 4 000 periods from a fresh drive,
+/// each run timed whole, its table rebuilds included (median of three).
+fn ramps(scene: &Scene, zone: &hdi_tribology::drive::Zone, configs: &[(&str, DriveOptions)]) {
+    println!();
+    println!("| scheme | programme | wall ms (4 000 periods) | CPU ms | refreshes | rebuilds |");
+    println!("|---|---|---|---|---|---|");
+    for (name, period) in [
+        ("ramp 0.2 s", Some(0.2)),
+        ("ramp 2 s", Some(2.0)),
+        ("step 70 → 80 mW", None),
+    ] {
+        for (atol_name, o) in configs.iter().take(2) {
+            let label = format!("{atol_name}/wavy/{name}");
+            if std::env::var("DRIVE_BENCH_ONLY").is_ok_and(|o| !label.contains(&o)) {
+                continue;
+            }
+            let o = DriveOptions {
+                disk: DiskSpec::default(),
+                ..o.clone()
+            };
+            let plant = Plant::new(scene, zone, 1, o).expect("plant");
+            let mut runs = Vec::new();
+            let mut counts = None;
+            for _ in 0..3 {
+                let mut d = plant.drive().expect("drive");
+                let (_, t) = timing::measure(1, 1, Duration::ZERO, || {
+                    for k in 0..4000 {
+                        let t = k as f64 * DT;
+                        let mw = match period {
+                            Some(p) => 60.0 + 22.0 * (std::f64::consts::PI * t / p).sin().powi(2),
+                            None if k < 2000 => 70.0,
+                            None => 80.0,
+                        };
+                        d.step(&Command::heater_mw(mw), DT).expect("step");
+                    }
+                });
+                runs.push((t.wall, t.cpu));
+                counts = Some(d.scheme_counts());
+            }
+            runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let (wall, cpu) = runs[1];
+            let c = counts.expect("ran");
+            println!(
+                "| {atol_name} | {name} | {:.1} | {:.1} | {} | {} |",
+                wall * 1e3,
+                cpu * 1e3,
+                c.refreshes,
+                c.rebuilds
+            );
         }
     }
 }
