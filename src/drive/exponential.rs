@@ -22,7 +22,10 @@
 //! under the same inputs but the heater, takes its two-step method instead
 //! ([`ExponentialStepper::step_two`], one right-hand side a period,
 //! [`ExpScheme::continuation`]), and so does every substep after a period's first, from the
-//! substep before (one right-hand side a substep). Before it, a check of the contact force's
+//! substep before (one right-hand side a substep). Where the forces curve over the disk's
+//! sweep (near the peaks, in contact), the disk's table also takes out the periodic part of
+//! their remainder beyond `J` along that sweep ([`Periodic`], the curvature), when a period
+//! needed it and the table before lasted [`CURVATURE_WAIT`]. Before it, a check of the contact force's
 //! curvature over the forcings' reach ([`ExpScheme::straight`]) refuses what the estimate
 //! cannot see. A period whose estimate is above 1 is tried again with the Jacobian taken
 //! afresh at its start (the disk's table rebuilt when that moved `J` by more than
@@ -59,8 +62,8 @@ pub(crate) const REBUILD_SHIFT: f64 = 1e-4;
 /// Most passes of the disk table's curvature ([`Periodic`]). Each leaves out of its sweep what
 /// the pass before had not found. On the paper scene, the part left out moves the gap by
 /// 3.5e-13, 1.9e-14, 7.9e-16 and 2.4e-17 m after one to four passes at the jump into contact
-/// (80 mW), and by 4–7e-15, 4–6e-17 and 3–5e-19 m after one to three in flight (70 mW) and in
-/// settled contact; [`ExpScheme::straight`] needs it within about 6e-14 m in contact.
+/// (80 mW), and by 4–7e-15 and 4–6e-17 m after one and two in settled contact;
+/// [`ExpScheme::straight`] needs it within about 6e-14 m there.
 pub(crate) const CURVATURE_PASSES: usize = 4;
 
 /// The passes end once the part left out moves the gaps by this fraction of the smallest

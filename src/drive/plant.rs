@@ -259,7 +259,9 @@ pub enum DriveScheme {
     /// (ETD2RK, [`crate::ode::ExponentialStepper`]; a period of one step that continues the one
     /// before by the two-step ETD2, one right-hand side, `step_two`), with the slider's Jacobian held across
     /// periods and refreshed when a period misses the tolerances; the disk's waviness and an
-    /// AC dither are taken out by their exact periodic responses to the held linear part. A
+    /// AC dither are taken out by their exact periodic responses to the held linear part, and
+    /// where the forces curve over the disk's sweep (near the peaks, in contact) the disk's
+    /// table also takes out their remainder's periodic part along it. A
     /// period whose error estimate still misses the drive's contact tolerances
     /// ([`DriveOptions::atol_displacement`], `rtol`), or where the contact force curves too
     /// much over the gaps the disk and the dither sweep, is run by the integrator from the
@@ -268,8 +270,9 @@ pub enum DriveScheme {
     /// command on a flat disk without a dither is left to the integrator after the four
     /// periods that follow each change (its steps span many periods there);
     /// [`Drive::scheme_counts`] counts each kind of period. Faster than the integrator where
-    /// the command changes every period; docs/clearance.md, "The exponential scheme", gives
-    /// its cost and accuracy.
+    /// the command changes every period or the disk is wavy, slower under a heater ramped on a
+    /// wavy disk (its tables rebuilt); docs/clearance.md, "The exponential scheme", gives its
+    /// cost and accuracy.
     Exponential,
 }
 
