@@ -25,9 +25,9 @@
 //! substep before (one right-hand side a substep). Where the forces curve over the disk's
 //! sweep (near the peaks, in contact), the disk's table also takes out the periodic part of
 //! their remainder beyond `J` along that sweep ([`Periodic`], the curvature), when a period
-//! needed it and the table before lasted [`CURVATURE_WAIT`]. Before it, a check of the contact force's
-//! curvature over the forcings' reach ([`ExpScheme::straight`]) refuses what the estimate
-//! cannot see. A period whose estimate is above 1 is tried again with the Jacobian taken
+//! needed it and the table before lasted [`CURVATURE_WAIT`]. Before the step, a check of the
+//! contact force's curvature over the forcings' reach ([`ExpScheme::straight`]) refuses what
+//! the estimate cannot see. A period whose estimate is above 1 is tried again with the Jacobian taken
 //! afresh at its start (the disk's table rebuilt when that moved `J` by more than
 //! [`REBUILD_SHIFT`]), then with twice the substeps, up to [`LEVELS`]; if it still misses,
 //! the period is run by the integrator from the same start, as the default drive runs it, and
@@ -105,7 +105,7 @@ pub(crate) const MAX_SKIP_DITHER: usize = 4096;
 /// along the disk's sweep: `q(t) = f(x_s + p(t)) − f(x_s) − J p(t)` at the slow state `x_s`
 /// the table is built at. Its lines are those of the sampled `q` over the revolution (a
 /// discrete Fourier transform on the disk's nodes), each answered like a harmonic's; the mean of
-/// `q` stays in the remainder. `p` is the table's own response, so `q` is found by
+/// `q` stays in the remainder. `p` is the table's own response, so `q` is found by at most
 /// [`CURVATURE_PASSES`] passes: the first along the response to the disk's motion alone, each
 /// next along the response the pass before found.
 #[derive(Clone, Debug)]
@@ -281,8 +281,8 @@ impl Periodic {
         })
     }
 
-    /// The spectra of the response to the curvature `q_of` along the sweep of the linear
-    /// response `spectra`: `q` at the disk's nodes, its lines by the transform, each line's
+    /// The spectra of the response to the curvature `q_of` along the sweep `values` (each
+    /// component at the disk's nodes): `q` at the nodes, its lines by the transform, each line's
     /// `C` from `solver` (the mean and the Nyquist line left out).
     fn curvature(
         disk: &Disk,
@@ -885,7 +885,7 @@ impl ExpScheme {
         // The curvature is taken with the voltage held: under a dither, `V²` swings within
         // the period and its product with the disk's sweep is not periodic in the revolution.
         let v = sys.inputs().voltage;
-        let dithered = v.ac_amplitude != 0.0 && v.frequency > 0.0;
+        let dithered = v.is_time_dependent();
         let gaps = sys.gaps(t, &slow);
         let lasted = self.lasted(t, h);
         let curving = !dithered && lasted && self.curvature_needed;
@@ -972,9 +972,7 @@ impl ExpScheme {
     /// it, or one whose slow gaps are off by `off` (m), more than the part its sweep left out
     /// (see [`ExpScheme::refresh`]).
     fn wants_curvature(&self, sys: &SliderSystem, t: f64, h: f64, off: f64) -> bool {
-        let v = sys.inputs().voltage;
-        let dithered = v.ac_amplitude != 0.0 && v.frequency > 0.0;
-        !dithered
+        !sys.inputs().voltage.is_time_dependent()
             && self.curvature_needed
             && self.lasted(t, h)
             && self
@@ -1013,8 +1011,8 @@ impl ExpScheme {
     ///
     /// Where the disk's table holds the curvature along the sweep from the slow gaps `d_r` it
     /// was built at ([`Periodic`]), the remainder left is `(F_c′(d_r + δ(t)) − F_c′(d_r)) D`,
-    /// with `D` the slow gaps' offset from `d_r` plus the reach of the curvature's own response
-    /// (which its sweep leaves out): its impulse over the period is within
+    /// with `D` the slow gaps' offset from `d_r` plus the reach of the part of the response the
+    /// last pass's sweep left out: its impulse over the period is within
     /// `h D |F_c′(d − A) − F_c′(d + A)|`, and that bound passes the check too. When it misses by
     /// an offset larger than that reach, and a table built at the slow state here would pass,
     /// the Jacobian and the table are taken afresh there ([`ExpScheme::refresh`]) and the
@@ -1357,7 +1355,7 @@ impl ExpScheme {
             (Some((_, held)), _) if *held != h => true,
             (_, d) => {
                 let v = sys.inputs().voltage;
-                let want = v.ac_amplitude != 0.0 && v.frequency > 0.0;
+                let want = v.is_time_dependent();
                 match d {
                     Some(d) => !want || d.voltage != v,
                     None => want,
