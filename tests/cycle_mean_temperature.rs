@@ -10,6 +10,9 @@ use hdi_tribology::ode::Method;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::sim::Problem;
 
+#[path = "common/scenes.rs"]
+mod scenes;
+
 /// The paper scene at 0 and 0.6 V, and the few-peak rigid slider with a 10 ns interface lag at
 /// 0.55 V (intermittent contact on five Hertz peaks).
 fn cases() -> Vec<(
@@ -20,11 +23,7 @@ fn cases() -> Vec<(
     f64,
 )> {
     let paper = Scene::paper();
-    let few = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let few = scenes::paper_bulge();
     let mut out = Vec::new();
     for (name, scene, v_ac) in [
         ("paper, 0 V", &paper, 0.0),

@@ -5,6 +5,9 @@ use hdi_tribology::analysis::cycle::{simulate_cycle, CycleOptions, HeaterProgram
 use hdi_tribology::model::{SliderModel, Structure};
 use hdi_tribology::scene::Scene;
 
+#[path = "common/scenes.rs"]
+mod scenes;
+
 /// Runs `model` under `programme` whole and stopped at the take-off, and compares them.
 fn compare(model: &SliderModel, programme: &HeaterProgramme, scene: &Scene, what: &str) {
     let mut opts = CycleOptions::from_scene(scene).unwrap();
@@ -56,11 +59,7 @@ fn a_run_stopped_at_the_takeoff_finds_the_whole_runs_powers() {
     compare(&model, &triggered, &paper, "paper, triggered");
     // The few-peak scene of the maps, rigid with a 10 ns interface lag at 0.27 V, and its
     // bulge at 0.55 V.
-    let bulge = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let bulge = scenes::paper_bulge();
     let base = SliderModel::from_scene(&bulge).unwrap();
     let few = HeaterProgramme::fixed_from_scene(&bulge).unwrap();
     let rigid = base

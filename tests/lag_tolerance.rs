@@ -11,14 +11,13 @@ use hdi_tribology::model::{SliderModel, SliderSystem, Structure};
 use hdi_tribology::ode::Method;
 use hdi_tribology::scene::Scene;
 
+#[path = "common/scenes.rs"]
+mod scenes;
+
 const DISPLACEMENT: f64 = 1e-14;
 
 fn few_peak() -> Scene {
-    Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap()
+    scenes::paper_bulge()
 }
 
 /// The lagged force's absolute tolerance of `model`.

@@ -15,6 +15,9 @@ use hdi_tribology::scene::{LubricantSpec, Scene, WettingSpec};
 use hdi_tribology::surface::{Discrete, Gaussian, PeakDistribution, RiceMaxima};
 use hdi_tribology::Error;
 
+#[path = "common/scenes.rs"]
+mod scenes;
+
 const GAMMA: f64 = 0.024; // N/m, PFPE (Zdol) at room temperature
 const R: f64 = 1e-7; // asperity radius of the paper scene, m
 
@@ -569,11 +572,7 @@ fn the_held_branch_integrates_the_law_picked_by_sign() {
 fn the_largest_lubricated_layout_runs() {
     use hdi_tribology::drive::{scene_zone, Command, DiskSpec, DriveOptions, Plant};
     use hdi_tribology::model::StateLayout;
-    let mut scene = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let mut scene = scenes::paper_bulge();
     scene.heater.thermal_lag_s = 1e-6;
     scene.slider.interface_lag_s = 1e-8;
     scene.lubricant = paper_lubricated(true).lubricant;

@@ -10,16 +10,15 @@ use hdi_tribology::ode::OdeSystem;
 use hdi_tribology::scene::Scene;
 use nalgebra::{DVector, Dyn};
 
+#[path = "common/scenes.rs"]
+mod scenes;
+
 /// The stated accuracy of the reduced model's touchdown and take-off where its check passes (W):
 /// a tenth of the maps' convergence tolerance of 0.05 mW.
 const ACCURACY: f64 = 5e-6;
 
 fn scene() -> Scene {
-    Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap()
+    scenes::paper_bulge()
 }
 
 fn cycle(model: &SliderModel, scene: &Scene, rtol: f64) -> CycleResult {

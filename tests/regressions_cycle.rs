@@ -21,6 +21,9 @@ use hdi_tribology::model::SliderModel;
 use hdi_tribology::scene::Scene;
 use hdi_tribology::Error;
 
+#[path = "common/scenes.rs"]
+mod scenes;
+
 /// A 100 ns interface lag on the paper scene (c/K_contact ≈ 27 ns) makes the contact branch
 /// self-excited: the head bounced ever higher and harder and the integration ended with
 /// `Ode(NonFinite)` at t ≈ 3.67 ms, 26 nm deep in the disk. It now stops where the pad reaches
@@ -76,11 +79,7 @@ fn a_short_interface_lag_runs_through() {
 /// a 10 ms programme; it now stops once it spends steps at more than twice the even pace.
 #[test]
 fn a_cycle_spending_steps_too_fast_stops_early() {
-    let scene = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let scene = scenes::paper_bulge();
     let model = SliderModel::from_scene(&scene)
         .unwrap()
         .with_ac_amplitude(1.0)
@@ -137,11 +136,7 @@ fn auto_on_a_stiff_structure_starts_stiff() {
 /// spent the allowance of 1 % of the budget since then at more than twice the even pace.
 #[test]
 fn a_bounce_below_the_tables_stops_when_asked() {
-    let scene = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let scene = scenes::paper_bulge();
     let mut model = SliderModel::from_scene(&scene)
         .unwrap()
         .with_interface_lag(1e-10);
@@ -199,11 +194,7 @@ fn a_bounce_below_the_tables_stops_when_asked() {
 #[test]
 fn the_stop_below_the_tables_leaves_finished_cycles_alone() {
     use hdi_tribology::model::Structure;
-    let scene = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let scene = scenes::paper_bulge();
     let bulge = SliderModel::from_scene(&scene).unwrap();
     let rigid = bulge
         .with_structure(Structure::rigid(scene.slider.mass_kg).unwrap())

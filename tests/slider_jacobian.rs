@@ -11,6 +11,9 @@ use hdi_tribology::ode::{OdeSystem, TimeMemo};
 use hdi_tribology::scene::Scene;
 use nalgebra::{DMatrix, DVector, Dyn};
 
+#[path = "common/scenes.rs"]
+mod scenes;
+
 /// Displacement increment of the differences (m): small against the 0.1 nm scale of the contact
 /// forces and above rounding (the differences agree with the derivative to about 1e-6).
 const H_DISPLACEMENT: f64 = 1e-14;
@@ -170,11 +173,7 @@ fn rigid_slider_with_interface_and_thermal_lags() {
 
 #[test]
 fn few_peak_bulge_in_contact() {
-    let scene = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let scene = scenes::paper_bulge();
     let model = SliderModel::from_scene(&scene)
         .unwrap()
         .with_ac_amplitude(0.5);
@@ -201,11 +200,7 @@ fn rigid_slider_with_a_stateful_term() {
 #[test]
 fn quasi_static_bulge_in_contact() {
     use hdi_tribology::model::Structure;
-    let scene = Scene::from_path(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/paper_bulge.toml"
-    ))
-    .unwrap();
+    let scene = scenes::paper_bulge();
     let full = SliderModel::from_scene(&scene)
         .unwrap()
         .with_structure(Structure::bulge(scene.slider.mass_kg, 5e-13, 2e6, 0.05).unwrap())
