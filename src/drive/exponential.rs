@@ -76,6 +76,17 @@ pub(crate) const ENOUGH_UNSWEPT: f64 = 0.01;
 /// heater), and halves when one lasted.
 pub(crate) const CURVATURE_WAIT: (usize, usize) = (64, 65_536);
 
+/// A disk table replaced (the held Jacobian moved past [`REBUILD_SHIFT`]) within this many
+/// periods of its build did not pay for itself: a rebuild costs about a millisecond, what the
+/// integrator costs over the scheme in some hundred periods. The periods that follow are left to the
+/// integrator, for a number that doubles with each such table in a row, up to
+/// [`MAX_CHURN_SKIP`] (a heater ramp moves the Jacobian every 10–20 periods).
+pub(crate) const SHORT_TABLE: usize = 128;
+
+/// Most periods left to the integrator after tables replaced within [`SHORT_TABLE`] periods
+/// of their build: the integrator's extra time over so many periods is about ten rebuilds'.
+pub(crate) const MAX_CHURN_SKIP: usize = 512;
+
 /// Substep levels: a period is `1`, `2`, `4`, `8` or `16` exponential steps.
 pub(crate) const LEVELS: usize = 5;
 
@@ -656,6 +667,8 @@ pub(crate) struct ExpScheme {
     pub(crate) owned: Option<[f64; MAX_STATE]>,
     /// Periods to leave to the integrator after misses.
     misses: Backoff,
+    /// Periods to leave to the integrator after tables replaced within [`SHORT_TABLE`].
+    churn: Backoff,
     pub(crate) counts: SchemeCounts,
     /// Work vectors.
     p: Vec<f64>,
@@ -768,6 +781,7 @@ impl ExpScheme {
             dither: None,
             owned: None,
             misses: Backoff::default(),
+            churn: Backoff::default(),
             counts: SchemeCounts::default(),
             p: vec![0.0; n],
             dp: vec![0.0; n],
@@ -812,9 +826,11 @@ impl ExpScheme {
         self.misses = Backoff::default();
     }
 
-    /// Whether the next period is left to the integrator without a try (counted).
+    /// Whether the next period is left to the integrator without a try (counted): after misses,
+    /// where the integrator holds the state, and after tables replaced within [`SHORT_TABLE`]
+    /// periods, where the plant hands it the scheme's state ([`ExpScheme::owned`]).
     pub(crate) fn skips(&mut self) -> bool {
-        if self.owned.is_none() && self.misses.waits() {
+        if self.churn.waits() || (self.owned.is_none() && self.misses.waits()) {
             self.counts.skipped += 1;
             true
         } else {
@@ -899,6 +915,13 @@ impl ExpScheme {
                             .is_some_and(|r| offset(gaps, r) > d.unswept_reach(self.dofs))))
         });
         if !disk.is_flat() && (self.disk.is_none() || shifted || stale) {
+            if shifted && self.disk.is_some() {
+                if t - self.built_at < SHORT_TABLE as f64 * h {
+                    self.churn.missed(1, MAX_CHURN_SKIP);
+                } else {
+                    self.churn.succeeded();
+                }
+            }
             if curved {
                 self.curvature_wait = if lasted {
                     (self.curvature_wait / 2).max(CURVATURE_WAIT.0)

@@ -1528,10 +1528,22 @@ where
             return Ok(report);
         }
     }
-    if exp.skips() {
-        return advance(it, layout, set, integrals0, span, tol, None);
-    }
     let Span { t0, rebase, .. } = span;
+    if exp.skips() {
+        return match exp.owned.take() {
+            None => advance(it, layout, set, integrals0, span, tol, None),
+            // The scheme held the state: the integrator from it, under the new command.
+            Some(x) => {
+                let mut x0 = state_vector::<D>(D::from_usize(layout.len()), |i| x[i]);
+                rebase_integrals(layout, rebase, &mut x0, integrals0);
+                if let Some(held) = set {
+                    held.apply(it.system_mut());
+                }
+                let landed = Span { land: true, ..span };
+                advance(it, layout, None, integrals0, landed, tol, Some(x0))
+            }
+        };
+    }
     // A held command on a flat disk without a dither: nothing moves within the periods, and
     // the integrator's steps span many of them at the cost of the read-out alone.
     let still = disk.is_flat()
