@@ -1532,15 +1532,9 @@ where
     if exp.skips() {
         return match exp.owned.take() {
             None => advance(it, layout, set, integrals0, span, tol, None),
-            // The scheme held the state: the integrator from it, under the new command.
             Some(x) => {
-                let mut x0 = state_vector::<D>(D::from_usize(layout.len()), |i| x[i]);
-                rebase_integrals(layout, rebase, &mut x0, integrals0);
-                if let Some(held) = set {
-                    held.apply(it.system_mut());
-                }
-                let landed = Span { land: true, ..span };
-                advance(it, layout, None, integrals0, landed, tol, Some(x0))
+                let x0 = state_vector::<D>(D::from_usize(layout.len()), |i| x[i]);
+                from_the_schemes_state(it, layout, set, integrals0, span, tol, x0)
             }
         };
     }
@@ -1600,9 +1594,25 @@ where
             }
         }
     }
-    // The scheme held the state and the contact force is not straight enough: the integrator
-    // from the same start, under the new command.
-    rebase_integrals(layout, rebase, &mut x0, integrals0);
+    // The scheme held the state and the contact force is not straight enough.
+    from_the_schemes_state(it, layout, set, integrals0, span, tol, x0)
+}
+
+/// The period by the integrator from the state the exponential scheme held, `x0`, under the new
+/// command `set`; its last step ends on the period's end.
+fn from_the_schemes_state<D: Dim>(
+    it: &mut Integrator<'static, D, SliderSystem>,
+    layout: &StateLayout,
+    set: Option<Held<'_>>,
+    integrals0: &mut (f64, f64),
+    span: Span,
+    tol: Option<(&TolRule, &mut TolState)>,
+    mut x0: OVector<f64, D>,
+) -> Result<(OVector<f64, D>, PeriodReport)>
+where
+    DefaultAllocator: Allocator<D> + Allocator<D, D>,
+{
+    rebase_integrals(layout, span.rebase, &mut x0, integrals0);
     if let Some(held) = set {
         held.apply(it.system_mut());
     }
