@@ -714,8 +714,10 @@ fn a_bounded_drive_that_leaves_the_tables_says_so() {
 }
 
 /// The exponential scheme through the C ABI: the same drive as the Rust one with
-/// `DriveScheme::Exponential`, to the bit, each period's scheme in `HdiPeriod::exponential`; a
-/// scheme that does not exist is named.
+/// `DriveScheme::Exponential`, to the bit, each period's scheme in `HdiPeriod::exponential`,
+/// most of 80 periods the scheme's (the start's transient replaces its first tables within a
+/// few periods, and the periods after them go to the integrator); a scheme that does not exist
+/// is named.
 #[test]
 fn the_exponential_scheme_is_the_rust_one() {
     let scene = paper();
@@ -738,7 +740,8 @@ fn the_exponential_scheme_is_the_rust_one() {
     let plant = Plant::new(&s, &zone_at(&s, 0.025, None).unwrap(), 1, opts).unwrap();
     let mut rust = plant.drive().unwrap();
     let mut own = 0;
-    for k in 0..40 {
+    let periods = 80;
+    for k in 0..periods {
         // A command changed every period: the case the scheme is for.
         let p = 66.0 + if k % 2 == 1 { 0.001 } else { 0.0 };
         let cmd = HdiCommand {
@@ -754,7 +757,10 @@ fn the_exponential_scheme_is_the_rust_one() {
         assert_eq!(q.exponential, rust.last_period().exponential);
         own += usize::from(q.exponential);
     }
-    assert!(own > 20, "{own} of 40 periods by the exponential scheme");
+    assert!(
+        own > periods / 2,
+        "{own} of {periods} periods by the exponential scheme"
+    );
     ok(unsafe { hdi_drive_free(drive) });
     ok(unsafe { hdi_scene_free(scene) });
 }
