@@ -32,7 +32,9 @@
 //! [`REBUILD_SHIFT`]), then with twice the substeps, up to [`LEVELS`]; if it still misses,
 //! the period is run by the integrator from the same start, as the default drive runs it, and
 //! the following periods too, for a number that doubles with each consecutive miss, up to
-//! [`MAX_SKIP`] ([`MAX_SKIP_DITHER`] with a dither). A held command on a flat disk without a
+//! [`MAX_SKIP`] ([`MAX_SKIP_DITHER`] with a dither); so are the periods after a disk table
+//! replaced within [`SHORT_TABLE`] periods of its build, for a wait that doubles up to
+//! [`MAX_CHURN_SKIP`]. A held command on a flat disk without a
 //! dither is left to the integrator (`src/drive/plant.rs`), whose steps span many periods
 //! there; with a dither, once the slider has settled onto the dither's periodic orbit, the
 //! periods are read from a table of that orbit (`src/drive/orbit.rs`).
@@ -562,7 +564,8 @@ pub struct SchemeCounts {
     pub two_step: u64,
     /// Periods run by the integrator after the exponential step missed the tolerances there.
     pub fallbacks: u64,
-    /// Periods run by the integrator without a try, after misses (see the module docs).
+    /// Periods run by the integrator without a try: after misses, and after disk tables replaced
+    /// within 128 periods of their build (see docs/clearance.md, "The exponential scheme").
     pub skipped: u64,
     /// Periods of a command held on a flat disk without a dither, past the four after each
     /// change: left to the integrator, whose steps span them.
