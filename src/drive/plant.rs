@@ -227,14 +227,15 @@ pub struct DriveOptions {
     /// without the bound. `None` (the default): adaptive steps under the tolerances.
     /// docs/clearance.md, "The bounded mode", gives its cost and accuracy. 1 to
     /// [`MAX_STEPS_PER_PERIOD`]; the method must be Radau5 ([`DriveOptions::bounded`] sets
-    /// both). Radau5's Newton iteration may still shorten a step below the bound where it
-    /// fails to converge: in the periods of a snap into contact, not in flight or in a held
-    /// contact. The integration reads the interface forces from their tables alone
-    /// ([`OutsideTables::Refused`]): a trial state outside them fails its step, which is
-    /// shortened, instead of paying for direct quadrature, and a path that leaves them ends in
-    /// [`DriveError::LeftTheTables`](super::DriveError::LeftTheTables). That keeps the snap's
-    /// periods to 0.13–0.41 ms at 4 to 32 steps, where the diverging Newton iterates had
-    /// cost up to 29 ms.
+    /// both). Where Radau5's Newton iteration fails at the bound (in a dithered contact, and
+    /// in the periods of a snap into contact), the step is tried again shorter, up to 16 times
+    /// a period; after those it is taken by backward Euler, extrapolated, with a bounded Newton
+    /// iteration of its own, and flagged like any other (the floor's step,
+    /// [`Integrator::set_floor_retries`](crate::ode::Integrator::set_floor_retries)); only
+    /// where that fails too is the step shortened again. The integration reads the interface
+    /// forces from their tables alone ([`OutsideTables::Refused`]): a trial state outside them
+    /// fails its step instead of paying for direct quadrature, and a path that leaves them ends
+    /// in [`DriveError::LeftTheTables`](super::DriveError::LeftTheTables).
     pub steps_per_period: Option<usize>,
     /// How each period is advanced: the adaptive integrator (the default) or one exponential
     /// step with the Jacobian held across periods ([`DriveScheme`]).
@@ -314,6 +315,13 @@ impl std::str::FromStr for DriveScheme {
 
 /// Most steps a period may take in the bounded mode ([`DriveOptions::steps_per_period`]).
 pub const MAX_STEPS_PER_PERIOD: usize = 64;
+
+/// In the bounded mode, the trials of one period that Radau5 fails at the step floor (its Newton
+/// iteration diverges) and tries again shorter; after these, the floor's own step takes them
+/// ([`Integrator::set_floor_retries`]). Sixteen leave a dithered contact at 8 to 32 steps a
+/// period as it was without the bound (at 4 steps it needs 32); the worst period of a snap
+/// into contact asked for 164 (docs/benchmarks.md, "A step of fixed cost at the floor").
+pub(crate) const FLOOR_RETRIES: usize = 16;
 
 impl Default for DriveOptions {
     /// Start at 60 mW; 100 µs heater time constant; the default disk and sensors; no drift;
@@ -1371,6 +1379,7 @@ where
     let Span { t0, t1, rebase, .. } = span;
     if let Some(floor) = span.floor {
         it.set_step_floor(Some(floor))?;
+        it.set_floor_retries(Some(FLOOR_RETRIES));
     }
     let integrals = [layout.contact_impulse, layout.heat];
     let grown = start.is_none()

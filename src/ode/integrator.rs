@@ -7,6 +7,7 @@ use super::dense::StepPoly;
 use super::dop853::Dop853;
 use super::error::OdeError;
 use super::event::{crossing, locate, Event, EventHit};
+use super::floor_step::FloorStep;
 use super::jacobian::{eval_jacobian, spectral_radius};
 use super::options::{Method, Options};
 use super::radau5::Radau5;
@@ -79,6 +80,8 @@ struct Accepted {
     order: f64,
     stiff: bool,
     hit_stop: bool,
+    /// Taken by the step floor's backward Euler step (`floor_step`), not the method.
+    by_floor: bool,
 }
 
 /// What one call of [`Integrator::step`] (or [`Integrator::advance_to`]) ended with.
@@ -371,6 +374,12 @@ where
     /// The switch whose entry waits for its first accepted step.
     entry_pending: Option<usize>,
     jac_work: Option<OMatrix<f64, D, D>>,
+    /// The step floor's own step, for trials the method fails at the floor
+    /// ([`set_step_floor`](Integrator::set_step_floor)).
+    floor_step: Option<Box<FloorStep<D>>>,
+    /// Trials failed at the floor that may still be tried again shorter
+    /// ([`set_floor_retries`](Integrator::set_floor_retries)); `None`: every one.
+    floor_retries: Option<usize>,
 }
 
 impl<'a, D: Dim, S: OdeSystem<D>> Integrator<'a, D, S>
@@ -486,6 +495,8 @@ where
             entry_steps: Vec::new(),
             entry_pending: None,
             jac_work: switching.then(|| OMatrix::zeros_generic(rows, rows)),
+            floor_step: None,
+            floor_retries: None,
         };
         it.init_switches();
         it.restart()?;
@@ -675,7 +686,8 @@ where
     /// `log(h / floor) / log 5` for a step that began at `h`), and a span the error control
     /// can cross in longer steps still does. Steps may still be shortened below the floor to
     /// land on the end time, a kink or an event, and a step whose state or right-hand side is
-    /// not finite, or whose Newton iteration fails, is still tried again shorter. `None`
+    /// not finite, or whose Newton iteration fails, is tried again shorter, unless
+    /// [`set_floor_retries`](Integrator::set_floor_retries) bounds those retries. `None`
     /// removes the floor.
     ///
     /// ```
@@ -717,6 +729,43 @@ where
             self.h = self.h_floor;
         }
         Ok(())
+    }
+
+    /// Bounds the retries below the step floor ([`set_step_floor`](Integrator::set_step_floor))
+    /// from now on: at most `retries` trials that failed at the floor for another reason than
+    /// their error (a Newton iteration that diverged, a state or right-hand side that is not
+    /// finite) are tried again shorter. After those, such a trial is taken at its length by the
+    /// floor's own step and accepted whatever its estimate: backward Euler over the step and
+    /// over its two halves, extrapolated (second order, L-stable), each solved by at most eight
+    /// Newton iterations with a fresh Jacobian, its estimate that of the halves against the
+    /// whole ([`Stats::floor_steps`] counts them). Where that iteration fails too, the trial is
+    /// tried again shorter. Each call sets the count afresh; `None` (the default) retries
+    /// every such trial shorter, as without the bound.
+    ///
+    /// ```
+    /// use hdi_tribology::nalgebra::{Vector1, U1};
+    /// use hdi_tribology::ode::{Integrator, Method, OdeSystem, Options};
+    /// /// y' = -k y³: over a step much longer than 1/k, Radau5's simplified Newton iteration
+    /// /// (its Jacobian frozen at the step's start) fails.
+    /// struct Cubic;
+    /// impl OdeSystem<U1> for Cubic {
+    ///     fn rhs(&self, _t: f64, y: &Vector1<f64>, dy: &mut Vector1<f64>) {
+    ///         dy[0] = -100.0 * y[0].powi(3);
+    ///     }
+    /// }
+    /// let opts = Options::default().rtol(1e-8).atol(1e-12);
+    /// let mut it = Integrator::new(Cubic, 0.0, Vector1::new(1.0), 1.0, Method::Radau5, &opts)?;
+    /// it.set_step_floor(Some(0.125))?;
+    /// it.set_floor_retries(Some(0));
+    /// it.advance_to(1.0)?;
+    /// // Eight steps of an eighth, those Radau5 failed taken by the floor's step.
+    /// assert_eq!(it.stats().accepted, 8);
+    /// assert!(it.stats().floor_steps > 0);
+    /// assert!((it.state()[0] * 201f64.sqrt() - 1.0).abs() < 0.03);
+    /// # Ok::<(), hdi_tribology::ode::OdeError>(())
+    /// ```
+    pub fn set_floor_retries(&mut self, retries: Option<usize>) {
+        self.floor_retries = retries;
     }
 
     /// Work counters so far (all steps since [`new`](Integrator::new), across reinits).
@@ -941,6 +990,7 @@ where
         self.hits.clear();
         let mut ev = std::mem::take(&mut self.events);
         self.target = Some(t);
+
         let mut status = Ok(StepStatus::Accepted);
         while self.t < t {
             status = self.step_with(&mut ev);
@@ -991,6 +1041,7 @@ where
             order: k,
             stiff,
             hit_stop,
+            by_floor,
         }) = self.attempt_until_accepted(stop)?
         else {
             // Rodas5P's rounding floor: the same step again with the method that took over.
@@ -1009,14 +1060,27 @@ where
         if let Some(i) = self.entry_pending.take() {
             self.entry_steps[i] = h;
         }
-        let stepper = self.steppers.get::<S>(self.active);
-        let step = Step {
-            t,
-            h,
-            y: &self.y,
-            y_new: &mut self.y_new,
-        };
-        stepper.accept(&self.sys, &step, &mut self.poly, &mut self.ctx);
+        if by_floor {
+            // Backward Euler's interpolant is the chord; the method starts again at its end.
+            if self.ctx.need_poly {
+                self.poly.begin(t, h, 1);
+                let [a0, a1] = self.poly.rows_mut::<2>();
+                for i in 0..self.y.len() {
+                    a0[i] = self.y[i];
+                    a1[i] = self.y_new[i] - self.y[i];
+                }
+            }
+            self.needs_restart = true;
+        } else {
+            let stepper = self.steppers.get::<S>(self.active);
+            let step = Step {
+                t,
+                h,
+                y: &self.y,
+                y_new: &mut self.y_new,
+            };
+            stepper.accept(&self.sys, &step, &mut self.poly, &mut self.ctx);
+        }
         self.have_poly = self.ctx.need_poly;
         let t_new = if hit_stop { stop } else { t + h };
 
@@ -1068,7 +1132,6 @@ where
     /// to be taken again).
     #[inline]
     fn attempt_until_accepted(&mut self, stop: f64) -> Result<Option<Accepted>, OdeError> {
-        let sys = &self.sys;
         let t = self.t;
         let mut h = self.h;
         // The error control has asked for the step floor (`set_step_floor`).
@@ -1112,14 +1175,17 @@ where
                 y: &self.y,
                 y_new: &mut self.y_new,
             };
-            let trial = stepper.attempt(sys, step, &mut self.ctx);
+            let trial = stepper.attempt(&self.sys, step, &mut self.ctx);
             let err = match trial {
                 Trial::Done { err } if err.is_finite() => err,
                 Trial::Done { .. } => {
                     self.recent_nonfinite += 1;
                     self.accepted_run = 0;
-                    register_failure(&mut self.fails, FailKind::NonFinite, t, h)?;
                     self.ctx.stats.rejected += 1;
+                    if let Some(a) = self.at_the_floor(t, h, 0.25, hit_stop) {
+                        return Ok(Some(a));
+                    }
+                    register_failure(&mut self.fails, FailKind::NonFinite, t, h)?;
                     h *= 0.25;
                     self.last_rejected = true;
                     continue;
@@ -1137,8 +1203,11 @@ where
                         self.recent_nonfinite += 1;
                     }
                     self.accepted_run = 0;
-                    register_failure(&mut self.fails, kind, t, h)?;
                     self.ctx.stats.rejected += 1;
+                    if let Some(a) = self.at_the_floor(t, h, factor, hit_stop) {
+                        return Ok(Some(a));
+                    }
+                    register_failure(&mut self.fails, kind, t, h)?;
                     h *= factor;
                     self.last_rejected = true;
                     continue;
@@ -1164,8 +1233,43 @@ where
                 order: k,
                 stiff,
                 hit_stop,
+                by_floor: false,
             }));
         }
+    }
+
+    /// A trial of length `h` from `t` failed (not for its error), and the method would try it
+    /// again at `h · factor`: below the step floor, once the retries
+    /// ([`set_floor_retries`](Integrator::set_floor_retries)) are spent, the step is taken at
+    /// `h` by the floor's step instead ([`FloorStep`]), accepted whatever its error estimate.
+    /// `None` when there is no floor, the shorter trial would stay above it, a retry is left,
+    /// or the floor's step failed too (the trial is then shortened as without a floor).
+    #[cold]
+    fn at_the_floor(&mut self, t: f64, h: f64, factor: f64, hit_stop: bool) -> Option<Accepted> {
+        if !(self.h_floor > 0.0 && h * factor < self.h_floor) {
+            return None;
+        }
+        match self.floor_retries.as_mut() {
+            None => return None,
+            Some(left) if *left > 0 => {
+                *left -= 1;
+                return None;
+            }
+            Some(_) => {}
+        }
+        let fs = self
+            .floor_step
+            .get_or_insert_with(|| Box::new(FloorStep::new(&self.y)));
+        let err = fs.take(&self.sys, t, h, &self.y, &mut self.y_new, &mut self.ctx)?;
+        self.ctx.stats.floor_steps += 1;
+        Some(Accepted {
+            h,
+            err,
+            order: self.steppers.get::<S>(self.active).error_order(),
+            stiff: true,
+            hit_stop,
+            by_floor: true,
+        })
     }
 
     /// The events' sign changes between the ends of the accepted step `[t, t_new]`, located

@@ -40,6 +40,7 @@ mod driver;
 mod error;
 mod event;
 mod exponential;
+mod floor_step;
 mod integrator;
 mod jacobian;
 pub(crate) mod lu;

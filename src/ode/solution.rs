@@ -36,6 +36,11 @@ pub struct Stats {
     /// written without it.
     #[serde(default)]
     pub branch_switches: usize,
+    /// Steps taken by the step floor's backward Euler step where the method's trial failed at
+    /// the floor ([`Integrator::set_step_floor`](super::Integrator::set_step_floor)); 0 when
+    /// read from a record written without it.
+    #[serde(default)]
+    pub floor_steps: usize,
 }
 
 impl std::ops::AddAssign<&Stats> for Stats {
@@ -53,6 +58,7 @@ impl std::ops::AddAssign<&Stats> for Stats {
         self.stiff_steps += s.stiff_steps;
         self.event_evals += s.event_evals;
         self.branch_switches += s.branch_switches;
+        self.floor_steps += s.floor_steps;
     }
 }
 
