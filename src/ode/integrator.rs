@@ -1181,11 +1181,12 @@ where
                 Trial::Done { .. } => {
                     self.recent_nonfinite += 1;
                     self.accepted_run = 0;
-                    self.ctx.stats.rejected += 1;
                     if let Some(a) = self.at_the_floor(t, h, 0.25, hit_stop) {
+                        self.ctx.stats.rejected += 1;
                         return Ok(Some(a));
                     }
                     register_failure(&mut self.fails, FailKind::NonFinite, t, h)?;
+                    self.ctx.stats.rejected += 1;
                     h *= 0.25;
                     self.last_rejected = true;
                     continue;
@@ -1203,11 +1204,12 @@ where
                         self.recent_nonfinite += 1;
                     }
                     self.accepted_run = 0;
-                    self.ctx.stats.rejected += 1;
                     if let Some(a) = self.at_the_floor(t, h, factor, hit_stop) {
+                        self.ctx.stats.rejected += 1;
                         return Ok(Some(a));
                     }
                     register_failure(&mut self.fails, kind, t, h)?;
+                    self.ctx.stats.rejected += 1;
                     h *= factor;
                     self.last_rejected = true;
                     continue;
