@@ -680,11 +680,11 @@ fn the_bounded_mode_reports_its_flag() {
 
 /// A bounded drive whose path leaves the force tables stops with `HDI_STATUS_ANALYSIS` and a
 /// message that names the tables (docs/firmware.md): the paper scene's tables cut off at
-/// 0.5 nm, which the snap into contact at 80 mW passes.
+/// 0.62 nm, above the contact a heater at 120 mW settles into.
 #[test]
 fn a_bounded_drive_that_leaves_the_tables_says_so() {
     let mut s = Scene::paper();
-    s.table.d_min_m = Some(5e-10);
+    s.table.d_min_m = Some(6.2e-10);
     let text = std::ffi::CString::new(s.to_toml_string().unwrap()).unwrap();
     let mut scene = null_mut();
     ok(unsafe { hdi_scene_from_toml(text.as_ptr(), &mut scene) });
@@ -695,7 +695,7 @@ fn a_bounded_drive_that_leaves_the_tables_says_so() {
     let mut drive = null_mut();
     ok(unsafe { hdi_drive_new(scene, &config, 1, &mut drive) });
     let cmd = HdiCommand {
-        heater_power_mw: 80.0,
+        heater_power_mw: 120.0,
         ..HdiCommand::default()
     };
     let mut status = HdiStatus::Ok;
@@ -708,7 +708,7 @@ fn a_bounded_drive_that_leaves_the_tables_says_so() {
     }
     assert_eq!(status, HdiStatus::Analysis, "{}", last_error());
     let e = last_error();
-    assert!(e.contains("0.500 to") && e.contains("table.d_min_m"), "{e}");
+    assert!(e.contains("0.620 to") && e.contains("table.d_min_m"), "{e}");
     ok(unsafe { hdi_drive_free(drive) });
     ok(unsafe { hdi_scene_free(scene) });
 }
